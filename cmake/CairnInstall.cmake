@@ -1,0 +1,18 @@
+# `cmake --install` exports cairn::jobs and cairn::physics so that another project can find_package(Cairn).
+
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+install(TARGETS cairn_jobs cairn_physics EXPORT CairnTargets
+        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY jobs/include/ physics/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(EXPORT CairnTargets NAMESPACE cairn:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/Cairn)
+
+configure_package_config_file(cmake/CairnConfig.cmake.in "${CMAKE_CURRENT_BINARY_DIR}/CairnConfig.cmake"
+                              INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/Cairn)
+write_basic_package_version_file("${CMAKE_CURRENT_BINARY_DIR}/CairnConfigVersion.cmake"
+                                 COMPATIBILITY SameMinorVersion)
+install(FILES "${CMAKE_CURRENT_BINARY_DIR}/CairnConfig.cmake" "${CMAKE_CURRENT_BINARY_DIR}/CairnConfigVersion.cmake"
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/Cairn)

@@ -1,0 +1,23 @@
+# FindRecast: Debian's librecast-dev ships headers under recastnavigation/ and no CMake config.
+# Defines Recast::Recast and Recast::Detour (imported, SYSTEM headers) and Recast_FOUND.
+
+find_path(Recast_INCLUDE_DIR NAMES Recast.h PATH_SUFFIXES recastnavigation)
+find_library(Recast_LIBRARY NAMES Recast)
+find_library(Detour_LIBRARY NAMES Detour)
+
+include(FindPackageHandleStandardArgs)
+find_package_handle_standard_args(Recast REQUIRED_VARS Recast_LIBRARY Detour_LIBRARY Recast_INCLUDE_DIR)
+
+if(Recast_FOUND)
+    if(NOT TARGET Recast::Recast)
+        add_library(Recast::Recast UNKNOWN IMPORTED)
+        set_target_properties(Recast::Recast PROPERTIES IMPORTED_LOCATION "${Recast_LIBRARY}"
+                                                        INTERFACE_INCLUDE_DIRECTORIES "${Recast_INCLUDE_DIR}")
+    endif()
+    if(NOT TARGET Recast::Detour)
+        add_library(Recast::Detour UNKNOWN IMPORTED)
+        set_target_properties(Recast::Detour PROPERTIES IMPORTED_LOCATION "${Detour_LIBRARY}"
+                                                        INTERFACE_INCLUDE_DIRECTORIES "${Recast_INCLUDE_DIR}")
+    endif()
+endif()
+mark_as_advanced(Recast_INCLUDE_DIR Recast_LIBRARY Detour_LIBRARY)
