@@ -1,0 +1,49 @@
+#pragma once
+
+// A height field (terrain): a grid of mSampleCountX x mSampleCountZ heights with spacing mCellSize, whose
+// sample (x, z) sits at local (x * cellSize, height, z * cellSize). A NaN height, or cHole, makes every cell
+// touching that sample a hole (no triangles). Each cell is two triangles; internal edges are flagged as in
+// TriangleMeshShape. No volume: static or kinematic bodies only. Immutable: safe to share between threads.
+
+#include "cairn/physics/math/Result.h"
+#include "cairn/physics/shapes/Shape.h"
+
+#include <span>
+
+namespace cairn
+{
+
+class HeightFieldShape final : public Shape
+{
+public:
+    /// Marks a hole sample.
+    static constexpr float cHole = std::numeric_limits<float>::quiet_NaN();
+
+    /// inHeights is row-major: index x + z * inSampleCountX. Fails for fewer than 2 x 2 samples, a size
+    /// mismatch, a cell size that is not finite and > 0, infinite heights, or all samples holes.
+    static Result<std::shared_ptr<const HeightFieldShape>> Create(uint32_t inSampleCountX, uint32_t inSampleCountZ,
+                                                                  float inCellSize, std::span<const float> inHeights);
+
+    uint32_t GetSampleCountX() const { return mSampleCountX; }
+    uint32_t GetSampleCountZ() const { return mSampleCountZ; }
+    float GetCellSize() const { return mCellSize; }
+    /// Height of sample (x, z); NaN for a hole.
+    float GetHeight(uint32_t inX, uint32_t inZ) const { return mHeights[inX + inZ * mSampleCountX]; }
+
+    AABB GetLocalBounds() const override;
+    MassProperties GetMassProperties(float inDensity) const override; ///< Zero mass: no volume
+    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
+    void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
+
+    HeightFieldShape(uint32_t inSampleCountX, uint32_t inSampleCountZ, float inCellSize,
+                     std::vector<float> inHeights); ///< Use Create()
+
+private:
+    uint32_t mSampleCountX;
+    uint32_t mSampleCountZ;
+    float mCellSize;
+    std::vector<float> mHeights; ///< Row-major, NaN = hole
+    AABB mBounds;
+};
+
+} // namespace cairn
