@@ -1,0 +1,102 @@
+#pragma once
+
+// BroadPhase: finds bodies whose AABBs overlap a query or each other. It keeps its own copy of every added
+// body's world AABB and object layer (pushed to it by the body interface and the physics step), so it never
+// reads body memory and takes no body lock.
+//
+// Threads: every method may be called from any thread at any time, except
+//  - FindCollidingPairs and Update: the physics step only (one thread at a time);
+//  - AddBodiesFinalize / AddBodiesAbort: exactly once per AddState, from any one thread.
+// A body id is added at most once; the caller (BodyInterface) serialises add/remove of the same body.
+// Queries report every body whose stored AABB overlaps; a body added, moved or removed concurrently with a
+// query is reported with either its old or its new state.
+// Visitors may run while the broad phase holds an internal lock (the reference implementations hold a shared
+// lock): a visitor must not call back into the broad phase and must not wait for a lock that a thread calling
+// a modifying method may hold (e.g. a body write lock); collect the ids and lock after the query returns. Bad
+// input (non-finite or inverted bounds, unknown ids, double adds) is ignored; see each implementation.
+
+#include "cairn/physics/body/BodyID.h"
+#include "cairn/physics/body/Layers.h"
+#include "cairn/physics/math/AABB.h"
+#include "cairn/physics/math/FunctionRef.h"
+#include "cairn/physics/shapes/Shape.h"
+
+#include <span>
+
+namespace cairn
+{
+
+/// What the broad phase stores of a body.
+struct BroadPhaseBody
+{
+    BodyID mID;
+    AABB mBounds; ///< World space, finite
+    ObjectLayer mLayer = 0;
+};
+
+/// Which bodies a query may report.
+struct BroadPhaseQueryFilter
+{
+    ObjectLayerMask mObjectLayers = cAllObjectLayers; ///< Only bodies in these object layers
+};
+
+/// Receives a body found by an overlap query.
+using BodyVisitor = FunctionRef<void(BodyID)>;
+/// Receives a body whose AABB the ray enters at inFraction; returns the new maximum fraction (return the
+/// current maximum to keep going, a smaller one to prune farther bodies, a negative one to stop).
+using RayBodyVisitor = FunctionRef<float(BodyID inBody, float inFraction)>;
+/// Receives a potentially colliding pair; inActive is the active body whose AABB was queried.
+using BodyPairVisitor = FunctionRef<void(BodyID inActive, BodyID inOther)>;
+
+class BroadPhase
+{
+public:
+    /// Opaque result of AddBodiesPrepare, owned by the broad phase until finalized or aborted.
+    using AddState = void*;
+
+    virtual ~BroadPhase() = default;
+
+    /// Builds whatever a batch needs without touching the live structure: safe on a loading thread while
+    /// physics runs. inBodies must stay valid until AddBodiesFinalize/Abort.
+    virtual AddState AddBodiesPrepare(std::span<const BroadPhaseBody> inBodies) = 0;
+    /// Makes a prepared batch visible to queries.
+    virtual void AddBodiesFinalize(AddState inState) = 0;
+    /// Throws a prepared batch away.
+    virtual void AddBodiesAbort(AddState inState) = 0;
+
+    /// Removes added bodies.
+    virtual void RemoveBodies(std::span<const BodyID> inBodies) = 0;
+
+    /// New world AABBs for added bodies (after a move).
+    virtual void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) = 0;
+
+    /// Optimises the structure after moves, adds and removes (re-sort, rebuild). Physics step only.
+    virtual void Update() = 0;
+
+    /// Bodies whose AABB overlaps inBox.
+    virtual void CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
+                              BodyVisitor inVisitor) const = 0;
+    /// Bodies whose AABB overlaps the sphere.
+    virtual void CollideSphere(const Vec3& inCenter, float inRadius, const BroadPhaseQueryFilter& inFilter,
+                               BodyVisitor inVisitor) const = 0;
+    /// Bodies whose AABB contains inPoint.
+    virtual void CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
+                              BodyVisitor inVisitor) const = 0;
+    /// Bodies whose AABB the segment enters before the visitor's current maximum fraction (starting at 1),
+    /// in no particular order.
+    virtual void CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
+                         RayBodyVisitor inVisitor) const = 0;
+    /// Bodies whose AABB the box swept along inDisplacement touches; the fraction is where contact starts.
+    virtual void CastAABox(const AABB& inBox, const Vec3& inDisplacement,
+                           const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const = 0;
+
+    /// Every pair (active body, other body) whose AABBs overlap and whose object layers collide according to
+    /// inLayers; a pair of two active bodies is reported once. Physics step only.
+    virtual void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
+                                    BodyPairVisitor inVisitor) const = 0;
+
+    /// Number of bodies currently added (for statistics and tests).
+    virtual size_t GetBodyCount() const = 0;
+};
+
+} // namespace cairn

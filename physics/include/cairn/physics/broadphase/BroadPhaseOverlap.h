@@ -1,0 +1,75 @@
+#pragma once
+
+// The exact AABB-level tests every broad phase uses, in one place so that all implementations (the
+// brute-force oracle, sort and sweep, later the quad tree) agree bit for bit on touching and grazing cases:
+// an equivalence test compares their results as exact sets, so they must not each round in their own way.
+// Pure functions on values: safe from any thread.
+
+#include "cairn/physics/broadphase/BroadPhase.h"
+
+#include <cmath>
+
+namespace cairn
+{
+
+/// Bounds a broad phase accepts: finite and not inverted (min <= max on every axis). Anything else is a
+/// caller bug (the body interface validates first); broad phases assert in debug and ignore the body.
+inline bool IsValidBroadPhaseBounds(const AABB& inBounds)
+{
+    return inBounds.IsFinite() && (inBounds.mMin.array() <= inBounds.mMax.array()).all();
+}
+
+/// True when object layer inLayer is in inMask.
+inline bool IsInLayerMask(ObjectLayerMask inMask, ObjectLayer inLayer)
+{
+    return ((inMask >> inLayer) & 1u) != 0;
+}
+
+/// AABB::Overlaps (closed intervals: touching counts) evaluated without branches: in a scan the six
+/// comparisons are cheaper than the mispredicted early-outs of Eigen's all(). Same IEEE comparisons, so the
+/// same result.
+inline bool AABBsOverlap(const AABB& inA, const AABB& inB)
+{
+    return (inA.mMin.x() <= inB.mMax.x()) & (inB.mMin.x() <= inA.mMax.x()) & (inA.mMin.y() <= inB.mMax.y()) &
+           (inB.mMin.y() <= inA.mMax.y()) & (inA.mMin.z() <= inB.mMax.z()) & (inB.mMin.z() <= inA.mMax.z());
+}
+
+/// AABB::Contains without branches, for the same reason.
+inline bool AABBContains(const AABB& inBox, const Vec3& inPoint)
+{
+    return (inBox.mMin.x() <= inPoint.x()) & (inPoint.x() <= inBox.mMax.x()) &
+           (inBox.mMin.y() <= inPoint.y()) & (inPoint.y() <= inBox.mMax.y()) &
+           (inBox.mMin.z() <= inPoint.z()) & (inPoint.z() <= inBox.mMax.z());
+}
+
+/// Closed-interval sphere-box test: the point of the box closest to the centre is within inRadius.
+inline bool SphereOverlapsAABB(const Vec3& inCenter, float inRadius, const AABB& inBox)
+{
+    const Vec3 closest = inCenter.cwiseMax(inBox.mMin).cwiseMin(inBox.mMax);
+    return (inCenter - closest).squaredNorm() <= inRadius * inRadius;
+}
+
+/// Precomputed swept-box cast: the box centre is ray-cast against each body box grown by the box half extents
+/// (Minkowski sum), so one slab test per body answers "where does the moving box first touch it".
+struct SweptAABox
+{
+    /// Prepares the cast of inBox along inDisplacement.
+    SweptAABox(const AABB& inBox, const Vec3& inDisplacement)
+        : mCenter(inBox.Center()), mHalfExtent(inBox.HalfExtent()),
+          mInvDisplacement(SafeReciprocal(inDisplacement))
+    {
+    }
+
+    /// Entry fraction into inBody's box, or a value > inMaxFraction when missed.
+    float EntryFraction(const AABB& inBody, float inMaxFraction) const
+    {
+        const AABB grown(inBody.mMin - mHalfExtent, inBody.mMax + mHalfExtent);
+        return grown.RayEntryFraction(mCenter, mInvDisplacement, inMaxFraction);
+    }
+
+    Vec3 mCenter;          ///< Start of the ray: the box centre
+    Vec3 mHalfExtent;      ///< Added around every body box
+    Vec3 mInvDisplacement; ///< SafeReciprocal of the displacement
+};
+
+} // namespace cairn
