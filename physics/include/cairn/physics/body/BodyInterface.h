@@ -1,0 +1,91 @@
+#pragma once
+
+// BodyInterface: the locking API to create, add, remove, move and push bodies, callable from any thread outside
+// the physics step. Every call validates its input and returns an error without changing anything when the
+// input is bad (stale id, NaN, body in the wrong state). Calls made from inside the step (a step callback)
+// return ErrorCode::WrongThread instead of deadlocking.
+//
+// Locks: each call takes at most one body mutex at a time (BodyLockWrite), then the broad phase's own lock
+// (lock order body mutex < broad phase). Waking the neighbours of a removed body happens after its lock is
+// released.
+
+#include "cairn/physics/body/BodyManager.h"
+#include "cairn/physics/broadphase/BroadPhase.h"
+
+#include <span>
+#include <vector>
+
+namespace cairn
+{
+
+class BodyInterface
+{
+public:
+    BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, const LayerSetup& inLayers);
+
+    /// Creates a body (not yet in the world).
+    Result<BodyID> CreateBody(const BodyCreationSettings& inSettings);
+    /// Destroys a body that is not in the world.
+    Status DestroyBody(const BodyID& inID);
+    /// Puts a body into the world (broad phase, and the active list for Activation::Activate).
+    Status AddBody(const BodyID& inID, Activation inActivation);
+    /// CreateBody + AddBody; nothing is left behind on failure.
+    Result<BodyID> CreateAndAddBody(const BodyCreationSettings& inSettings, Activation inActivation);
+    /// Takes a body out of the world; bodies resting on it are woken.
+    Status RemoveBody(const BodyID& inID);
+
+    /// A batch of bodies being added: the slow part (broad-phase preparation) runs on the caller's thread
+    /// without touching the live world; AddBodiesFinalize then links it quickly.
+    struct AddBatch
+    {
+        std::vector<BroadPhaseBody> mBodies;
+        BroadPhase::AddState mState = nullptr;
+        bool IsEmpty() const { return mBodies.empty(); }
+    };
+    /// Fails (and marks nothing) if any id is stale, already in the world, or already in another batch.
+    Result<AddBatch> AddBodiesPrepare(std::span<const BodyID> inIDs);
+    Status AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation);
+    void AddBodiesAbort(AddBatch& ioBatch);
+
+    Status SetPosition(const BodyID& inID, const Vec3& inPosition, Activation inActivation);
+    Status SetRotation(const BodyID& inID, const Quat& inRotation, Activation inActivation);
+    Status SetPositionAndRotation(const BodyID& inID, const Vec3& inPosition, const Quat& inRotation,
+                                  Activation inActivation);
+    Status SetLinearVelocity(const BodyID& inID, const Vec3& inVelocity);
+    Status SetAngularVelocity(const BodyID& inID, const Vec3& inVelocity);
+    /// Force through the centre of mass until the next step, N.
+    Status AddForce(const BodyID& inID, const Vec3& inForce);
+    Status AddTorque(const BodyID& inID, const Vec3& inTorque);
+    /// Impulse at the centre of mass, N s.
+    Status AddImpulse(const BodyID& inID, const Vec3& inImpulse);
+    /// Impulse at a world point, N s.
+    Status AddImpulse(const BodyID& inID, const Vec3& inImpulse, const Vec3& inWorldPoint);
+    Status AddAngularImpulse(const BodyID& inID, const Vec3& inImpulse);
+    Status ActivateBody(const BodyID& inID);
+    Status DeactivateBody(const BodyID& inID);
+
+    Result<Vec3> GetPosition(const BodyID& inID) const;
+    Result<Quat> GetRotation(const BodyID& inID) const;
+    Result<Vec3> GetLinearVelocity(const BodyID& inID) const;
+    Result<Vec3> GetAngularVelocity(const BodyID& inID) const;
+    Result<AABB> GetWorldBounds(const BodyID& inID) const;
+    Result<bool> IsActive(const BodyID& inID) const;
+    Result<bool> IsAdded(const BodyID& inID) const;
+
+private:
+    /// Runs inChange on the body under its write lock after the common checks; inChange returns the status.
+    template <class F>
+    Status ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange);
+    template <class T, class F>
+    Result<T> ReadBody(const BodyID& inID, F&& inRead) const;
+    /// Pushes the body's new bounds to the broad phase and, for dynamic/kinematic bodies, activates them.
+    void OnBodyMoved(Body& ioBody, Activation inActivation);
+    /// Activates every sleeping dynamic body whose bounds overlap inBounds (after a removal).
+    void WakeBodiesIn(const AABB& inBounds);
+
+    BodyManager& mBodies;
+    BroadPhase& mBroadPhase;
+    const LayerSetup& mLayers;
+};
+
+} // namespace cairn

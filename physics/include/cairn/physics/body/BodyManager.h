@@ -1,0 +1,91 @@
+#pragma once
+
+// BodyManager: owns every Body in a fixed array (so a Body never moves in memory), hands out BodyIDs, and owns
+// the 32 sharded read-write mutexes that guard them (body index i is guarded by mutex i % 32).
+//
+// Threads and locks:
+//  - A body's fields: its shard mutex (shared to read, exclusive to write). The physics step holds all 32
+//    exclusively while it runs (LockAllBodies), so code inside the step reads and writes bodies without locks.
+//  - Free list and body count: mFreeListMutex. Lock order: body mutex < mFreeListMutex < mActiveListMutex.
+//  - Active list: mActiveListMutex, taken by threads that (de)activate a body while holding its body mutex;
+//    the step holds every body mutex, so it may read and change the list without taking mActiveListMutex.
+//  - A thread never holds two body mutexes except LockAllBodies (in index order, so no cycle).
+
+#include "cairn/physics/body/Body.h"
+#include "cairn/physics/math/Result.h"
+
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <span>
+#include <vector>
+
+namespace cairn
+{
+
+class BodyManager
+{
+public:
+    static constexpr uint32_t cNumBodyMutexes = 32;
+
+    explicit BodyManager(uint32_t inMaxBodies);
+    ~BodyManager();
+
+    uint32_t GetMaxBodies() const { return mMaxBodies; }
+    /// Bodies created and not destroyed.
+    uint32_t GetNumBodies() const;
+
+    /// Validates the settings and creates a body (not yet in the world). Any thread.
+    Result<BodyID> CreateBody(const BodyCreationSettings& inSettings);
+    /// Destroys a body that is not in the world. Any thread.
+    Status DestroyBody(const BodyID& inID);
+
+    /// The mutex guarding body index inIndex.
+    std::shared_mutex& GetMutexForBody(uint32_t inIndex) const { return mBodyMutexes[inIndex % cNumBodyMutexes].mMutex; }
+
+    /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the body's
+    /// mutex (or be the physics step).
+    Body* TryGetBody(const BodyID& inID) const;
+    /// The body in slot inIndex whatever its sequence, or nullptr when the slot is free. Same locking as TryGetBody.
+    Body* TryGetBodyAtIndex(uint32_t inIndex) const;
+
+    /// Puts a dynamic or kinematic body in the world into the active list. Caller holds the body's mutex
+    /// exclusively, or is the step.
+    void ActivateBody(Body& ioBody);
+    /// Takes a body out of the active list and zeroes its velocities. Same locking as ActivateBody.
+    void DeactivateBody(Body& ioBody);
+
+    /// Indices of active bodies. Physics step only (it holds every body mutex).
+    std::span<const uint32_t> GetActiveBodiesUnsafe() const { return mActiveBodies; }
+
+    /// Locks every body mutex for write, in index order. The physics step only.
+    void LockAllBodies() const;
+    void UnlockAllBodies() const;
+
+    /// True on the thread that holds every body lock (inside a step): locking calls there would deadlock.
+    static bool IsInsideStep();
+
+private:
+    friend class PhysicsStep;
+    struct alignas(64) PaddedMutex // one cache line each, so shards do not false-share
+    {
+        mutable std::shared_mutex mMutex;
+    };
+
+    /// Active list with the step's privileges (it holds every body mutex).
+    std::vector<uint32_t>& GetActiveBodiesForStep() { return mActiveBodies; }
+
+    uint32_t mMaxBodies;
+    std::unique_ptr<Body[]> mBodies;                       ///< Guarded per body by its shard mutex
+    std::unique_ptr<bool[]> mSlotInUse;                    ///< Guarded per slot by its shard mutex
+    mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
+
+    mutable std::mutex mFreeListMutex;
+    std::vector<uint32_t> mFreeList;                       ///< Guarded by mFreeListMutex
+    uint32_t mNumBodies = 0;                               ///< Guarded by mFreeListMutex
+
+    std::mutex mActiveListMutex;
+    std::vector<uint32_t> mActiveBodies;                   ///< Guarded by mActiveListMutex (or all body mutexes)
+};
+
+} // namespace cairn

@@ -1,0 +1,394 @@
+#include "cairn/physics/body/BodyInterface.h"
+
+#include "cairn/physics/body/BodyLock.h"
+
+namespace cairn
+{
+
+namespace
+{
+Error WrongThread() { return MakeError(ErrorCode::WrongThread, "body interface called from inside the physics step"); }
+Error StaleID() { return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id"); }
+Error InvalidVector(const char* inWhat)
+{
+    return MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + " is NaN, infinite or out of range");
+}
+BroadPhaseBody ToBroadPhase(const Body& inBody)
+{
+    return {inBody.GetID(), inBody.GetWorldBounds(), inBody.GetObjectLayer()};
+}
+} // namespace
+
+BodyInterface::BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, const LayerSetup& inLayers)
+    : mBodies(ioBodies), mBroadPhase(ioBroadPhase), mLayers(inLayers)
+{
+}
+
+Result<BodyID> BodyInterface::CreateBody(const BodyCreationSettings& inSettings)
+{
+    if (!mLayers.IsValid(inSettings.mObjectLayer))
+        return MakeError(ErrorCode::InvalidArgument, "object layer " + std::to_string(inSettings.mObjectLayer) +
+                                                         " is not in the layer setup");
+    return mBodies.CreateBody(inSettings);
+}
+
+Status BodyInterface::DestroyBody(const BodyID& inID) { return mBodies.DestroyBody(inID); }
+
+Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
+{
+    BodyLockWrite lock(mBodies, inID);
+    if (lock.WasWrongThread())
+        return WrongThread();
+    Body* body = lock.GetBody();
+    if (body == nullptr)
+        return StaleID();
+    if (body->mInWorld || body->mAddPending)
+        return MakeError(ErrorCode::AlreadyAdded, "body is already in the world");
+    body->UpdateBounds();
+    const BroadPhaseBody entry = ToBroadPhase(*body);
+    mBroadPhase.AddBodiesFinalize(mBroadPhase.AddBodiesPrepare({&entry, 1}));
+    body->mInWorld = true;
+    if (inActivation == Activation::Activate)
+        mBodies.ActivateBody(*body);
+    return Status::Ok();
+}
+
+Result<BodyID> BodyInterface::CreateAndAddBody(const BodyCreationSettings& inSettings, Activation inActivation)
+{
+    Result<BodyID> id = CreateBody(inSettings);
+    if (!id)
+        return id;
+    if (Status added = AddBody(id.Value(), inActivation); !added)
+    {
+        (void)mBodies.DestroyBody(id.Value());
+        return added.GetError();
+    }
+    return id;
+}
+
+Status BodyInterface::RemoveBody(const BodyID& inID)
+{
+    AABB bounds;
+    {
+        BodyLockWrite lock(mBodies, inID);
+        if (lock.WasWrongThread())
+            return WrongThread();
+        Body* body = lock.GetBody();
+        if (body == nullptr)
+            return StaleID();
+        if (!body->mInWorld)
+            return MakeError(ErrorCode::NotAdded, "body is not in the world");
+        mBroadPhase.RemoveBodies({&inID, 1});
+        mBodies.DeactivateBody(*body);
+        body->mInWorld = false;
+        bounds = body->GetWorldBounds();
+    }
+    // Bodies resting on the removed one must fall: wake them (with the removed body's lock released, since a
+    // thread may hold only one body lock at a time)
+    WakeBodiesIn(bounds.Expanded(0.05f));
+    return Status::Ok();
+}
+
+void BodyInterface::WakeBodiesIn(const AABB& inBounds)
+{
+    thread_local std::vector<BodyID> found;
+    found.clear();
+    mBroadPhase.CollideAABox(inBounds, {}, [&](BodyID inBody) { found.push_back(inBody); });
+    for (const BodyID& id : found)
+    {
+        BodyLockWrite lock(mBodies, id);
+        if (Body* body = lock.GetBody(); body != nullptr && body->IsDynamic() && body->mInWorld)
+            mBodies.ActivateBody(*body);
+    }
+}
+
+Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const BodyID> inIDs)
+{
+    if (BodyManager::IsInsideStep())
+        return WrongThread();
+    AddBatch batch;
+    batch.mBodies.reserve(inIDs.size());
+    auto undo = [&] {
+        for (const BroadPhaseBody& entry : batch.mBodies)
+        {
+            BodyLockWrite lock(mBodies, entry.mID);
+            if (Body* body = lock.GetBody(); body != nullptr)
+                body->mAddPending = false;
+        }
+    };
+    for (const BodyID& id : inIDs)
+    {
+        BodyLockWrite lock(mBodies, id);
+        Body* body = lock.GetBody();
+        Error error = StaleID();
+        if (body != nullptr && !body->mInWorld && !body->mAddPending)
+        {
+            // Pending: no other AddBody or batch may take this body until this batch is finalized or aborted
+            body->mAddPending = true;
+            body->UpdateBounds();
+            batch.mBodies.push_back(ToBroadPhase(*body));
+            continue;
+        }
+        if (body != nullptr)
+            error = MakeError(ErrorCode::AlreadyAdded, "body is already in the world or in another batch");
+        lock.Release();
+        undo();
+        return error;
+    }
+    batch.mState = mBroadPhase.AddBodiesPrepare(batch.mBodies);
+    return batch;
+}
+
+Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation)
+{
+    if (BodyManager::IsInsideStep())
+        return WrongThread();
+    if (ioBatch.mState == nullptr)
+        return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
+    mBroadPhase.AddBodiesFinalize(ioBatch.mState);
+    ioBatch.mState = nullptr;
+    for (const BroadPhaseBody& entry : ioBatch.mBodies)
+    {
+        BodyLockWrite lock(mBodies, entry.mID);
+        Body* body = lock.GetBody();
+        // A pending body cannot be destroyed or added elsewhere, so the lookup cannot fail
+        assert(body != nullptr && body->mAddPending);
+        body->mAddPending = false;
+        body->mInWorld = true;
+        if (inActivation == Activation::Activate)
+            mBodies.ActivateBody(*body);
+    }
+    ioBatch.mBodies.clear();
+    return Status::Ok();
+}
+
+void BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
+{
+    if (ioBatch.mState != nullptr)
+        mBroadPhase.AddBodiesAbort(ioBatch.mState);
+    ioBatch.mState = nullptr;
+    for (const BroadPhaseBody& entry : ioBatch.mBodies)
+    {
+        BodyLockWrite lock(mBodies, entry.mID);
+        if (Body* body = lock.GetBody(); body != nullptr)
+            body->mAddPending = false;
+    }
+    ioBatch.mBodies.clear();
+}
+
+template <class F>
+Status BodyInterface::ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange)
+{
+    BodyLockWrite lock(mBodies, inID);
+    if (lock.WasWrongThread())
+        return WrongThread();
+    Body* body = lock.GetBody();
+    if (body == nullptr)
+        return StaleID();
+    if (inMustBeDynamic && body->IsStatic())
+        return MakeError(ErrorCode::InvalidArgument, "a static body has no velocity");
+    return inChange(*body);
+}
+
+template <class T, class F>
+Result<T> BodyInterface::ReadBody(const BodyID& inID, F&& inRead) const
+{
+    BodyLockRead lock(mBodies, inID);
+    if (lock.WasWrongThread())
+        return WrongThread();
+    if (lock.GetBody() == nullptr)
+        return StaleID();
+    return inRead(*lock.GetBody());
+}
+
+void BodyInterface::OnBodyMoved(Body& ioBody, Activation inActivation)
+{
+    ioBody.UpdateBounds();
+    if (ioBody.mInWorld)
+    {
+        const BroadPhaseBody entry = ToBroadPhase(ioBody);
+        mBroadPhase.NotifyBodiesAABBChanged({&entry, 1});
+        if (inActivation == Activation::Activate)
+            mBodies.ActivateBody(ioBody);
+    }
+}
+
+Status BodyInterface::SetPosition(const BodyID& inID, const Vec3& inPosition, Activation inActivation)
+{
+    if (!IsValidWorldPosition(inPosition))
+        return InvalidVector("position");
+    return ModifyBody(inID, false, [&](Body& ioBody) {
+        ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+        OnBodyMoved(ioBody, inActivation);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::SetRotation(const BodyID& inID, const Quat& inRotation, Activation inActivation)
+{
+    if (!IsValidRotation(inRotation))
+        return MakeError(ErrorCode::InvalidArgument, "rotation is not a finite unit quaternion");
+    return ModifyBody(inID, false, [&](Body& ioBody) {
+        const Vec3 origin = ioBody.GetPosition();
+        ioBody.mRotation = inRotation.normalized();
+        ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+        OnBodyMoved(ioBody, inActivation);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::SetPositionAndRotation(const BodyID& inID, const Vec3& inPosition, const Quat& inRotation,
+                                             Activation inActivation)
+{
+    if (!IsValidWorldPosition(inPosition))
+        return InvalidVector("position");
+    if (!IsValidRotation(inRotation))
+        return MakeError(ErrorCode::InvalidArgument, "rotation is not a finite unit quaternion");
+    return ModifyBody(inID, false, [&](Body& ioBody) {
+        ioBody.mRotation = inRotation.normalized();
+        ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+        OnBodyMoved(ioBody, inActivation);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::SetLinearVelocity(const BodyID& inID, const Vec3& inVelocity)
+{
+    if (!IsFinite(inVelocity))
+        return InvalidVector("linear velocity");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        ioBody.mLinearVelocity = inVelocity;
+        if (inVelocity.squaredNorm() > 0.0f)
+            mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::SetAngularVelocity(const BodyID& inID, const Vec3& inVelocity)
+{
+    if (!IsFinite(inVelocity))
+        return InvalidVector("angular velocity");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        ioBody.mAngularVelocity = inVelocity;
+        if (inVelocity.squaredNorm() > 0.0f)
+            mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::AddForce(const BodyID& inID, const Vec3& inForce)
+{
+    if (!IsFinite(inForce))
+        return InvalidVector("force");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        if (!ioBody.IsDynamic())
+            return Status(MakeError(ErrorCode::InvalidArgument, "forces act on dynamic bodies only"));
+        ioBody.mForce += inForce;
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::AddTorque(const BodyID& inID, const Vec3& inTorque)
+{
+    if (!IsFinite(inTorque))
+        return InvalidVector("torque");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        if (!ioBody.IsDynamic())
+            return Status(MakeError(ErrorCode::InvalidArgument, "torques act on dynamic bodies only"));
+        ioBody.mTorque += inTorque;
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse)
+{
+    if (!IsFinite(inImpulse))
+        return InvalidVector("impulse");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        if (!ioBody.IsDynamic())
+            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
+        ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse, const Vec3& inWorldPoint)
+{
+    if (!IsFinite(inImpulse))
+        return InvalidVector("impulse");
+    if (!IsValidWorldPosition(inWorldPoint))
+        return InvalidVector("impulse point");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        if (!ioBody.IsDynamic())
+            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
+        ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
+        ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * (inWorldPoint - ioBody.mPosition).cross(inImpulse);
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::AddAngularImpulse(const BodyID& inID, const Vec3& inImpulse)
+{
+    if (!IsFinite(inImpulse))
+        return InvalidVector("angular impulse");
+    return ModifyBody(inID, true, [&](Body& ioBody) {
+        if (!ioBody.IsDynamic())
+            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
+        ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * inImpulse;
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::ActivateBody(const BodyID& inID)
+{
+    return ModifyBody(inID, false, [&](Body& ioBody) {
+        if (!ioBody.mInWorld)
+            return Status(MakeError(ErrorCode::NotAdded, "only bodies in the world can be activated"));
+        mBodies.ActivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Status BodyInterface::DeactivateBody(const BodyID& inID)
+{
+    return ModifyBody(inID, false, [&](Body& ioBody) {
+        mBodies.DeactivateBody(ioBody);
+        return Status::Ok();
+    });
+}
+
+Result<Vec3> BodyInterface::GetPosition(const BodyID& inID) const
+{
+    return ReadBody<Vec3>(inID, [](const Body& inBody) { return inBody.GetPosition(); });
+}
+Result<Quat> BodyInterface::GetRotation(const BodyID& inID) const
+{
+    return ReadBody<Quat>(inID, [](const Body& inBody) { return inBody.GetRotation(); });
+}
+Result<Vec3> BodyInterface::GetLinearVelocity(const BodyID& inID) const
+{
+    return ReadBody<Vec3>(inID, [](const Body& inBody) { return inBody.GetLinearVelocity(); });
+}
+Result<Vec3> BodyInterface::GetAngularVelocity(const BodyID& inID) const
+{
+    return ReadBody<Vec3>(inID, [](const Body& inBody) { return inBody.GetAngularVelocity(); });
+}
+Result<AABB> BodyInterface::GetWorldBounds(const BodyID& inID) const
+{
+    return ReadBody<AABB>(inID, [](const Body& inBody) { return inBody.GetWorldBounds(); });
+}
+Result<bool> BodyInterface::IsActive(const BodyID& inID) const
+{
+    return ReadBody<bool>(inID, [](const Body& inBody) { return inBody.IsActive(); });
+}
+Result<bool> BodyInterface::IsAdded(const BodyID& inID) const
+{
+    return ReadBody<bool>(inID, [](const Body& inBody) { return inBody.IsInWorld(); });
+}
+
+} // namespace cairn

@@ -1,0 +1,188 @@
+#include "cairn/physics/body/BodyManager.h"
+
+#include <cassert>
+#include <string>
+
+namespace cairn
+{
+
+namespace
+{
+// Set on the stepping thread while it holds every body mutex; read only by that same thread
+thread_local bool tInsideStep = false;
+
+Status ValidateSettings(const BodyCreationSettings& inSettings)
+{
+    auto invalid = [](std::string inWhat) { return Status(MakeError(ErrorCode::InvalidArgument, std::move(inWhat))); };
+    if (inSettings.mShape == nullptr)
+        return invalid("body has no shape");
+    if (!IsValidWorldPosition(inSettings.mPosition))
+        return invalid("body position is NaN, infinite or beyond 1e6 m");
+    if (!IsValidRotation(inSettings.mRotation))
+        return invalid("body rotation is not a finite unit quaternion");
+    if (!IsFinite(inSettings.mLinearVelocity) || !IsFinite(inSettings.mAngularVelocity))
+        return invalid("body velocity is NaN or infinite");
+    if (!std::isfinite(inSettings.mFriction) || inSettings.mFriction < 0.0f)
+        return invalid("friction must be finite and >= 0");
+    if (!(inSettings.mRestitution >= 0.0f && inSettings.mRestitution <= 1.0f))
+        return invalid("restitution must be in [0, 1]");
+    if (!(inSettings.mLinearDamping >= 0.0f) || !(inSettings.mAngularDamping >= 0.0f) ||
+        !std::isfinite(inSettings.mLinearDamping) || !std::isfinite(inSettings.mAngularDamping))
+        return invalid("damping must be finite and >= 0");
+    if (!std::isfinite(inSettings.mGravityFactor))
+        return invalid("gravity factor must be finite");
+    if (!(inSettings.mMaxLinearVelocity > 0.0f) || !(inSettings.mMaxAngularVelocity > 0.0f))
+        return invalid("velocity limits must be > 0");
+    if (!inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation}).IsFinite())
+        return invalid("body bounds are not finite");
+    if (inSettings.mMotionType == MotionType::Dynamic)
+    {
+        if (!std::isfinite(inSettings.mDensity) || inSettings.mDensity <= 0.0f)
+            return invalid("density must be finite and > 0");
+        const MassProperties mass = inSettings.mShape->GetMassProperties(inSettings.mDensity);
+        if (!(mass.mMass > 0.0f) || !std::isfinite(mass.mMass) || !mass.mInertia.allFinite())
+            return invalid(std::string("a dynamic body needs a shape with volume; a ") +
+                           ToString(inSettings.mShape->GetType()) + " has none");
+    }
+    return Status::Ok();
+}
+} // namespace
+
+BodyManager::BodyManager(uint32_t inMaxBodies)
+    : mMaxBodies(inMaxBodies), mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]())
+{
+    // Hand out low indices first: they pack the hot part of the array
+    mFreeList.reserve(inMaxBodies);
+    for (uint32_t i = inMaxBodies; i > 0; --i)
+        mFreeList.push_back(i - 1);
+    for (uint32_t i = 0; i < inMaxBodies; ++i)
+        mBodies[i].mID = BodyID(i, 0);
+    mActiveBodies.reserve(inMaxBodies);
+}
+
+BodyManager::~BodyManager() = default;
+
+uint32_t BodyManager::GetNumBodies() const
+{
+    std::lock_guard lock(mFreeListMutex);
+    return mNumBodies;
+}
+
+Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
+{
+    if (Status status = ValidateSettings(inSettings); !status)
+        return status.GetError();
+    if (IsInsideStep())
+        return MakeError(ErrorCode::WrongThread, "CreateBody called from inside the physics step");
+
+    uint32_t index;
+    {
+        std::lock_guard lock(mFreeListMutex);
+        if (mFreeList.empty())
+            return MakeError(ErrorCode::OutOfCapacity,
+                             "body manager is full (" + std::to_string(mMaxBodies) + " bodies)");
+        index = mFreeList.back();
+        mFreeList.pop_back();
+        ++mNumBodies;
+    }
+
+    std::unique_lock lock(GetMutexForBody(index));
+    Body& body = mBodies[index];
+    const BodyID id(index, body.mID.GetSequence());
+    body.Init(id, inSettings);
+    mSlotInUse[index] = true;
+    return id;
+}
+
+Status BodyManager::DestroyBody(const BodyID& inID)
+{
+    if (IsInsideStep())
+        return MakeError(ErrorCode::WrongThread, "DestroyBody called from inside the physics step");
+    if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)
+        return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
+    {
+        std::unique_lock lock(GetMutexForBody(inID.GetIndex()));
+        Body* body = TryGetBody(inID);
+        if (body == nullptr)
+            return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
+        if (body->mInWorld)
+            return MakeError(ErrorCode::AlreadyAdded, "remove the body from the world before destroying it");
+        body->mShape.reset();
+        // A new sequence makes every copy of the old id stale
+        body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);
+        mSlotInUse[inID.GetIndex()] = false;
+    }
+    std::lock_guard lock(mFreeListMutex);
+    mFreeList.push_back(inID.GetIndex());
+    --mNumBodies;
+    return Status::Ok();
+}
+
+Body* BodyManager::TryGetBody(const BodyID& inID) const
+{
+    if (inID.GetIndex() >= mMaxBodies || !mSlotInUse[inID.GetIndex()])
+        return nullptr;
+    Body& body = mBodies[inID.GetIndex()];
+    return body.mID == inID ? &body : nullptr;
+}
+
+Body* BodyManager::TryGetBodyAtIndex(uint32_t inIndex) const
+{
+    return inIndex < mMaxBodies && mSlotInUse[inIndex] ? &mBodies[inIndex] : nullptr;
+}
+
+void BodyManager::ActivateBody(Body& ioBody)
+{
+    if (ioBody.IsActive() || ioBody.IsStatic() || !ioBody.mInWorld)
+        return;
+    ioBody.mSleepTimer = 0.0f;
+    // The step already owns every body mutex, and with it the list
+    std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
+    if (!IsInsideStep())
+    {
+        lock.lock();
+        // Woken from outside: the bodies it slept with may rest on it; the next step wakes them (it holds every
+        // lock, so it can walk the island's ring safely)
+        ioBody.mWakeIsland = true;
+    }
+    ioBody.SetActiveIndex(uint32_t(mActiveBodies.size()));
+    mActiveBodies.push_back(ioBody.mID.GetIndex());
+}
+
+void BodyManager::DeactivateBody(Body& ioBody)
+{
+    if (!ioBody.IsActive())
+        return;
+    std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
+    if (!IsInsideStep())
+        lock.lock();
+    // Swap-remove: the last body takes this body's place in the list
+    const uint32_t slot = ioBody.GetActiveIndex();
+    const uint32_t last = mActiveBodies.back();
+    mActiveBodies[slot] = last;
+    mBodies[last].SetActiveIndex(slot); // another body, but its index is guarded by the list mutex we hold
+    mActiveBodies.pop_back();
+    ioBody.SetActiveIndex(Body::cInactive);
+    ioBody.mLinearVelocity.setZero();
+    ioBody.mAngularVelocity.setZero();
+    ioBody.mSleepTimer = 0.0f;
+}
+
+void BodyManager::LockAllBodies() const
+{
+    assert(!tInsideStep);
+    for (PaddedMutex& m : mBodyMutexes)
+        m.mMutex.lock();
+    tInsideStep = true;
+}
+
+void BodyManager::UnlockAllBodies() const
+{
+    tInsideStep = false;
+    for (PaddedMutex& m : mBodyMutexes)
+        m.mMutex.unlock();
+}
+
+bool BodyManager::IsInsideStep() { return tInsideStep; }
+
+} // namespace cairn
