@@ -1,0 +1,58 @@
+#pragma once
+
+// PhysicsSystem: the world. Owns the bodies, the broad phase and the step.
+//
+// Threads:
+//  - Update: one thread at a time (a second concurrent call gets ErrorCode::WrongThread). While it runs it
+//    holds every body mutex for write, so BodyInterface calls and narrow-phase reads from other threads wait
+//    for the step; broad-phase queries do not.
+//  - GetBodyInterface() / GetWorldQuery(): from any thread, outside step callbacks.
+// The step: broad-phase update -> velocities (gravity, forces, damping) -> broad-phase pairs -> narrow phase
+// (contacts, warm-start lookup, island links) -> islands -> per island: warm start, velocity iterations,
+// restitution, symplectic Euler integration, position iterations -> bounds to the broad phase -> sleeping.
+
+#include "cairn/physics/PhysicsSettings.h"
+#include "cairn/physics/body/BodyInterface.h"
+#include "cairn/physics/queries/WorldQuery.h"
+
+#include <atomic>
+#include <memory>
+
+namespace cairn
+{
+
+class PhysicsStep;
+
+class PhysicsSystem
+{
+public:
+    explicit PhysicsSystem(const PhysicsSettings& inSettings = {}, const LayerSetup& inLayers = LayerSetup::CreateDefault());
+    ~PhysicsSystem();
+    PhysicsSystem(const PhysicsSystem&) = delete;
+    PhysicsSystem& operator=(const PhysicsSystem&) = delete;
+
+    /// Advances the world by inDeltaTime seconds in inCollisionSteps equal steps (1..16).
+    Status Update(float inDeltaTime, int inCollisionSteps = 1);
+
+    BodyInterface& GetBodyInterface() { return *mBodyInterface; }
+    const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
+    const BroadPhase& GetBroadPhase() const { return *mBroadPhase; }
+    const BodyManager& GetBodyManager() const { return *mBodies; }
+    const LayerSetup& GetLayers() const { return mLayers; }
+    const PhysicsSettings& GetSettings() const { return mSettings; }
+    /// Figures of the last Update. Read it from the thread that calls Update.
+    const StepStatistics& GetLastStepStatistics() const { return mLastStatistics; }
+
+private:
+    PhysicsSettings mSettings;
+    LayerSetup mLayers;
+    std::unique_ptr<BodyManager> mBodies;
+    std::unique_ptr<BroadPhase> mBroadPhase;
+    std::unique_ptr<BodyInterface> mBodyInterface;
+    std::unique_ptr<WorldQuery> mWorldQuery;
+    std::unique_ptr<PhysicsStep> mStep;
+    std::atomic<bool> mUpdating{false}; ///< Guards against concurrent Update calls (acquire/release below)
+    StepStatistics mLastStatistics;     ///< Written by the updating thread only
+};
+
+} // namespace cairn

@@ -1,0 +1,42 @@
+#pragma once
+
+// Sequential impulse contact solver (Catto, GDC 2009) for one island at a time:
+//  - order: the caller sorts each island's constraints by a hash of their bodies (see PhysicsStep), so no
+//    geometric order (bottom-up, left-right) biases the result, and the order is the same on every run;
+//  - friction per manifold ("patch friction", as PhysX does): see PatchFriction;
+//  - warm starting: each point starts from last step's accumulated impulses (matched through the ContactCache);
+//  - accumulated-impulse clamping: normal >= 0, friction inside the Coulomb circle |(t1, t2)| <= mu * normal;
+//  - restitution: a separate pass after the velocity iterations (as in Box2D v3) gives points that touched and
+//    approached faster than the threshold a target velocity of -e * approach velocity;
+//  - position correction by split impulses: no Baumgarte term in the velocity solve (it would add energy);
+//    after integration, non-linear Gauss-Seidel iterations move the bodies apart by mBaumgarte of the
+//    penetration beyond mPenetrationSlop, directly on positions.
+// Runs inside the step, by the one thread that owns the island: no locks.
+
+#include "cairn/physics/solver/ContactConstraint.h"
+#include "cairn/physics/solver/SolverSettings.h"
+
+#include <span>
+
+namespace cairn
+{
+
+namespace SequentialImpulseSolver
+{
+/// Fills a constraint from a manifold between A and B (world space). Impulses start at zero.
+void InitConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
+                    ContactConstraint& outConstraint);
+/// Applies the accumulated (warm-start) impulses.
+void WarmStart(std::span<ContactConstraint* const> ioConstraints);
+/// One velocity iteration over the constraints, in the order given. Each manifold's points are swept forwards
+/// then backwards: a single fixed order biases which corner of a resting face takes the load first, and in a
+/// tall stack that bias tilts every joint the same way until the column leans over (a 10-box column leaned
+/// 0.5 m in 10 s; with the double sweep, 2 cm).
+void SolveVelocities(std::span<ContactConstraint* const> ioConstraints);
+/// The restitution pass, after the velocity iterations.
+void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, const SolverSettings& inSettings);
+/// One position iteration; returns the largest remaining penetration beyond the slop.
+float SolvePositions(std::span<ContactConstraint* const> ioConstraints, const SolverSettings& inSettings);
+} // namespace SequentialImpulseSolver
+
+} // namespace cairn

@@ -1,0 +1,357 @@
+#include "PhysicsStep.h"
+
+#include "cairn/physics/narrowphase/CollideShapes.h"
+#include "cairn/physics/solver/SequentialImpulseSolver.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace cairn
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point& ioStart)
+{
+    const Clock::time_point now = Clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - ioStart).count();
+    ioStart = now;
+    return ms;
+}
+
+/// A bijective 64-bit mix (the finaliser of MurmurHash3): neighbouring keys land far apart.
+uint64_t MixBits(uint64_t inKey)
+{
+    inKey ^= inKey >> 33;
+    inKey *= 0xff51afd7ed558ccdULL;
+    inKey ^= inKey >> 33;
+    inKey *= 0xc4ceb9fe1a85ec53ULL;
+    inKey ^= inKey >> 33;
+    return inKey;
+}
+
+Vec3 ClampLength(const Vec3& inV, float inMax)
+{
+    const float lengthSq = inV.squaredNorm();
+    return lengthSq > inMax * inMax ? inV * (inMax / std::sqrt(lengthSq)) : inV;
+}
+} // namespace
+
+PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& inLayers, BodyManager& ioBodies,
+                         BroadPhase& ioBroadPhase)
+    : mSettings(inSettings), mLayers(inLayers), mBodies(ioBodies), mBroadPhase(ioBroadPhase)
+{
+}
+
+void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics)
+{
+    Clock::time_point phase = Clock::now();
+    const Clock::time_point start = phase;
+    mBroadPhase.Update();
+    ioStatistics.mBroadPhaseUpdateMs += MillisecondsSince(phase);
+
+    mContactCache.BeginStep();
+    mConstraints.clear();
+    mNumBodyPairs = 0;
+    mNumWarmStartedPoints = 0;
+    WakeIslandsOfWokenBodies();
+    CollideNewlyActive(0, inDeltaTime);
+    ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
+
+    BuildIslands();
+    ioStatistics.mIslandsMs += MillisecondsSince(phase);
+
+    std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    for (uint32_t index : active)
+        if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
+            IntegratePositions(body, inDeltaTime);
+    uint32_t largestIsland = 0;
+    for (uint32_t island = 0; island < mIslands.GetNumIslands(); ++island)
+    {
+        SolveIsland(island, inDeltaTime);
+        largestIsland = std::max(largestIsland, uint32_t(mIslands.GetBodies(island).size()));
+    }
+    mContactCache.EndStep();
+    ioStatistics.mSolveMs += MillisecondsSince(phase);
+
+    ioStatistics.mNumBodyPairs += mNumBodyPairs;
+    ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
+    ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
+    for (const ContactConstraint& c : mConstraints)
+        ioStatistics.mNumContactPoints += uint32_t(c.mNumPoints);
+    ioStatistics.mNumIslands += mIslands.GetNumIslands();
+    ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
+
+    UpdateBoundsAndSleep(inDeltaTime);
+    ioStatistics.mFinishMs += MillisecondsSince(phase);
+    ioStatistics.mNumActiveBodies = uint32_t(active.size());
+    ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+void PhysicsStep::WakeIslandsOfWokenBodies()
+{
+    std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    // Bodies appended by this loop were woken by it, not from outside: their flags are clear
+    for (size_t i = 0; i < active.size(); ++i)
+    {
+        Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+        if (!body.mWakeIsland)
+            continue;
+        body.mWakeIsland = false;
+        // Walk the ring of the island it slept in. Every hop wakes a sleeping body, and the walk stops at an
+        // active one (the start, or a body that woke since and whose ring link is stale), so it terminates
+        for (uint32_t next = body.mSleepRingNext;;)
+        {
+            Body* member = mBodies.TryGetBodyAtIndex(next);
+            if (member == nullptr || !member->IsInWorld() || member->IsActive())
+                break;
+            mBodies.ActivateBody(*member);
+            next = member->mSleepRingNext;
+        }
+    }
+}
+
+void PhysicsStep::ApplyForces(std::span<const uint32_t> inBodies, float inDeltaTime)
+{
+    for (uint32_t index : inBodies)
+    {
+        Body& body = *mBodies.TryGetBodyAtIndex(index);
+        if (!body.IsDynamic())
+            continue;
+        // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new velocity
+        body.mLinearVelocity += inDeltaTime * (body.mGravityFactor * mSettings.mGravity + body.mInvMass * body.mForce);
+        body.mAngularVelocity += inDeltaTime * (body.GetInverseInertiaWorld() * body.mTorque);
+        body.mLinearVelocity *= std::max(0.0f, 1.0f - body.mLinearDamping * inDeltaTime);
+        body.mAngularVelocity *= std::max(0.0f, 1.0f - body.mAngularDamping * inDeltaTime);
+        body.mLinearVelocity = ClampLength(body.mLinearVelocity, body.mMaxLinearVelocity);
+        body.mAngularVelocity = ClampLength(body.mAngularVelocity, body.mMaxAngularVelocity);
+        body.mForce.setZero();
+        body.mTorque.setZero();
+    }
+}
+
+void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
+{
+    std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    thread_local std::vector<BodyID> sliceIDs;
+    // Bodies woken by a contact join the active list during the narrow phase; they get forces and pairs of
+    // their own in the next round, so a sleeping pile wakes as a whole within one step
+    for (size_t begin = inBegin; begin < active.size();)
+    {
+        const size_t end = active.size();
+        const std::span<const uint32_t> slice(active.data() + begin, end - begin);
+        ApplyForces(slice, inDeltaTime);
+        sliceIDs.clear();
+        for (uint32_t index : slice)
+            sliceIDs.push_back(mBodies.TryGetBodyAtIndex(index)->GetID());
+
+        mPairs.clear();
+        mBroadPhase.FindCollidingPairs(sliceIDs, mLayers, [&](BodyID inActive, BodyID inOther) {
+            const Body* other = mBodies.TryGetBody(inOther);
+            // Pairs with bodies of an earlier round were collided then
+            if (other == nullptr || (other->IsActive() && other->GetActiveIndex() < begin))
+                return;
+            mPairs.push_back({std::min(inActive.GetIndex(), inOther.GetIndex()),
+                              std::max(inActive.GetIndex(), inOther.GetIndex())});
+        });
+        // Canonical order: the same scene gives the same contacts whatever order the broad phase reports
+        std::sort(mPairs.begin(), mPairs.end(), [](const BodyPair& inL, const BodyPair& inR) {
+            return inL.mA < inR.mA || (inL.mA == inR.mA && inL.mB < inR.mB);
+        });
+        mNumBodyPairs += uint32_t(mPairs.size());
+        for (const BodyPair& pair : mPairs)
+            CollidePair(*mBodies.TryGetBodyAtIndex(pair.mA), *mBodies.TryGetBodyAtIndex(pair.mB), inDeltaTime);
+        begin = end;
+    }
+}
+
+void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime)
+{
+    if (!ioA.IsDynamic() && !ioB.IsDynamic())
+        return;
+    // Look ahead by how far the bodies can close in this step, so fast bodies get speculative contacts before
+    // they tunnel
+    CollideSettings settings;
+    settings.mMaxSeparation =
+        mSettings.mSpeculativeDistance + inDeltaTime * (ioB.mLinearVelocity - ioA.mLinearVelocity).norm();
+    int numManifolds = 0;
+    CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
+                  [&](const ContactManifold& inManifold) {
+                      AddConstraint(ioA, ioB, inManifold, inDeltaTime);
+                      ++numManifolds;
+                  });
+    if (numManifolds == 0)
+        return;
+    // Touching an active body wakes a sleeping one
+    if (!ioA.IsActive() && ioA.IsDynamic())
+        mBodies.ActivateBody(ioA);
+    if (!ioB.IsActive() && ioB.IsDynamic())
+        mBodies.ActivateBody(ioB);
+}
+
+void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime)
+{
+    if (inManifold.mNumPoints <= 0)
+        return;
+    ContactConstraint& c = mConstraints.emplace_back();
+    SequentialImpulseSolver::InitConstraint(ioA, ioB, inManifold, inDeltaTime, c);
+
+    CachedManifold cached;
+    cached.mKey = {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB};
+    cached.mNumPoints = c.mNumPoints;
+    const CachedManifold* previous = mContactCache.FindPrevious(cached.mKey);
+    if (previous != nullptr)
+    {
+        for (int t = 0; t < 2; ++t)
+            c.mPatch.mTangent[t].mAccumulated = c.mTangent[t].dot(previous->mFrictionImpulse);
+        c.mPatch.mTwistAccumulated = previous->mTwistImpulse;
+    }
+    for (int i = 0; i < c.mNumPoints; ++i)
+    {
+        ContactConstraintPoint& p = c.mPoints[i];
+        cached.mLocalOnA[i] = p.mLocalOnA;
+        cached.mNormalImpulse[i] = 0.0f;
+        cached.mDeferredBounce[i] = 0.0f;
+        if (previous == nullptr)
+            continue;
+        // Warm start from the nearest point of last step's manifold, if it is the same contact
+        for (int j = 0; j < previous->mNumPoints; ++j)
+            if ((previous->mLocalOnA[j] - p.mLocalOnA).squaredNorm() <
+                ContactCache::cPointMatchDistance * ContactCache::cPointMatchDistance)
+            {
+                p.mNormal.mAccumulated = previous->mNormalImpulse[j];
+                // A bounce deferred by last step (its point was still a gap away) happens now
+                p.mApproachVelocity = std::min(p.mApproachVelocity, previous->mDeferredBounce[j]);
+                ++mNumWarmStartedPoints;
+                break;
+            }
+    }
+    c.mCacheIndex = mContactCache.Add(cached);
+    c.mOrderKey = MixBits((uint64_t(ioA.GetID().GetIndex()) << 32 | ioB.GetID().GetIndex()) ^
+                          (uint64_t(inManifold.mSubShapeA) << 40) ^ inManifold.mSubShapeB);
+}
+
+void PhysicsStep::BuildIslands()
+{
+    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    mIslands.Prepare(uint32_t(active.size()));
+    // Only dynamic-dynamic contacts link: a static or kinematic body would merge everything that touches it
+    for (const ContactConstraint& c : mConstraints)
+        if (c.mBodyA->IsDynamic() && c.mBodyB->IsDynamic())
+            mIslands.Link(c.mBodyA->GetActiveIndex(), c.mBodyB->GetActiveIndex());
+    mIslands.Finalize();
+
+    const uint32_t numIslands = mIslands.GetNumIslands();
+    mConstraintStart.assign(numIslands + 1, 0);
+    for (ContactConstraint& c : mConstraints)
+    {
+        const Body& dynamicBody = c.mBodyA->IsDynamic() ? *c.mBodyA : *c.mBodyB;
+        c.mIsland = mIslands.GetIsland(dynamicBody.GetActiveIndex());
+        ++mConstraintStart[c.mIsland + 1];
+    }
+    for (uint32_t i = 0; i < numIslands; ++i)
+        mConstraintStart[i + 1] += mConstraintStart[i];
+    mIslandConstraints.resize(mConstraints.size());
+    thread_local std::vector<uint32_t> cursor;
+    cursor.assign(mConstraintStart.begin(), mConstraintStart.end() - 1);
+    for (ContactConstraint& c : mConstraints)
+        mIslandConstraints[cursor[c.mIsland]++] = &c;
+    // Solve order: a hash of the bodies and sub-shapes, the same on every run. Creation order follows body
+    // indices, which usually follow the geometry (a stack is built bottom-up); a solver sweeping in geometric order
+    // drifts in that direction, and a wall of boxes leaned over
+    for (uint32_t island = 0; island < numIslands; ++island)
+        std::sort(mIslandConstraints.begin() + mConstraintStart[island],
+                  mIslandConstraints.begin() + mConstraintStart[island + 1],
+                  [](const ContactConstraint* inL, const ContactConstraint* inR) {
+                      return inL->mOrderKey < inR->mOrderKey ||
+                             (inL->mOrderKey == inR->mOrderKey && inL->mCacheIndex < inR->mCacheIndex);
+                  });
+}
+
+void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
+{
+    const std::span<ContactConstraint* const> constraints(mIslandConstraints.data() + mConstraintStart[inIsland],
+                                                           mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const SolverSettings& solver = mSettings.mSolver;
+    SequentialImpulseSolver::WarmStart(constraints);
+    for (int i = 0; i < solver.mVelocityIterations; ++i)
+        SequentialImpulseSolver::SolveVelocities(constraints);
+    SequentialImpulseSolver::ApplyRestitution(constraints, solver);
+
+    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    for (uint32_t activeIndex : mIslands.GetBodies(inIsland))
+        if (Body& body = *mBodies.TryGetBodyAtIndex(active[activeIndex]); body.IsDynamic())
+            IntegratePositions(body, inDeltaTime);
+
+    for (int i = 0; i < solver.mPositionIterations; ++i)
+        SequentialImpulseSolver::SolvePositions(constraints, solver);
+
+    for (const ContactConstraint* c : constraints)
+    {
+        CachedManifold& cached = mContactCache.Get(c->mCacheIndex);
+        for (int i = 0; i < c->mNumPoints; ++i)
+        {
+            cached.mNormalImpulse[i] = c->mPoints[i].mNormal.mAccumulated;
+            cached.mDeferredBounce[i] = c->mPoints[i].mDeferredBounce;
+        }
+        cached.mFrictionImpulse =
+            c->mPatch.mTangent[0].mAccumulated * c->mTangent[0] + c->mPatch.mTangent[1].mAccumulated * c->mTangent[1];
+        cached.mTwistImpulse = c->mPatch.mTwistAccumulated;
+    }
+}
+
+void PhysicsStep::IntegratePositions(Body& ioBody, float inDeltaTime)
+{
+    // Symplectic Euler, position half: uses the velocity after gravity and contacts
+    ioBody.mPosition += inDeltaTime * ioBody.mLinearVelocity;
+    ioBody.mRotation = IntegrateRotation(ioBody.mRotation, inDeltaTime * ioBody.mAngularVelocity);
+}
+
+void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
+{
+    std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    mMovedBodies.clear();
+    for (uint32_t index : active)
+    {
+        Body& body = *mBodies.TryGetBodyAtIndex(index);
+        body.UpdateBounds();
+        // The broad phase gets the bounds swept over the next step plus the speculative distance, so the next
+        // step finds the pairs this body can reach
+        AABB swept = body.mBounds;
+        swept.Encapsulate(AABB(body.mBounds.mMin + inDeltaTime * body.mLinearVelocity,
+                               body.mBounds.mMax + inDeltaTime * body.mLinearVelocity));
+        mMovedBodies.push_back({body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance), body.GetObjectLayer()});
+
+        const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
+        const float speed = body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
+        const bool slow = mSettings.mAllowSleeping && body.mAllowSleeping && speed < mSettings.mSleepVelocity;
+        body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
+    }
+    mBroadPhase.NotifyBodiesAABBChanged(mMovedBodies);
+
+    // An island sleeps as a whole when every body in it has been slow long enough
+    mSleepingIslands.clear();
+    for (uint32_t island = 0; island < mIslands.GetNumIslands(); ++island)
+    {
+        bool canSleep = true;
+        for (uint32_t activeIndex : mIslands.GetBodies(island))
+            canSleep &= mBodies.TryGetBodyAtIndex(active[activeIndex])->mSleepTimer >= mSettings.mTimeBeforeSleep;
+        if (!canSleep)
+            continue;
+        // Link the island into a ring, so that waking one of its bodies from outside wakes them all
+        const std::span<const uint32_t> members = mIslands.GetBodies(island);
+        for (size_t i = 0; i < members.size(); ++i)
+        {
+            Body& body = *mBodies.TryGetBodyAtIndex(active[members[i]]);
+            body.mSleepRingNext = active[members[(i + 1) % members.size()]];
+            mSleepingIslands.push_back(active[members[i]]);
+        }
+    }
+    // Deactivating reorders the active list, so the islands' indices are resolved to bodies first
+    for (uint32_t bodyIndex : mSleepingIslands)
+        mBodies.DeactivateBody(*mBodies.TryGetBodyAtIndex(bodyIndex));
+}
+
+} // namespace cairn

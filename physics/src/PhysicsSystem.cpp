@@ -1,0 +1,57 @@
+#include "cairn/physics/PhysicsSystem.h"
+
+#include "PhysicsStep.h"
+#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
+
+namespace cairn
+{
+
+namespace
+{
+std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inMaxBodies, const LayerSetup& inLayers)
+{
+    switch (inType)
+    {
+    case BroadPhaseType::BruteForce: return std::make_unique<BroadPhaseBruteForce>();
+    case BroadPhaseType::SortAndSweep: return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
+    }
+    return nullptr;
+}
+} // namespace
+
+PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
+    : mSettings(inSettings), mLayers(inLayers), mBodies(std::make_unique<BodyManager>(inSettings.mMaxBodies)),
+      mBroadPhase(CreateBroadPhase(inSettings.mBroadPhase, inSettings.mMaxBodies, mLayers)),
+      mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
+      mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase)),
+      mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase))
+{
+}
+
+PhysicsSystem::~PhysicsSystem() = default;
+
+Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
+{
+    if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)
+        return MakeError(ErrorCode::InvalidArgument, "time step must be in (0, 1] s");
+    if (inCollisionSteps < 1 || inCollisionSteps > 16)
+        return MakeError(ErrorCode::InvalidArgument, "collision steps must be in 1..16");
+    if (BodyManager::IsInsideStep())
+        return MakeError(ErrorCode::WrongThread, "Update called from inside the physics step");
+    // Acquire pairs with the release below, so a step sees everything the previous updating thread wrote
+    if (mUpdating.exchange(true, std::memory_order_acquire))
+        return MakeError(ErrorCode::WrongThread, "Update is already running on another thread");
+
+    mBodies->LockAllBodies();
+    mLastStatistics = {};
+    const float stepTime = inDeltaTime / float(inCollisionSteps);
+    for (int step = 0; step < inCollisionSteps; ++step)
+        mStep->Run(stepTime, mLastStatistics);
+    mBodies->UnlockAllBodies();
+
+    mUpdating.store(false, std::memory_order_release);
+    return Status::Ok();
+}
+
+} // namespace cairn

@@ -1,0 +1,206 @@
+#include "cairn/physics/queries/WorldQuery.h"
+
+#include "cairn/physics/body/BodyLock.h"
+#include "cairn/physics/narrowphase/CollideShapes.h"
+#include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/SphereShape.h"
+
+#include <algorithm>
+
+namespace cairn
+{
+
+namespace
+{
+struct Candidate
+{
+    BodyID mBody;
+    float mEntry;
+};
+
+// Per-thread scratch so queries allocate nothing once warm; a query never re-enters another on the same thread
+thread_local std::vector<Candidate> tCandidates;
+thread_local std::vector<BodyID> tBodies;
+
+BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter) { return {inFilter.mObjectLayers}; }
+
+/// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
+Vec3 QueryHalfExtent(const AABB& inBox) { return inBox.HalfExtent().cwiseMax(Vec3::Constant(1.0e-5f)); }
+} // namespace
+
+WorldQuery::WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase)
+    : mBodies(inBodies), mBroadPhase(inBroadPhase)
+{
+}
+
+bool WorldQuery::ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& outTransform) const
+{
+    BodyLockRead lock(mBodies, inID);
+    const Body* body = lock.GetBody();
+    if (body == nullptr || !body->IsInWorld())
+        return false;
+    outShape = body->GetShape();
+    outTransform = body->GetTransform();
+    return true;
+}
+
+void WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
+                         std::vector<RayCastResult>& outHits, bool inClosestOnly) const
+{
+    outHits.clear();
+    if (!IsValidWorldPosition(inRay.mOrigin) || !IsFinite(inRay.mDirection))
+        return;
+    std::vector<Candidate>& candidates = tCandidates;
+    candidates.clear();
+    mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter), [&](BodyID inBody, float inFraction) {
+        if (inBody != inFilter.mIgnoreBody)
+            candidates.push_back({inBody, inFraction});
+        return 1.0f;
+    });
+    // Nearest boxes first, so the closest search can stop once boxes start beyond the best hit
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& inA, const Candidate& inB) {
+        return inA.mEntry < inB.mEntry || (inA.mEntry == inB.mEntry && inA.mBody < inB.mBody);
+    });
+    float best = 1.0f;
+    for (const Candidate& candidate : candidates)
+    {
+        if (inClosestOnly && candidate.mEntry > best)
+            break;
+        ShapeRef shape;
+        Transform transform;
+        if (!ReadBody(candidate.mBody, shape, transform))
+            continue;
+        const RayCast local{transform.InverseTransformPoint(inRay.mOrigin), transform.InverseRotateVector(inRay.mDirection)};
+        RayHit hit;
+        hit.mFraction = inClosestOnly ? std::nextafter(best, 2.0f) : 1.0f + 1.0e-6f;
+        if (!shape->CastRay(local, hit))
+            continue;
+        const RayCastResult result{candidate.mBody, std::min(hit.mFraction, 1.0f), transform.RotateVector(hit.mNormal),
+                                   hit.mSubShape};
+        if (inClosestOnly)
+        {
+            outHits.assign(1, result);
+            best = result.mFraction;
+        }
+        else
+            outHits.push_back(result);
+        if (inAny)
+            return;
+    }
+    std::sort(outHits.begin(), outHits.end(), [](const RayCastResult& inA, const RayCastResult& inB) {
+        return inA.mFraction < inB.mFraction || (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
+    });
+}
+
+std::optional<RayCastResult> WorldQuery::CastRayClosest(const RayCast& inRay, const QueryFilter& inFilter) const
+{
+    thread_local std::vector<RayCastResult> hits;
+    CastRay(inRay, inFilter, false, hits, true);
+    if (hits.empty())
+        return std::nullopt;
+    return hits.front();
+}
+
+bool WorldQuery::CastRayAny(const RayCast& inRay, const QueryFilter& inFilter) const
+{
+    thread_local std::vector<RayCastResult> hits;
+    CastRay(inRay, inFilter, true, hits, false);
+    return !hits.empty();
+}
+
+void WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits, const QueryFilter& inFilter) const
+{
+    CastRay(inRay, inFilter, false, outHits, false);
+}
+
+void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform, std::vector<ShapeQueryHit>& outHits,
+                              const QueryFilter& inFilter, float inMaxSeparation) const
+{
+    outHits.clear();
+    if (!IsValidWorldPosition(inTransform.mPosition) || !IsValidRotation(inTransform.mRotation) ||
+        !std::isfinite(inMaxSeparation))
+        return;
+    std::vector<BodyID>& bodies = tBodies;
+    bodies.clear();
+    const AABB bounds = inShape.GetWorldBounds(inTransform).Expanded(std::max(inMaxSeparation, 0.0f));
+    mBroadPhase.CollideAABox(bounds, ToBroadPhase(inFilter), [&](BodyID inBody) {
+        if (inBody != inFilter.mIgnoreBody)
+            bodies.push_back(inBody);
+    });
+    std::sort(bodies.begin(), bodies.end());
+    CollideSettings settings;
+    settings.mMaxSeparation = std::max(inMaxSeparation, 0.0f);
+    for (const BodyID& id : bodies)
+    {
+        ShapeRef shape;
+        Transform transform;
+        if (!ReadBody(id, shape, transform))
+            continue;
+        // Keep only the deepest manifold per body: callers ask "which bodies, and how"
+        ShapeQueryHit hit{id, {}};
+        float deepest = -cLargeFloat;
+        CollideShapes(inShape, inTransform, *shape, transform, settings, [&](const ContactManifold& inManifold) {
+            for (int i = 0; i < inManifold.mNumPoints; ++i)
+                if (inManifold.mPoints[i].mPenetration > deepest)
+                {
+                    deepest = inManifold.mPoints[i].mPenetration;
+                    hit.mManifold = inManifold;
+                }
+        });
+        if (deepest >= -settings.mMaxSeparation)
+            outHits.push_back(hit);
+    }
+}
+
+void WorldQuery::CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies, const QueryFilter& inFilter) const
+{
+    outBodies.clear();
+    if (!inBox.IsFinite() || inBox.IsEmpty())
+        return;
+    const BoxShape box(QueryHalfExtent(inBox));
+    thread_local std::vector<ShapeQueryHit> hits;
+    CollideShape(box, {inBox.Center(), Quat::Identity()}, hits, inFilter);
+    for (const ShapeQueryHit& hit : hits)
+        outBodies.push_back(hit.mBody);
+}
+
+void WorldQuery::CollideSphere(const Vec3& inCenter, float inRadius, std::vector<BodyID>& outBodies,
+                               const QueryFilter& inFilter) const
+{
+    outBodies.clear();
+    if (!IsValidWorldPosition(inCenter) || !std::isfinite(inRadius) || inRadius <= 0.0f)
+        return;
+    const SphereShape sphere(inRadius);
+    thread_local std::vector<ShapeQueryHit> hits;
+    CollideShape(sphere, {inCenter, Quat::Identity()}, hits, inFilter);
+    for (const ShapeQueryHit& hit : hits)
+        outBodies.push_back(hit.mBody);
+}
+
+void WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies, const QueryFilter& inFilter) const
+{
+    outBodies.clear();
+    if (!IsValidWorldPosition(inPoint))
+        return;
+    std::vector<BodyID>& bodies = tBodies;
+    bodies.clear();
+    mBroadPhase.CollidePoint(inPoint, {inFilter.mObjectLayers}, [&](BodyID inBody) {
+        if (inBody != inFilter.mIgnoreBody)
+            bodies.push_back(inBody);
+    });
+    std::sort(bodies.begin(), bodies.end());
+    for (const BodyID& id : bodies)
+    {
+        ShapeRef shape;
+        Transform transform;
+        if (!ReadBody(id, shape, transform))
+            continue;
+        // A zero-length ray hits a solid shape exactly when it starts inside
+        RayHit hit;
+        hit.mFraction = 1.0f;
+        if (shape->CastRay({transform.InverseTransformPoint(inPoint), Vec3::Zero()}, hit))
+            outBodies.push_back(id);
+    }
+}
+
+} // namespace cairn

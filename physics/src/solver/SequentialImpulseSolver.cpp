@@ -1,0 +1,282 @@
+#include "cairn/physics/solver/SequentialImpulseSolver.h"
+
+#include "cairn/physics/body/Body.h"
+
+#include <algorithm>
+
+namespace cairn
+{
+
+// Body's velocity and pose are private; the solver is its friend through this one accessor
+struct SolverAccess
+{
+    static Vec3& V(Body& ioBody) { return ioBody.mLinearVelocity; }
+    static Vec3& W(Body& ioBody) { return ioBody.mAngularVelocity; }
+    static Vec3& X(Body& ioBody) { return ioBody.mPosition; }
+    static Quat& Q(Body& ioBody) { return ioBody.mRotation; }
+};
+
+namespace
+{
+/// A speculative point further apart than this at the start of the step does not bounce in this step.
+constexpr float cTouchingTolerance = 1.0e-3f;
+
+void InitAxis(const Vec3& inAxis, const Vec3& inRA, const Vec3& inRB, const Mat3& inInvIA, const Mat3& inInvIB,
+              float inInvMassA, float inInvMassB, AxisImpulse& outAxis)
+{
+    outAxis.mRAxAxis = inRA.cross(inAxis);
+    outAxis.mRBxAxis = inRB.cross(inAxis);
+    outAxis.mInvIA_RAxAxis = inInvIA * outAxis.mRAxAxis;
+    outAxis.mInvIB_RBxAxis = inInvIB * outAxis.mRBxAxis;
+    const float k = inInvMassA + inInvMassB + outAxis.mRAxAxis.dot(outAxis.mInvIA_RAxAxis) +
+                    outAxis.mRBxAxis.dot(outAxis.mInvIB_RBxAxis);
+    outAxis.mEffectiveMass = k > 0.0f ? 1.0f / k : 0.0f;
+    outAxis.mAccumulated = 0.0f;
+}
+
+/// Relative velocity of B with respect to A along an axis.
+float RelativeVelocity(const ContactConstraint& inC, const Vec3& inAxis, const AxisImpulse& inPart)
+{
+    Body& a = *inC.mBodyA;
+    Body& b = *inC.mBodyB;
+    return inAxis.dot(SolverAccess::V(b) - SolverAccess::V(a)) + inPart.mRBxAxis.dot(SolverAccess::W(b)) -
+           inPart.mRAxAxis.dot(SolverAccess::W(a));
+}
+
+/// Applies impulse inLambda along inAxis: B is pushed along +axis, A along -axis.
+void ApplyImpulse(const ContactConstraint& inC, const Vec3& inAxis, const AxisImpulse& inPart, float inLambda)
+{
+    // Only dynamic bodies are written: static and kinematic ones are shared between islands (read-only)
+    Body& a = *inC.mBodyA;
+    Body& b = *inC.mBodyB;
+    if (a.IsDynamic())
+    {
+        SolverAccess::V(a) -= (a.GetInverseMass() * inLambda) * inAxis;
+        SolverAccess::W(a) -= inLambda * inPart.mInvIA_RAxAxis;
+    }
+    if (b.IsDynamic())
+    {
+        SolverAccess::V(b) += (b.GetInverseMass() * inLambda) * inAxis;
+        SolverAccess::W(b) += inLambda * inPart.mInvIB_RBxAxis;
+    }
+}
+
+/// Relative angular velocity of B with respect to A about the normal.
+float RelativeTwist(const ContactConstraint& inC)
+{
+    return inC.mNormal.dot(SolverAccess::W(*inC.mBodyB) - SolverAccess::W(*inC.mBodyA));
+}
+
+void ApplyTwist(const ContactConstraint& inC, float inLambda)
+{
+    if (inC.mBodyA->IsDynamic())
+        SolverAccess::W(*inC.mBodyA) -= inLambda * inC.mInvIA_Normal;
+    if (inC.mBodyB->IsDynamic())
+        SolverAccess::W(*inC.mBodyB) += inLambda * inC.mInvIB_Normal;
+}
+
+float TotalNormalImpulse(const ContactConstraint& inC)
+{
+    float total = 0.0f;
+    for (int i = 0; i < inC.mNumPoints; ++i)
+        total += inC.mPoints[i].mNormal.mAccumulated;
+    return total;
+}
+
+void SolvePatchFriction(ContactConstraint& ioC)
+{
+    PatchFriction& patch = ioC.mPatch;
+    const float maxFriction = ioC.mFriction * TotalNormalImpulse(ioC);
+    float total[2];
+    for (int t = 0; t < 2; ++t)
+        total[t] = patch.mTangent[t].mAccumulated -
+                   patch.mTangent[t].mEffectiveMass * RelativeVelocity(ioC, ioC.mTangent[t], patch.mTangent[t]);
+    // Clamp to the friction circle rather than a box, so sliding friction is mu * N in every direction
+    const float lengthSq = total[0] * total[0] + total[1] * total[1];
+    if (lengthSq > maxFriction * maxFriction)
+    {
+        const float scale = lengthSq > 0.0f ? maxFriction / std::sqrt(lengthSq) : 0.0f;
+        total[0] *= scale;
+        total[1] *= scale;
+    }
+    for (int t = 0; t < 2; ++t)
+    {
+        const float applied = total[t] - patch.mTangent[t].mAccumulated;
+        patch.mTangent[t].mAccumulated = total[t];
+        ApplyImpulse(ioC, ioC.mTangent[t], patch.mTangent[t], applied);
+    }
+
+    // Twist: the torsional friction of a contact patch of mean radius r is at most mu * N * r
+    const float maxTwist = maxFriction * patch.mTwistRadius;
+    const float twist = std::clamp(patch.mTwistAccumulated - patch.mTwistEffectiveMass * RelativeTwist(ioC), -maxTwist,
+                                   maxTwist);
+    ApplyTwist(ioC, twist - patch.mTwistAccumulated);
+    patch.mTwistAccumulated = twist;
+}
+
+void SolveNormal(ContactConstraint& ioC, ContactConstraintPoint& ioP)
+{
+    const float vn = RelativeVelocity(ioC, ioC.mNormal, ioP.mNormal);
+    const float total = std::max(ioP.mNormal.mAccumulated + ioP.mNormal.mEffectiveMass * (ioP.mVelocityBias - vn), 0.0f);
+    const float applied = total - ioP.mNormal.mAccumulated;
+    ioP.mNormal.mAccumulated = total;
+    ioP.mMaxNormalImpulse = std::max(ioP.mMaxNormalImpulse, total);
+    ApplyImpulse(ioC, ioC.mNormal, ioP.mNormal, applied);
+}
+} // namespace
+
+void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold,
+                                             float inDeltaTime, ContactConstraint& outConstraint)
+{
+    ContactConstraint& c = outConstraint;
+    c.mBodyA = &ioA;
+    c.mBodyB = &ioB;
+    c.mNormal = inManifold.mNormal;
+    c.mTangent[0] = AnyPerpendicular(c.mNormal);
+    c.mTangent[1] = c.mNormal.cross(c.mTangent[0]);
+    // Geometric mean: a frictionless surface makes every contact with it frictionless (as Jolt and Box2D do)
+    c.mFriction = std::sqrt(ioA.GetFriction() * ioB.GetFriction());
+    // Max: a bouncy ball bounces on any floor
+    c.mRestitution = std::max(ioA.GetRestitution(), ioB.GetRestitution());
+    c.mNumPoints = inManifold.mNumPoints;
+
+    const Mat3 invIA = ioA.GetInverseInertiaWorld();
+    const Mat3 invIB = ioB.GetInverseInertiaWorld();
+    const Vec3& xA = ioA.GetCenterOfMassPosition();
+    const Vec3& xB = ioB.GetCenterOfMassPosition();
+    Vec3 centroid = Vec3::Zero();
+    for (int i = 0; i < c.mNumPoints; ++i)
+    {
+        const ContactPoint& mp = inManifold.mPoints[i];
+        ContactConstraintPoint& p = c.mPoints[i];
+        const Vec3 rA = mp.mPositionOnA - xA;
+        const Vec3 rB = mp.mPositionOnB - xB;
+        p.mLocalOnA = ioA.GetRotation().conjugate() * rA;
+        p.mLocalOnB = ioB.GetRotation().conjugate() * rB;
+        InitAxis(c.mNormal, rA, rB, invIA, invIB, ioA.GetInverseMass(), ioB.GetInverseMass(), p.mNormal);
+        // A speculative point (separated by s) may close its gap this step, but no more
+        p.mSeparation = -mp.mPenetration;
+        p.mVelocityBias = p.mSeparation > 0.0f ? -p.mSeparation / inDeltaTime : 0.0f;
+        p.mApproachVelocity = RelativeVelocity(c, c.mNormal, p.mNormal);
+        p.mMaxNormalImpulse = 0.0f;
+        p.mDeferredBounce = 0.0f;
+        centroid += 0.5f * (mp.mPositionOnA + mp.mPositionOnB);
+    }
+    centroid /= float(std::max(c.mNumPoints, 1));
+
+    PatchFriction& patch = c.mPatch;
+    for (int t = 0; t < 2; ++t)
+        InitAxis(c.mTangent[t], centroid - xA, centroid - xB, invIA, invIB, ioA.GetInverseMass(), ioB.GetInverseMass(),
+                 patch.mTangent[t]);
+    c.mInvIA_Normal = invIA * c.mNormal;
+    c.mInvIB_Normal = invIB * c.mNormal;
+    const float twistK = c.mNormal.dot(c.mInvIA_Normal + c.mInvIB_Normal);
+    patch.mTwistEffectiveMass = twistK > 0.0f ? 1.0f / twistK : 0.0f;
+    patch.mTwistAccumulated = 0.0f;
+    patch.mTwistRadius = 0.0f;
+    for (int i = 0; i < c.mNumPoints; ++i)
+    {
+        const Vec3 offset = 0.5f * (inManifold.mPoints[i].mPositionOnA + inManifold.mPoints[i].mPositionOnB) - centroid;
+        patch.mTwistRadius += (offset - offset.dot(c.mNormal) * c.mNormal).norm();
+    }
+    patch.mTwistRadius /= float(std::max(c.mNumPoints, 1));
+}
+
+void SequentialImpulseSolver::WarmStart(std::span<ContactConstraint* const> ioConstraints)
+{
+    for (ContactConstraint* c : ioConstraints)
+    {
+        for (int i = 0; i < c->mNumPoints; ++i)
+            ApplyImpulse(*c, c->mNormal, c->mPoints[i].mNormal, c->mPoints[i].mNormal.mAccumulated);
+        for (int t = 0; t < 2; ++t)
+            ApplyImpulse(*c, c->mTangent[t], c->mPatch.mTangent[t], c->mPatch.mTangent[t].mAccumulated);
+        ApplyTwist(*c, c->mPatch.mTwistAccumulated);
+    }
+}
+
+void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const> ioConstraints)
+{
+    for (ContactConstraint* c : ioConstraints)
+    {
+        // Friction first, against last iteration's normal impulse: normal is solved last so that
+        // non-penetration, the more important constraint, wins when the two disagree
+        SolvePatchFriction(*c);
+        for (int i = 0; i < c->mNumPoints; ++i)
+            SolveNormal(*c, c->mPoints[i]);
+        for (int i = c->mNumPoints - 1; i >= 0; --i)
+            SolveNormal(*c, c->mPoints[i]);
+    }
+}
+
+void SequentialImpulseSolver::ApplyRestitution(std::span<ContactConstraint* const> ioConstraints,
+                                               const SolverSettings& inSettings)
+{
+    for (ContactConstraint* c : ioConstraints)
+    {
+        if (c->mRestitution == 0.0f)
+            continue;
+        for (int i = 0; i < c->mNumPoints; ++i)
+        {
+            ContactConstraintPoint& p = c->mPoints[i];
+            // Only points that touched (received an impulse) and hit hard enough bounce
+            if (p.mApproachVelocity > -inSettings.mRestitutionThreshold || p.mMaxNormalImpulse == 0.0f)
+                continue;
+            // A speculative point that only closed its gap this step bounces next step, from where it touches:
+            // bouncing now would launch it from the far side of the gap, too high (up to a step's travel)
+            if (p.mSeparation > cTouchingTolerance)
+            {
+                p.mDeferredBounce = p.mApproachVelocity;
+                continue;
+            }
+            const float vn = RelativeVelocity(*c, c->mNormal, p.mNormal);
+            const float lambda = -p.mNormal.mEffectiveMass * (vn + c->mRestitution * p.mApproachVelocity);
+            const float total = std::max(p.mNormal.mAccumulated + lambda, 0.0f);
+            const float applied = total - p.mNormal.mAccumulated;
+            p.mNormal.mAccumulated = total;
+            ApplyImpulse(*c, c->mNormal, p.mNormal, applied);
+        }
+    }
+}
+
+float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const> ioConstraints,
+                                              const SolverSettings& inSettings)
+{
+    float maxPenetration = 0.0f;
+    for (ContactConstraint* c : ioConstraints)
+    {
+        Body& a = *c->mBodyA;
+        Body& b = *c->mBodyB;
+        const Mat3 invIA = a.GetInverseInertiaWorld();
+        const Mat3 invIB = b.GetInverseInertiaWorld();
+        for (int i = 0; i < c->mNumPoints; ++i)
+        {
+            const ContactConstraintPoint& p = c->mPoints[i];
+            // Penetration from the bodies' current poses (they moved since the manifold was made)
+            const Vec3 rA = SolverAccess::Q(a) * p.mLocalOnA;
+            const Vec3 rB = SolverAccess::Q(b) * p.mLocalOnB;
+            const float separation = c->mNormal.dot((SolverAccess::X(b) + rB) - (SolverAccess::X(a) + rA));
+            maxPenetration = std::max(maxPenetration, -separation - inSettings.mPenetrationSlop);
+            const float correction = std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
+                                                -inSettings.mMaxPenetrationCorrection, 0.0f);
+            if (correction == 0.0f)
+                continue;
+            AxisImpulse axis;
+            InitAxis(c->mNormal, rA, rB, invIA, invIB, a.GetInverseMass(), b.GetInverseMass(), axis);
+            const float impulse = -correction * axis.mEffectiveMass;
+            // Move positions directly (a pseudo-impulse): it corrects the overlap without adding velocity
+            if (a.IsDynamic())
+            {
+                SolverAccess::X(a) -= (a.GetInverseMass() * impulse) * c->mNormal;
+                SolverAccess::Q(a) = IntegrateRotation(SolverAccess::Q(a), -impulse * axis.mInvIA_RAxAxis);
+            }
+            if (b.IsDynamic())
+            {
+                SolverAccess::X(b) += (b.GetInverseMass() * impulse) * c->mNormal;
+                SolverAccess::Q(b) = IntegrateRotation(SolverAccess::Q(b), impulse * axis.mInvIB_RBxAxis);
+            }
+        }
+    }
+    return maxPenetration;
+}
+
+} // namespace cairn
