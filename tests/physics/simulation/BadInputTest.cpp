@@ -1,0 +1,144 @@
+#include "SimulationFixture.h"
+
+#include "cairn/physics/shapes/CapsuleShape.h"
+#include "cairn/physics/shapes/ConvexHullShape.h"
+#include "cairn/physics/shapes/TriangleMeshShape.h"
+
+#include <limits>
+
+namespace cairn::test
+{
+
+class BadInputTest : public SimulationFixture
+{
+protected:
+    void SetUp() override
+    {
+        mFloor = AddFloor();
+        mBox = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+        mBoxPosition = Position(mBox);
+    }
+
+    /// The world is as SetUp left it.
+    void ExpectWorldUnchanged()
+    {
+        EXPECT_EQ(System().GetBodyManager().GetNumBodies(), 2u);
+        EXPECT_EQ(System().GetBroadPhase().GetBodyCount(), 2u);
+        EXPECT_EQ(Position(mBox), mBoxPosition);
+    }
+
+    BodyID mFloor;
+    BodyID mBox;
+    Vec3 mBoxPosition;
+};
+
+TEST_F(BadInputTest, UnknownAndStaleIDsAreRejected)
+{
+    const BodyID unknown(12345, 0);
+    EXPECT_EQ(Bodies().SetPosition(unknown, Vec3::Zero(), Activation::Activate).GetError().mCode,
+              ErrorCode::InvalidBodyID);
+    EXPECT_EQ(Bodies().GetPosition(BodyID()).GetError().mCode, ErrorCode::InvalidBodyID);
+
+    // A destroyed body's id stays stale even after its slot is reused
+    const BodyID temporary = Bodies().CreateBody(DynamicSettings(Sphere(1), Vec3(5, 5, 5))).Value();
+    ASSERT_TRUE(Bodies().DestroyBody(temporary).IsOk());
+    const BodyID reused = Bodies().CreateBody(DynamicSettings(Sphere(1), Vec3(9, 9, 9))).Value();
+    EXPECT_EQ(reused.GetIndex(), temporary.GetIndex());
+    EXPECT_NE(reused, temporary);
+    EXPECT_EQ(Bodies().AddBody(temporary, Activation::Activate).GetError().mCode, ErrorCode::InvalidBodyID);
+    EXPECT_EQ(Bodies().AddImpulse(temporary, Vec3(1, 0, 0)).GetError().mCode, ErrorCode::InvalidBodyID);
+    EXPECT_EQ(Position(reused), Vec3(9, 9, 9));
+    ASSERT_TRUE(Bodies().DestroyBody(reused).IsOk());
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, NaNAndInfinitePositionsAreRejected)
+{
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(Bodies().SetPosition(mBox, Vec3(nan, 0, 0), Activation::Activate).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(Bodies().SetPosition(mBox, Vec3(0, inf, 0), Activation::Activate).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(Bodies().SetPosition(mBox, Vec3(0, 0, 1.0e9f), Activation::Activate).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_FALSE(Bodies().SetLinearVelocity(mBox, Vec3(nan, 0, 0)).IsOk());
+    EXPECT_FALSE(Bodies().AddForce(mBox, Vec3(0, inf, 0)).IsOk());
+    EXPECT_FALSE(Bodies().SetRotation(mBox, Quat(nan, 0, 0, 0), Activation::Activate).IsOk());
+    EXPECT_FALSE(Bodies().SetRotation(mBox, Quat(2, 0, 0, 0), Activation::Activate).IsOk());
+
+    BodyCreationSettings settings = DynamicSettings(Sphere(1), Vec3(nan, 0, 0));
+    Result<BodyID> created = Bodies().CreateBody(settings);
+    ASSERT_FALSE(created.IsOk());
+    EXPECT_EQ(created.GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_NE(created.GetError().mMessage.find("position"), std::string::npos);
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, DegenerateShapesAreRejected)
+{
+    EXPECT_EQ(BoxShape::Create(Vec3(0, 1, 1)).GetError().mCode, ErrorCode::DegenerateShape);
+    EXPECT_FALSE(BoxShape::Create(Vec3(-1, 1, 1)).IsOk());
+    EXPECT_FALSE(SphereShape::Create(0.0f).IsOk());
+    EXPECT_FALSE(SphereShape::Create(std::numeric_limits<float>::quiet_NaN()).IsOk());
+    EXPECT_FALSE(CapsuleShape::Create(1.0f, -0.5f).IsOk());
+    const Vec3 coplanar[] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(0.5f, 0, 0.5f)};
+    Result<std::shared_ptr<const ConvexHullShape>> hull = ConvexHullShape::Create(coplanar);
+    ASSERT_FALSE(hull.IsOk());
+    EXPECT_EQ(hull.GetError().mCode, ErrorCode::DegenerateShape);
+
+    // A shape without volume cannot be dynamic
+    const Vec3 vertices[] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};
+    const std::array<uint32_t, 3> triangles[] = {{0, 1, 2}};
+    BodyCreationSettings meshBody = DynamicSettings(TriangleMeshShape::Create(vertices, triangles).Value(), Vec3::Zero());
+    EXPECT_FALSE(Bodies().CreateBody(meshBody).IsOk());
+    BodyCreationSettings noShape = DynamicSettings(nullptr, Vec3::Zero());
+    EXPECT_FALSE(Bodies().CreateBody(noShape).IsOk());
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, AddingTwiceAndRemovingTwiceAreRejected)
+{
+    EXPECT_EQ(Bodies().AddBody(mBox, Activation::Activate).GetError().mCode, ErrorCode::AlreadyAdded);
+    const BodyID extra = Bodies().CreateBody(DynamicSettings(Sphere(1), Vec3(5, 5, 5))).Value();
+    ASSERT_TRUE(Bodies().AddBody(extra, Activation::Activate).IsOk());
+    ASSERT_TRUE(Bodies().RemoveBody(extra).IsOk());
+    EXPECT_EQ(Bodies().RemoveBody(extra).GetError().mCode, ErrorCode::NotAdded);
+    EXPECT_EQ(Bodies().DestroyBody(mBox).GetError().mCode, ErrorCode::AlreadyAdded) << "destroying a body in the world";
+    ASSERT_TRUE(Bodies().DestroyBody(extra).IsOk());
+    EXPECT_EQ(Bodies().DestroyBody(extra).GetError().mCode, ErrorCode::InvalidBodyID);
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, BatchWithABadIDMarksNothing)
+{
+    const BodyID a = Bodies().CreateBody(DynamicSettings(Sphere(1), Vec3(5, 5, 5))).Value();
+    const BodyID ids[] = {a, mBox};
+    Result<BodyInterface::AddBatch> batch = Bodies().AddBodiesPrepare(ids);
+    ASSERT_FALSE(batch.IsOk());
+    EXPECT_EQ(batch.GetError().mCode, ErrorCode::AlreadyAdded);
+    // a was not left pending: it can still be added
+    EXPECT_TRUE(Bodies().AddBody(a, Activation::Activate).IsOk());
+    ASSERT_TRUE(Bodies().RemoveBody(a).IsOk());
+    ASSERT_TRUE(Bodies().DestroyBody(a).IsOk());
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, BadTimeStepsAreRejected)
+{
+    EXPECT_FALSE(System().Update(0.0f).IsOk());
+    EXPECT_FALSE(System().Update(-1.0f).IsOk());
+    EXPECT_FALSE(System().Update(std::numeric_limits<float>::quiet_NaN()).IsOk());
+    EXPECT_FALSE(System().Update(cDeltaTime, 0).IsOk());
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, ObjectLayerOutsideTheSetupIsRejected)
+{
+    BodyCreationSettings settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+    settings.mObjectLayer = 40;
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    ExpectWorldUnchanged();
+}
+
+} // namespace cairn::test

@@ -1,0 +1,88 @@
+#include "SimulationFixture.h"
+
+namespace cairn::test
+{
+
+using SleepAndWakeTest = SimulationFixture;
+
+TEST_F(SleepAndWakeTest, IslandSleepsOnlyAfterHalfASecondOfRest)
+{
+    AddFloor();
+    const BodyID box = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+    Step(20); // 1/3 s at rest: not yet
+    EXPECT_TRUE(IsActive(box));
+    Step(40);
+    EXPECT_FALSE(IsActive(box));
+}
+
+TEST_F(SleepAndWakeTest, MovingABodyThroughTheInterfaceWakesItsIsland)
+{
+    AddFloor();
+    const BodyID bottom = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+    const BodyID top = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.5f, 0)));
+    Step(120);
+    ASSERT_FALSE(IsActive(bottom));
+    ASSERT_FALSE(IsActive(top));
+    // Shove the bottom box sideways out from under the top box
+    ASSERT_TRUE(Bodies().SetPosition(bottom, Vec3(2, 0.5f, 0), Activation::Activate).IsOk());
+    Step(1);
+    EXPECT_TRUE(IsActive(bottom));
+    EXPECT_TRUE(IsActive(top)) << "the box resting on it should wake";
+    Step(60);
+    EXPECT_LT(Position(top).y(), 0.6f) << "the top box should have fallen to the floor";
+}
+
+TEST_F(SleepAndWakeTest, RemovingTheSupportWakesTheBodyOnIt)
+{
+    const BodyID support = AddStatic(Box(Vec3(2, 0.5f, 2)), Vec3(0, 0, 0));
+    const BodyID box = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.0f, 0)));
+    Step(120);
+    ASSERT_FALSE(IsActive(box));
+    ASSERT_TRUE(Bodies().RemoveBody(support).IsOk());
+    EXPECT_TRUE(IsActive(box));
+    Step(30);
+    EXPECT_LT(Position(box).y(), 0.5f) << "the box should be falling";
+}
+
+TEST_F(SleepAndWakeTest, ContactWithAnActiveBodyWakesASleepingOne)
+{
+    AddFloor();
+    const BodyID sleeper = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+    Step(60);
+    ASSERT_FALSE(IsActive(sleeper));
+    BodyCreationSettings ball = DynamicSettings(Sphere(0.3f), Vec3(-3, 0.5f, 0));
+    ball.mLinearVelocity = Vec3(8, 0, 0);
+    AddDynamic(ball);
+    bool woke = false;
+    for (int i = 0; i < 60 && !woke; ++i)
+    {
+        Step(1);
+        woke = IsActive(sleeper);
+    }
+    EXPECT_TRUE(woke);
+}
+
+TEST_F(SleepAndWakeTest, SleepingCanBeDisabled)
+{
+    PhysicsSettings settings;
+    settings.mAllowSleeping = false;
+    ResetWorld(settings);
+    AddFloor();
+    const BodyID box = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+    Step(120);
+    EXPECT_TRUE(IsActive(box));
+}
+
+TEST_F(SleepAndWakeTest, StaticBodiesNeverMoveOrJoinIslands)
+{
+    const BodyID floor = AddFloor();
+    for (int i = 0; i < 5; ++i)
+        AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(3.0f * float(i), 0.6f, 0)));
+    Step(5);
+    // Five boxes on one floor are five islands: the floor does not connect them
+    EXPECT_EQ(System().GetLastStepStatistics().mNumIslands, 5u);
+    EXPECT_EQ(Position(floor), Vec3(0, -1, 0));
+    EXPECT_FALSE(IsActive(floor));
+}
+
+} // namespace cairn::test
