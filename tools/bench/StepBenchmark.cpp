@@ -1,0 +1,199 @@
+// cairn-bench-step: the physics step benchmarks of ../shared/bench/SPEC.md.
+//  step_pile2k   2,000 dynamic boxes fall onto the 20,020 static boxes: 600 steps of 1/60 s.
+//  step_pyramid  a 3D pyramid of 1,240 boxes on a static floor: 500 steps, sleeping disabled.
+// Prints ms per step (mean, p99, max) for each repetition and the median over repetitions, the mean time per
+// phase, and a checksum (sum of final body heights and contact points) that proves the work was done.
+
+#include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/shapes/BoxShape.h"
+#include "common/FrameTimes.h"
+#include "common/SharedBenchData.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace cairn;
+
+namespace
+{
+struct RunResult
+{
+    tools::TimingSummary mStep;
+    StepStatistics mPhaseSums;     ///< Phase times summed over all steps
+    double mHeightChecksum = 0.0;  ///< Sum of final y of the dynamic bodies
+    uint64_t mContactPoints = 0;   ///< Contact points summed over all steps
+    int mSteps = 0;
+};
+
+BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, float inYaw, MotionType inMotion,
+                                 float inFriction)
+{
+    BodyCreationSettings settings;
+    settings.mShape = BoxShape::Create(inHalfExtent).Value();
+    settings.mPosition = inCenter;
+    settings.mRotation = Quat(Eigen::AngleAxisf(inYaw, Vec3::UnitY()));
+    settings.mMotionType = inMotion;
+    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
+    settings.mFriction = inFriction;
+    settings.mRestitution = 0.0f;
+    settings.mDensity = 1000.0f;
+    return settings;
+}
+
+/// Adds bodies in one batch, as a streaming loader would.
+void AddBatch(BodyInterface& ioBodies, const std::vector<BodyCreationSettings>& inSettings, Activation inActivation,
+              std::vector<BodyID>& outIDs)
+{
+    std::vector<BodyID> ids;
+    for (const BodyCreationSettings& settings : inSettings)
+        ids.push_back(ioBodies.CreateBody(settings).Value());
+    BodyInterface::AddBatch batch = ioBodies.AddBodiesPrepare(ids).Value();
+    (void)ioBodies.AddBodiesFinalize(batch, inActivation);
+    outIDs.insert(outIDs.end(), ids.begin(), ids.end());
+}
+
+RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic, int inSteps)
+{
+    RunResult result;
+    result.mSteps = inSteps;
+    std::vector<double> stepMs;
+    stepMs.reserve(size_t(inSteps));
+    for (int step = 0; step < inSteps; ++step)
+    {
+        const auto start = std::chrono::steady_clock::now();
+        (void)ioSystem.Update(1.0f / 60.0f, 1);
+        stepMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        const StepStatistics& stats = ioSystem.GetLastStepStatistics();
+        result.mPhaseSums.mBroadPhaseUpdateMs += stats.mBroadPhaseUpdateMs;
+        result.mPhaseSums.mNarrowPhaseMs += stats.mNarrowPhaseMs;
+        result.mPhaseSums.mIslandsMs += stats.mIslandsMs;
+        result.mPhaseSums.mSolveMs += stats.mSolveMs;
+        result.mPhaseSums.mFinishMs += stats.mFinishMs;
+        result.mContactPoints += stats.mNumContactPoints;
+    }
+    result.mStep = tools::Summarize(stepMs);
+    for (const BodyID& id : inDynamic)
+        result.mHeightChecksum += ioSystem.GetBodyInterface().GetPosition(id).Value().y();
+    return result;
+}
+
+PhysicsSettings BenchSettings(bool inAllowSleeping)
+{
+    PhysicsSettings settings;
+    settings.mMaxBodies = 32768;
+    settings.mSolver.mVelocityIterations = 10;
+    settings.mSolver.mPositionIterations = 2;
+    settings.mAllowSleeping = inAllowSleeping;
+    return settings;
+}
+
+RunResult RunPile2k(const SharedBenchData& inData)
+{
+    PhysicsSystem system(BenchSettings(true));
+    std::vector<BodyCreationSettings> statics, dynamics;
+    for (const BenchBox& box : inData.mStatic)
+        statics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Static, 0.5f));
+    for (const BenchBox& box : inData.mDynamic)
+        dynamics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Dynamic, 0.5f));
+    std::vector<BodyID> staticIDs, dynamicIDs;
+    AddBatch(system.GetBodyInterface(), statics, Activation::DontActivate, staticIDs);
+    AddBatch(system.GetBodyInterface(), dynamics, Activation::Activate, dynamicIDs);
+    return RunScene(system, dynamicIDs, 600);
+}
+
+RunResult RunPyramid()
+{
+    PhysicsSystem system(BenchSettings(false));
+    std::vector<BodyCreationSettings> boxes;
+    std::vector<BodyID> floorIDs, boxIDs;
+    AddBatch(system.GetBodyInterface(), {BoxSettings(Vec3(0, -1, 0), Vec3(50, 1, 50), 0, MotionType::Static, 0.2f)},
+             Activation::DontActivate, floorIDs);
+    for (int i = 0; i < 15; ++i)
+        for (int j = i / 2; j < 15 - (i + 1) / 2; ++j)
+            for (int k = i / 2; k < 15 - (i + 1) / 2; ++k)
+            {
+                const float offset = (i % 2 == 1) ? 1.0f : 0.0f;
+                boxes.push_back(BoxSettings(Vec3(-15.0f + 2.0f * float(j) + offset, 1.0f + 2.5f * float(i),
+                                                 -15.0f + 2.0f * float(k) + offset),
+                                            Vec3(1, 1, 1), 0, MotionType::Dynamic, 0.2f));
+            }
+    AddBatch(system.GetBodyInterface(), boxes, Activation::Activate, boxIDs);
+    return RunScene(system, boxIDs, 500);
+}
+
+void Print(const char* inName, const std::vector<RunResult>& inRuns)
+{
+    std::vector<double> means, p99s, maxes;
+    for (size_t i = 0; i < inRuns.size(); ++i)
+    {
+        const RunResult& run = inRuns[i];
+        std::printf("%s rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: broadphase-update %.3f  "
+                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f contacts %llu\n",
+                    inName, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
+                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
+                    run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
+                    run.mPhaseSums.mFinishMs / run.mSteps, run.mHeightChecksum,
+                    static_cast<unsigned long long>(run.mContactPoints));
+        means.push_back(run.mStep.mMean);
+        p99s.push_back(run.mStep.mP99);
+        maxes.push_back(run.mStep.mMax);
+    }
+    auto median = [](std::vector<double> inValues) {
+        std::sort(inValues.begin(), inValues.end());
+        return inValues[inValues.size() / 2];
+    };
+    std::printf("%s threads=1 median of %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms per step\n", inName,
+                inRuns.size(), median(means), median(p99s), median(maxes));
+}
+} // namespace
+
+int main(int inArgc, char** inArgv)
+{
+    int repetitions = 3;
+    std::string only;
+    for (int i = 1; i < inArgc; ++i)
+    {
+        if (std::strcmp(inArgv[i], "--repetitions") == 0 && i + 1 < inArgc)
+            repetitions = std::max(1, std::atoi(inArgv[++i]));
+        else if (std::strcmp(inArgv[i], "--only") == 0 && i + 1 < inArgc)
+            only = inArgv[++i];
+        else
+        {
+            std::fprintf(stderr, "usage: cairn-bench-step [--repetitions N] [--only step_pile2k|step_pyramid]\n");
+            return 2;
+        }
+    }
+#ifdef NDEBUG
+    const char* buildType = "Release";
+#else
+    const char* buildType = "Debug (figures not representative)";
+#endif
+    std::printf("cairn-bench-step: build %s, 1 thread, %d repetitions\n", buildType, repetitions);
+
+    if (only.empty() || only == "step_pile2k")
+    {
+        Result<SharedBenchData> data = LoadSharedBenchData();
+        if (!data)
+            std::printf("step_pile2k skipped: %s\n", data.GetError().mMessage.c_str());
+        else
+        {
+            std::vector<RunResult> runs;
+            for (int i = 0; i < repetitions; ++i)
+                runs.push_back(RunPile2k(data.Value()));
+            Print("step_pile2k", runs);
+        }
+    }
+    if (only.empty() || only == "step_pyramid")
+    {
+        std::vector<RunResult> runs;
+        for (int i = 0; i < repetitions; ++i)
+            runs.push_back(RunPyramid());
+        Print("step_pyramid", runs);
+    }
+    return 0;
+}

@@ -1,0 +1,39 @@
+#pragma once
+
+// Collects per-frame timings and summarises them (mean, percentiles, max) for the tools' reports.
+
+#include <algorithm>
+#include <cstddef>
+#include <numeric>
+#include <vector>
+
+namespace cairn::tools
+{
+
+struct TimingSummary
+{
+    double mMean = 0.0;
+    double mP50 = 0.0;
+    double mP99 = 0.0;
+    double mMax = 0.0;
+};
+
+/// Percentiles by nearest rank over a copy of the samples.
+inline TimingSummary Summarize(std::vector<double> inSamples)
+{
+    TimingSummary summary;
+    if (inSamples.empty())
+        return summary;
+    std::sort(inSamples.begin(), inSamples.end());
+    auto rank = [&](double inFraction) {
+        const size_t index = size_t(inFraction * double(inSamples.size() - 1) + 0.5);
+        return inSamples[std::min(index, inSamples.size() - 1)];
+    };
+    summary.mMean = std::accumulate(inSamples.begin(), inSamples.end(), 0.0) / double(inSamples.size());
+    summary.mP50 = rank(0.50);
+    summary.mP99 = rank(0.99);
+    summary.mMax = inSamples.back();
+    return summary;
+}
+
+} // namespace cairn::tools
