@@ -276,72 +276,50 @@ Status BodyInterface::SetAngularVelocity(const BodyID& inID, const Vec3& inVeloc
     });
 }
 
-Status BodyInterface::AddForce(const BodyID& inID, const Vec3& inForce)
+template <class F>
+Status BodyInterface::PushBody(const BodyID& inID, const Vec3& inAmount, const char* inWhat, F&& inApply)
 {
-    if (!IsFinite(inForce))
-        return InvalidVector("force");
+    if (!IsFinite(inAmount))
+        return InvalidVector(inWhat);
     return ModifyBody(inID, true, [&](Body& ioBody) {
         if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, "forces act on dynamic bodies only"));
-        ioBody.mForce += inForce;
+            return Status(MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + " acts on dynamic bodies only"));
+        inApply(ioBody);
         mBodies.ActivateBody(ioBody);
         return Status::Ok();
     });
+}
+
+Status BodyInterface::AddForce(const BodyID& inID, const Vec3& inForce)
+{
+    return PushBody(inID, inForce, "force", [&](Body& ioBody) { ioBody.mForce += inForce; });
 }
 
 Status BodyInterface::AddTorque(const BodyID& inID, const Vec3& inTorque)
 {
-    if (!IsFinite(inTorque))
-        return InvalidVector("torque");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, "torques act on dynamic bodies only"));
-        ioBody.mTorque += inTorque;
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    return PushBody(inID, inTorque, "torque", [&](Body& ioBody) { ioBody.mTorque += inTorque; });
 }
 
 Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse)
 {
-    if (!IsFinite(inImpulse))
-        return InvalidVector("impulse");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
-        ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    return PushBody(inID, inImpulse, "impulse",
+                    [&](Body& ioBody) { ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse; });
 }
 
 Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse, const Vec3& inWorldPoint)
 {
-    if (!IsFinite(inImpulse))
-        return InvalidVector("impulse");
     if (!IsValidWorldPosition(inWorldPoint))
         return InvalidVector("impulse point");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
+    return PushBody(inID, inImpulse, "impulse", [&](Body& ioBody) {
         ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
         ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * (inWorldPoint - ioBody.mPosition).cross(inImpulse);
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
     });
 }
 
 Status BodyInterface::AddAngularImpulse(const BodyID& inID, const Vec3& inImpulse)
 {
-    if (!IsFinite(inImpulse))
-        return InvalidVector("angular impulse");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, "impulses act on dynamic bodies only"));
-        ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * inImpulse;
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    return PushBody(inID, inImpulse, "angular impulse",
+                    [&](Body& ioBody) { ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * inImpulse; });
 }
 
 Status BodyInterface::ActivateBody(const BodyID& inID)

@@ -76,6 +76,9 @@ private:
     /// Runs inChange on the body under its write lock after the common checks; inChange returns the status.
     template <class F>
     Status ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange);
+    /// Validates inAmount (named inWhat in errors), then runs inApply on a dynamic body and activates it.
+    template <class F>
+    Status PushBody(const BodyID& inID, const Vec3& inAmount, const char* inWhat, F&& inApply);
     template <class T, class F>
     Result<T> ReadBody(const BodyID& inID, F&& inRead) const;
     /// Pushes the body's new bounds to the broad phase and, for dynamic/kinematic bodies, activates them.
