@@ -1,0 +1,242 @@
+// The CollideShapes entry point: dispatch, argument-order symmetry, generic convex manifolds (hulls, capsule
+// on box), compounds, and the pairs that must produce nothing.
+
+#include "cairn/physics/narrowphase/CollideShapes.h"
+
+#include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
+#include "cairn/physics/shapes/CompoundShape.h"
+#include "cairn/physics/shapes/ConvexHullShape.h"
+#include "cairn/physics/shapes/HeightFieldShape.h"
+#include "cairn/physics/shapes/SphereShape.h"
+#include "cairn/physics/shapes/TriangleMeshShape.h"
+
+#include <array>
+#include <gtest/gtest.h>
+#include <random>
+#include <vector>
+
+namespace cairn
+{
+namespace
+{
+
+std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, const Shape& inB,
+                                     const Transform& inTB, const CollideSettings& inSettings = {})
+{
+    std::vector<ContactManifold> result;
+    const int count = CollideShapes(inA, inTA, inB, inTB, inSettings,
+                                    [&](const ContactManifold& inM) { result.push_back(inM); });
+    EXPECT_EQ(count, int(result.size()));
+    return result;
+}
+
+float MaxPenetration(const ContactManifold& inManifold)
+{
+    float best = -cLargeFloat;
+    for (int i = 0; i < inManifold.mNumPoints; ++i)
+        best = std::max(best, inManifold.mPoints[i].mPenetration);
+    return best;
+}
+
+std::shared_ptr<const ConvexHullShape> MakeHullBox(const Vec3& inHalfExtent)
+{
+    std::vector<Vec3> corners;
+    for (const float x : {-1.0f, 1.0f})
+        for (const float y : {-1.0f, 1.0f})
+            for (const float z : {-1.0f, 1.0f})
+                corners.push_back(inHalfExtent.cwiseProduct(Vec3(x, y, z)));
+    return ConvexHullShape::Create(corners).Value();
+}
+
+std::shared_ptr<const TriangleMeshShape> MakeQuad(float inSize)
+{
+    const std::vector<Vec3> vertices = {Vec3(0, 0, 0), Vec3(inSize, 0, 0), Vec3(0, 0, inSize),
+                                        Vec3(inSize, 0, inSize)};
+    const std::vector<std::array<uint32_t, 3>> triangles = {{0, 2, 1}, {1, 2, 3}};
+    return TriangleMeshShape::Create(vertices, triangles).Value();
+}
+
+TEST(CollideShapesTest, SymmetricUnderArgumentSwap)
+{
+    const std::vector<ShapeRef> shapes = {
+        SphereShape::Create(0.4f).Value(),
+        BoxShape::Create(Vec3(0.3f, 0.5f, 0.4f)).Value(),
+        CapsuleShape::Create(0.4f, 0.25f).Value(),
+        MakeHullBox(Vec3(0.35f, 0.3f, 0.45f)),
+    };
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-0.6f, 0.6f);
+    std::normal_distribution<float> g;
+    int compared = 0;
+    int mismatches = 0;
+    for (const ShapeRef& a : shapes)
+        for (const ShapeRef& b : shapes)
+            for (int i = 0; i < 300; ++i)
+            {
+                const Transform ta{Vec3(u(rng), u(rng), u(rng)),
+                                   Quat(g(rng), g(rng), g(rng), g(rng)).normalized()};
+                const Transform tb{Vec3(u(rng), u(rng), u(rng)),
+                                   Quat(g(rng), g(rng), g(rng), g(rng)).normalized()};
+                const auto ab = Collide(*a, ta, *b, tb);
+                const auto ba = Collide(*b, tb, *a, ta);
+                ASSERT_EQ(ab.size(), ba.size());
+                if (ab.empty()) continue;
+                ++compared;
+                // The answer is the same contact seen from the other side: flipped normal, same depth
+                const bool same = ab[0].mNormal.dot(-ba[0].mNormal) > 0.999f &&
+                                  std::abs(MaxPenetration(ab[0]) - MaxPenetration(ba[0])) < 1.0e-3f;
+                mismatches += same ? 0 : 1;
+            }
+    EXPECT_GT(compared, 2000);
+    // GJK/EPA and the box SAT bias may pick a different but equally deep axis in rare ties
+    EXPECT_LT(mismatches, compared / 100) << mismatches << " of " << compared;
+}
+
+TEST(CollideShapesTest, SwapFlipsPointsAndSubShapes)
+{
+    const auto quad = MakeQuad(2.0f);
+    const auto box = BoxShape::Create(Vec3(0.25f, 0.25f, 0.25f)).Value();
+    const Transform boxAt{Vec3(0.5f, 0.24f, 0.5f), Quat::Identity()}; // Over triangle 0 only
+    const auto boxFirst = Collide(*box, boxAt, *quad, {});
+    const auto meshFirst = Collide(*quad, {}, *box, boxAt);
+    ASSERT_EQ(boxFirst.size(), 1u);
+    ASSERT_EQ(meshFirst.size(), 1u);
+    EXPECT_GT(boxFirst[0].mNormal.dot(-Vec3::UnitY()), 0.9999f);
+    EXPECT_GT(meshFirst[0].mNormal.dot(Vec3::UnitY()), 0.9999f);
+    EXPECT_EQ(boxFirst[0].mSubShapeB, 0u);
+    EXPECT_EQ(meshFirst[0].mSubShapeA, 0u);
+    ASSERT_EQ(boxFirst[0].mNumPoints, meshFirst[0].mNumPoints);
+    for (int i = 0; i < boxFirst[0].mNumPoints; ++i)
+    {
+        EXPECT_NEAR(boxFirst[0].mPoints[i].mPositionOnA.y(), 0.24f - 0.25f, 1.0e-5f);
+        EXPECT_NEAR(meshFirst[0].mPoints[i].mPositionOnB.y(), 0.24f - 0.25f, 1.0e-5f);
+        EXPECT_NEAR(meshFirst[0].mPoints[i].mPenetration, 0.01f, 1.0e-4f);
+    }
+    // Over triangle 1 the id follows
+    const auto other = Collide(*box, {Vec3(1.5f, 0.24f, 1.5f), Quat::Identity()}, *quad, {});
+    ASSERT_EQ(other.size(), 1u);
+    EXPECT_EQ(other[0].mSubShapeB, 1u);
+}
+
+TEST(CollideShapesTest, HullOnBoxGivesFaceManifold)
+{
+    const auto floor = BoxShape::Create(Vec3(2, 0.5f, 2)).Value();
+    const auto hull = MakeHullBox(Vec3(0.5f, 0.5f, 0.5f));
+    const Quat yaw(Eigen::AngleAxisf(0.3f, Vec3::UnitY()));
+    const Transform t{Vec3(0.2f, 0.98f, 0.1f), yaw};
+    const auto manifolds = Collide(*floor, {}, *hull, t);
+    ASSERT_EQ(manifolds.size(), 1u);
+    const ContactManifold& m = manifolds[0];
+    EXPECT_GT(m.mNormal.dot(Vec3::UnitY()), 0.9999f);
+    ASSERT_EQ(m.mNumPoints, 4);
+    for (int i = 0; i < 4; ++i)
+    {
+        EXPECT_NEAR(m.mPoints[i].mPenetration, 0.02f, 1.0e-4f);
+        EXPECT_NEAR(m.mPoints[i].mPositionOnB.y(), 0.48f, 1.0e-4f);
+        EXPECT_NEAR(m.mPoints[i].mPenetration,
+                    (m.mPoints[i].mPositionOnA - m.mPoints[i].mPositionOnB).dot(m.mNormal), 1.0e-5f);
+    }
+}
+
+TEST(CollideShapesTest, CapsuleOnBoxLyingAndStanding)
+{
+    const auto floor = BoxShape::Create(Vec3(2, 0.5f, 2)).Value();
+    const auto capsule = CapsuleShape::Create(0.5f, 0.25f).Value();
+    const Quat lying(Eigen::AngleAxisf(0.5f * cPi, Vec3::UnitZ()));
+    const auto flat = Collide(*capsule, {Vec3(0.1f, 0.74f, 0.3f), lying}, *floor, {});
+    ASSERT_EQ(flat.size(), 1u);
+    EXPECT_GT(-flat[0].mNormal.y(), 0.9999f);
+    ASSERT_EQ(flat[0].mNumPoints, 2);
+    for (int i = 0; i < 2; ++i)
+        EXPECT_NEAR(flat[0].mPoints[i].mPenetration, 0.01f, 1.0e-4f);
+    EXPECT_NEAR(std::abs(flat[0].mPoints[0].mPositionOnA.x() - flat[0].mPoints[1].mPositionOnA.x()), 1.0f,
+                1.0e-3f);
+
+    const auto standing = Collide(*capsule, {Vec3(0.1f, 1.24f, 0.3f), Quat::Identity()}, *floor, {});
+    ASSERT_EQ(standing.size(), 1u);
+    EXPECT_EQ(standing[0].mNumPoints, 1);
+    EXPECT_NEAR(standing[0].mPoints[0].mPenetration, 0.01f, 1.0e-4f);
+}
+
+TEST(CollideShapesTest, CompoundOfTwoSpheresOnBox)
+{
+    const auto sphere = SphereShape::Create(0.5f).Value();
+    const auto compound = CompoundShape::Create({{sphere, {Vec3(-1, 0, 0), Quat::Identity()}},
+                                                 {sphere, {Vec3(1, 0, 0), Quat::Identity()}}})
+                              .Value();
+    const auto box = BoxShape::Create(Vec3(3, 1, 3)).Value();
+    const auto manifolds = Collide(*compound, {Vec3(0, 1.49f, 0), Quat::Identity()}, *box, {});
+    ASSERT_EQ(manifolds.size(), 2u);
+    bool seen[2] = {false, false};
+    for (const ContactManifold& m : manifolds)
+    {
+        ASSERT_LT(m.mSubShapeA, 2u);
+        seen[m.mSubShapeA] = true;
+        EXPECT_GT(-m.mNormal.y(), 0.9999f);
+        EXPECT_NEAR(MaxPenetration(m), 0.01f, 1.0e-5f);
+        const float expectedX = m.mSubShapeA == 0 ? -1.0f : 1.0f;
+        EXPECT_NEAR(m.mPoints[0].mPositionOnB.x(), expectedX, 1.0e-5f);
+    }
+    EXPECT_TRUE(seen[0] && seen[1]);
+    // Swapped: the compound's ids move to B
+    const auto swapped = Collide(*box, {}, *compound, {Vec3(0, 1.49f, 0), Quat::Identity()});
+    ASSERT_EQ(swapped.size(), 2u);
+    EXPECT_NE(swapped[0].mSubShapeB, swapped[1].mSubShapeB);
+    EXPECT_GT(swapped[0].mNormal.y(), 0.9999f);
+}
+
+TEST(CollideShapesTest, CompoundAgainstCompoundAndMesh)
+{
+    const auto box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+    const auto pair = CompoundShape::Create({{box, {Vec3(-2, 0, 0), Quat::Identity()}},
+                                             {box, {Vec3(2, 0, 0), Quat::Identity()}}})
+                          .Value();
+    // Second compound's child 1 sits on the first compound's child 1 only
+    const auto manifolds = Collide(*pair, {}, *pair, {Vec3(4, 0.99f, 0), Quat::Identity()});
+    ASSERT_EQ(manifolds.size(), 1u);
+    EXPECT_EQ(manifolds[0].mSubShapeA, 1u);
+    EXPECT_EQ(manifolds[0].mSubShapeB, 0u);
+    EXPECT_EQ(manifolds[0].mNumPoints, 4);
+    EXPECT_NEAR(MaxPenetration(manifolds[0]), 0.01f, 1.0e-5f);
+
+    const auto quad = MakeQuad(10.0f);
+    const auto onMesh = Collide(*pair, {Vec3(5, 0.49f, 5), Quat::Identity()}, *quad, {});
+    ASSERT_GE(onMesh.size(), 2u);
+    bool seen[2] = {false, false};
+    for (const ContactManifold& m : onMesh)
+    {
+        ASSERT_LT(m.mSubShapeA, 2u);
+        seen[m.mSubShapeA] = true;
+        EXPECT_GT(-m.mNormal.y(), 0.9999f);
+    }
+    EXPECT_TRUE(seen[0] && seen[1]);
+}
+
+TEST(CollideShapesTest, StaticPairsProduceNothing)
+{
+    const auto quad = MakeQuad(2.0f);
+    std::vector<float> heights(3 * 3, 0.0f);
+    const auto field = HeightFieldShape::Create(3, 3, 1.0f, heights).Value();
+    EXPECT_TRUE(Collide(*quad, {}, *quad, {}).empty());
+    EXPECT_TRUE(Collide(*quad, {}, *field, {}).empty());
+    EXPECT_TRUE(Collide(*field, {}, *field, {}).empty());
+}
+
+TEST(CollideShapesTest, SpeculativeThroughDispatch)
+{
+    const auto box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+    const auto hull = MakeHullBox(Vec3(0.5f, 0.5f, 0.5f));
+    CollideSettings settings;
+    settings.mMaxSeparation = 0.05f;
+    for (const ShapeRef& other : {ShapeRef(box), ShapeRef(hull)})
+    {
+        const auto near = Collide(*box, {}, *other, {Vec3(0, 1.03f, 0), Quat::Identity()}, settings);
+        ASSERT_EQ(near.size(), 1u);
+        EXPECT_NEAR(MaxPenetration(near[0]), -0.03f, 1.0e-4f);
+        EXPECT_TRUE(Collide(*box, {}, *other, {Vec3(0, 1.06f, 0), Quat::Identity()}, settings).empty());
+    }
+}
+
+} // namespace
+} // namespace cairn
