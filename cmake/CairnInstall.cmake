@@ -7,7 +7,12 @@ install(TARGETS cairn_jobs cairn_physics EXPORT CairnTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY jobs/include/ physics/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# A module's include/ may not exist yet in a checkout (git keeps no empty folders): install those that do
+foreach(module jobs physics)
+    if(EXISTS "${PROJECT_SOURCE_DIR}/${module}/include")
+        install(DIRECTORY ${module}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+    endif()
+endforeach()
 install(EXPORT CairnTargets NAMESPACE cairn:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/Cairn)
 
 configure_package_config_file(cmake/CairnConfig.cmake.in "${CMAKE_CURRENT_BINARY_DIR}/CairnConfig.cmake"
