@@ -97,16 +97,14 @@ void PhysicsStep::WakeIslandsOfWokenBodies()
     for (size_t i = 0; i < active.size(); ++i)
     {
         Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
-        if (!body.mWakeIsland)
-            continue;
+        if (!body.mWakeIsland) continue;
         body.mWakeIsland = false;
         // Walk the ring of the island it slept in. Every hop wakes a sleeping body, and the walk stops at an
         // active one (the start, or a body that woke since and whose ring link is stale), so it terminates
         for (uint32_t next = body.mSleepRingNext;;)
         {
             Body* member = mBodies.TryGetBodyAtIndex(next);
-            if (member == nullptr || !member->IsInWorld() || member->IsActive())
-                break;
+            if (member == nullptr || !member->IsInWorld() || member->IsActive()) break;
             mBodies.ActivateBody(*member);
             next = member->mSleepRingNext;
         }
@@ -118,10 +116,11 @@ void PhysicsStep::ApplyForces(std::span<const uint32_t> inBodies, float inDeltaT
     for (uint32_t index : inBodies)
     {
         Body& body = *mBodies.TryGetBodyAtIndex(index);
-        if (!body.IsDynamic())
-            continue;
-        // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new velocity
-        body.mLinearVelocity += inDeltaTime * (body.mGravityFactor * mSettings.mGravity + body.mInvMass * body.mForce);
+        if (!body.IsDynamic()) continue;
+        // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new
+        // velocity
+        body.mLinearVelocity +=
+            inDeltaTime * (body.mGravityFactor * mSettings.mGravity + body.mInvMass * body.mForce);
         body.mAngularVelocity += inDeltaTime * (body.GetInverseInertiaWorld() * body.mTorque);
         body.mLinearVelocity *= std::max(0.0f, 1.0f - body.mLinearDamping * inDeltaTime);
         body.mAngularVelocity *= std::max(0.0f, 1.0f - body.mAngularDamping * inDeltaTime);
@@ -148,29 +147,31 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
             sliceIDs.push_back(mBodies.TryGetBodyAtIndex(index)->GetID());
 
         mPairs.clear();
-        mBroadPhase.FindCollidingPairs(sliceIDs, mLayers, [&](BodyID inActive, BodyID inOther) {
-            const Body* other = mBodies.TryGetBody(inOther);
-            // Pairs with bodies of an earlier round were collided then
-            if (other == nullptr || (other->IsActive() && other->GetActiveIndex() < begin))
-                return;
-            mPairs.push_back({std::min(inActive.GetIndex(), inOther.GetIndex()),
-                              std::max(inActive.GetIndex(), inOther.GetIndex())});
-        });
+        mBroadPhase.FindCollidingPairs(
+            sliceIDs, mLayers,
+            [&](BodyID inActive, BodyID inOther)
+            {
+                const Body* other = mBodies.TryGetBody(inOther);
+                // Pairs with bodies of an earlier round were collided then
+                if (other == nullptr || (other->IsActive() && other->GetActiveIndex() < begin)) return;
+                mPairs.push_back({std::min(inActive.GetIndex(), inOther.GetIndex()),
+                                  std::max(inActive.GetIndex(), inOther.GetIndex())});
+            });
         // Canonical order: the same scene gives the same contacts whatever order the broad phase reports
-        std::sort(mPairs.begin(), mPairs.end(), [](const BodyPair& inL, const BodyPair& inR) {
-            return inL.mA < inR.mA || (inL.mA == inR.mA && inL.mB < inR.mB);
-        });
+        std::sort(mPairs.begin(), mPairs.end(),
+                  [](const BodyPair& inL, const BodyPair& inR)
+                  { return inL.mA < inR.mA || (inL.mA == inR.mA && inL.mB < inR.mB); });
         mNumBodyPairs += uint32_t(mPairs.size());
         for (const BodyPair& pair : mPairs)
-            CollidePair(*mBodies.TryGetBodyAtIndex(pair.mA), *mBodies.TryGetBodyAtIndex(pair.mB), inDeltaTime);
+            CollidePair(*mBodies.TryGetBodyAtIndex(pair.mA), *mBodies.TryGetBodyAtIndex(pair.mB),
+                        inDeltaTime);
         begin = end;
     }
 }
 
 void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime)
 {
-    if (!ioA.IsDynamic() && !ioB.IsDynamic())
-        return;
+    if (!ioA.IsDynamic() && !ioB.IsDynamic()) return;
     // Look ahead by how far the bodies can close in this step, so fast bodies get speculative contacts before
     // they tunnel
     CollideSettings settings;
@@ -178,23 +179,20 @@ void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime)
         mSettings.mSpeculativeDistance + inDeltaTime * (ioB.mLinearVelocity - ioA.mLinearVelocity).norm();
     int numManifolds = 0;
     CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
-                  [&](const ContactManifold& inManifold) {
+                  [&](const ContactManifold& inManifold)
+                  {
                       AddConstraint(ioA, ioB, inManifold, inDeltaTime);
                       ++numManifolds;
                   });
-    if (numManifolds == 0)
-        return;
+    if (numManifolds == 0) return;
     // Touching an active body wakes a sleeping one
-    if (!ioA.IsActive() && ioA.IsDynamic())
-        mBodies.ActivateBody(ioA);
-    if (!ioB.IsActive() && ioB.IsDynamic())
-        mBodies.ActivateBody(ioB);
+    if (!ioA.IsActive() && ioA.IsDynamic()) mBodies.ActivateBody(ioA);
+    if (!ioB.IsActive() && ioB.IsDynamic()) mBodies.ActivateBody(ioB);
 }
 
 void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime)
 {
-    if (inManifold.mNumPoints <= 0)
-        return;
+    if (inManifold.mNumPoints <= 0) return;
     ContactConstraint& c = mConstraints.emplace_back();
     SequentialImpulseSolver::InitConstraint(ioA, ioB, inManifold, inDeltaTime, c);
 
@@ -214,8 +212,7 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
         cached.mLocalOnA[i] = p.mLocalOnA;
         cached.mNormalImpulse[i] = 0.0f;
         cached.mDeferredBounce[i] = 0.0f;
-        if (previous == nullptr)
-            continue;
+        if (previous == nullptr) continue;
         // Warm start from the nearest point of last step's manifold, if it is the same contact
         for (int j = 0; j < previous->mNumPoints; ++j)
             if ((previous->mLocalOnA[j] - p.mLocalOnA).squaredNorm() <
@@ -259,12 +256,13 @@ void PhysicsStep::BuildIslands()
     for (ContactConstraint& c : mConstraints)
         mIslandConstraints[cursor[c.mIsland]++] = &c;
     // Solve order: a hash of the bodies and sub-shapes, the same on every run. Creation order follows body
-    // indices, which usually follow the geometry (a stack is built bottom-up); a solver sweeping in geometric order
-    // drifts in that direction, and a wall of boxes leaned over
+    // indices, which usually follow the geometry (a stack is built bottom-up); a solver sweeping in geometric
+    // order drifts in that direction, and a wall of boxes leaned over
     for (uint32_t island = 0; island < numIslands; ++island)
         std::sort(mIslandConstraints.begin() + mConstraintStart[island],
                   mIslandConstraints.begin() + mConstraintStart[island + 1],
-                  [](const ContactConstraint* inL, const ContactConstraint* inR) {
+                  [](const ContactConstraint* inL, const ContactConstraint* inR)
+                  {
                       return inL->mOrderKey < inR->mOrderKey ||
                              (inL->mOrderKey == inR->mOrderKey && inL->mCacheIndex < inR->mCacheIndex);
                   });
@@ -272,8 +270,9 @@ void PhysicsStep::BuildIslands()
 
 void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
 {
-    const std::span<ContactConstraint* const> constraints(mIslandConstraints.data() + mConstraintStart[inIsland],
-                                                           mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const std::span<ContactConstraint* const> constraints(
+        mIslandConstraints.data() + mConstraintStart[inIsland],
+        mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
     const SolverSettings& solver = mSettings.mSolver;
     SequentialImpulseSolver::WarmStart(constraints);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
@@ -296,8 +295,8 @@ void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
             cached.mNormalImpulse[i] = c->mPoints[i].mNormal.mAccumulated;
             cached.mDeferredBounce[i] = c->mPoints[i].mDeferredBounce;
         }
-        cached.mFrictionImpulse =
-            c->mPatch.mTangent[0].mAccumulated * c->mTangent[0] + c->mPatch.mTangent[1].mAccumulated * c->mTangent[1];
+        cached.mFrictionImpulse = c->mPatch.mTangent[0].mAccumulated * c->mTangent[0] +
+                                  c->mPatch.mTangent[1].mAccumulated * c->mTangent[1];
         cached.mTwistImpulse = c->mPatch.mTwistAccumulated;
     }
 }
@@ -322,7 +321,8 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
         AABB swept = body.mBounds;
         swept.Encapsulate(AABB(body.mBounds.mMin + inDeltaTime * body.mLinearVelocity,
                                body.mBounds.mMax + inDeltaTime * body.mLinearVelocity));
-        mMovedBodies.push_back({body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance), body.GetObjectLayer()});
+        mMovedBodies.push_back(
+            {body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance), body.GetObjectLayer()});
 
         const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
         const float speed = body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
@@ -337,9 +337,9 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
     {
         bool canSleep = true;
         for (uint32_t activeIndex : mIslands.GetBodies(island))
-            canSleep &= mBodies.TryGetBodyAtIndex(active[activeIndex])->mSleepTimer >= mSettings.mTimeBeforeSleep;
-        if (!canSleep)
-            continue;
+            canSleep &=
+                mBodies.TryGetBodyAtIndex(active[activeIndex])->mSleepTimer >= mSettings.mTimeBeforeSleep;
+        if (!canSleep) continue;
         // Link the island into a ring, so that waking one of its bodies from outside wakes them all
         const std::span<const uint32_t> members = mIslands.GetBodies(island);
         for (size_t i = 0; i < members.size(); ++i)

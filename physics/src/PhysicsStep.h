@@ -51,13 +51,13 @@ private:
 
     ContactCache mContactCache;
     IslandBuilder mIslands;
-    std::vector<BodyPair> mPairs;                          ///< Scratch: pairs of the slice being collided
-    std::vector<ContactConstraint> mConstraints;           ///< This step's contacts
-    std::vector<uint32_t> mConstraintStart;                ///< Per island offsets into mIslandConstraints
-    std::vector<ContactConstraint*> mIslandConstraints;    ///< Constraints grouped by island
-    std::vector<BroadPhaseBody> mMovedBodies;              ///< Scratch for the broad-phase notify
-    std::vector<uint32_t> mSleepingIslands;                ///< Scratch
-    uint32_t mNumBodyPairs = 0;                            ///< Counters of the running step
+    std::vector<BodyPair> mPairs;                       ///< Scratch: pairs of the slice being collided
+    std::vector<ContactConstraint> mConstraints;        ///< This step's contacts
+    std::vector<uint32_t> mConstraintStart;             ///< Per island offsets into mIslandConstraints
+    std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island
+    std::vector<BroadPhaseBody> mMovedBodies;           ///< Scratch for the broad-phase notify
+    std::vector<uint32_t> mSleepingIslands;             ///< Scratch
+    uint32_t mNumBodyPairs = 0;                         ///< Counters of the running step
     uint32_t mNumWarmStartedPoints = 0;
 };
 

@@ -9,12 +9,15 @@ namespace cairn
 
 namespace
 {
-std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inMaxBodies, const LayerSetup& inLayers)
+std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inMaxBodies,
+                                             const LayerSetup& inLayers)
 {
     switch (inType)
     {
-    case BroadPhaseType::BruteForce: return std::make_unique<BroadPhaseBruteForce>();
-    case BroadPhaseType::SortAndSweep: return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
+    case BroadPhaseType::BruteForce:
+        return std::make_unique<BroadPhaseBruteForce>();
+    case BroadPhaseType::SortAndSweep:
+        return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
     }
     return nullptr;
 }

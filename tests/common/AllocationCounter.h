@@ -1,7 +1,8 @@
 #pragma once
 
-// Counts heap allocations made through the global operator new, so tests can prove a hot path allocates nothing.
-// Linking cairn_test_common replaces the global operator new/delete of the test program with counting versions.
+// Counts heap allocations made through the global operator new, so tests can prove a hot path allocates
+// nothing. Linking cairn_test_common replaces the global operator new/delete of the test program with
+// counting versions.
 
 #include <atomic>
 #include <cstdint>

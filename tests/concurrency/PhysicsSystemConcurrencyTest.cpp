@@ -1,14 +1,13 @@
-// The physics step on one thread while other threads query the world, move and push bodies, and add and remove
-// them: nothing crashes, no data race (this suite runs under ThreadSanitizer), and a query never misses the static
-// floor, whatever the step is doing.
+// The physics step on one thread while other threads query the world, move and push bodies, and add and
+// remove them: nothing crashes, no data race (this suite runs under ThreadSanitizer), and a query never
+// misses the static floor, whatever the step is doing.
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
-#include <gtest/gtest.h>
-
 #include <atomic>
+#include <gtest/gtest.h>
 #include <random>
 #include <thread>
 #include <vector>
@@ -44,60 +43,67 @@ TEST(PhysicsSystemConcurrencyTest, StepWhileOtherThreadsQueryMoveAddAndRemove)
     std::atomic<int> failedCalls{0};
 
     // Ray casts and overlap queries: the floor is always there
-    std::thread querier([&] {
-        std::mt19937 random(1);
-        std::uniform_real_distribution<float> coordinate(-40.0f, 40.0f);
-        std::vector<BodyID> found;
-        QueryFilter onlyStatic;
-        onlyStatic.mObjectLayers = ObjectLayerMask(1) << Layers::cStatic;
-        while (!stop.load(std::memory_order_relaxed))
+    std::thread querier(
+        [&]
         {
-            const Vec3 origin(coordinate(random), 20.0f, coordinate(random));
-            const std::optional<RayCastResult> hit = system.GetWorldQuery().CastRayClosest({origin, Vec3(0, -40, 0)}, onlyStatic);
-            if (!hit || hit->mBody != floorID)
-                floorMisses.fetch_add(1, std::memory_order_relaxed);
-            system.GetWorldQuery().CollideSphere(Vec3(origin.x(), 0.0f, origin.z()), 0.5f, found);
-            queries.fetch_add(1, std::memory_order_relaxed);
-        }
-    });
+            std::mt19937 random(1);
+            std::uniform_real_distribution<float> coordinate(-40.0f, 40.0f);
+            std::vector<BodyID> found;
+            QueryFilter onlyStatic;
+            onlyStatic.mObjectLayers = ObjectLayerMask(1) << Layers::cStatic;
+            while (!stop.load(std::memory_order_relaxed))
+            {
+                const Vec3 origin(coordinate(random), 20.0f, coordinate(random));
+                const std::optional<RayCastResult> hit =
+                    system.GetWorldQuery().CastRayClosest({origin, Vec3(0, -40, 0)}, onlyStatic);
+                if (!hit || hit->mBody != floorID) floorMisses.fetch_add(1, std::memory_order_relaxed);
+                system.GetWorldQuery().CollideSphere(Vec3(origin.x(), 0.0f, origin.z()), 0.5f, found);
+                queries.fetch_add(1, std::memory_order_relaxed);
+            }
+        });
 
     // Moves and pushes existing boxes through the interface
-    std::thread mover([&] {
-        std::mt19937 random(2);
-        std::uniform_int_distribution<size_t> pick(0, boxes.size() - 1);
-        std::uniform_real_distribution<float> coordinate(-10.0f, 10.0f);
-        while (!stop.load(std::memory_order_relaxed))
+    std::thread mover(
+        [&]
         {
-            const BodyID id = boxes[pick(random)];
-            if (!bodies.SetPosition(id, Vec3(coordinate(random), 3.0f, coordinate(random)), Activation::Activate))
-                failedCalls.fetch_add(1, std::memory_order_relaxed);
-            if (!bodies.AddImpulse(id, Vec3(0, 100, 0)))
-                failedCalls.fetch_add(1, std::memory_order_relaxed);
-        }
-    });
+            std::mt19937 random(2);
+            std::uniform_int_distribution<size_t> pick(0, boxes.size() - 1);
+            std::uniform_real_distribution<float> coordinate(-10.0f, 10.0f);
+            while (!stop.load(std::memory_order_relaxed))
+            {
+                const BodyID id = boxes[pick(random)];
+                if (!bodies.SetPosition(id, Vec3(coordinate(random), 3.0f, coordinate(random)),
+                                        Activation::Activate))
+                    failedCalls.fetch_add(1, std::memory_order_relaxed);
+                if (!bodies.AddImpulse(id, Vec3(0, 100, 0)))
+                    failedCalls.fetch_add(1, std::memory_order_relaxed);
+            }
+        });
 
     // Streams spheres in (as a batch) and out
-    std::thread streamer([&] {
-        const ShapeRef sphere = SphereShape::Create(0.3f).Value();
-        while (!stop.load(std::memory_order_relaxed))
+    std::thread streamer(
+        [&]
         {
-            std::vector<BodyID> batch;
-            for (int i = 0; i < 8; ++i)
+            const ShapeRef sphere = SphereShape::Create(0.3f).Value();
+            while (!stop.load(std::memory_order_relaxed))
             {
-                BodyCreationSettings settings;
-                settings.mShape = sphere;
-                settings.mPosition = Vec3(float(i) - 4.0f, 6.0f, 5.0f);
-                batch.push_back(bodies.CreateBody(settings).Value());
-            }
-            Result<BodyInterface::AddBatch> prepared = bodies.AddBodiesPrepare(batch);
-            if (!prepared || !bodies.AddBodiesFinalize(prepared.Value(), Activation::Activate))
-                failedCalls.fetch_add(1, std::memory_order_relaxed);
-            std::this_thread::yield();
-            for (const BodyID& id : batch)
-                if (!bodies.RemoveBody(id) || !bodies.DestroyBody(id))
+                std::vector<BodyID> batch;
+                for (int i = 0; i < 8; ++i)
+                {
+                    BodyCreationSettings settings;
+                    settings.mShape = sphere;
+                    settings.mPosition = Vec3(float(i) - 4.0f, 6.0f, 5.0f);
+                    batch.push_back(bodies.CreateBody(settings).Value());
+                }
+                Result<BodyInterface::AddBatch> prepared = bodies.AddBodiesPrepare(batch);
+                if (!prepared || !bodies.AddBodiesFinalize(prepared.Value(), Activation::Activate))
                     failedCalls.fetch_add(1, std::memory_order_relaxed);
-        }
-    });
+                std::this_thread::yield();
+                for (const BodyID& id : batch)
+                    if (!bodies.RemoveBody(id) || !bodies.DestroyBody(id))
+                        failedCalls.fetch_add(1, std::memory_order_relaxed);
+            }
+        });
 
     for (int step = 0; step < 240; ++step)
         ASSERT_TRUE(system.Update(1.0f / 60.0f).IsOk());
@@ -124,7 +130,8 @@ TEST(PhysicsSystemConcurrencyTest, SecondConcurrentUpdateIsRefused)
     }
     std::atomic<int> refused{0};
     std::atomic<int> succeeded{0};
-    auto stepper = [&] {
+    auto stepper = [&]
+    {
         for (int i = 0; i < 100; ++i)
         {
             Status status = system.Update(1.0f / 60.0f);

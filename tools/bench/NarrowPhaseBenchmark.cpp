@@ -1,6 +1,6 @@
-// cairn-bench-narrowphase: the hot pair routines of the narrow phase, with Google Benchmark. Each benchmark prints
-// ns per call and, as counters, the share of pairs that made contact and the manifolds per call: the proof that
-// the work was done.
+// cairn-bench-narrowphase: the hot pair routines of the narrow phase, with Google Benchmark. Each benchmark
+// prints ns per call and, as counters, the share of pairs that made contact and the manifolds per call: the
+// proof that the work was done.
 
 #include "cairn/physics/narrowphase/CollideBoxBox.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
@@ -10,9 +10,8 @@
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 
-#include <benchmark/benchmark.h>
-
 #include <array>
+#include <benchmark/benchmark.h>
 #include <random>
 #include <vector>
 
@@ -29,7 +28,8 @@ struct Pair
 /// Random nearby poses: most unit shapes overlap, as in a pile.
 const std::vector<Pair>& RandomPairs()
 {
-    static const std::vector<Pair> pairs = [] {
+    static const std::vector<Pair> pairs = []
+    {
         std::mt19937 random(3);
         std::uniform_real_distribution<float> offset(-0.9f, 0.9f);
         std::normal_distribution<float> gauss;
@@ -46,8 +46,7 @@ const std::vector<Pair>& RandomPairs()
 }
 
 /// Runs inCollide over the random pairs, one pair per iteration.
-template <class F>
-void RunPairs(benchmark::State& ioState, F inCollide)
+template <class F> void RunPairs(benchmark::State& ioState, F inCollide)
 {
     const std::vector<Pair>& pairs = RandomPairs();
     size_t next = 0;
@@ -67,7 +66,8 @@ void BM_BoxBox(benchmark::State& ioState)
 {
     const auto box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     ContactManifold manifold;
-    RunPairs(ioState, [&](const Pair& inP) { return CollideBoxBox(*box, inP.mA, *box, inP.mB, {}, manifold); });
+    RunPairs(ioState,
+             [&](const Pair& inP) { return CollideBoxBox(*box, inP.mA, *box, inP.mB, {}, manifold); });
 }
 
 void BM_SphereBox(benchmark::State& ioState)
@@ -75,15 +75,16 @@ void BM_SphereBox(benchmark::State& ioState)
     const auto box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     const auto sphere = SphereShape::Create(0.5f).Value();
     ContactManifold manifold;
-    RunPairs(ioState, [&](const Pair& inP) { return CollideSphereBox(*sphere, inP.mA, *box, inP.mB, {}, manifold); });
+    RunPairs(ioState,
+             [&](const Pair& inP) { return CollideSphereBox(*sphere, inP.mA, *box, inP.mB, {}, manifold); });
 }
 
 void BM_SphereSphere(benchmark::State& ioState)
 {
     const auto sphere = SphereShape::Create(0.5f).Value();
     ContactManifold manifold;
-    RunPairs(ioState,
-             [&](const Pair& inP) { return CollideSphereSphere(*sphere, inP.mA, *sphere, inP.mB, {}, manifold); });
+    RunPairs(ioState, [&](const Pair& inP)
+             { return CollideSphereSphere(*sphere, inP.mA, *sphere, inP.mB, {}, manifold); });
 }
 
 /// A box resting on a flat 4 x 4 grid mesh (32 triangles), touching 2 to 8 of them.
@@ -107,12 +108,14 @@ void BM_BoxOnMesh(benchmark::State& ioState)
     std::uniform_real_distribution<float> place(0.5f, 3.5f);
     std::vector<Transform> poses;
     for (int i = 0; i < 1000; ++i)
-        poses.push_back({Vec3(place(random), 0.39f, place(random)), Quat(Eigen::AngleAxisf(place(random), Vec3::UnitY()))});
+        poses.push_back({Vec3(place(random), 0.39f, place(random)),
+                         Quat(Eigen::AngleAxisf(place(random), Vec3::UnitY()))});
     size_t next = 0;
     int64_t manifolds = 0;
     for (auto _ : ioState)
     {
-        manifolds += CollideShapes(*box, poses[next], *mesh, Transform::Identity(), {}, [](const ContactManifold&) {});
+        manifolds +=
+            CollideShapes(*box, poses[next], *mesh, Transform::Identity(), {}, [](const ContactManifold&) {});
         next = (next + 1) % poses.size();
     }
     ioState.counters["manifolds_per_call"] = double(manifolds) / double(ioState.iterations());

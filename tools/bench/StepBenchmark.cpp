@@ -24,14 +24,14 @@ namespace
 struct RunResult
 {
     tools::TimingSummary mStep;
-    StepStatistics mPhaseSums;     ///< Phase times summed over all steps
-    double mHeightChecksum = 0.0;  ///< Sum of final y of the dynamic bodies
-    uint64_t mContactPoints = 0;   ///< Contact points summed over all steps
+    StepStatistics mPhaseSums;    ///< Phase times summed over all steps
+    double mHeightChecksum = 0.0; ///< Sum of final y of the dynamic bodies
+    uint64_t mContactPoints = 0;  ///< Contact points summed over all steps
     int mSteps = 0;
 };
 
-BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, float inYaw, MotionType inMotion,
-                                 float inFriction)
+BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, float inYaw,
+                                 MotionType inMotion, float inFriction)
 {
     BodyCreationSettings settings;
     settings.mShape = BoxShape::Create(inHalfExtent).Value();
@@ -46,8 +46,8 @@ BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent,
 }
 
 /// Adds bodies in one batch, as a streaming loader would.
-void AddBatch(BodyInterface& ioBodies, const std::vector<BodyCreationSettings>& inSettings, Activation inActivation,
-              std::vector<BodyID>& outIDs)
+void AddBatch(BodyInterface& ioBodies, const std::vector<BodyCreationSettings>& inSettings,
+              Activation inActivation, std::vector<BodyID>& outIDs)
 {
     std::vector<BodyID> ids;
     for (const BodyCreationSettings& settings : inSettings)
@@ -67,7 +67,8 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     {
         const auto start = std::chrono::steady_clock::now();
         (void)ioSystem.Update(1.0f / 60.0f, 1);
-        stepMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        stepMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         const StepStatistics& stats = ioSystem.GetLastStepStatistics();
         result.mPhaseSums.mBroadPhaseUpdateMs += stats.mBroadPhaseUpdateMs;
         result.mPhaseSums.mNarrowPhaseMs += stats.mNarrowPhaseMs;
@@ -111,7 +112,8 @@ RunResult RunPyramid()
     PhysicsSystem system(BenchSettings(false));
     std::vector<BodyCreationSettings> boxes;
     std::vector<BodyID> floorIDs, boxIDs;
-    AddBatch(system.GetBodyInterface(), {BoxSettings(Vec3(0, -1, 0), Vec3(50, 1, 50), 0, MotionType::Static, 0.2f)},
+    AddBatch(system.GetBodyInterface(),
+             {BoxSettings(Vec3(0, -1, 0), Vec3(50, 1, 50), 0, MotionType::Static, 0.2f)},
              Activation::DontActivate, floorIDs);
     for (int i = 0; i < 15; ++i)
         for (int j = i / 2; j < 15 - (i + 1) / 2; ++j)
@@ -133,17 +135,19 @@ void Print(const char* inName, const std::vector<RunResult>& inRuns)
     {
         const RunResult& run = inRuns[i];
         std::printf("%s rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: broadphase-update %.3f  "
-                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f contacts %llu\n",
+                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
+                    "contacts %llu\n",
                     inName, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
-                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
-                    run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
-                    run.mPhaseSums.mFinishMs / run.mSteps, run.mHeightChecksum,
-                    static_cast<unsigned long long>(run.mContactPoints));
+                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
+                    run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
+                    run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
+                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints));
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);
     }
-    auto median = [](std::vector<double> inValues) {
+    auto median = [](std::vector<double> inValues)
+    {
         std::sort(inValues.begin(), inValues.end());
         return inValues[inValues.size() / 2];
     };
@@ -164,7 +168,8 @@ int main(int inArgc, char** inArgv)
             only = inArgv[++i];
         else
         {
-            std::fprintf(stderr, "usage: cairn-bench-step [--repetitions N] [--only step_pile2k|step_pyramid]\n");
+            std::fprintf(stderr,
+                         "usage: cairn-bench-step [--repetitions N] [--only step_pile2k|step_pyramid]\n");
             return 2;
         }
     }

@@ -22,10 +22,10 @@ struct TimingSummary
 inline TimingSummary Summarize(std::vector<double> inSamples)
 {
     TimingSummary summary;
-    if (inSamples.empty())
-        return summary;
+    if (inSamples.empty()) return summary;
     std::sort(inSamples.begin(), inSamples.end());
-    auto rank = [&](double inFraction) {
+    auto rank = [&](double inFraction)
+    {
         const size_t index = size_t(inFraction * double(inSamples.size() - 1) + 0.5);
         return inSamples[std::min(index, inSamples.size() - 1)];
     };

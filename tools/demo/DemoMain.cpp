@@ -1,5 +1,5 @@
-// cairn-demo: until the streaming open-world demo lands, a small physics scene (stacks knocked over by a rain of
-// spheres and a kinematic sweeper) that steps at 60 Hz and prints its frame times.
+// cairn-demo: until the streaming open-world demo lands, a small physics scene (stacks knocked over by a rain
+// of spheres and a kinematic sweeper) that steps at 60 Hz and prints its frame times.
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
@@ -25,9 +25,10 @@ struct Options
 
 void PrintHelp()
 {
-    std::printf("usage: cairn-demo [--frames N] [--collision-steps N] [--help]\n"
-                "  Steps a small scene (box stacks, falling spheres and capsules, a kinematic sweeper) at 60 Hz\n"
-                "  and prints physics frame times.\n");
+    std::printf(
+        "usage: cairn-demo [--frames N] [--collision-steps N] [--help]\n"
+        "  Steps a small scene (box stacks, falling spheres and capsules, a kinematic sweeper) at 60 Hz\n"
+        "  and prints physics frame times.\n");
 }
 
 /// Parses the flags; exits with a message on bad input.
@@ -37,7 +38,8 @@ Options ParseOptions(int inArgc, char** inArgv)
     for (int i = 1; i < inArgc; ++i)
     {
         const std::string flag = inArgv[i];
-        auto value = [&](int inMin, int inMax) {
+        auto value = [&](int inMin, int inMax)
+        {
             if (i + 1 >= inArgc)
             {
                 std::fprintf(stderr, "cairn-demo: %s needs a value\n", flag.c_str());
@@ -47,7 +49,8 @@ Options ParseOptions(int inArgc, char** inArgv)
             const long parsed = std::strtol(inArgv[++i], &end, 10);
             if (*end != '\0' || parsed < inMin || parsed > inMax)
             {
-                std::fprintf(stderr, "cairn-demo: %s must be a whole number in [%d, %d]\n", flag.c_str(), inMin, inMax);
+                std::fprintf(stderr, "cairn-demo: %s must be a whole number in [%d, %d]\n", flag.c_str(),
+                             inMin, inMax);
                 std::exit(2);
             }
             return int(parsed);
@@ -92,7 +95,8 @@ int main(int inArgc, char** inArgv)
     const ShapeRef crate = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     for (int stack = 0; stack < 16; ++stack)
         for (int level = 0; level < 8; ++level)
-            Add(bodies, crate, Vec3(-24.0f + 3.0f * float(stack), 0.5f + float(level), 4.0f * float(stack % 3)),
+            Add(bodies, crate,
+                Vec3(-24.0f + 3.0f * float(stack), 0.5f + float(level), 4.0f * float(stack % 3)),
                 MotionType::Dynamic);
     BodyCreationSettings sweeper;
     sweeper.mShape = CapsuleShape::Create(8.0f, 0.6f).Value();
@@ -115,7 +119,8 @@ int main(int inArgc, char** inArgv)
             std::fprintf(stderr, "cairn-demo: step failed: %s\n", status.GetError().mMessage.c_str());
             return 1;
         }
-        frameMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        frameMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         if ((frame + 1) % 100 == 0)
         {
             const StepStatistics& stats = system.GetLastStepStatistics();
@@ -124,8 +129,9 @@ int main(int inArgc, char** inArgv)
         }
     }
     const tools::TimingSummary summary = tools::Summarize(frameMs);
-    std::printf("\nphysics frame time over %d frames (1/60 s, %d collision step(s)): mean %.3f ms, p50 %.3f ms, "
-                "p99 %.3f ms, max %.3f ms\n",
-                options.mFrames, options.mCollisionSteps, summary.mMean, summary.mP50, summary.mP99, summary.mMax);
+    std::printf(
+        "\nphysics frame time over %d frames (1/60 s, %d collision step(s)): mean %.3f ms, p50 %.3f ms, "
+        "p99 %.3f ms, max %.3f ms\n",
+        options.mFrames, options.mCollisionSteps, summary.mMean, summary.mP50, summary.mP99, summary.mMax);
     return 0;
 }

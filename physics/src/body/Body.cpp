@@ -44,8 +44,7 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
         // needs only a diagonal in the rotated frame
         Eigen::SelfAdjointEigenSolver<Mat3> solver(mass.mInertia);
         Mat3 axes = solver.eigenvectors();
-        if (axes.determinant() < 0.0f)
-            axes.col(2) = -axes.col(2); // a reflection is not a rotation
+        if (axes.determinant() < 0.0f) axes.col(2) = -axes.col(2); // a reflection is not a rotation
         mInertiaRotation = Quat(axes).normalized();
         const Vec3 moments = solver.eigenvalues();
         for (int i = 0; i < 3; ++i)

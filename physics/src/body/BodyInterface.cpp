@@ -7,8 +7,14 @@ namespace cairn
 
 namespace
 {
-Error WrongThread() { return MakeError(ErrorCode::WrongThread, "body interface called from inside the physics step"); }
-Error StaleID() { return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id"); }
+Error WrongThread()
+{
+    return MakeError(ErrorCode::WrongThread, "body interface called from inside the physics step");
+}
+Error StaleID()
+{
+    return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
+}
 Error InvalidVector(const char* inWhat)
 {
     return MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + " is NaN, infinite or out of range");
@@ -27,37 +33,38 @@ BodyInterface::BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, co
 Result<BodyID> BodyInterface::CreateBody(const BodyCreationSettings& inSettings)
 {
     if (!mLayers.IsValid(inSettings.mObjectLayer))
-        return MakeError(ErrorCode::InvalidArgument, "object layer " + std::to_string(inSettings.mObjectLayer) +
+        return MakeError(ErrorCode::InvalidArgument, "object layer " +
+                                                         std::to_string(inSettings.mObjectLayer) +
                                                          " is not in the layer setup");
     return mBodies.CreateBody(inSettings);
 }
 
-Status BodyInterface::DestroyBody(const BodyID& inID) { return mBodies.DestroyBody(inID); }
+Status BodyInterface::DestroyBody(const BodyID& inID)
+{
+    return mBodies.DestroyBody(inID);
+}
 
 Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
 {
     BodyLockWrite lock(mBodies, inID);
-    if (lock.WasWrongThread())
-        return WrongThread();
+    if (lock.WasWrongThread()) return WrongThread();
     Body* body = lock.GetBody();
-    if (body == nullptr)
-        return StaleID();
+    if (body == nullptr) return StaleID();
     if (body->mInWorld || body->mAddPending)
         return MakeError(ErrorCode::AlreadyAdded, "body is already in the world");
     body->UpdateBounds();
     const BroadPhaseBody entry = ToBroadPhase(*body);
     mBroadPhase.AddBodiesFinalize(mBroadPhase.AddBodiesPrepare({&entry, 1}));
     body->mInWorld = true;
-    if (inActivation == Activation::Activate)
-        mBodies.ActivateBody(*body);
+    if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     return Status::Ok();
 }
 
-Result<BodyID> BodyInterface::CreateAndAddBody(const BodyCreationSettings& inSettings, Activation inActivation)
+Result<BodyID> BodyInterface::CreateAndAddBody(const BodyCreationSettings& inSettings,
+                                               Activation inActivation)
 {
     Result<BodyID> id = CreateBody(inSettings);
-    if (!id)
-        return id;
+    if (!id) return id;
     if (Status added = AddBody(id.Value(), inActivation); !added)
     {
         (void)mBodies.DestroyBody(id.Value());
@@ -71,13 +78,10 @@ Status BodyInterface::RemoveBody(const BodyID& inID)
     AABB bounds;
     {
         BodyLockWrite lock(mBodies, inID);
-        if (lock.WasWrongThread())
-            return WrongThread();
+        if (lock.WasWrongThread()) return WrongThread();
         Body* body = lock.GetBody();
-        if (body == nullptr)
-            return StaleID();
-        if (!body->mInWorld)
-            return MakeError(ErrorCode::NotAdded, "body is not in the world");
+        if (body == nullptr) return StaleID();
+        if (!body->mInWorld) return MakeError(ErrorCode::NotAdded, "body is not in the world");
         mBroadPhase.RemoveBodies({&inID, 1});
         mBodies.DeactivateBody(*body);
         body->mInWorld = false;
@@ -104,16 +108,15 @@ void BodyInterface::WakeBodiesIn(const AABB& inBounds)
 
 Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const BodyID> inIDs)
 {
-    if (BodyManager::IsInsideStep())
-        return WrongThread();
+    if (BodyManager::IsInsideStep()) return WrongThread();
     AddBatch batch;
     batch.mBodies.reserve(inIDs.size());
-    auto undo = [&] {
+    auto undo = [&]
+    {
         for (const BroadPhaseBody& entry : batch.mBodies)
         {
             BodyLockWrite lock(mBodies, entry.mID);
-            if (Body* body = lock.GetBody(); body != nullptr)
-                body->mAddPending = false;
+            if (Body* body = lock.GetBody(); body != nullptr) body->mAddPending = false;
         }
     };
     for (const BodyID& id : inIDs)
@@ -141,8 +144,7 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
 
 Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation)
 {
-    if (BodyManager::IsInsideStep())
-        return WrongThread();
+    if (BodyManager::IsInsideStep()) return WrongThread();
     if (ioBatch.mState == nullptr)
         return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
     mBroadPhase.AddBodiesFinalize(ioBatch.mState);
@@ -155,8 +157,7 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
         assert(body != nullptr && body->mAddPending);
         body->mAddPending = false;
         body->mInWorld = true;
-        if (inActivation == Activation::Activate)
-            mBodies.ActivateBody(*body);
+        if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     }
     ioBatch.mBodies.clear();
     return Status::Ok();
@@ -164,40 +165,32 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
 
 void BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
 {
-    if (ioBatch.mState != nullptr)
-        mBroadPhase.AddBodiesAbort(ioBatch.mState);
+    if (ioBatch.mState != nullptr) mBroadPhase.AddBodiesAbort(ioBatch.mState);
     ioBatch.mState = nullptr;
     for (const BroadPhaseBody& entry : ioBatch.mBodies)
     {
         BodyLockWrite lock(mBodies, entry.mID);
-        if (Body* body = lock.GetBody(); body != nullptr)
-            body->mAddPending = false;
+        if (Body* body = lock.GetBody(); body != nullptr) body->mAddPending = false;
     }
     ioBatch.mBodies.clear();
 }
 
-template <class F>
-Status BodyInterface::ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange)
+template <class F> Status BodyInterface::ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange)
 {
     BodyLockWrite lock(mBodies, inID);
-    if (lock.WasWrongThread())
-        return WrongThread();
+    if (lock.WasWrongThread()) return WrongThread();
     Body* body = lock.GetBody();
-    if (body == nullptr)
-        return StaleID();
+    if (body == nullptr) return StaleID();
     if (inMustBeDynamic && body->IsStatic())
         return MakeError(ErrorCode::InvalidArgument, "a static body has no velocity");
     return inChange(*body);
 }
 
-template <class T, class F>
-Result<T> BodyInterface::ReadBody(const BodyID& inID, F&& inRead) const
+template <class T, class F> Result<T> BodyInterface::ReadBody(const BodyID& inID, F&& inRead) const
 {
     BodyLockRead lock(mBodies, inID);
-    if (lock.WasWrongThread())
-        return WrongThread();
-    if (lock.GetBody() == nullptr)
-        return StaleID();
+    if (lock.WasWrongThread()) return WrongThread();
+    if (lock.GetBody() == nullptr) return StaleID();
     return inRead(*lock.GetBody());
 }
 
@@ -208,86 +201,91 @@ void BodyInterface::OnBodyMoved(Body& ioBody, Activation inActivation)
     {
         const BroadPhaseBody entry = ToBroadPhase(ioBody);
         mBroadPhase.NotifyBodiesAABBChanged({&entry, 1});
-        if (inActivation == Activation::Activate)
-            mBodies.ActivateBody(ioBody);
+        if (inActivation == Activation::Activate) mBodies.ActivateBody(ioBody);
     }
 }
 
 Status BodyInterface::SetPosition(const BodyID& inID, const Vec3& inPosition, Activation inActivation)
 {
-    if (!IsValidWorldPosition(inPosition))
-        return InvalidVector("position");
-    return ModifyBody(inID, false, [&](Body& ioBody) {
-        ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
-        OnBodyMoved(ioBody, inActivation);
-        return Status::Ok();
-    });
+    if (!IsValidWorldPosition(inPosition)) return InvalidVector("position");
+    return ModifyBody(inID, false,
+                      [&](Body& ioBody)
+                      {
+                          ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+                          OnBodyMoved(ioBody, inActivation);
+                          return Status::Ok();
+                      });
 }
 
 Status BodyInterface::SetRotation(const BodyID& inID, const Quat& inRotation, Activation inActivation)
 {
     if (!IsValidRotation(inRotation))
         return MakeError(ErrorCode::InvalidArgument, "rotation is not a finite unit quaternion");
-    return ModifyBody(inID, false, [&](Body& ioBody) {
-        const Vec3 origin = ioBody.GetPosition();
-        ioBody.mRotation = inRotation.normalized();
-        ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
-        OnBodyMoved(ioBody, inActivation);
-        return Status::Ok();
-    });
+    return ModifyBody(inID, false,
+                      [&](Body& ioBody)
+                      {
+                          const Vec3 origin = ioBody.GetPosition();
+                          ioBody.mRotation = inRotation.normalized();
+                          ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+                          OnBodyMoved(ioBody, inActivation);
+                          return Status::Ok();
+                      });
 }
 
-Status BodyInterface::SetPositionAndRotation(const BodyID& inID, const Vec3& inPosition, const Quat& inRotation,
-                                             Activation inActivation)
+Status BodyInterface::SetPositionAndRotation(const BodyID& inID, const Vec3& inPosition,
+                                             const Quat& inRotation, Activation inActivation)
 {
-    if (!IsValidWorldPosition(inPosition))
-        return InvalidVector("position");
+    if (!IsValidWorldPosition(inPosition)) return InvalidVector("position");
     if (!IsValidRotation(inRotation))
         return MakeError(ErrorCode::InvalidArgument, "rotation is not a finite unit quaternion");
-    return ModifyBody(inID, false, [&](Body& ioBody) {
-        ioBody.mRotation = inRotation.normalized();
-        ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
-        OnBodyMoved(ioBody, inActivation);
-        return Status::Ok();
-    });
+    return ModifyBody(inID, false,
+                      [&](Body& ioBody)
+                      {
+                          ioBody.mRotation = inRotation.normalized();
+                          ioBody.mPosition = inPosition + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+                          OnBodyMoved(ioBody, inActivation);
+                          return Status::Ok();
+                      });
 }
 
 Status BodyInterface::SetLinearVelocity(const BodyID& inID, const Vec3& inVelocity)
 {
-    if (!IsFinite(inVelocity))
-        return InvalidVector("linear velocity");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        ioBody.mLinearVelocity = inVelocity;
-        if (inVelocity.squaredNorm() > 0.0f)
-            mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    if (!IsFinite(inVelocity)) return InvalidVector("linear velocity");
+    return ModifyBody(inID, true,
+                      [&](Body& ioBody)
+                      {
+                          ioBody.mLinearVelocity = inVelocity;
+                          if (inVelocity.squaredNorm() > 0.0f) mBodies.ActivateBody(ioBody);
+                          return Status::Ok();
+                      });
 }
 
 Status BodyInterface::SetAngularVelocity(const BodyID& inID, const Vec3& inVelocity)
 {
-    if (!IsFinite(inVelocity))
-        return InvalidVector("angular velocity");
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        ioBody.mAngularVelocity = inVelocity;
-        if (inVelocity.squaredNorm() > 0.0f)
-            mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    if (!IsFinite(inVelocity)) return InvalidVector("angular velocity");
+    return ModifyBody(inID, true,
+                      [&](Body& ioBody)
+                      {
+                          ioBody.mAngularVelocity = inVelocity;
+                          if (inVelocity.squaredNorm() > 0.0f) mBodies.ActivateBody(ioBody);
+                          return Status::Ok();
+                      });
 }
 
 template <class F>
 Status BodyInterface::PushBody(const BodyID& inID, const Vec3& inAmount, const char* inWhat, F&& inApply)
 {
-    if (!IsFinite(inAmount))
-        return InvalidVector(inWhat);
-    return ModifyBody(inID, true, [&](Body& ioBody) {
-        if (!ioBody.IsDynamic())
-            return Status(MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + " acts on dynamic bodies only"));
-        inApply(ioBody);
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    if (!IsFinite(inAmount)) return InvalidVector(inWhat);
+    return ModifyBody(inID, true,
+                      [&](Body& ioBody)
+                      {
+                          if (!ioBody.IsDynamic())
+                              return Status(MakeError(ErrorCode::InvalidArgument,
+                                                      std::string(inWhat) + " acts on dynamic bodies only"));
+                          inApply(ioBody);
+                          mBodies.ActivateBody(ioBody);
+                          return Status::Ok();
+                      });
 }
 
 Status BodyInterface::AddForce(const BodyID& inID, const Vec3& inForce)
@@ -308,36 +306,44 @@ Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse)
 
 Status BodyInterface::AddImpulse(const BodyID& inID, const Vec3& inImpulse, const Vec3& inWorldPoint)
 {
-    if (!IsValidWorldPosition(inWorldPoint))
-        return InvalidVector("impulse point");
-    return PushBody(inID, inImpulse, "impulse", [&](Body& ioBody) {
-        ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
-        ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * (inWorldPoint - ioBody.mPosition).cross(inImpulse);
-    });
+    if (!IsValidWorldPosition(inWorldPoint)) return InvalidVector("impulse point");
+    return PushBody(inID, inImpulse, "impulse",
+                    [&](Body& ioBody)
+                    {
+                        ioBody.mLinearVelocity += ioBody.mInvMass * inImpulse;
+                        ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() *
+                                                   (inWorldPoint - ioBody.mPosition).cross(inImpulse);
+                    });
 }
 
 Status BodyInterface::AddAngularImpulse(const BodyID& inID, const Vec3& inImpulse)
 {
     return PushBody(inID, inImpulse, "angular impulse",
-                    [&](Body& ioBody) { ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * inImpulse; });
+                    [&](Body& ioBody)
+                    { ioBody.mAngularVelocity += ioBody.GetInverseInertiaWorld() * inImpulse; });
 }
 
 Status BodyInterface::ActivateBody(const BodyID& inID)
 {
-    return ModifyBody(inID, false, [&](Body& ioBody) {
-        if (!ioBody.mInWorld)
-            return Status(MakeError(ErrorCode::NotAdded, "only bodies in the world can be activated"));
-        mBodies.ActivateBody(ioBody);
-        return Status::Ok();
-    });
+    return ModifyBody(
+        inID, false,
+        [&](Body& ioBody)
+        {
+            if (!ioBody.mInWorld)
+                return Status(MakeError(ErrorCode::NotAdded, "only bodies in the world can be activated"));
+            mBodies.ActivateBody(ioBody);
+            return Status::Ok();
+        });
 }
 
 Status BodyInterface::DeactivateBody(const BodyID& inID)
 {
-    return ModifyBody(inID, false, [&](Body& ioBody) {
-        mBodies.DeactivateBody(ioBody);
-        return Status::Ok();
-    });
+    return ModifyBody(inID, false,
+                      [&](Body& ioBody)
+                      {
+                          mBodies.DeactivateBody(ioBody);
+                          return Status::Ok();
+                      });
 }
 
 Result<Vec3> BodyInterface::GetPosition(const BodyID& inID) const

@@ -13,9 +13,9 @@ thread_local bool tInsideStep = false;
 
 Status ValidateSettings(const BodyCreationSettings& inSettings)
 {
-    auto invalid = [](std::string inWhat) { return Status(MakeError(ErrorCode::InvalidArgument, std::move(inWhat))); };
-    if (inSettings.mShape == nullptr)
-        return invalid("body has no shape");
+    auto invalid = [](std::string inWhat)
+    { return Status(MakeError(ErrorCode::InvalidArgument, std::move(inWhat))); };
+    if (inSettings.mShape == nullptr) return invalid("body has no shape");
     if (!IsValidWorldPosition(inSettings.mPosition))
         return invalid("body position is NaN, infinite or beyond 1e6 m");
     if (!IsValidRotation(inSettings.mRotation))
@@ -29,8 +29,7 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (!(inSettings.mLinearDamping >= 0.0f) || !(inSettings.mAngularDamping >= 0.0f) ||
         !std::isfinite(inSettings.mLinearDamping) || !std::isfinite(inSettings.mAngularDamping))
         return invalid("damping must be finite and >= 0");
-    if (!std::isfinite(inSettings.mGravityFactor))
-        return invalid("gravity factor must be finite");
+    if (!std::isfinite(inSettings.mGravityFactor)) return invalid("gravity factor must be finite");
     if (!(inSettings.mMaxLinearVelocity > 0.0f) || !(inSettings.mMaxAngularVelocity > 0.0f))
         return invalid("velocity limits must be > 0");
     if (!inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation}).IsFinite())
@@ -70,8 +69,7 @@ uint32_t BodyManager::GetNumBodies() const
 
 Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 {
-    if (Status status = ValidateSettings(inSettings); !status)
-        return status.GetError();
+    if (Status status = ValidateSettings(inSettings); !status) return status.GetError();
     if (IsInsideStep())
         return MakeError(ErrorCode::WrongThread, "CreateBody called from inside the physics step");
 
@@ -103,8 +101,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
     {
         std::unique_lock lock(GetMutexForBody(inID.GetIndex()));
         Body* body = TryGetBody(inID);
-        if (body == nullptr)
-            return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
+        if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
         if (body->mInWorld)
             return MakeError(ErrorCode::AlreadyAdded, "remove the body from the world before destroying it");
         body->mShape.reset();
@@ -120,8 +117,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
 
 Body* BodyManager::TryGetBody(const BodyID& inID) const
 {
-    if (inID.GetIndex() >= mMaxBodies || !mSlotInUse[inID.GetIndex()])
-        return nullptr;
+    if (inID.GetIndex() >= mMaxBodies || !mSlotInUse[inID.GetIndex()]) return nullptr;
     Body& body = mBodies[inID.GetIndex()];
     return body.mID == inID ? &body : nullptr;
 }
@@ -133,16 +129,15 @@ Body* BodyManager::TryGetBodyAtIndex(uint32_t inIndex) const
 
 void BodyManager::ActivateBody(Body& ioBody)
 {
-    if (ioBody.IsActive() || ioBody.IsStatic() || !ioBody.mInWorld)
-        return;
+    if (ioBody.IsActive() || ioBody.IsStatic() || !ioBody.mInWorld) return;
     ioBody.mSleepTimer = 0.0f;
     // The step already owns every body mutex, and with it the list
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
     if (!IsInsideStep())
     {
         lock.lock();
-        // Woken from outside: the bodies it slept with may rest on it; the next step wakes them (it holds every
-        // lock, so it can walk the island's ring safely)
+        // Woken from outside: the bodies it slept with may rest on it; the next step wakes them (it holds
+        // every lock, so it can walk the island's ring safely)
         ioBody.mWakeIsland = true;
     }
     ioBody.SetActiveIndex(uint32_t(mActiveBodies.size()));
@@ -151,11 +146,9 @@ void BodyManager::ActivateBody(Body& ioBody)
 
 void BodyManager::DeactivateBody(Body& ioBody)
 {
-    if (!ioBody.IsActive())
-        return;
+    if (!ioBody.IsActive()) return;
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
-    if (!IsInsideStep())
-        lock.lock();
+    if (!IsInsideStep()) lock.lock();
     // Swap-remove: the last body takes this body's place in the list
     const uint32_t slot = ioBody.GetActiveIndex();
     const uint32_t last = mActiveBodies.back();
@@ -183,6 +176,9 @@ void BodyManager::UnlockAllBodies() const
         m.mMutex.unlock();
 }
 
-bool BodyManager::IsInsideStep() { return tInsideStep; }
+bool BodyManager::IsInsideStep()
+{
+    return tInsideStep;
+}
 
 } // namespace cairn

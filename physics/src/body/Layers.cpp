@@ -52,8 +52,7 @@ ObjectLayerMask LayerSetup::GetObjectLayersIn(BroadPhaseLayer inLayer) const
 {
     ObjectLayerMask mask = 0;
     for (uint32_t layer = 0; layer < mNumObjectLayers; ++layer)
-        if (mBroadPhaseLayer[layer] == inLayer)
-            mask |= ObjectLayerMask(1) << layer;
+        if (mBroadPhaseLayer[layer] == inLayer) mask |= ObjectLayerMask(1) << layer;
     return mask;
 }
 

@@ -27,11 +27,9 @@ void IslandBuilder::Link(uint32_t inA, uint32_t inB)
 {
     uint32_t a = Find(inA);
     uint32_t b = Find(inB);
-    if (a == b)
-        return;
+    if (a == b) return;
     // The lower index becomes the root, as the lock-free builder will do
-    if (a > b)
-        std::swap(a, b);
+    if (a > b) std::swap(a, b);
     mParent[b] = a;
 }
 

@@ -18,14 +18,21 @@ struct Candidate
     float mEntry;
 };
 
-// Per-thread scratch so queries allocate nothing once warm; a query never re-enters another on the same thread
+// Per-thread scratch so queries allocate nothing once warm; a query never re-enters another on the same
+// thread
 thread_local std::vector<Candidate> tCandidates;
 thread_local std::vector<BodyID> tBodies;
 
-BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter) { return {inFilter.mObjectLayers}; }
+BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter)
+{
+    return {inFilter.mObjectLayers};
+}
 
 /// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
-Vec3 QueryHalfExtent(const AABB& inBox) { return inBox.HalfExtent().cwiseMax(Vec3::Constant(1.0e-5f)); }
+Vec3 QueryHalfExtent(const AABB& inBox)
+{
+    return inBox.HalfExtent().cwiseMax(Vec3::Constant(1.0e-5f));
+}
 } // namespace
 
 WorldQuery::WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase)
@@ -37,8 +44,7 @@ bool WorldQuery::ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& out
 {
     BodyLockRead lock(mBodies, inID);
     const Body* body = lock.GetBody();
-    if (body == nullptr || !body->IsInWorld())
-        return false;
+    if (body == nullptr || !body->IsInWorld()) return false;
     outShape = body->GetShape();
     outTransform = body->GetTransform();
     return true;
@@ -48,35 +54,33 @@ void WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool
                          std::vector<RayCastResult>& outHits, bool inClosestOnly) const
 {
     outHits.clear();
-    if (!IsValidWorldPosition(inRay.mOrigin) || !IsFinite(inRay.mDirection))
-        return;
+    if (!IsValidWorldPosition(inRay.mOrigin) || !IsFinite(inRay.mDirection)) return;
     std::vector<Candidate>& candidates = tCandidates;
     candidates.clear();
-    mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter), [&](BodyID inBody, float inFraction) {
-        if (inBody != inFilter.mIgnoreBody)
-            candidates.push_back({inBody, inFraction});
-        return 1.0f;
-    });
+    mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter),
+                        [&](BodyID inBody, float inFraction)
+                        {
+                            if (inBody != inFilter.mIgnoreBody) candidates.push_back({inBody, inFraction});
+                            return 1.0f;
+                        });
     // Nearest boxes first, so the closest search can stop once boxes start beyond the best hit
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& inA, const Candidate& inB) {
-        return inA.mEntry < inB.mEntry || (inA.mEntry == inB.mEntry && inA.mBody < inB.mBody);
-    });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const Candidate& inA, const Candidate& inB)
+              { return inA.mEntry < inB.mEntry || (inA.mEntry == inB.mEntry && inA.mBody < inB.mBody); });
     float best = 1.0f;
     for (const Candidate& candidate : candidates)
     {
-        if (inClosestOnly && candidate.mEntry > best)
-            break;
+        if (inClosestOnly && candidate.mEntry > best) break;
         ShapeRef shape;
         Transform transform;
-        if (!ReadBody(candidate.mBody, shape, transform))
-            continue;
-        const RayCast local{transform.InverseTransformPoint(inRay.mOrigin), transform.InverseRotateVector(inRay.mDirection)};
+        if (!ReadBody(candidate.mBody, shape, transform)) continue;
+        const RayCast local{transform.InverseTransformPoint(inRay.mOrigin),
+                            transform.InverseRotateVector(inRay.mDirection)};
         RayHit hit;
         hit.mFraction = inClosestOnly ? std::nextafter(best, 2.0f) : 1.0f + 1.0e-6f;
-        if (!shape->CastRay(local, hit))
-            continue;
-        const RayCastResult result{candidate.mBody, std::min(hit.mFraction, 1.0f), transform.RotateVector(hit.mNormal),
-                                   hit.mSubShape};
+        if (!shape->CastRay(local, hit)) continue;
+        const RayCastResult result{candidate.mBody, std::min(hit.mFraction, 1.0f),
+                                   transform.RotateVector(hit.mNormal), hit.mSubShape};
         if (inClosestOnly)
         {
             outHits.assign(1, result);
@@ -84,20 +88,21 @@ void WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool
         }
         else
             outHits.push_back(result);
-        if (inAny)
-            return;
+        if (inAny) return;
     }
-    std::sort(outHits.begin(), outHits.end(), [](const RayCastResult& inA, const RayCastResult& inB) {
-        return inA.mFraction < inB.mFraction || (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
-    });
+    std::sort(outHits.begin(), outHits.end(),
+              [](const RayCastResult& inA, const RayCastResult& inB) {
+                  return inA.mFraction < inB.mFraction ||
+                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
+              });
 }
 
-std::optional<RayCastResult> WorldQuery::CastRayClosest(const RayCast& inRay, const QueryFilter& inFilter) const
+std::optional<RayCastResult> WorldQuery::CastRayClosest(const RayCast& inRay,
+                                                        const QueryFilter& inFilter) const
 {
     thread_local std::vector<RayCastResult> hits;
     CastRay(inRay, inFilter, false, hits, true);
-    if (hits.empty())
-        return std::nullopt;
+    if (hits.empty()) return std::nullopt;
     return hits.front();
 }
 
@@ -108,13 +113,15 @@ bool WorldQuery::CastRayAny(const RayCast& inRay, const QueryFilter& inFilter) c
     return !hits.empty();
 }
 
-void WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits, const QueryFilter& inFilter) const
+void WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
+                            const QueryFilter& inFilter) const
 {
     CastRay(inRay, inFilter, false, outHits, false);
 }
 
-void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform, std::vector<ShapeQueryHit>& outHits,
-                              const QueryFilter& inFilter, float inMaxSeparation) const
+void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform,
+                              std::vector<ShapeQueryHit>& outHits, const QueryFilter& inFilter,
+                              float inMaxSeparation) const
 {
     outHits.clear();
     if (!IsValidWorldPosition(inTransform.mPosition) || !IsValidRotation(inTransform.mRotation) ||
@@ -123,10 +130,11 @@ void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
     const AABB bounds = inShape.GetWorldBounds(inTransform).Expanded(std::max(inMaxSeparation, 0.0f));
-    mBroadPhase.CollideAABox(bounds, ToBroadPhase(inFilter), [&](BodyID inBody) {
-        if (inBody != inFilter.mIgnoreBody)
-            bodies.push_back(inBody);
-    });
+    mBroadPhase.CollideAABox(bounds, ToBroadPhase(inFilter),
+                             [&](BodyID inBody)
+                             {
+                                 if (inBody != inFilter.mIgnoreBody) bodies.push_back(inBody);
+                             });
     std::sort(bodies.begin(), bodies.end());
     CollideSettings settings;
     settings.mMaxSeparation = std::max(inMaxSeparation, 0.0f);
@@ -134,29 +142,29 @@ void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform
     {
         ShapeRef shape;
         Transform transform;
-        if (!ReadBody(id, shape, transform))
-            continue;
+        if (!ReadBody(id, shape, transform)) continue;
         // Keep only the deepest manifold per body: callers ask "which bodies, and how"
         ShapeQueryHit hit{id, {}};
         float deepest = -cLargeFloat;
-        CollideShapes(inShape, inTransform, *shape, transform, settings, [&](const ContactManifold& inManifold) {
-            for (int i = 0; i < inManifold.mNumPoints; ++i)
-                if (inManifold.mPoints[i].mPenetration > deepest)
-                {
-                    deepest = inManifold.mPoints[i].mPenetration;
-                    hit.mManifold = inManifold;
-                }
-        });
-        if (deepest >= -settings.mMaxSeparation)
-            outHits.push_back(hit);
+        CollideShapes(inShape, inTransform, *shape, transform, settings,
+                      [&](const ContactManifold& inManifold)
+                      {
+                          for (int i = 0; i < inManifold.mNumPoints; ++i)
+                              if (inManifold.mPoints[i].mPenetration > deepest)
+                              {
+                                  deepest = inManifold.mPoints[i].mPenetration;
+                                  hit.mManifold = inManifold;
+                              }
+                      });
+        if (deepest >= -settings.mMaxSeparation) outHits.push_back(hit);
     }
 }
 
-void WorldQuery::CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies, const QueryFilter& inFilter) const
+void WorldQuery::CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies,
+                              const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!inBox.IsFinite() || inBox.IsEmpty())
-        return;
+    if (!inBox.IsFinite() || inBox.IsEmpty()) return;
     const BoxShape box(QueryHalfExtent(inBox));
     thread_local std::vector<ShapeQueryHit> hits;
     CollideShape(box, {inBox.Center(), Quat::Identity()}, hits, inFilter);
@@ -168,8 +176,7 @@ void WorldQuery::CollideSphere(const Vec3& inCenter, float inRadius, std::vector
                                const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!IsValidWorldPosition(inCenter) || !std::isfinite(inRadius) || inRadius <= 0.0f)
-        return;
+    if (!IsValidWorldPosition(inCenter) || !std::isfinite(inRadius) || inRadius <= 0.0f) return;
     const SphereShape sphere(inRadius);
     thread_local std::vector<ShapeQueryHit> hits;
     CollideShape(sphere, {inCenter, Quat::Identity()}, hits, inFilter);
@@ -177,24 +184,24 @@ void WorldQuery::CollideSphere(const Vec3& inCenter, float inRadius, std::vector
         outBodies.push_back(hit.mBody);
 }
 
-void WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies, const QueryFilter& inFilter) const
+void WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies,
+                              const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!IsValidWorldPosition(inPoint))
-        return;
+    if (!IsValidWorldPosition(inPoint)) return;
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
-    mBroadPhase.CollidePoint(inPoint, {inFilter.mObjectLayers}, [&](BodyID inBody) {
-        if (inBody != inFilter.mIgnoreBody)
-            bodies.push_back(inBody);
-    });
+    mBroadPhase.CollidePoint(inPoint, {inFilter.mObjectLayers},
+                             [&](BodyID inBody)
+                             {
+                                 if (inBody != inFilter.mIgnoreBody) bodies.push_back(inBody);
+                             });
     std::sort(bodies.begin(), bodies.end());
     for (const BodyID& id : bodies)
     {
         ShapeRef shape;
         Transform transform;
-        if (!ReadBody(id, shape, transform))
-            continue;
+        if (!ReadBody(id, shape, transform)) continue;
         // A zero-length ray hits a solid shape exactly when it starts inside
         RayHit hit;
         hit.mFraction = 1.0f;

@@ -13,8 +13,9 @@ void ContactCache::BeginStep()
 
 const CachedManifold* ContactCache::FindPrevious(const ContactKey& inKey) const
 {
-    auto it = std::lower_bound(mPrevious.begin(), mPrevious.end(), inKey,
-                               [](const CachedManifold& inM, const ContactKey& inK) { return inM.mKey < inK; });
+    auto it =
+        std::lower_bound(mPrevious.begin(), mPrevious.end(), inKey,
+                         [](const CachedManifold& inM, const ContactKey& inK) { return inM.mKey < inK; });
     return it != mPrevious.end() && it->mKey == inKey ? &*it : nullptr;
 }
 

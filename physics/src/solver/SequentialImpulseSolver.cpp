@@ -21,8 +21,8 @@ namespace
 /// A speculative point further apart than this at the start of the step does not bounce in this step.
 constexpr float cTouchingTolerance = 1.0e-3f;
 
-void InitAxis(const Vec3& inAxis, const Vec3& inRA, const Vec3& inRB, const Mat3& inInvIA, const Mat3& inInvIB,
-              float inInvMassA, float inInvMassB, AxisImpulse& outAxis)
+void InitAxis(const Vec3& inAxis, const Vec3& inRA, const Vec3& inRB, const Mat3& inInvIA,
+              const Mat3& inInvIB, float inInvMassA, float inInvMassB, AxisImpulse& outAxis)
 {
     outAxis.mRAxAxis = inRA.cross(inAxis);
     outAxis.mRBxAxis = inRB.cross(inAxis);
@@ -69,10 +69,8 @@ float RelativeTwist(const ContactConstraint& inC)
 
 void ApplyTwist(const ContactConstraint& inC, float inLambda)
 {
-    if (inC.mBodyA->IsDynamic())
-        SolverAccess::W(*inC.mBodyA) -= inLambda * inC.mInvIA_Normal;
-    if (inC.mBodyB->IsDynamic())
-        SolverAccess::W(*inC.mBodyB) += inLambda * inC.mInvIB_Normal;
+    if (inC.mBodyA->IsDynamic()) SolverAccess::W(*inC.mBodyA) -= inLambda * inC.mInvIA_Normal;
+    if (inC.mBodyB->IsDynamic()) SolverAccess::W(*inC.mBodyB) += inLambda * inC.mInvIB_Normal;
 }
 
 float TotalNormalImpulse(const ContactConstraint& inC)
@@ -89,8 +87,9 @@ void SolvePatchFriction(ContactConstraint& ioC)
     const float maxFriction = ioC.mFriction * TotalNormalImpulse(ioC);
     float total[2];
     for (int t = 0; t < 2; ++t)
-        total[t] = patch.mTangent[t].mAccumulated -
-                   patch.mTangent[t].mEffectiveMass * RelativeVelocity(ioC, ioC.mTangent[t], patch.mTangent[t]);
+        total[t] =
+            patch.mTangent[t].mAccumulated -
+            patch.mTangent[t].mEffectiveMass * RelativeVelocity(ioC, ioC.mTangent[t], patch.mTangent[t]);
     // Clamp to the friction circle rather than a box, so sliding friction is mu * N in every direction
     const float lengthSq = total[0] * total[0] + total[1] * total[1];
     if (lengthSq > maxFriction * maxFriction)
@@ -108,8 +107,8 @@ void SolvePatchFriction(ContactConstraint& ioC)
 
     // Twist: the torsional friction of a contact patch of mean radius r is at most mu * N * r
     const float maxTwist = maxFriction * patch.mTwistRadius;
-    const float twist = std::clamp(patch.mTwistAccumulated - patch.mTwistEffectiveMass * RelativeTwist(ioC), -maxTwist,
-                                   maxTwist);
+    const float twist = std::clamp(patch.mTwistAccumulated - patch.mTwistEffectiveMass * RelativeTwist(ioC),
+                                   -maxTwist, maxTwist);
     ApplyTwist(ioC, twist - patch.mTwistAccumulated);
     patch.mTwistAccumulated = twist;
 }
@@ -117,7 +116,8 @@ void SolvePatchFriction(ContactConstraint& ioC)
 void SolveNormal(ContactConstraint& ioC, ContactConstraintPoint& ioP)
 {
     const float vn = RelativeVelocity(ioC, ioC.mNormal, ioP.mNormal);
-    const float total = std::max(ioP.mNormal.mAccumulated + ioP.mNormal.mEffectiveMass * (ioP.mVelocityBias - vn), 0.0f);
+    const float total =
+        std::max(ioP.mNormal.mAccumulated + ioP.mNormal.mEffectiveMass * (ioP.mVelocityBias - vn), 0.0f);
     const float applied = total - ioP.mNormal.mAccumulated;
     ioP.mNormal.mAccumulated = total;
     ioP.mMaxNormalImpulse = std::max(ioP.mMaxNormalImpulse, total);
@@ -166,8 +166,8 @@ void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Contact
 
     PatchFriction& patch = c.mPatch;
     for (int t = 0; t < 2; ++t)
-        InitAxis(c.mTangent[t], centroid - xA, centroid - xB, invIA, invIB, ioA.GetInverseMass(), ioB.GetInverseMass(),
-                 patch.mTangent[t]);
+        InitAxis(c.mTangent[t], centroid - xA, centroid - xB, invIA, invIB, ioA.GetInverseMass(),
+                 ioB.GetInverseMass(), patch.mTangent[t]);
     c.mInvIA_Normal = invIA * c.mNormal;
     c.mInvIB_Normal = invIB * c.mNormal;
     const float twistK = c.mNormal.dot(c.mInvIA_Normal + c.mInvIB_Normal);
@@ -176,7 +176,8 @@ void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Contact
     patch.mTwistRadius = 0.0f;
     for (int i = 0; i < c.mNumPoints; ++i)
     {
-        const Vec3 offset = 0.5f * (inManifold.mPoints[i].mPositionOnA + inManifold.mPoints[i].mPositionOnB) - centroid;
+        const Vec3 offset =
+            0.5f * (inManifold.mPoints[i].mPositionOnA + inManifold.mPoints[i].mPositionOnB) - centroid;
         patch.mTwistRadius += (offset - offset.dot(c.mNormal) * c.mNormal).norm();
     }
     patch.mTwistRadius /= float(std::max(c.mNumPoints, 1));
@@ -213,16 +214,16 @@ void SequentialImpulseSolver::ApplyRestitution(std::span<ContactConstraint* cons
 {
     for (ContactConstraint* c : ioConstraints)
     {
-        if (c->mRestitution == 0.0f)
-            continue;
+        if (c->mRestitution == 0.0f) continue;
         for (int i = 0; i < c->mNumPoints; ++i)
         {
             ContactConstraintPoint& p = c->mPoints[i];
             // Only points that touched (received an impulse) and hit hard enough bounce
             if (p.mApproachVelocity > -inSettings.mRestitutionThreshold || p.mMaxNormalImpulse == 0.0f)
                 continue;
-            // A speculative point that only closed its gap this step bounces next step, from where it touches:
-            // bouncing now would launch it from the far side of the gap, too high (up to a step's travel)
+            // A speculative point that only closed its gap this step bounces next step, from where it
+            // touches: bouncing now would launch it from the far side of the gap, too high (up to a step's
+            // travel)
             if (p.mSeparation > cTouchingTolerance)
             {
                 p.mDeferredBounce = p.mApproachVelocity;
@@ -256,10 +257,10 @@ float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const
             const Vec3 rB = SolverAccess::Q(b) * p.mLocalOnB;
             const float separation = c->mNormal.dot((SolverAccess::X(b) + rB) - (SolverAccess::X(a) + rA));
             maxPenetration = std::max(maxPenetration, -separation - inSettings.mPenetrationSlop);
-            const float correction = std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
-                                                -inSettings.mMaxPenetrationCorrection, 0.0f);
-            if (correction == 0.0f)
-                continue;
+            const float correction =
+                std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
+                           -inSettings.mMaxPenetrationCorrection, 0.0f);
+            if (correction == 0.0f) continue;
             AxisImpulse axis;
             InitAxis(c->mNormal, rA, rB, invIA, invIB, a.GetInverseMass(), b.GetInverseMass(), axis);
             const float impulse = -correction * axis.mEffectiveMass;

@@ -2,7 +2,6 @@
 // falls under gravity. Prints the height after one second so the test can check the library really ran.
 #include <cairn/physics/PhysicsSystem.h>
 #include <cairn/physics/shapes/SphereShape.h>
-
 #include <cstdio>
 
 int main()
@@ -11,7 +10,8 @@ int main()
     cairn::BodyCreationSettings settings;
     settings.mShape = cairn::SphereShape::Create(1.0f).Value();
     settings.mPosition = cairn::Vec3(0, 10, 0);
-    const cairn::BodyID id = system.GetBodyInterface().CreateAndAddBody(settings, cairn::Activation::Activate).Value();
+    const cairn::BodyID id =
+        system.GetBodyInterface().CreateAndAddBody(settings, cairn::Activation::Activate).Value();
     for (int i = 0; i < 60; ++i)
         (void)system.Update(1.0f / 60.0f);
     std::printf("height after 1 s: %.2f\n", system.GetBodyInterface().GetPosition(id).Value().y());

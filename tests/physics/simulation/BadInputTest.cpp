@@ -1,5 +1,4 @@
 #include "SimulationFixture.h"
-
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
@@ -90,7 +89,8 @@ TEST_F(BadInputTest, DegenerateShapesAreRejected)
     // A shape without volume cannot be dynamic
     const Vec3 vertices[] = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};
     const std::array<uint32_t, 3> triangles[] = {{0, 1, 2}};
-    BodyCreationSettings meshBody = DynamicSettings(TriangleMeshShape::Create(vertices, triangles).Value(), Vec3::Zero());
+    BodyCreationSettings meshBody =
+        DynamicSettings(TriangleMeshShape::Create(vertices, triangles).Value(), Vec3::Zero());
     EXPECT_FALSE(Bodies().CreateBody(meshBody).IsOk());
     BodyCreationSettings noShape = DynamicSettings(nullptr, Vec3::Zero());
     EXPECT_FALSE(Bodies().CreateBody(noShape).IsOk());
@@ -104,7 +104,8 @@ TEST_F(BadInputTest, AddingTwiceAndRemovingTwiceAreRejected)
     ASSERT_TRUE(Bodies().AddBody(extra, Activation::Activate).IsOk());
     ASSERT_TRUE(Bodies().RemoveBody(extra).IsOk());
     EXPECT_EQ(Bodies().RemoveBody(extra).GetError().mCode, ErrorCode::NotAdded);
-    EXPECT_EQ(Bodies().DestroyBody(mBox).GetError().mCode, ErrorCode::AlreadyAdded) << "destroying a body in the world";
+    EXPECT_EQ(Bodies().DestroyBody(mBox).GetError().mCode, ErrorCode::AlreadyAdded)
+        << "destroying a body in the world";
     ASSERT_TRUE(Bodies().DestroyBody(extra).IsOk());
     EXPECT_EQ(Bodies().DestroyBody(extra).GetError().mCode, ErrorCode::InvalidBodyID);
     ExpectWorldUnchanged();

@@ -67,10 +67,8 @@ TEST_F(RestitutionTest, SphereBouncesToRestitutionSquaredHeight)
         Step(1);
         const float vy = Velocity(sphere).y();
         bounced |= vy > 0.0f;
-        if (bounced)
-            apex = std::max(apex, Position(sphere).y() - radius);
-        if (bounced && vy < 0.0f)
-            break;
+        if (bounced) apex = std::max(apex, Position(sphere).y() - radius);
+        if (bounced && vy < 0.0f) break;
     }
     ASSERT_TRUE(bounced);
     EXPECT_NEAR(apex, 0.64f, 0.05f * 0.64f);

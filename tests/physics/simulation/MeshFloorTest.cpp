@@ -1,5 +1,4 @@
 #include "SimulationFixture.h"
-
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 

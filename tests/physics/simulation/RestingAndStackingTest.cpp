@@ -29,7 +29,8 @@ TEST_F(StackTest, ColumnOfTenBoxesStandsForTenSeconds)
     std::vector<BodyID> boxes;
     for (int i = 0; i < 10; ++i)
     {
-        BodyCreationSettings settings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f + 1.0f * i, 0));
+        BodyCreationSettings settings =
+            DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f + 1.0f * i, 0));
         settings.mFriction = 0.5f;
         boxes.push_back(AddDynamic(settings));
     }

@@ -17,7 +17,10 @@ protected:
     static constexpr float cDeltaTime = 1.0f / 60.0f;
 
     /// Recreates the world with non-default settings.
-    void ResetWorld(const PhysicsSettings& inSettings) { mSystem = std::make_unique<PhysicsSystem>(inSettings); }
+    void ResetWorld(const PhysicsSettings& inSettings)
+    {
+        mSystem = std::make_unique<PhysicsSystem>(inSettings);
+    }
 
     PhysicsSystem& System() { return *mSystem; }
     BodyInterface& Bodies() { return mSystem->GetBodyInterface(); }
@@ -25,8 +28,9 @@ protected:
     static ShapeRef Box(const Vec3& inHalfExtent) { return BoxShape::Create(inHalfExtent).Value(); }
     static ShapeRef Sphere(float inRadius) { return SphereShape::Create(inRadius).Value(); }
 
-    BodyID AddStatic(const ShapeRef& inShape, const Vec3& inPosition, const Quat& inRotation = Quat::Identity(),
-                     float inFriction = 0.5f, float inRestitution = 0.0f)
+    BodyID AddStatic(const ShapeRef& inShape, const Vec3& inPosition,
+                     const Quat& inRotation = Quat::Identity(), float inFriction = 0.5f,
+                     float inRestitution = 0.0f)
     {
         BodyCreationSettings settings;
         settings.mShape = inShape;
@@ -40,7 +44,10 @@ protected:
     }
 
     /// The default floor: a static box whose top face is y = 0.
-    BodyID AddFloor(float inFriction = 0.5f) { return AddStatic(Box(Vec3(50, 1, 50)), Vec3(0, -1, 0), Quat::Identity(), inFriction); }
+    BodyID AddFloor(float inFriction = 0.5f)
+    {
+        return AddStatic(Box(Vec3(50, 1, 50)), Vec3(0, -1, 0), Quat::Identity(), inFriction);
+    }
 
     static BodyCreationSettings DynamicSettings(const ShapeRef& inShape, const Vec3& inPosition)
     {

@@ -1,11 +1,13 @@
 #include "SimulationFixture.h"
-
 #include "common/AllocationCounter.h"
 
 namespace cairn::test
 {
 
-TEST(BodyLayout, BodyFitsIn256Bytes) { EXPECT_LE(sizeof(Body), 256u); }
+TEST(BodyLayout, BodyFitsIn256Bytes)
+{
+    EXPECT_LE(sizeof(Body), 256u);
+}
 
 using StepPropertiesTest = SimulationFixture;
 
@@ -14,7 +16,8 @@ TEST_F(StepPropertiesTest, WarmSceneStepsWithoutHeapAllocation)
     AddFloor();
     for (int i = 0; i < 5; ++i)
         for (int j = 0; j < 5; ++j)
-            AddDynamic(DynamicSettings(Box(Vec3(0.4f, 0.4f, 0.4f)), Vec3(float(i), 0.5f + 1.2f * float(j), 0.3f * float(i))));
+            AddDynamic(DynamicSettings(Box(Vec3(0.4f, 0.4f, 0.4f)),
+                                       Vec3(float(i), 0.5f + 1.2f * float(j), 0.3f * float(i))));
     Step(120); // warm: contact arrays reach their size
     AllocationScope scope;
     Step(60);
@@ -40,7 +43,8 @@ TEST_F(StepPropertiesTest, BatchAddMakesBodiesSimulated)
 
 TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
 {
-    auto run = [](std::vector<Vec3>& outPositions) {
+    auto run = [](std::vector<Vec3>& outPositions)
+    {
         PhysicsSystem system;
         BodyInterface& bodies = system.GetBodyInterface();
         BodyCreationSettings floor;

@@ -47,7 +47,8 @@ TEST_F(WorldQueryTest, AllHitsAreSortedAndFiltered)
 
     QueryFilter ignoreSphere;
     ignoreSphere.mIgnoreBody = mSphere;
-    const std::optional<RayCastResult> hit = Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -20, 0)}, ignoreSphere);
+    const std::optional<RayCastResult> hit =
+        Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -20, 0)}, ignoreSphere);
     ASSERT_TRUE(hit.has_value());
     EXPECT_EQ(hit->mBody, mFloor);
 }
@@ -56,7 +57,8 @@ TEST_F(WorldQueryTest, AnyRayAndMisses)
 {
     EXPECT_TRUE(Query().CastRayAny({Vec3(0, 10, 0), Vec3(0, -20, 0)}));
     EXPECT_FALSE(Query().CastRayAny({Vec3(0, 10, 0), Vec3(0, 5, 0)}));
-    EXPECT_FALSE(Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -5, 0)}).has_value()) << "segment ends above the sphere";
+    EXPECT_FALSE(Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -5, 0)}).has_value())
+        << "segment ends above the sphere";
 }
 
 TEST_F(WorldQueryTest, OverlapQueriesUseExactShapes)
@@ -84,11 +86,13 @@ TEST_F(WorldQueryTest, QueriesFromOtherThreadsWhileStepping)
     AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(-5, 3, 0)));
     std::atomic<bool> stop{false};
     std::atomic<int> misses{0};
-    std::thread querier([&] {
-        while (!stop.load(std::memory_order_relaxed))
-            if (!Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -20, 0)}).has_value())
-                misses.fetch_add(1, std::memory_order_relaxed);
-    });
+    std::thread querier(
+        [&]
+        {
+            while (!stop.load(std::memory_order_relaxed))
+                if (!Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -20, 0)}).has_value())
+                    misses.fetch_add(1, std::memory_order_relaxed);
+        });
     Step(60);
     stop.store(true, std::memory_order_relaxed);
     querier.join();

@@ -18,13 +18,13 @@ enum class BroadPhaseType : uint8_t
 
 struct PhysicsSettings
 {
-    uint32_t mMaxBodies = 65536;                    ///< Fixed capacity of the body array
-    Vec3 mGravity = Vec3(0.0f, -9.81f, 0.0f);       ///< m/s^2
-    SolverSettings mSolver;                         ///< Iterations, slop, restitution threshold
-    float mSpeculativeDistance = 0.02f;             ///< m: contacts start this far before touching
+    uint32_t mMaxBodies = 65536;              ///< Fixed capacity of the body array
+    Vec3 mGravity = Vec3(0.0f, -9.81f, 0.0f); ///< m/s^2
+    SolverSettings mSolver;                   ///< Iterations, slop, restitution threshold
+    float mSpeculativeDistance = 0.02f;       ///< m: contacts start this far before touching
     bool mAllowSleeping = true;
-    float mTimeBeforeSleep = 0.5f;                  ///< s an island must stay slow before it sleeps
-    float mSleepVelocity = 0.05f;                   ///< m/s: the fastest point of a body must stay below this
+    float mTimeBeforeSleep = 0.5f; ///< s an island must stay slow before it sleeps
+    float mSleepVelocity = 0.05f;  ///< m/s: the fastest point of a body must stay below this
     BroadPhaseType mBroadPhase = BroadPhaseType::SortAndSweep;
 };
 
@@ -32,18 +32,18 @@ struct PhysicsSettings
 struct StepStatistics
 {
     uint32_t mNumActiveBodies = 0;
-    uint32_t mNumBodyPairs = 0;        ///< Broad-phase pairs
+    uint32_t mNumBodyPairs = 0; ///< Broad-phase pairs
     uint32_t mNumManifolds = 0;
     uint32_t mNumContactPoints = 0;
     uint32_t mNumWarmStartedPoints = 0; ///< Contact points that took over last step's impulses
     uint32_t mNumIslands = 0;
-    uint32_t mLargestIsland = 0;       ///< Bodies
+    uint32_t mLargestIsland = 0; ///< Bodies
     double mBroadPhaseUpdateMs = 0.0;
     double mFindPairsMs = 0.0;
     double mNarrowPhaseMs = 0.0;
     double mIslandsMs = 0.0;
-    double mSolveMs = 0.0;             ///< Velocity and position iterations plus integration
-    double mFinishMs = 0.0;            ///< Bounds update, broad-phase notify and sleeping
+    double mSolveMs = 0.0;  ///< Velocity and position iterations plus integration
+    double mFinishMs = 0.0; ///< Bounds update, broad-phase notify and sleeping
     double mTotalMs = 0.0;
 };
 

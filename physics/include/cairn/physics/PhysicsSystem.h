@@ -26,7 +26,8 @@ class PhysicsStep;
 class PhysicsSystem
 {
 public:
-    explicit PhysicsSystem(const PhysicsSettings& inSettings = {}, const LayerSetup& inLayers = LayerSetup::CreateDefault());
+    explicit PhysicsSystem(const PhysicsSettings& inSettings = {},
+                           const LayerSetup& inLayers = LayerSetup::CreateDefault());
     ~PhysicsSystem();
     PhysicsSystem(const PhysicsSystem&) = delete;
     PhysicsSystem& operator=(const PhysicsSystem&) = delete;

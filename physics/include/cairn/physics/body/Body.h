@@ -1,8 +1,8 @@
 #pragma once
 
-// Body: one rigid body. Bodies live in the BodyManager's fixed array and are read and written only under their
-// body mutex (BodyLockRead / BodyLockWrite), or by the physics step, which holds every body mutex for write
-// while it runs. Nothing in a Body is atomic: the lock is the synchronisation.
+// Body: one rigid body. Bodies live in the BodyManager's fixed array and are read and written only under
+// their body mutex (BodyLockRead / BodyLockWrite), or by the physics step, which holds every body mutex for
+// write while it runs. Nothing in a Body is atomic: the lock is the synchronisation.
 
 #include "cairn/physics/body/BodyCreationSettings.h"
 #include "cairn/physics/body/BodyID.h"
@@ -69,24 +69,25 @@ private:
     /// Sets mass properties and everything else from the settings (validated by the caller).
     void Init(const BodyID& inID, const BodyCreationSettings& inSettings);
     void UpdateBounds() { mBounds = mShape->GetWorldBounds(GetTransform()); }
-    // Relaxed: the index is only changed under the active-list mutex (or by the step, which holds everything);
-    // a reader under the body lock needs only active vs inactive, which no concurrent swap of another body changes
+    // Relaxed: the index is only changed under the active-list mutex (or by the step, which holds
+    // everything); a reader under the body lock needs only active vs inactive, which no concurrent swap of
+    // another body changes
     uint32_t GetActiveIndex() const { return mActiveIndex.load(std::memory_order_relaxed); }
     void SetActiveIndex(uint32_t inIndex) { mActiveIndex.store(inIndex, std::memory_order_relaxed); }
 
     // Hot data first: what the solver and integrator touch every step
-    Vec3 mPosition;                 ///< Centre of mass, world
-    Quat mRotation;                 ///< World rotation
-    Vec3 mLinearVelocity;           ///< m/s
-    Vec3 mAngularVelocity;          ///< rad/s, world
-    Vec3 mForce;                    ///< Accumulated until the next step, N
-    Vec3 mTorque;                   ///< Accumulated until the next step, N m
-    Quat mInertiaRotation;          ///< Rotates the principal axes of inertia into body space
-    Vec3 mInvInertiaDiagonal;       ///< Inverse principal moments (0 for static/kinematic)
-    float mInvMass;                 ///< 0 for static/kinematic
-    Vec3 mCenterOfMassOffset;       ///< Centre of mass in shape-local space
-    AABB mBounds;                   ///< World bounds as last pushed to the broad phase
-    ShapeRef mShape;                ///< Immutable, shared
+    Vec3 mPosition;           ///< Centre of mass, world
+    Quat mRotation;           ///< World rotation
+    Vec3 mLinearVelocity;     ///< m/s
+    Vec3 mAngularVelocity;    ///< rad/s, world
+    Vec3 mForce;              ///< Accumulated until the next step, N
+    Vec3 mTorque;             ///< Accumulated until the next step, N m
+    Quat mInertiaRotation;    ///< Rotates the principal axes of inertia into body space
+    Vec3 mInvInertiaDiagonal; ///< Inverse principal moments (0 for static/kinematic)
+    float mInvMass;           ///< 0 for static/kinematic
+    Vec3 mCenterOfMassOffset; ///< Centre of mass in shape-local space
+    AABB mBounds;             ///< World bounds as last pushed to the broad phase
+    ShapeRef mShape;          ///< Immutable, shared
     float mFriction;
     float mRestitution;
     float mLinearDamping;
@@ -94,18 +95,19 @@ private:
     float mGravityFactor;
     float mMaxLinearVelocity;
     float mMaxAngularVelocity;
-    float mSleepTimer = 0.0f;       ///< Seconds this body has been slow enough to sleep
-    std::atomic<uint32_t> mActiveIndex = cInactive; ///< Index in the active list, or cInactive; see GetActiveIndex
+    float mSleepTimer = 0.0f; ///< Seconds this body has been slow enough to sleep
+    std::atomic<uint32_t> mActiveIndex =
+        cInactive; ///< Index in the active list, or cInactive; see GetActiveIndex
     BodyID mID;
     uint64_t mUserData;
-    uint32_t mSleepRingNext;        ///< Next body (index) of the island this body fell asleep with: a ring
+    uint32_t mSleepRingNext; ///< Next body (index) of the island this body fell asleep with: a ring
     MotionType mMotionType;
     ObjectLayer mObjectLayer;
     uint8_t mNavMeshArea;
     bool mAllowSleeping;
-    bool mInWorld = false;          ///< Added to the broad phase and simulated
-    bool mAddPending = false;       ///< In a prepared add batch that is not finalized yet
-    bool mWakeIsland = false;       ///< Woken from outside the step: the step wakes its sleeping island too
+    bool mInWorld = false;    ///< Added to the broad phase and simulated
+    bool mAddPending = false; ///< In a prepared add batch that is not finalized yet
+    bool mWakeIsland = false; ///< Woken from outside the step: the step wakes its sleeping island too
 };
 
 } // namespace cairn

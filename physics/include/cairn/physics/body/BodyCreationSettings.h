@@ -11,24 +11,24 @@ namespace cairn
 
 struct BodyCreationSettings
 {
-    ShapeRef mShape;                           ///< Required
-    Vec3 mPosition = Vec3::Zero();             ///< World position of the shape's origin
-    Quat mRotation = Quat::Identity();         ///< World rotation (unit)
-    Vec3 mLinearVelocity = Vec3::Zero();       ///< Of the centre of mass, m/s
-    Vec3 mAngularVelocity = Vec3::Zero();      ///< rad/s, world space
+    ShapeRef mShape;                      ///< Required
+    Vec3 mPosition = Vec3::Zero();        ///< World position of the shape's origin
+    Quat mRotation = Quat::Identity();    ///< World rotation (unit)
+    Vec3 mLinearVelocity = Vec3::Zero();  ///< Of the centre of mass, m/s
+    Vec3 mAngularVelocity = Vec3::Zero(); ///< rad/s, world space
     MotionType mMotionType = MotionType::Dynamic;
     ObjectLayer mObjectLayer = Layers::cMoving;
-    float mDensity = 1000.0f;                  ///< kg/m^3, used for the mass of dynamic bodies
-    float mFriction = 0.2f;                    ///< Coulomb coefficient, >= 0 (combined as sqrt(a * b))
-    float mRestitution = 0.0f;                 ///< In [0, 1] (combined as max(a, b))
-    float mLinearDamping = 0.05f;              ///< 1/s: dv/dt = -c v
-    float mAngularDamping = 0.05f;             ///< 1/s
-    float mGravityFactor = 1.0f;               ///< Scales the world's gravity for this body
-    float mMaxLinearVelocity = 500.0f;         ///< m/s, clamped each step
+    float mDensity = 1000.0f;          ///< kg/m^3, used for the mass of dynamic bodies
+    float mFriction = 0.2f;            ///< Coulomb coefficient, >= 0 (combined as sqrt(a * b))
+    float mRestitution = 0.0f;         ///< In [0, 1] (combined as max(a, b))
+    float mLinearDamping = 0.05f;      ///< 1/s: dv/dt = -c v
+    float mAngularDamping = 0.05f;     ///< 1/s
+    float mGravityFactor = 1.0f;       ///< Scales the world's gravity for this body
+    float mMaxLinearVelocity = 500.0f; ///< m/s, clamped each step
     float mMaxAngularVelocity = 0.25f * 3.14159265f * 60.0f; ///< rad/s: a quarter turn per 1/60 s step
     bool mAllowSleeping = true;
-    uint8_t mNavMeshArea = 0;                  ///< Navmesh area type (0 = default walkable); the navmesh reads it
-    uint64_t mUserData = 0;                    ///< Free for the game
+    uint8_t mNavMeshArea = 0; ///< Navmesh area type (0 = default walkable); the navmesh reads it
+    uint64_t mUserData = 0;   ///< Free for the game
 };
 
 } // namespace cairn

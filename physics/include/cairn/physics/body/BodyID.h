@@ -32,8 +32,7 @@ private:
 
 } // namespace cairn
 
-template <>
-struct std::hash<cairn::BodyID>
+template <> struct std::hash<cairn::BodyID>
 {
     size_t operator()(const cairn::BodyID& inID) const noexcept
     {

@@ -1,9 +1,9 @@
 #pragma once
 
-// BodyInterface: the locking API to create, add, remove, move and push bodies, callable from any thread outside
-// the physics step. Every call validates its input and returns an error without changing anything when the
-// input is bad (stale id, NaN, body in the wrong state). Calls made from inside the step (a step callback)
-// return ErrorCode::WrongThread instead of deadlocking.
+// BodyInterface: the locking API to create, add, remove, move and push bodies, callable from any thread
+// outside the physics step. Every call validates its input and returns an error without changing anything
+// when the input is bad (stale id, NaN, body in the wrong state). Calls made from inside the step (a step
+// callback) return ErrorCode::WrongThread instead of deadlocking.
 //
 // Locks: each call takes at most one body mutex at a time (BodyLockWrite), then the broad phase's own lock
 // (lock order body mutex < broad phase). Waking the neighbours of a removed body happens after its lock is
@@ -74,13 +74,11 @@ public:
 
 private:
     /// Runs inChange on the body under its write lock after the common checks; inChange returns the status.
-    template <class F>
-    Status ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange);
+    template <class F> Status ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange);
     /// Validates inAmount (named inWhat in errors), then runs inApply on a dynamic body and activates it.
     template <class F>
     Status PushBody(const BodyID& inID, const Vec3& inAmount, const char* inWhat, F&& inApply);
-    template <class T, class F>
-    Result<T> ReadBody(const BodyID& inID, F&& inRead) const;
+    template <class T, class F> Result<T> ReadBody(const BodyID& inID, F&& inRead) const;
     /// Pushes the body's new bounds to the broad phase and, for dynamic/kinematic bodies, activates them.
     void OnBodyMoved(Body& ioBody, Activation inActivation);
     /// Activates every sleeping dynamic body whose bounds overlap inBounds (after a removal).

@@ -13,8 +13,7 @@
 namespace cairn
 {
 
-template <bool Write>
-class BodyLock
+template <bool Write> class BodyLock
 {
 public:
     BodyLock(const BodyManager& inManager, const BodyID& inID)
@@ -24,8 +23,7 @@ public:
             mWrongThread = true;
             return;
         }
-        if (inID.IsInvalid() || inID.GetIndex() >= inManager.GetMaxBodies())
-            return;
+        if (inID.IsInvalid() || inID.GetIndex() >= inManager.GetMaxBodies()) return;
         mMutex = &inManager.GetMutexForBody(inID.GetIndex());
         if constexpr (Write)
             mMutex->lock();
@@ -40,8 +38,7 @@ public:
     /// Unlocks early; GetBody() is null afterwards.
     void Release()
     {
-        if (mMutex == nullptr)
-            return;
+        if (mMutex == nullptr) return;
         if constexpr (Write)
             mMutex->unlock();
         else

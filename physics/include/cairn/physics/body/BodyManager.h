@@ -1,11 +1,12 @@
 #pragma once
 
-// BodyManager: owns every Body in a fixed array (so a Body never moves in memory), hands out BodyIDs, and owns
-// the 32 sharded read-write mutexes that guard them (body index i is guarded by mutex i % 32).
+// BodyManager: owns every Body in a fixed array (so a Body never moves in memory), hands out BodyIDs, and
+// owns the 32 sharded read-write mutexes that guard them (body index i is guarded by mutex i % 32).
 //
 // Threads and locks:
 //  - A body's fields: its shard mutex (shared to read, exclusive to write). The physics step holds all 32
-//    exclusively while it runs (LockAllBodies), so code inside the step reads and writes bodies without locks.
+//    exclusively while it runs (LockAllBodies), so code inside the step reads and writes bodies without
+//    locks.
 //  - Free list and body count: mFreeListMutex. Lock order: body mutex < mFreeListMutex < mActiveListMutex.
 //  - Active list: mActiveListMutex, taken by threads that (de)activate a body while holding its body mutex;
 //    the step holds every body mutex, so it may read and change the list without taking mActiveListMutex.
@@ -41,12 +42,16 @@ public:
     Status DestroyBody(const BodyID& inID);
 
     /// The mutex guarding body index inIndex.
-    std::shared_mutex& GetMutexForBody(uint32_t inIndex) const { return mBodyMutexes[inIndex % cNumBodyMutexes].mMutex; }
+    std::shared_mutex& GetMutexForBody(uint32_t inIndex) const
+    {
+        return mBodyMutexes[inIndex % cNumBodyMutexes].mMutex;
+    }
 
-    /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the body's
-    /// mutex (or be the physics step).
+    /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the
+    /// body's mutex (or be the physics step).
     Body* TryGetBody(const BodyID& inID) const;
-    /// The body in slot inIndex whatever its sequence, or nullptr when the slot is free. Same locking as TryGetBody.
+    /// The body in slot inIndex whatever its sequence, or nullptr when the slot is free. Same locking as
+    /// TryGetBody.
     Body* TryGetBodyAtIndex(uint32_t inIndex) const;
 
     /// Puts a dynamic or kinematic body in the world into the active list. Caller holds the body's mutex
@@ -76,16 +81,16 @@ private:
     std::vector<uint32_t>& GetActiveBodiesForStep() { return mActiveBodies; }
 
     uint32_t mMaxBodies;
-    std::unique_ptr<Body[]> mBodies;                       ///< Guarded per body by its shard mutex
-    std::unique_ptr<bool[]> mSlotInUse;                    ///< Guarded per slot by its shard mutex
+    std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
+    std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
 
     mutable std::mutex mFreeListMutex;
-    std::vector<uint32_t> mFreeList;                       ///< Guarded by mFreeListMutex
-    uint32_t mNumBodies = 0;                               ///< Guarded by mFreeListMutex
+    std::vector<uint32_t> mFreeList; ///< Guarded by mFreeListMutex
+    uint32_t mNumBodies = 0;         ///< Guarded by mFreeListMutex
 
     std::mutex mActiveListMutex;
-    std::vector<uint32_t> mActiveBodies;                   ///< Guarded by mActiveListMutex (or all body mutexes)
+    std::vector<uint32_t> mActiveBodies; ///< Guarded by mActiveListMutex (or all body mutexes)
 };
 
 } // namespace cairn

@@ -23,8 +23,9 @@ inline constexpr ObjectLayerMask cAllObjectLayers = ~ObjectLayerMask(0);
 /// The layers of the default setup (LayerSetup::CreateDefault).
 namespace Layers
 {
-inline constexpr ObjectLayer cStatic = 0;  ///< World geometry: never moves; collides with moving and debris
-inline constexpr ObjectLayer cMoving = 1;  ///< Dynamic and kinematic bodies: collide with everything but triggers
+inline constexpr ObjectLayer cStatic = 0; ///< World geometry: never moves; collides with moving and debris
+inline constexpr ObjectLayer cMoving =
+    1; ///< Dynamic and kinematic bodies: collide with everything but triggers
 inline constexpr ObjectLayer cDebris = 2;  ///< Small dynamic bodies: collide with static only
 inline constexpr ObjectLayer cTrigger = 3; ///< Sensors: found by queries, never collide
 } // namespace Layers
@@ -38,8 +39,8 @@ inline constexpr BroadPhaseLayer cMoving = 1;
 class LayerSetup
 {
 public:
-    /// inNumObjectLayers <= cMaxObjectLayers, inNumBroadPhaseLayers <= cMaxBroadPhaseLayers; all object layers
-    /// start in broad-phase layer 0 and collide with nothing.
+    /// inNumObjectLayers <= cMaxObjectLayers, inNumBroadPhaseLayers <= cMaxBroadPhaseLayers; all object
+    /// layers start in broad-phase layer 0 and collide with nothing.
     LayerSetup(uint32_t inNumObjectLayers, uint32_t inNumBroadPhaseLayers);
 
     /// Static, Moving, Debris and Trigger object layers over Static and Moving broad-phase layers.

@@ -1,9 +1,9 @@
 #pragma once
 
 // IslandBuilder: groups active dynamic bodies connected by contacts into simulation islands, with a plain
-// sequential union-find (union by lower index, path halving). Static and kinematic bodies never join an island:
-// the caller only links pairs of dynamic bodies. Physics step only (one thread): no locks.
-// Bodies are named by their dense index in the active list.
+// sequential union-find (union by lower index, path halving). Static and kinematic bodies never join an
+// island: the caller only links pairs of dynamic bodies. Physics step only (one thread): no locks. Bodies are
+// named by their dense index in the active list.
 
 #include <cstdint>
 #include <span>

@@ -11,7 +11,7 @@ namespace cairn
 
 struct AABB
 {
-    Vec3 mMin = Vec3::Constant(cLargeFloat);   ///< Empty by default: min > max
+    Vec3 mMin = Vec3::Constant(cLargeFloat); ///< Empty by default: min > max
     Vec3 mMax = Vec3::Constant(-cLargeFloat);
 
     AABB() = default;
@@ -56,8 +56,7 @@ struct AABB
     /// Bounds of this box after a rigid transform (exact bounds of the rotated box).
     AABB Transformed(const Transform& inTransform) const
     {
-        if (IsEmpty())
-            return *this;
+        if (IsEmpty()) return *this;
         const Mat3 r = inTransform.mRotation.toRotationMatrix();
         const Vec3 c = inTransform * Center();
         const Vec3 e = r.cwiseAbs() * HalfExtent();
@@ -76,10 +75,8 @@ struct AABB
             float t1 = (mMin[axis] - inOrigin[axis]) * inInvDirection[axis];
             float t2 = (mMax[axis] - inOrigin[axis]) * inInvDirection[axis];
             // 0 * inf gives NaN when the origin lies on a slab plane of a parallel ray; treat it as inside
-            if (std::isnan(t1))
-                t1 = -cLargeFloat;
-            if (std::isnan(t2))
-                t2 = cLargeFloat;
+            if (std::isnan(t1)) t1 = -cLargeFloat;
+            if (std::isnan(t2)) t2 = cLargeFloat;
             tMin = std::max(tMin, std::min(t1, t2));
             tMax = std::min(tMax, std::max(t1, t2));
         }

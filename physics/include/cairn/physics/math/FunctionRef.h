@@ -9,20 +9,19 @@
 namespace cairn
 {
 
-template <class Signature>
-class FunctionRef;
+template <class Signature> class FunctionRef;
 
-template <class R, class... Args>
-class FunctionRef<R(Args...)>
+template <class R, class... Args> class FunctionRef<R(Args...)>
 {
 public:
     template <class F>
-        requires(!std::is_same_v<std::remove_cvref_t<F>, FunctionRef> && std::is_invocable_r_v<R, F&, Args...>)
-    FunctionRef(F&& inCallable) // NOLINT: implicit by design, like std::function
+    requires(!std::is_same_v<std::remove_cvref_t<F>, FunctionRef> && std::is_invocable_r_v<R, F&, Args...>)
+        FunctionRef(F&& inCallable) // NOLINT: implicit by design, like std::function
         : mObject(const_cast<void*>(static_cast<const void*>(&inCallable))),
-          mInvoke([](void* inObject, Args... inArgs) -> R {
-              return (*static_cast<std::remove_reference_t<F>*>(inObject))(std::forward<Args>(inArgs)...);
-          })
+          mInvoke(
+              [](void* inObject, Args... inArgs) -> R {
+                  return (*static_cast<std::remove_reference_t<F>*>(inObject))(std::forward<Args>(inArgs)...);
+              })
     {
     }
 

@@ -49,7 +49,8 @@ inline Vec3 AnyPerpendicular(const Vec3& inV)
 {
     // Cross with the axis least aligned with inV, which keeps the result well conditioned
     const Vec3 a = inV.cwiseAbs();
-    const Vec3 axis = a.x() <= a.y() && a.x() <= a.z() ? Vec3::UnitX() : (a.y() <= a.z() ? Vec3::UnitY() : Vec3::UnitZ());
+    const Vec3 axis =
+        a.x() <= a.y() && a.x() <= a.z() ? Vec3::UnitX() : (a.y() <= a.z() ? Vec3::UnitY() : Vec3::UnitZ());
     return inV.cross(axis).normalized();
 }
 

@@ -13,15 +13,15 @@ namespace cairn
 
 enum class ErrorCode
 {
-    InvalidArgument,   ///< NaN, infinity, out-of-range or otherwise malformed input
-    DegenerateShape,   ///< Zero/negative extents, coplanar hull points, empty mesh...
-    InvalidBodyID,     ///< Unknown or stale body id
-    AlreadyAdded,      ///< Body already in the world
-    NotAdded,          ///< Body not in the world
-    OutOfCapacity,     ///< A fixed-capacity pool is full
-    WrongThread,       ///< Called from a thread that may not call it
-    ParseError,        ///< A malformed file
-    IOError,           ///< A file could not be read or written
+    InvalidArgument, ///< NaN, infinity, out-of-range or otherwise malformed input
+    DegenerateShape, ///< Zero/negative extents, coplanar hull points, empty mesh...
+    InvalidBodyID,   ///< Unknown or stale body id
+    AlreadyAdded,    ///< Body already in the world
+    NotAdded,        ///< Body not in the world
+    OutOfCapacity,   ///< A fixed-capacity pool is full
+    WrongThread,     ///< Called from a thread that may not call it
+    ParseError,      ///< A malformed file
+    IOError,         ///< A file could not be read or written
 };
 
 const char* ToString(ErrorCode inCode);
@@ -32,8 +32,7 @@ struct Error
     std::string mMessage;
 };
 
-template <class T>
-class [[nodiscard]] Result
+template <class T> class [[nodiscard]] Result
 {
 public:
     Result(T inValue) : mData(std::move(inValue)) {}
@@ -88,6 +87,9 @@ private:
     bool mOk = true;
 };
 
-inline Error MakeError(ErrorCode inCode, std::string inMessage) { return Error{inCode, std::move(inMessage)}; }
+inline Error MakeError(ErrorCode inCode, std::string inMessage)
+{
+    return Error{inCode, std::move(inMessage)};
+}
 
 } // namespace cairn

@@ -9,8 +9,8 @@ namespace cairn
 
 struct Transform
 {
-    Vec3 mPosition = Vec3::Zero();       ///< Translation in world (or parent) space
-    Quat mRotation = Quat::Identity();   ///< Unit quaternion
+    Vec3 mPosition = Vec3::Zero();     ///< Translation in world (or parent) space
+    Quat mRotation = Quat::Identity(); ///< Unit quaternion
 
     static Transform Identity() { return {}; }
 
@@ -33,7 +33,10 @@ struct Transform
     }
 
     /// Maps a point from parent to local space.
-    Vec3 InverseTransformPoint(const Vec3& inPoint) const { return mRotation.conjugate() * (inPoint - mPosition); }
+    Vec3 InverseTransformPoint(const Vec3& inPoint) const
+    {
+        return mRotation.conjugate() * (inPoint - mPosition);
+    }
 
     /// Maps a direction from parent to local space.
     Vec3 InverseRotateVector(const Vec3& inDir) const { return mRotation.conjugate() * inDir; }

@@ -23,8 +23,8 @@ public:
     bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
     Vec3 GetSupport(const Vec3& inDirection) const override;
-    /// Two points (the segment pushed out by the radius) when inDirection is nearly perpendicular to the axis,
-    /// otherwise the single support point.
+    /// Two points (the segment pushed out by the radius) when inDirection is nearly perpendicular to the
+    /// axis, otherwise the single support point.
     void GetSupportingFace(const Vec3& inDirection, SupportingFace& outFace) const override;
 
     CapsuleShape(float inHalfHeight, float inRadius); ///< Use Create(), which validates

@@ -17,8 +17,8 @@ class CompoundShape final : public Shape
 public:
     struct SubShape
     {
-        ShapeRef mShape;               ///< Never null
-        Transform mLocalTransform;     ///< Child space to compound space
+        ShapeRef mShape;           ///< Never null
+        Transform mLocalTransform; ///< Child space to compound space
     };
 
     /// Fails for no children, a null child, or a non-finite / non-unit transform.

@@ -16,9 +16,9 @@ public:
     /// One planar face of the hull: vertex indices counter-clockwise seen from outside.
     struct Face
     {
-        Vec3 mNormal;                    ///< Outward unit normal
-        float mPlaneConstant;            ///< dot(mNormal, p) == mPlaneConstant for points p on the face
-        std::vector<uint32_t> mIndices;  ///< Into GetVertices(); coplanar triangles are merged into one face
+        Vec3 mNormal;                   ///< Outward unit normal
+        float mPlaneConstant;           ///< dot(mNormal, p) == mPlaneConstant for points p on the face
+        std::vector<uint32_t> mIndices; ///< Into GetVertices(); coplanar triangles are merged into one face
     };
 
     /// Builds the hull of inPoints. Fails with DegenerateShape for fewer than 4 points, coincident,

@@ -21,8 +21,9 @@ public:
 
     /// inHeights is row-major: index x + z * inSampleCountX. Fails for fewer than 2 x 2 samples, a size
     /// mismatch, a cell size that is not finite and > 0, infinite heights, or all samples holes.
-    static Result<std::shared_ptr<const HeightFieldShape>> Create(uint32_t inSampleCountX, uint32_t inSampleCountZ,
-                                                                  float inCellSize, std::span<const float> inHeights);
+    static Result<std::shared_ptr<const HeightFieldShape>> Create(uint32_t inSampleCountX,
+                                                                  uint32_t inSampleCountZ, float inCellSize,
+                                                                  std::span<const float> inHeights);
 
     uint32_t GetSampleCountX() const { return mSampleCountX; }
     uint32_t GetSampleCountZ() const { return mSampleCountZ; }
@@ -31,7 +32,7 @@ public:
     float GetHeight(uint32_t inX, uint32_t inZ) const { return mHeights[inX + inZ * mSampleCountX]; }
 
     AABB GetLocalBounds() const override;
-    MassProperties GetMassProperties(float inDensity) const override; ///< Zero mass: no volume
+    MassProperties GetMassProperties(float inDensity) const override;      ///< Zero mass: no volume
     bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
 

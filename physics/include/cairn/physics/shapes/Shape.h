@@ -30,16 +30,16 @@ const char* ToString(ShapeType inType);
 /// Mass, centre of mass and inertia of a shape of uniform density.
 struct MassProperties
 {
-    float mMass = 0.0f;                        ///< kg
-    Vec3 mCenterOfMass = Vec3::Zero();         ///< In shape-local space
-    Mat3 mInertia = Mat3::Zero();              ///< kg m^2, about the centre of mass, in shape-local axes
+    float mMass = 0.0f;                ///< kg
+    Vec3 mCenterOfMass = Vec3::Zero(); ///< In shape-local space
+    Mat3 mInertia = Mat3::Zero();      ///< kg m^2, about the centre of mass, in shape-local axes
 };
 
 /// A ray as a segment: points mOrigin + t * mDirection for t in [0, 1].
 struct RayCast
 {
     Vec3 mOrigin = Vec3::Zero();
-    Vec3 mDirection = Vec3::Zero();   ///< Full displacement, not unit length
+    Vec3 mDirection = Vec3::Zero(); ///< Full displacement, not unit length
 };
 
 /// Identifies a part of a shape: a triangle of a mesh, a cell half of a height field, a compound child...
@@ -48,8 +48,9 @@ using SubShapeID = uint32_t;
 
 struct RayHit
 {
-    float mFraction = cLargeFloat;    ///< Along RayCast::mDirection, in [0, 1]
-    Vec3 mNormal = Vec3::Zero();      ///< Unit surface normal at the hit, facing against the ray, same space as the ray
+    float mFraction = cLargeFloat; ///< Along RayCast::mDirection, in [0, 1]
+    Vec3 mNormal =
+        Vec3::Zero(); ///< Unit surface normal at the hit, facing against the ray, same space as the ray
     SubShapeID mSubShape = 0;
 };
 
@@ -65,9 +66,9 @@ enum TriangleEdge : uint8_t
 
 struct Triangle
 {
-    Vec3 mV[3];                              ///< Counter-clockwise seen from the front (normal = (v1-v0) x (v2-v0))
-    uint8_t mActiveEdges = cAllEdgesActive;  ///< TriangleEdge bits
-    SubShapeID mSubShape = 0;                ///< Triangle index inside its shape
+    Vec3 mV[3]; ///< Counter-clockwise seen from the front (normal = (v1-v0) x (v2-v0))
+    uint8_t mActiveEdges = cAllEdgesActive; ///< TriangleEdge bits
+    SubShapeID mSubShape = 0;               ///< Triangle index inside its shape
 };
 
 /// Called once per triangle; triangles are in the space the caller asked for.
@@ -94,14 +95,17 @@ public:
 
     /// Bounds in world space for the given transform; shapes override this when they can be tighter than
     /// the transformed local box.
-    virtual AABB GetWorldBounds(const Transform& inTransform) const { return GetLocalBounds().Transformed(inTransform); }
+    virtual AABB GetWorldBounds(const Transform& inTransform) const
+    {
+        return GetLocalBounds().Transformed(inTransform);
+    }
 
     /// Mass properties for a uniform density in kg/m^3. Shapes without volume (meshes, height fields)
     /// return zero mass: they can only be static or kinematic.
     virtual MassProperties GetMassProperties(float inDensity) const = 0;
 
-    /// Closest hit of a local-space ray with fraction < ioHit.mFraction; updates ioHit and returns true on a hit.
-    /// A ray starting inside a solid shape hits at fraction 0 (normal = -ray direction).
+    /// Closest hit of a local-space ray with fraction < ioHit.mFraction; updates ioHit and returns true on a
+    /// hit. A ray starting inside a solid shape hits at fraction 0 (normal = -ray direction).
     virtual bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const = 0;
 
     /// Visits every triangle of the surface that may overlap inLocalBox (local space). Convex primitives
@@ -111,7 +115,8 @@ public:
 
     /// World-space triangles (3 vertices each, appended to outVertices) of this shape at inTransform that may
     /// overlap inWorldBox: the navmesh collects geometry with this.
-    void CollectTriangles(const AABB& inWorldBox, const Transform& inTransform, std::vector<Vec3>& outVertices) const;
+    void CollectTriangles(const AABB& inWorldBox, const Transform& inTransform,
+                          std::vector<Vec3>& outVertices) const;
 
 private:
     ShapeType mType;

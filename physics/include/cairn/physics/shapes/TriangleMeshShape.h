@@ -25,13 +25,13 @@ public:
 
     /// Builds the mesh. Fails on NaN/infinite vertices, out-of-range indices, no triangles, or when every
     /// triangle is degenerate (zero area); degenerate triangles among good ones are dropped.
-    static Result<std::shared_ptr<const TriangleMeshShape>> Create(std::span<const Vec3> inVertices,
-                                                                   std::span<const std::array<uint32_t, 3>> inTriangles);
+    static Result<std::shared_ptr<const TriangleMeshShape>>
+    Create(std::span<const Vec3> inVertices, std::span<const std::array<uint32_t, 3>> inTriangles);
 
     size_t GetTriangleCount() const;
 
     AABB GetLocalBounds() const override;
-    MassProperties GetMassProperties(float inDensity) const override; ///< Zero mass: no volume
+    MassProperties GetMassProperties(float inDensity) const override;      ///< Zero mass: no volume
     bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
 

@@ -26,11 +26,13 @@ struct CachedManifold
 {
     ContactKey mKey;
     int mNumPoints = 0;
-    Vec3 mLocalOnA[ContactManifold::cMaxPoints];       ///< In A's centre-of-mass frame
+    Vec3 mLocalOnA[ContactManifold::cMaxPoints]; ///< In A's centre-of-mass frame
     float mNormalImpulse[ContactManifold::cMaxPoints];
-    float mDeferredBounce[ContactManifold::cMaxPoints]; ///< Approach velocity of a bounce that happens next step
-    Vec3 mFrictionImpulse = Vec3::Zero(); ///< Patch friction as a world vector, so a new tangent basis can take it over
-    float mTwistImpulse = 0.0f;           ///< Patch twist friction about the normal
+    float mDeferredBounce[ContactManifold::cMaxPoints]; ///< Approach velocity of a bounce that happens next
+                                                        ///< step
+    Vec3 mFrictionImpulse =
+        Vec3::Zero();           ///< Patch friction as a world vector, so a new tangent basis can take it over
+    float mTwistImpulse = 0.0f; ///< Patch twist friction about the normal
 };
 
 class ContactCache

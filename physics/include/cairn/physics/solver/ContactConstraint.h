@@ -16,24 +16,25 @@ class Body;
 /// The impulse along one axis at one contact point, with its precomputed effective mass.
 struct AxisImpulse
 {
-    Vec3 mRAxAxis;          ///< rA x axis
-    Vec3 mRBxAxis;          ///< rB x axis
-    Vec3 mInvIA_RAxAxis;    ///< World inverse inertia of A times rA x axis
+    Vec3 mRAxAxis;       ///< rA x axis
+    Vec3 mRBxAxis;       ///< rB x axis
+    Vec3 mInvIA_RAxAxis; ///< World inverse inertia of A times rA x axis
     Vec3 mInvIB_RBxAxis;
-    float mEffectiveMass;   ///< 1 / (J M^-1 J^T)
-    float mAccumulated;     ///< Total impulse this step (warm-started from the cache)
+    float mEffectiveMass; ///< 1 / (J M^-1 J^T)
+    float mAccumulated;   ///< Total impulse this step (warm-started from the cache)
 };
 
 struct ContactConstraintPoint
 {
-    Vec3 mLocalOnA;            ///< Contact point in A's centre-of-mass frame, for position correction
+    Vec3 mLocalOnA; ///< Contact point in A's centre-of-mass frame, for position correction
     Vec3 mLocalOnB;
     AxisImpulse mNormal;
-    float mSeparation;         ///< Gap at the start of the step (negative: penetration)
-    float mVelocityBias;       ///< Minimum normal relative velocity (negative: a speculative gap may close)
-    float mApproachVelocity;   ///< Normal relative velocity before solving (or a bounce deferred from last step)
-    float mMaxNormalImpulse;   ///< Largest normal impulse applied this step: > 0 means the point really touched
-    float mDeferredBounce;     ///< Approach velocity to bounce with next step (0: none), see ApplyRestitution
+    float mSeparation;   ///< Gap at the start of the step (negative: penetration)
+    float mVelocityBias; ///< Minimum normal relative velocity (negative: a speculative gap may close)
+    float
+        mApproachVelocity; ///< Normal relative velocity before solving (or a bounce deferred from last step)
+    float mMaxNormalImpulse; ///< Largest normal impulse applied this step: > 0 means the point really touched
+    float mDeferredBounce;   ///< Approach velocity to bounce with next step (0: none), see ApplyRestitution
 };
 
 /// Friction for a whole manifold ("patch friction"): a 2D impulse at the centroid of the contact points and a
@@ -52,16 +53,16 @@ struct ContactConstraint
 {
     Body* mBodyA;
     Body* mBodyB;
-    Vec3 mNormal;               ///< World, from A to B
-    Vec3 mTangent[2];           ///< World, perpendicular to mNormal and each other
+    Vec3 mNormal;     ///< World, from A to B
+    Vec3 mTangent[2]; ///< World, perpendicular to mNormal and each other
     PatchFriction mPatch;
-    Vec3 mInvIA_Normal;         ///< World inverse inertia of A times the normal (twist)
+    Vec3 mInvIA_Normal; ///< World inverse inertia of A times the normal (twist)
     Vec3 mInvIB_Normal;
-    float mFriction;            ///< Combined: sqrt(frictionA * frictionB)
-    float mRestitution;         ///< Combined: max(restitutionA, restitutionB)
-    uint32_t mCacheIndex;       ///< Where this manifold's impulses are stored for next step's warm start
-    uint32_t mIsland;           ///< Island this constraint is solved in
-    uint64_t mOrderKey;         ///< Hash of bodies and sub-shapes: the solve order within the island
+    float mFriction;      ///< Combined: sqrt(frictionA * frictionB)
+    float mRestitution;   ///< Combined: max(restitutionA, restitutionB)
+    uint32_t mCacheIndex; ///< Where this manifold's impulses are stored for next step's warm start
+    uint32_t mIsland;     ///< Island this constraint is solved in
+    uint64_t mOrderKey;   ///< Hash of bodies and sub-shapes: the solve order within the island
     int mNumPoints;
     ContactConstraintPoint mPoints[ContactManifold::cMaxPoints];
 };

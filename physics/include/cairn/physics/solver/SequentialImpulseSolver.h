@@ -4,9 +4,11 @@
 //  - order: the caller sorts each island's constraints by a hash of their bodies (see PhysicsStep), so no
 //    geometric order (bottom-up, left-right) biases the result, and the order is the same on every run;
 //  - friction per manifold ("patch friction", as PhysX does): see PatchFriction;
-//  - warm starting: each point starts from last step's accumulated impulses (matched through the ContactCache);
+//  - warm starting: each point starts from last step's accumulated impulses (matched through the
+//  ContactCache);
 //  - accumulated-impulse clamping: normal >= 0, friction inside the Coulomb circle |(t1, t2)| <= mu * normal;
-//  - restitution: a separate pass after the velocity iterations (as in Box2D v3) gives points that touched and
+//  - restitution: a separate pass after the velocity iterations (as in Box2D v3) gives points that touched
+//  and
 //    approached faster than the threshold a target velocity of -e * approach velocity;
 //  - position correction by split impulses: no Baumgarte term in the velocity solve (it would add energy);
 //    after integration, non-linear Gauss-Seidel iterations move the bodies apart by mBaumgarte of the

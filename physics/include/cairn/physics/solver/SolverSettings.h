@@ -7,12 +7,12 @@ namespace cairn
 
 struct SolverSettings
 {
-    int mVelocityIterations = 10;            ///< Sequential impulse iterations on velocities
-    int mPositionIterations = 2;             ///< Non-linear Gauss-Seidel iterations on positions
-    float mPenetrationSlop = 0.005f;         ///< m of penetration left alone, so resting contacts stay touching
-    float mBaumgarte = 0.2f;                 ///< Fraction of the remaining penetration removed per position iteration
-    float mMaxPenetrationCorrection = 0.2f;  ///< m per position iteration, so deep overlaps do not explode
-    float mRestitutionThreshold = 1.0f;      ///< m/s of approach below which contacts do not bounce
+    int mVelocityIterations = 10;    ///< Sequential impulse iterations on velocities
+    int mPositionIterations = 2;     ///< Non-linear Gauss-Seidel iterations on positions
+    float mPenetrationSlop = 0.005f; ///< m of penetration left alone, so resting contacts stay touching
+    float mBaumgarte = 0.2f;         ///< Fraction of the remaining penetration removed per position iteration
+    float mMaxPenetrationCorrection = 0.2f; ///< m per position iteration, so deep overlaps do not explode
+    float mRestitutionThreshold = 1.0f;     ///< m/s of approach below which contacts do not bounce
 };
 
 } // namespace cairn
