@@ -115,6 +115,15 @@ template <class MakeCase> void RunCases(uint32_t inSeed, MakeCase inMakeCase)
     ExpectAgreement(tally);
 }
 
+/// GJK/EPA's answer for the pair; false when it does not overlap by at least 1 mm (then it is not a case).
+bool ReferenceContact(const ConvexShape& inA, const Transform& inTransformA, const ConvexShape& inB,
+                      const Transform& inTransformB, ConvexContact& outReference)
+{
+    return FindConvexContact(ConvexSupport::FromShape(inA, inTransformA),
+                             ConvexSupport::FromShape(inB, inTransformB), 0.0f, outReference) &&
+           outReference.mPenetration >= 1.0e-3f;
+}
+
 TEST(AgreementTest, SphereSphere)
 {
     const CollideSettings settings;
@@ -126,10 +135,7 @@ TEST(AgreementTest, SphereSphere)
                  const Transform ta{ioRng.InBox(1.0f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.0f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!FindConvexContact(ConvexSupport::FromShape(*a, ta), ConvexSupport::FromShape(*b, tb),
-                                        0.0f, ref) ||
-                     ref.mPenetration < 1.0e-3f)
-                     return false;
+                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
                  ContactManifold m;
                  const bool hit = CollideSphereSphere(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -150,10 +156,7 @@ TEST(AgreementTest, SphereBox)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!FindConvexContact(ConvexSupport::FromShape(*a, ta), ConvexSupport::FromShape(*b, tb),
-                                        0.0f, ref) ||
-                     ref.mPenetration < 1.0e-3f)
-                     return false;
+                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
                  // Centre inside the box with two faces at nearly the same distance: either face is right
                  const Vec3 local = tb.InverseTransformPoint(ta.mPosition);
                  if ((local.cwiseAbs().array() < extent.array()).all())
@@ -185,10 +188,7 @@ TEST(AgreementTest, SphereCapsule)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!FindConvexContact(ConvexSupport::FromShape(*a, ta), ConvexSupport::FromShape(*b, tb),
-                                        0.0f, ref) ||
-                     ref.mPenetration < 1.0e-3f)
-                     return false;
+                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
                  ContactManifold m;
                  const bool hit = CollideSphereCapsule(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -209,10 +209,7 @@ TEST(AgreementTest, CapsuleCapsule)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!FindConvexContact(ConvexSupport::FromShape(*a, ta), ConvexSupport::FromShape(*b, tb),
-                                        0.0f, ref) ||
-                     ref.mPenetration < 1.0e-3f)
-                     return false;
+                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
                  ContactManifold m;
                  const bool hit = CollideCapsuleCapsule(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -265,10 +262,7 @@ TEST(AgreementTest, BoxBox)
             const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
             const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
             ConvexContact ref;
-            if (!FindConvexContact(ConvexSupport::FromShape(*a, ta), ConvexSupport::FromShape(*b, tb), 0.0f,
-                                   ref) ||
-                ref.mPenetration < 1.0e-3f)
-                return false;
+            if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
             // Two different axes with nearly the same penetration: both answers are right
             const auto axes = BoxAxisPenetrations(ea, ta, eb, tb);
             for (size_t i = 1; i < axes.size() && axes[i].first - axes[0].first < cAmbiguityGap; ++i)
