@@ -102,8 +102,9 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         std::unique_lock lock(GetMutexForBody(inID.GetIndex()));
         Body* body = TryGetBody(inID);
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
-        if (body->mInWorld)
-            return MakeError(ErrorCode::AlreadyAdded, "remove the body from the world before destroying it");
+        if (body->mInWorld || body->mAddPending)
+            return MakeError(ErrorCode::AlreadyAdded,
+                             "remove the body from the world (or abort its add batch) before destroying it");
         body->mShape.reset();
         // A new sequence makes every copy of the old id stale
         body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);

@@ -125,6 +125,17 @@ TEST_F(BadInputTest, BatchWithABadIDMarksNothing)
     ExpectWorldUnchanged();
 }
 
+TEST_F(BadInputTest, BodyInAPreparedBatchCannotBeDestroyed)
+{
+    const BodyID pending = Bodies().CreateBody(DynamicSettings(Sphere(1), Vec3(5, 5, 5))).Value();
+    Result<BodyInterface::AddBatch> batch = Bodies().AddBodiesPrepare({&pending, 1});
+    ASSERT_TRUE(batch.IsOk());
+    EXPECT_EQ(Bodies().DestroyBody(pending).GetError().mCode, ErrorCode::AlreadyAdded);
+    Bodies().AddBodiesAbort(batch.Value());
+    EXPECT_TRUE(Bodies().DestroyBody(pending).IsOk()) << "after the abort it is free to go";
+    ExpectWorldUnchanged();
+}
+
 TEST_F(BadInputTest, BadTimeStepsAreRejected)
 {
     EXPECT_FALSE(System().Update(0.0f).IsOk());
