@@ -42,6 +42,9 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
         return MakeError(ErrorCode::InvalidArgument, "collision steps must be in 1..16");
     if (BodyManager::IsInsideStep())
         return MakeError(ErrorCode::WrongThread, "Update called from inside the physics step");
+    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        return MakeError(ErrorCode::WrongThread,
+                         "Update called while this thread holds a body lock (it would deadlock)");
     // Acquire pairs with the release below, so a step sees everything the previous updating thread wrote
     if (mUpdating.exchange(true, std::memory_order_acquire))
         return MakeError(ErrorCode::WrongThread, "Update is already running on another thread");

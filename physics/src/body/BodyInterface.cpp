@@ -9,7 +9,8 @@ namespace
 {
 Error WrongThread()
 {
-    return MakeError(ErrorCode::WrongThread, "body interface called from inside the physics step");
+    return MakeError(ErrorCode::WrongThread,
+                     "body interface called inside the physics step or while this thread holds a body lock");
 }
 Error StaleID()
 {
@@ -108,7 +109,7 @@ void BodyInterface::WakeBodiesIn(const AABB& inBounds)
 
 Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const BodyID> inIDs)
 {
-    if (BodyManager::IsInsideStep()) return WrongThread();
+    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
     AddBatch batch;
     batch.mBodies.reserve(inIDs.size());
     auto undo = [&]
@@ -144,7 +145,7 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
 
 Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation)
 {
-    if (BodyManager::IsInsideStep()) return WrongThread();
+    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
     if (ioBatch.mState == nullptr)
         return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
     mBroadPhase.AddBodiesFinalize(ioBatch.mState);

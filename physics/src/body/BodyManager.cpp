@@ -10,6 +10,8 @@ namespace
 {
 // Set on the stepping thread while it holds every body mutex; read only by that same thread
 thread_local bool tInsideStep = false;
+// Body locks this thread holds through BodyLock; read and written only by that same thread
+thread_local uint32_t tBodyLocksHeld = 0;
 
 Status ValidateSettings(const BodyCreationSettings& inSettings)
 {
@@ -70,8 +72,9 @@ uint32_t BodyManager::GetNumBodies() const
 Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 {
     if (Status status = ValidateSettings(inSettings); !status) return status.GetError();
-    if (IsInsideStep())
-        return MakeError(ErrorCode::WrongThread, "CreateBody called from inside the physics step");
+    if (IsInsideStep() || tBodyLocksHeld > 0)
+        return MakeError(ErrorCode::WrongThread,
+                         "CreateBody called inside the physics step or while holding a body lock");
 
     uint32_t index;
     {
@@ -94,8 +97,9 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 
 Status BodyManager::DestroyBody(const BodyID& inID)
 {
-    if (IsInsideStep())
-        return MakeError(ErrorCode::WrongThread, "DestroyBody called from inside the physics step");
+    if (IsInsideStep() || tBodyLocksHeld > 0)
+        return MakeError(ErrorCode::WrongThread,
+                         "DestroyBody called inside the physics step or while holding a body lock");
     if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)
         return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
     {
@@ -180,6 +184,16 @@ void BodyManager::UnlockAllBodies() const
 bool BodyManager::IsInsideStep()
 {
     return tInsideStep;
+}
+
+uint32_t BodyManager::GetBodyLocksHeldByThisThread()
+{
+    return tBodyLocksHeld;
+}
+
+void BodyManager::NoteBodyLockHeld(int inDelta)
+{
+    tBodyLocksHeld = uint32_t(int(tBodyLocksHeld) + inDelta);
 }
 
 } // namespace cairn

@@ -1,4 +1,5 @@
 #include "SimulationFixture.h"
+#include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
@@ -134,6 +135,25 @@ TEST_F(BadInputTest, BodyInAPreparedBatchCannotBeDestroyed)
     Bodies().AddBodiesAbort(batch.Value());
     EXPECT_TRUE(Bodies().DestroyBody(pending).IsOk()) << "after the abort it is free to go";
     ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, CallsThatWouldDeadlockWhileHoldingABodyLockAreRefused)
+{
+    {
+        BodyLockRead lock(System().GetBodyManager(), mBox);
+        ASSERT_TRUE(lock.Succeeded());
+        // Each of these would wait for a lock this thread holds, or take a second one: refused, not hung
+        EXPECT_EQ(System().Update(cDeltaTime).GetError().mCode, ErrorCode::WrongThread);
+        EXPECT_EQ(Bodies().GetPosition(mFloor).GetError().mCode, ErrorCode::WrongThread);
+        EXPECT_EQ(Bodies().SetLinearVelocity(mBox, Vec3(1, 0, 0)).GetError().mCode, ErrorCode::WrongThread);
+        BodyLockWrite second(System().GetBodyManager(), mFloor);
+        EXPECT_FALSE(second.Succeeded());
+        EXPECT_TRUE(second.WasWrongThread());
+    }
+    // Released: everything works again
+    EXPECT_TRUE(System().Update(cDeltaTime).IsOk());
+    EXPECT_TRUE(Bodies().GetPosition(mFloor).IsOk());
+    EXPECT_EQ(System().GetBodyManager().GetNumBodies(), 2u);
 }
 
 TEST_F(BadInputTest, BadTimeStepsAreRejected)

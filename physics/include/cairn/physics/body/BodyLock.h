@@ -2,8 +2,9 @@
 
 // Scoped body locks for code outside the physics step. Each takes the body's shard mutex (shared for read,
 // exclusive for write) and checks the id, so a stale id gives no body instead of another body.
-// Taking one inside a step callback (where the step already holds every body mutex) would deadlock: it is
-// refused instead (GetBody() returns nullptr, WasWrongThread() is true).
+// Taking one inside a step callback (where the step already holds every body mutex), or while this thread
+// already holds one (two locks held in any order can deadlock against the step, which takes all of them),
+// would risk a deadlock: it is refused instead (GetBody() returns nullptr, WasWrongThread() is true).
 
 #include "cairn/physics/body/BodyManager.h"
 
@@ -18,7 +19,7 @@ template <bool Write> class BodyLock
 public:
     BodyLock(const BodyManager& inManager, const BodyID& inID)
     {
-        if (BodyManager::IsInsideStep())
+        if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
         {
             mWrongThread = true;
             return;
@@ -29,6 +30,7 @@ public:
             mMutex->lock();
         else
             mMutex->lock_shared();
+        BodyManager::NoteBodyLockHeld(+1);
         mBody = inManager.TryGetBody(inID);
     }
     ~BodyLock() { Release(); }
@@ -43,6 +45,7 @@ public:
             mMutex->unlock();
         else
             mMutex->unlock_shared();
+        BodyManager::NoteBodyLockHeld(-1);
         mMutex = nullptr;
         mBody = nullptr;
     }

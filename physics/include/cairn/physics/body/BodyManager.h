@@ -69,6 +69,11 @@ public:
 
     /// True on the thread that holds every body lock (inside a step): locking calls there would deadlock.
     static bool IsInsideStep();
+    /// Body locks (BodyLockRead/Write) the calling thread holds now. A thread may hold one at a time: a
+    /// second, or a step started while holding one, could deadlock against the step, which takes them all.
+    static uint32_t GetBodyLocksHeldByThisThread();
+    /// Bookkeeping for BodyLock: +1 when it locks, -1 when it unlocks.
+    static void NoteBodyLockHeld(int inDelta);
 
 private:
     friend class PhysicsStep;
