@@ -6,6 +6,7 @@
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
+#include "common/TestRandom.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -21,27 +22,10 @@ constexpr uint32_t cNumBodies = 10000;
 
 /// Random worlds in a 250 m x 60 m x 250 m box; half the coordinates snapped to a 0.5 m grid so that touching
 /// boxes and rays along faces are common.
-class RandomWorld
+class RandomWorld : public test::TestRandom
 {
 public:
-    explicit RandomWorld(uint32_t inSeed) : mRandom(inSeed) {}
-
-    float Uniform(float inMin, float inMax)
-    {
-        return std::uniform_real_distribution<float>(inMin, inMax)(mRandom);
-    }
-    uint32_t Index(uint32_t inCount)
-    {
-        return std::uniform_int_distribution<uint32_t>(0, inCount - 1)(mRandom);
-    }
-    bool Chance(float inProbability) { return Uniform(0.0f, 1.0f) < inProbability; }
-
-    /// A coordinate, on the 0.5 m grid half of the time.
-    float Coordinate(float inMin, float inMax)
-    {
-        const float value = Uniform(inMin, inMax);
-        return Chance(0.5f) ? std::round(value * 2.0f) * 0.5f : value;
-    }
+    using TestRandom::TestRandom;
 
     /// Bounds of mixed sizes: points, small and medium boxes, and 1% wide ones (up to 80 m, like ground
     /// slabs).
@@ -66,8 +50,6 @@ public:
 
     /// A random object-layer filter: all layers most of the time, else a random subset.
     ObjectLayerMask Mask() { return Chance(0.6f) ? cAllObjectLayers : ObjectLayerMask(Index(16)); }
-
-    std::mt19937 mRandom; ///< Deterministic per seed
 };
 
 using HitList = std::vector<BodyID>;

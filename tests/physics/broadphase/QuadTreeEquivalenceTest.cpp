@@ -6,6 +6,7 @@
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/QuadTree.h"
+#include "common/TestRandom.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -20,26 +21,12 @@ namespace
 
 constexpr uint32_t cNumBodies = 5000;
 
-class World
+/// Random worlds in a 250 m x 60 m x 250 m box (see TestRandom for the grid snapping).
+class World : public test::TestRandom
 {
 public:
-    explicit World(uint32_t inSeed) : mRandom(inSeed) {}
+    using TestRandom::TestRandom;
 
-    float Uniform(float inMin, float inMax)
-    {
-        return std::uniform_real_distribution<float>(inMin, inMax)(mRandom);
-    }
-    uint32_t Index(uint32_t inCount)
-    {
-        return std::uniform_int_distribution<uint32_t>(0, inCount - 1)(mRandom);
-    }
-    bool Chance(float inProbability) { return Uniform(0.0f, 1.0f) < inProbability; }
-    /// A coordinate, on a 0.5 m grid half of the time so that touching boxes are common.
-    float Coordinate(float inMin, float inMax)
-    {
-        const float v = Uniform(inMin, inMax);
-        return Chance(0.5f) ? std::round(v * 2.0f) * 0.5f : v;
-    }
     Vec3 Point() { return Vec3(Coordinate(-125, 125), Coordinate(-30, 30), Coordinate(-125, 125)); }
     AABB Box()
     {
@@ -47,8 +34,6 @@ public:
         const Vec3 e(Coordinate(0, 4), Coordinate(0, 4), Coordinate(0, 4));
         return AABB(p - e, p + e);
     }
-
-    std::mt19937 mRandom;
 };
 
 template <class Query> std::vector<BodyID> Collect(Query&& inQuery)
