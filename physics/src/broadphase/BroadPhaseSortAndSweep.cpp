@@ -589,18 +589,26 @@ void BroadPhaseSortAndSweep::Query(const Window& inWindow, ObjectLayerMask inMas
             return;
 }
 
+template <class Test>
+void BroadPhaseSortAndSweep::VisitOverlapping(const Window& inWindow, ObjectLayerMask inMask, Test&& inTest,
+                                              BodyVisitor inVisitor) const
+{
+    std::shared_lock lock(mMutex);
+    Query(inWindow, inMask, inTest,
+          [&](BodyID inID)
+          {
+              inVisitor(inID);
+              return true;
+          });
+}
+
 void BroadPhaseSortAndSweep::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
                                           BodyVisitor inVisitor) const
 {
     const Window window{inBox.mMin.x(), inBox.mMax.x(), inBox.mMin.z(), inBox.mMax.z()};
-    std::shared_lock lock(mMutex);
-    Query(
+    VisitOverlapping(
         window, inFilter.mObjectLayers, [&](const AABB& inBounds) { return AABBsOverlap(inBounds, inBox); },
-        [&](BodyID inID)
-        {
-            inVisitor(inID);
-            return true;
-        });
+        inVisitor);
 }
 
 void BroadPhaseSortAndSweep::CollideSphere(const Vec3& inCenter, float inRadius,
@@ -610,29 +618,18 @@ void BroadPhaseSortAndSweep::CollideSphere(const Vec3& inCenter, float inRadius,
     const float radius = std::abs(inRadius);
     const Window window{inCenter.x() - radius, inCenter.x() + radius, inCenter.z() - radius,
                         inCenter.z() + radius};
-    std::shared_lock lock(mMutex);
-    Query(
+    VisitOverlapping(
         window, inFilter.mObjectLayers,
-        [&](const AABB& inBounds) { return SphereOverlapsAABB(inCenter, inRadius, inBounds); },
-        [&](BodyID inID)
-        {
-            inVisitor(inID);
-            return true;
-        });
+        [&](const AABB& inBounds) { return SphereOverlapsAABB(inCenter, inRadius, inBounds); }, inVisitor);
 }
 
 void BroadPhaseSortAndSweep::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
                                           BodyVisitor inVisitor) const
 {
     const Window window{inPoint.x(), inPoint.x(), inPoint.z(), inPoint.z()};
-    std::shared_lock lock(mMutex);
-    Query(
+    VisitOverlapping(
         window, inFilter.mObjectLayers, [&](const AABB& inBounds) { return AABBContains(inBounds, inPoint); },
-        [&](BodyID inID)
-        {
-            inVisitor(inID);
-            return true;
-        });
+        inVisitor);
 }
 
 void BroadPhaseSortAndSweep::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,

@@ -126,6 +126,11 @@ private:
     /// mMutex.
     template <class Test, class Visit>
     void Query(const Window& inWindow, ObjectLayerMask inMask, Test&& inTest, Visit&& inVisit) const;
+    /// Query() under the shared lock for the overlap queries, which visit every body that passes (no early
+    /// out).
+    template <class Test>
+    void VisitOverlapping(const Window& inWindow, ObjectLayerMask inMask, Test&& inTest,
+                          BodyVisitor inVisitor) const;
     /// Query() on one layer; returns false when the visitor asked to stop.
     template <class Test, class Visit>
     bool QueryLayer(const Layer& inLayer, const Window& inWindow, ObjectLayerMask inMask, Test& inTest,
