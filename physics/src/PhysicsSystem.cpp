@@ -2,6 +2,7 @@
 
 #include "PhysicsStep.h"
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 
 namespace cairn
@@ -18,6 +19,11 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inM
         return std::make_unique<BroadPhaseBruteForce>();
     case BroadPhaseType::SortAndSweep:
         return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
+    case BroadPhaseType::QuadTree:
+        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, inLayers);
+    case BroadPhaseType::QuadTreeGlobalMutex:
+        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, inLayers,
+                                                    BroadPhaseQuadTree::LockMode::GlobalMutex);
     }
     return nullptr;
 }

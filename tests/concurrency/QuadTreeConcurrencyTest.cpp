@@ -77,7 +77,8 @@ TEST(QuadTreeConcurrency, NodeAllocatorNeverHandsOutAnIndexTwice)
 TEST(QuadTreeConcurrency, MovedBodiesAreAlwaysFoundAtTheirFixedPoint)
 {
     constexpr uint32_t cNumBodies = 512;
-    QuadTree tree(cNumBodies, 4096);
+    QuadTreeBodyTable bodies(cNumBodies);
+    QuadTree tree(bodies, 0, 4096);
     std::mt19937 setup(7);
     std::uniform_real_distribution<float> coordinate(-50.0f, 50.0f);
     std::vector<Vec3> points(cNumBodies);
@@ -120,7 +121,8 @@ TEST(QuadTreeConcurrency, MovedBodiesAreAlwaysFoundAtTheirFixedPoint)
                 {
                     const uint32_t i = random() % cNumBodies;
                     bool found = false;
-                    tree.CollidePoint(points[i], {}, [&](BodyID inID) { found |= inID == BodyID(i, 1); });
+                    tree.CollidePoint(points[i], cAllObjectLayers,
+                                      [&](BodyID inID) { found |= inID == BodyID(i, 1); });
                     if (!found) misses.fetch_add(1, std::memory_order_relaxed);
                     queries.fetch_add(1, std::memory_order_relaxed);
                 }
@@ -142,7 +144,8 @@ TEST(QuadTreeConcurrency, LinkedBatchesAreFoundByLaterQueries)
     constexpr int cAdders = 2;
     constexpr uint32_t cBatchesPerAdder = 60;
     constexpr uint32_t cNumBodies = cBatch * cBatchesPerAdder * cAdders;
-    QuadTree tree(cNumBodies, 4 * cNumBodies);
+    QuadTreeBodyTable bodies(cNumBodies);
+    QuadTree tree(bodies, 0, 4 * cNumBodies);
     std::vector<Vec3> points(cNumBodies);
     std::mt19937 setup(9);
     std::uniform_real_distribution<float> coordinate(-50.0f, 50.0f);
@@ -180,7 +183,8 @@ TEST(QuadTreeConcurrency, LinkedBatchesAreFoundByLaterQueries)
                 const uint32_t i = random() % cNumBodies;
                 if (!linked[i].load(std::memory_order_acquire)) continue;
                 bool found = false;
-                tree.CollidePoint(points[i], {}, [&](BodyID inID) { found |= inID == BodyID(i, 1); });
+                tree.CollidePoint(points[i], cAllObjectLayers,
+                                  [&](BodyID inID) { found |= inID == BodyID(i, 1); });
                 if (!found) misses.fetch_add(1, std::memory_order_relaxed);
                 checks.fetch_add(1, std::memory_order_relaxed);
             }
@@ -192,7 +196,7 @@ TEST(QuadTreeConcurrency, LinkedBatchesAreFoundByLaterQueries)
     for (uint32_t i = 0; i < cNumBodies; ++i)
     {
         int count = 0;
-        tree.CollidePoint(points[i], {}, [&](BodyID inID) { count += inID == BodyID(i, 1); });
+        tree.CollidePoint(points[i], cAllObjectLayers, [&](BodyID inID) { count += inID == BodyID(i, 1); });
         ASSERT_EQ(count, 1) << i;
     }
 }

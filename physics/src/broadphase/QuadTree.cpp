@@ -1,104 +1,66 @@
 #include "cairn/physics/broadphase/QuadTree.h"
 
+#include "QuadTreeInternal.h"
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <algorithm>
 #include <cassert>
-#include <vector>
 
 namespace cairn
 {
 
-namespace
+using quadtree::BuildItem;
+using quadtree::IsEmptyBox;
+using quadtree::NodeStack;
+
+QuadTree::QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes)
+    : mBodies(ioBodies), mTreeId(inTreeId), mAllocator(std::clamp(inMaxNodes, 1u, 1u << 30)),
+      mChunks(
+          std::make_unique<std::atomic<Node*>[]>((mAllocator.GetCapacity() + cChunkSize - 1) >> cChunkShift))
 {
-
-/// Lowers ioValue to inValue if smaller. Relaxed load: the compare-exchange re-reads on failure.
-void AtomicMin(std::atomic<float>& ioValue, float inValue, std::memory_order inOrder)
-{
-    float current = ioValue.load(std::memory_order_relaxed); // Only a first guess for the exchange
-    // inOrder on success (see callers); relaxed on failure: we only retry with the fresh value
-    while (inValue < current &&
-           !ioValue.compare_exchange_weak(current, inValue, inOrder, std::memory_order_relaxed))
-    {
-    }
-}
-
-/// Raises ioValue to inValue if larger. Same orders as AtomicMin.
-void AtomicMax(std::atomic<float>& ioValue, float inValue, std::memory_order inOrder)
-{
-    float current = ioValue.load(std::memory_order_relaxed); // Only a first guess for the exchange
-    // inOrder on success (see callers); relaxed on failure: we only retry with the fresh value
-    while (inValue > current &&
-           !ioValue.compare_exchange_weak(current, inValue, inOrder, std::memory_order_relaxed))
-    {
-    }
-}
-
-/// Traversal stack: fixed-size array, spilling to the heap only for pathological depths (the tree grows a
-/// level every three add batches until a rebuild).
-class NodeStack
-{
-public:
-    void Push(uint32_t inNode)
-    {
-        if (mSize < cFixed)
-            mFixed[mSize++] = inNode;
-        else
-            mSpill.push_back(inNode);
-    }
-    bool Pop(uint32_t& outNode)
-    {
-        if (!mSpill.empty())
-        {
-            outNode = mSpill.back();
-            mSpill.pop_back();
-            return true;
-        }
-        if (mSize == 0) return false;
-        outNode = mFixed[--mSize];
-        return true;
-    }
-
-private:
-    static constexpr uint32_t cFixed = 512; ///< Entries before spilling
-    uint32_t mFixed[cFixed];                ///< Stack storage
-    uint32_t mSize = 0;                     ///< Entries used in mFixed
-    std::vector<uint32_t> mSpill;           ///< Overflow; empty (never allocates) in normal trees
-};
-
-/// True when min > max on some axis (an empty slot). Not AABB::IsEmpty: no Eigen reduction in the hot loop.
-bool IsEmptyBox(const AABB& inBox)
-{
-    return inBox.mMin.x() > inBox.mMax.x() || inBox.mMin.y() > inBox.mMax.y() ||
-           inBox.mMin.z() > inBox.mMax.z();
-}
-
-} // namespace
-
-QuadTree::QuadTree(uint32_t inMaxBodies, uint32_t inMaxNodes)
-    : mMaxBodies(std::min(inMaxBodies, cBodyFlag)), mAllocator(std::min(inMaxNodes, 1u << 30)),
-      mNodes(std::make_unique<Node[]>(mAllocator.GetCapacity())),
-      mBodyLocation(std::make_unique<std::atomic<uint32_t>[]>(mMaxBodies)),
-      mBodySequence(std::make_unique<std::atomic<uint32_t>[]>(mMaxBodies)),
-      mBodyLayer(std::make_unique<std::atomic<uint8_t>[]>(mMaxBodies))
-{
-    assert(inMaxNodes > 0 && inMaxNodes <= (1u << 30));
     // Construction is single-threaded; the object is published to other threads by whoever shares it
-    for (uint32_t i = 0; i < mMaxBodies; ++i)
-        mBodyLocation[i].store(cInvalidLocation, std::memory_order_relaxed);
+    const uint32_t numChunks = (mAllocator.GetCapacity() + cChunkSize - 1) >> cChunkShift;
+    for (uint32_t i = 0; i < numChunks; ++i)
+        mChunks[i].store(nullptr, std::memory_order_relaxed);
     mRoot.store(AllocateNode(cInvalidNode), std::memory_order_relaxed); // Construction: see above
+}
+
+QuadTree::~QuadTree()
+{
+    const uint32_t numChunks = (mAllocator.GetCapacity() + cChunkSize - 1) >> cChunkShift;
+    for (uint32_t i = 0; i < numChunks; ++i)
+        delete[] mChunks[i].load(std::memory_order_relaxed); // No other thread may use a dying tree
+}
+
+QuadTree::Node& QuadTree::GetNode(uint32_t inIndex) const
+{
+    // Acquire: pairs with the release that installed the chunk (a node index reaches another thread only
+    // after a release publication anyway; this keeps the chunk pointer itself ordered too)
+    return mChunks[inIndex >> cChunkShift].load(std::memory_order_acquire)[inIndex & (cChunkSize - 1)];
 }
 
 uint32_t QuadTree::AllocateNode(uint32_t inParent)
 {
     const uint32_t index = mAllocator.Allocate();
     if (index == cInvalidNode) return cInvalidNode;
-    Node& node = mNodes[index];
+    std::atomic<Node*>& chunk = mChunks[index >> cChunkShift];
+    // Acquire: if another thread installed the chunk, see its initialisation
+    if (chunk.load(std::memory_order_acquire) == nullptr)
+    {
+        Node* fresh = new Node[cChunkSize]; // Only when the high-water mark enters a new chunk
+        Node* expected = nullptr;
+        // Release on success: publishes the constructed chunk; acquire on failure: we use the winner's
+        if (!chunk.compare_exchange_strong(expected, fresh, std::memory_order_release,
+                                           std::memory_order_acquire))
+            delete[] fresh;
+    }
+    Node& node = GetNode(index);
     // Relaxed everywhere: the node is private until a release compare-exchange publishes it
     for (int s = 0; s < 4; ++s)
         InitSlot(node, s, cInvalidChild, AABB::Empty());
     node.mParent.store(inParent, std::memory_order_relaxed);
     node.mChanged.store(false, std::memory_order_relaxed);
+    node.mLoose.store(0, std::memory_order_relaxed);
     return index;
 }
 
@@ -116,70 +78,66 @@ void QuadTree::InitSlot(Node& ioNode, int inSlot, uint32_t inChild, const AABB& 
 
 void QuadTree::GrowSlot(Node& ioNode, int inSlot, const AABB& inBounds)
 {
-    // Maxes first (relaxed), then mins with release: a reader that acquires a new min also sees the new max,
-    // so a slot being filled from empty never looks like a box that is only partly there
-    AtomicMax(ioNode.mMaxX[inSlot], inBounds.mMax.x(), std::memory_order_relaxed);
-    AtomicMax(ioNode.mMaxY[inSlot], inBounds.mMax.y(), std::memory_order_relaxed);
-    AtomicMax(ioNode.mMaxZ[inSlot], inBounds.mMax.z(), std::memory_order_relaxed);
-    AtomicMin(ioNode.mMinX[inSlot], inBounds.mMin.x(), std::memory_order_release);
-    AtomicMin(ioNode.mMinY[inSlot], inBounds.mMin.y(), std::memory_order_release);
-    AtomicMin(ioNode.mMinZ[inSlot], inBounds.mMin.z(), std::memory_order_release);
+    // Maxes first, then mins, each with release: a reader that acquires a new min also sees the new maxes (a
+    // slot filled from empty never looks like a box that is only partly there), and a reader that acquires
+    // any grown value sees the loose bit that MoveBody set before growing
+    quadtree::AtomicMax(ioNode.mMaxX[inSlot], inBounds.mMax.x());
+    quadtree::AtomicMax(ioNode.mMaxY[inSlot], inBounds.mMax.y());
+    quadtree::AtomicMax(ioNode.mMaxZ[inSlot], inBounds.mMax.z());
+    quadtree::AtomicMin(ioNode.mMinX[inSlot], inBounds.mMin.x());
+    quadtree::AtomicMin(ioNode.mMinY[inSlot], inBounds.mMin.y());
+    quadtree::AtomicMin(ioNode.mMinZ[inSlot], inBounds.mMin.z());
+}
+
+void QuadTree::ClearSlot(Node& ioNode, int inSlot)
+{
+    // Relaxed: a reader seeing any mix of old and empty bounds reports the body or not, both allowed; the
+    // slot's writers are serialised (one body's operations, or the rebuild commit under the exclusive lock)
+    ioNode.mMinX[inSlot].store(cLargeFloat, std::memory_order_relaxed);
+    ioNode.mMinY[inSlot].store(cLargeFloat, std::memory_order_relaxed);
+    ioNode.mMinZ[inSlot].store(cLargeFloat, std::memory_order_relaxed);
+    ioNode.mMaxX[inSlot].store(-cLargeFloat, std::memory_order_relaxed);
+    ioNode.mMaxY[inSlot].store(-cLargeFloat, std::memory_order_relaxed);
+    ioNode.mMaxZ[inSlot].store(-cLargeFloat, std::memory_order_relaxed);
+    // Relaxed: a leaf slot is never refilled before a rebuild, which swaps in new nodes
+    ioNode.mChild[inSlot].store(cInvalidChild, std::memory_order_relaxed);
 }
 
 AABB QuadTree::LoadSlot(const Node& inNode, int inSlot)
 {
     AABB box;
-    // Acquire on the mins: pairs with the release in GrowSlot (maxes were written before the mins)
+    // Acquire: pairs with the releases in GrowSlot (see there)
     box.mMin = Vec3(inNode.mMinX[inSlot].load(std::memory_order_acquire),
                     inNode.mMinY[inSlot].load(std::memory_order_acquire),
                     inNode.mMinZ[inSlot].load(std::memory_order_acquire));
-    // Relaxed: ordered after the min loads by their acquire
-    box.mMax = Vec3(inNode.mMaxX[inSlot].load(std::memory_order_relaxed),
-                    inNode.mMaxY[inSlot].load(std::memory_order_relaxed),
-                    inNode.mMaxZ[inSlot].load(std::memory_order_relaxed));
+    box.mMax = Vec3(inNode.mMaxX[inSlot].load(std::memory_order_acquire),
+                    inNode.mMaxY[inSlot].load(std::memory_order_acquire),
+                    inNode.mMaxZ[inSlot].load(std::memory_order_acquire));
     return box;
 }
 
-QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodies)
+QuadTree::SubTree QuadTree::BuildNodes(std::span<BuildItem> ioItems, std::vector<uint32_t>& ioNewNodes,
+                                       LeafCallback inOnLeaf)
 {
-    // Off the hot path (loading thread): the item list may use the heap; nodes come from the pool
-    std::vector<BuildItem> items;
-    items.reserve(inBodies.size());
-    for (uint32_t i = 0; i < uint32_t(inBodies.size()); ++i)
+    if (ioItems.empty())
     {
-        const BroadPhaseBody& body = inBodies[i];
-        if (body.mID.GetIndex() >= mMaxBodies || !IsValidBroadPhaseBounds(body.mBounds) ||
-            body.mLayer >= cMaxObjectLayers)
-        {
-            assert(false && "QuadTree: invalid body");
-            continue;
-        }
-        items.push_back({i, body.mBounds.Center()});
+        SubTree empty;
+        empty.mChild = AllocateNode(cInvalidNode);
+        if (empty.mChild != cInvalidNode) ioNewNodes.push_back(empty.mChild);
+        return empty;
     }
-    if (items.empty()) return {};
-
-    bool outOfNodes = false;
-    SubTree tree = Build(inBodies, items.data(), items.data() + items.size(), cInvalidNode, outOfNodes);
-    if (outOfNodes)
-    {
-        FreeSubTree(tree);
-        return {};
-    }
-    return tree;
+    return BuildRange(ioItems.data(), ioItems.data() + ioItems.size(), cInvalidNode, ioNewNodes, inOnLeaf);
 }
 
-QuadTree::SubTree QuadTree::Build(std::span<const BroadPhaseBody> inBodies, BuildItem* inBegin,
-                                  BuildItem* inEnd, uint32_t inParent, bool& ioOutOfNodes)
+QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uint32_t inParent,
+                                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf)
 {
     SubTree result;
     const uint32_t nodeIndex = AllocateNode(inParent);
-    if (nodeIndex == cInvalidNode)
-    {
-        ioOutOfNodes = true;
-        return result;
-    }
+    if (nodeIndex == cInvalidNode) return result;
+    ioNewNodes.push_back(nodeIndex);
     result.mChild = nodeIndex;
-    Node& node = mNodes[nodeIndex];
+    Node& node = GetNode(nodeIndex);
 
     // Splits [inB, inE) at the midpoint of the longest axis of the centres; halves when degenerate
     auto split = [](BuildItem* inB, BuildItem* inE) -> BuildItem*
@@ -204,67 +162,116 @@ QuadTree::SubTree QuadTree::Build(std::span<const BroadPhaseBody> inBodies, Buil
         return mid;
     };
 
-    BuildItem* bounds[5];
+    BuildItem* groups[5];
     const ptrdiff_t count = inEnd - inBegin;
     if (count <= 4)
     {
         for (int g = 0; g < 5; ++g)
-            bounds[g] = inBegin + std::min<ptrdiff_t>(g, count);
+            groups[g] = inBegin + std::min<ptrdiff_t>(g, count);
     }
     else
     {
-        bounds[0] = inBegin;
-        bounds[2] = split(inBegin, inEnd);
-        bounds[1] = split(inBegin, bounds[2]);
-        bounds[3] = split(bounds[2], inEnd);
-        bounds[4] = inEnd;
+        groups[0] = inBegin;
+        groups[2] = split(inBegin, inEnd);
+        groups[1] = split(inBegin, groups[2]);
+        groups[3] = split(groups[2], inEnd);
+        groups[4] = inEnd;
     }
 
     for (int g = 0; g < 4; ++g)
     {
-        const ptrdiff_t n = bounds[g + 1] - bounds[g];
+        const ptrdiff_t n = groups[g + 1] - groups[g];
         if (n == 0) continue;
         if (n == 1)
         {
-            const BroadPhaseBody& body = inBodies[bounds[g]->mInput];
-            const uint32_t index = body.mID.GetIndex();
-            InitSlot(node, g, cBodyFlag | index, body.mBounds);
-            result.mBounds.Encapsulate(body.mBounds);
-            // Relaxed: read by queries only after the sub-tree is published by a release exchange
-            mBodySequence[index].store(body.mID.GetSequence(), std::memory_order_relaxed);
-            mBodyLayer[index].store(body.mLayer, std::memory_order_relaxed); // Same as above
-            // Release: Remove/Move of this body (acquire) see the node contents written above
-            mBodyLocation[index].store(nodeIndex << 2 | uint32_t(g), std::memory_order_release);
+            const BuildItem& item = *groups[g];
+            InitSlot(node, g, item.mChild, item.mBounds);
+            result.mBounds.Encapsulate(item.mBounds);
+            inOnLeaf(item, nodeIndex, g);
         }
         else
         {
-            const SubTree child = Build(inBodies, bounds[g], bounds[g + 1], nodeIndex, ioOutOfNodes);
-            if (child.mChild == cInvalidChild) return result; // Out of nodes: caller frees what was built
+            const SubTree child = BuildRange(groups[g], groups[g + 1], nodeIndex, ioNewNodes, inOnLeaf);
+            if (child.mChild == cInvalidChild) return SubTree{}; // Out of nodes: the caller frees ioNewNodes
             InitSlot(node, g, child.mChild, child.mBounds);
             result.mBounds.Encapsulate(child.mBounds);
-            if (ioOutOfNodes) return result;
         }
     }
     return result;
 }
 
+QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodies)
+{
+    // Off the hot path (loading thread): the item list may use the heap; nodes come from the pool
+    std::vector<BuildItem> items;
+    items.reserve(inBodies.size());
+    for (const BroadPhaseBody& body : inBodies)
+    {
+        const uint32_t index = body.mID.GetIndex();
+        if (index >= mBodies.GetMaxBodies() || index >= cBodyFlag || !IsValidBroadPhaseBounds(body.mBounds) ||
+            body.mLayer >= cMaxObjectLayers)
+        {
+            assert(false && "QuadTree: invalid body");
+            continue;
+        }
+        // Claim the index, so that a body already present (or twice in this batch) is not added again.
+        // Relaxed: the caller serialises operations on one body; the claim only detects double adds
+        uint32_t expected = QuadTreeBodyTable::cInvalidLocation;
+        if (!mBodies[index].mLocation.compare_exchange_strong(expected, QuadTreeBodyTable::cPendingLocation,
+                                                              std::memory_order_relaxed))
+            continue;
+        QuadTreeBodyTable::Entry& entry = mBodies[index];
+        // Relaxed: read by queries only after the sub-tree is published by a release exchange
+        entry.mSequence.store(body.mID.GetSequence(), std::memory_order_relaxed);
+        entry.mLayer.store(body.mLayer, std::memory_order_relaxed);
+        entry.mTree.store(mTreeId, std::memory_order_relaxed); // As above
+        QuadTreeBodyTable::StoreBounds(entry, body.mBounds);
+        items.push_back(
+            {cBodyFlag | index, body.mBounds, body.mBounds.Center(), QuadTreeBodyTable::cInvalidLocation});
+    }
+    if (items.empty()) return {};
+
+    std::vector<uint32_t> newNodes;
+    const SubTree tree = BuildNodes(items, newNodes,
+                                    [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
+                                    {
+                                        // Release: Remove/Move of this body (acquire) see the node contents
+                                        mBodies[inItem.mChild & ~cBodyFlag].mLocation.store(
+                                            inNode << 2 | uint32_t(inSlot), std::memory_order_release);
+                                    });
+    if (tree.mChild != cInvalidChild)
+    {
+        SubTree result = tree;
+        result.mNumBodies = uint32_t(items.size());
+        return result;
+    }
+    // Out of nodes: give everything back
+    for (uint32_t node : newNodes)
+        mAllocator.Free(node); // Never published
+    for (const BuildItem& item : items)
+        // Relaxed: never published
+        mBodies[item.mChild & ~cBodyFlag].mLocation.store(QuadTreeBodyTable::cInvalidLocation,
+                                                          std::memory_order_relaxed);
+    return {};
+}
+
 void QuadTree::FreeSubTree(const SubTree& inSubTree)
 {
-    if (inSubTree.mChild == cInvalidChild || (inSubTree.mChild & cBodyFlag) != 0) return;
+    if (inSubTree.mChild == cInvalidChild) return;
     // Iterative, so that deep trees cannot overflow the thread's stack; nodes are private (never linked)
     NodeStack stack;
     stack.Push(inSubTree.mChild);
     uint32_t nodeIndex;
     while (stack.Pop(nodeIndex))
     {
-        Node& node = mNodes[nodeIndex];
+        Node& node = GetNode(nodeIndex);
         for (int s = 0; s < 4; ++s)
         {
             const uint32_t child = node.mChild[s].load(std::memory_order_relaxed); // Private node
             if (child == cInvalidChild) continue;
             if ((child & cBodyFlag) != 0)
-                mBodyLocation[child & ~cBodyFlag].store(cInvalidLocation,
-                                                        std::memory_order_relaxed); // Never published
+                mBodies[child & ~cBodyFlag].mLocation.store(QuadTreeBodyTable::cInvalidLocation,
+                                                            std::memory_order_relaxed); // Never published
             else
                 stack.Push(child);
         }
@@ -275,28 +282,28 @@ void QuadTree::FreeSubTree(const SubTree& inSubTree)
 bool QuadTree::LinkSubTree(const SubTree& inSubTree)
 {
     if (inSubTree.mChild == cInvalidChild) return true;
+    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     const uint32_t subNode = inSubTree.mChild;
     for (;;)
     {
         // Acquire: we read the root's slots and may make it the child of a new root
         const uint32_t rootIndex = mRoot.load(std::memory_order_acquire);
-        Node& root = mNodes[rootIndex];
+        Node& root = GetNode(rootIndex);
         for (int s = 0; s < 4; ++s)
         {
             // Relaxed: only a hint to skip full slots; the exchange below decides
             if (root.mChild[s].load(std::memory_order_relaxed) != cInvalidChild) continue;
             // Relaxed: the sub-tree is private until the release exchange below publishes it
-            mNodes[subNode].mParent.store(rootIndex, std::memory_order_relaxed);
+            GetNode(subNode).mParent.store(rootIndex, std::memory_order_relaxed);
             uint32_t expected = cInvalidChild;
             // Release on success: publishes the sub-tree's nodes to readers that acquire the slot; relaxed on
             // failure: another linker took the slot, try the next one
             if (root.mChild[s].compare_exchange_strong(expected, subNode, std::memory_order_release,
                                                        std::memory_order_relaxed))
             {
-                GrowSlot(root, s, inSubTree.mBounds);
+                GrowSlot(root, s, inSubTree.mBounds);                 // Max first, then min (see GrowSlot)
                 root.mChanged.store(true, std::memory_order_relaxed); // Rebuild hint only
-                // The root may have been replaced meanwhile: its slot in the new root is unbounded, but keep
-                // the parents' changed flags right
+                // The root may have been replaced meanwhile: keep the new parents' bounds and flags right
                 PropagateUp(rootIndex, inSubTree.mBounds);
                 return true;
             }
@@ -305,11 +312,11 @@ bool QuadTree::LinkSubTree(const SubTree& inSubTree)
         // Root full: a new root holding the old one (unbounded: its bounds are not tracked upwards) and ours
         const uint32_t newRootIndex = AllocateNode(cInvalidNode);
         if (newRootIndex == cInvalidNode) return false;
-        Node& newRoot = mNodes[newRootIndex];
+        Node& newRoot = GetNode(newRootIndex);
         InitSlot(newRoot, 0, rootIndex, AABB(Vec3::Constant(-cLargeFloat), Vec3::Constant(cLargeFloat)));
         InitSlot(newRoot, 1, subNode, inSubTree.mBounds);
-        newRoot.mChanged.store(true, std::memory_order_relaxed);                // Private node
-        mNodes[subNode].mParent.store(newRootIndex, std::memory_order_relaxed); // Still private
+        newRoot.mChanged.store(true, std::memory_order_relaxed);                 // Private node
+        GetNode(subNode).mParent.store(newRootIndex, std::memory_order_relaxed); // Still private
         uint32_t expected = rootIndex;
         // Release on success: publishes the new root and the sub-tree; relaxed on failure: we retry from a
         // fresh acquire load of the root
@@ -330,12 +337,12 @@ void QuadTree::PropagateUp(uint32_t inNode, const AABB& inBounds)
     for (;;)
     {
         // Acquire: pairs with the release store of a new root's index in LinkSubTree
-        const uint32_t parentIndex = mNodes[nodeIndex].mParent.load(std::memory_order_acquire);
+        const uint32_t parentIndex = GetNode(nodeIndex).mParent.load(std::memory_order_acquire);
         if (parentIndex == cInvalidNode) return;
-        Node& parent = mNodes[parentIndex];
+        Node& parent = GetNode(parentIndex);
         int slot = -1;
         for (int s = 0; s < 4; ++s)
-            // Relaxed: a node's slot in its parent never changes once linked, and the parent link was
+            // Relaxed: a node's slot in its parent never changes while linked, and the parent link was
             // acquired above
             if (parent.mChild[s].load(std::memory_order_relaxed) == nodeIndex) slot = s;
         if (slot < 0) return; // Cannot happen for a linked node; be safe
@@ -345,85 +352,124 @@ void QuadTree::PropagateUp(uint32_t inNode, const AABB& inBounds)
     }
 }
 
-void QuadTree::RemoveBody(BodyID inBody)
+void QuadTree::MarkChangedUp(uint32_t inNode)
+{
+    for (uint32_t n = inNode; n != cInvalidNode;)
+    {
+        Node& node = GetNode(n);
+        node.mChanged.store(true, std::memory_order_relaxed); // Hint only
+        n = node.mParent.load(std::memory_order_acquire);     // Pairs with the release in LinkSubTree
+    }
+}
+
+bool QuadTree::RemoveBody(BodyID inBody)
 {
     const uint32_t index = inBody.GetIndex();
-    if (index >= mMaxBodies) return;
+    if (index >= mBodies.GetMaxBodies()) return false;
+    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
+    QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: same-body operations are serialised by the caller
-    if (mBodySequence[index].load(std::memory_order_relaxed) != inBody.GetSequence()) return;
-    // Acquire: pairs with the release in Build, so the node is seen initialised
-    const uint32_t location = mBodyLocation[index].exchange(cInvalidLocation, std::memory_order_acquire);
-    if (location == cInvalidLocation) return;
+    if (entry.mSequence.load(std::memory_order_relaxed) != inBody.GetSequence()) return false;
+    const uint32_t location = LoadOwnLocation(entry);
+    if (location == QuadTreeBodyTable::cInvalidLocation) return false;
     const uint32_t nodeIndex = location >> 2;
     const int slot = int(location & 3);
-    Node& node = mNodes[nodeIndex];
-    // Relaxed: a reader seeing any mix of old and empty bounds reports the body or not, both allowed; only
-    // this thread writes the slot of this body
-    node.mMinX[slot].store(cLargeFloat, std::memory_order_relaxed);
-    node.mMinY[slot].store(cLargeFloat, std::memory_order_relaxed);
-    node.mMinZ[slot].store(cLargeFloat, std::memory_order_relaxed);
-    node.mMaxX[slot].store(-cLargeFloat, std::memory_order_relaxed);
-    node.mMaxY[slot].store(-cLargeFloat, std::memory_order_relaxed);
-    node.mMaxZ[slot].store(-cLargeFloat, std::memory_order_relaxed);
-    // Relaxed: leaf slots are never reused before a rebuild, so no reader or writer depends on the order
-    node.mChild[slot].store(cInvalidChild, std::memory_order_relaxed);
-    // Mark the path changed (for the future rebuild)
-    for (uint32_t n = nodeIndex; n != cInvalidNode;)
-    {
-        mNodes[n].mChanged.store(true, std::memory_order_relaxed); // Hint only
-        n = mNodes[n].mParent.load(std::memory_order_acquire);     // Pairs with the release in LinkSubTree
-    }
+    Node& node = GetNode(nodeIndex);
+    // Relaxed: the location is only read by this body's serialised operations and the rebuild commit (which
+    // runs under the exclusive lock, so after we release ours)
+    entry.mLocation.store(QuadTreeBodyTable::cInvalidLocation, std::memory_order_relaxed);
+    ClearSlot(node, slot);
+    MarkChangedUp(nodeIndex);
+    return true;
 }
 
 void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
 {
     const uint32_t index = inBody.GetIndex();
-    if (index >= mMaxBodies || !IsValidBroadPhaseBounds(inBounds)) return;
+    if (index >= mBodies.GetMaxBodies() || !IsValidBroadPhaseBounds(inBounds)) return;
+    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
+    QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: same-body operations are serialised by the caller
-    if (mBodySequence[index].load(std::memory_order_relaxed) != inBody.GetSequence()) return;
-    // Acquire: pairs with the release in Build, so the node is seen initialised
-    const uint32_t location = mBodyLocation[index].load(std::memory_order_acquire);
-    if (location == cInvalidLocation) return;
+    if (entry.mSequence.load(std::memory_order_relaxed) != inBody.GetSequence()) return;
+    const uint32_t location = LoadOwnLocation(entry);
+    if (location == QuadTreeBodyTable::cInvalidLocation) return;
     const uint32_t nodeIndex = location >> 2;
-    Node& node = mNodes[nodeIndex];
-    GrowSlot(node, int(location & 3), inBounds);
+    const int slot = int(location & 3);
+    Node& node = GetNode(nodeIndex);
+    QuadTreeBodyTable::StoreBounds(entry, inBounds);
+    // Relaxed: ordered before the release of GrowSlot's first exchange, which readers acquire
+    node.mLoose.fetch_or(uint8_t(1u << slot), std::memory_order_relaxed);
+    GrowSlot(node, slot, inBounds);
     node.mChanged.store(true, std::memory_order_relaxed); // Rebuild hint only
     // Always walk to the root (no early out when a parent already contains the box): another mover may have
     // grown a slot below without having reached the parent yet, and our bounds must be visible when we return
     PropagateUp(nodeIndex, inBounds);
 }
 
+void QuadTree::SetBodyLayer(BodyID inBody, ObjectLayer inLayer)
+{
+    const uint32_t index = inBody.GetIndex();
+    if (index >= mBodies.GetMaxBodies() || inLayer >= cMaxObjectLayers) return;
+    QuadTreeBodyTable::Entry& entry = mBodies[index];
+    // Relaxed: same-body operations are serialised; a query sees the old or the new layer
+    if (entry.mSequence.load(std::memory_order_relaxed) == inBody.GetSequence())
+        entry.mLayer.store(inLayer, std::memory_order_relaxed);
+}
+
 bool QuadTree::Contains(BodyID inBody) const
 {
     const uint32_t index = inBody.GetIndex();
-    // Relaxed: a snapshot for tests and statistics
-    return index < mMaxBodies && mBodyLocation[index].load(std::memory_order_relaxed) != cInvalidLocation &&
-           mBodySequence[index].load(std::memory_order_relaxed) == inBody.GetSequence();
+    if (index >= mBodies.GetMaxBodies()) return false;
+    const QuadTreeBodyTable::Entry& entry = mBodies[index];
+    // Relaxed: a snapshot for tests, statistics and the broad phase's own serialised calls
+    return entry.mSequence.load(std::memory_order_relaxed) == inBody.GetSequence() &&
+           LoadOwnLocation(entry) != QuadTreeBodyTable::cInvalidLocation;
+}
+
+uint32_t QuadTree::LoadOwnLocation(const QuadTreeBodyTable::Entry& inEntry) const
+{
+    // Acquire: pairs with the release in BuildSubTree and the rebuild commit, so the node is seen initialised
+    const uint32_t location = inEntry.mLocation.load(std::memory_order_acquire);
+    // Relaxed: written with the location by the same serialised operations, before its release
+    if (location >= QuadTreeBodyTable::cPendingLocation ||
+        inEntry.mTree.load(std::memory_order_relaxed) != mTreeId)
+        return QuadTreeBodyTable::cInvalidLocation;
+    return location;
+}
+
+AABB QuadTree::GetBodySlotBounds(BodyID inBody) const
+{
+    if (!Contains(inBody)) return AABB::Empty();
+    EpochReclaimer::ReadScope scope(mReclaimer);
+    const uint32_t location = LoadOwnLocation(mBodies[inBody.GetIndex()]);
+    if (location == QuadTreeBodyTable::cInvalidLocation) return AABB::Empty();
+    return LoadSlot(GetNode(location >> 2), int(location & 3));
 }
 
 AABB QuadTree::GetBodyBounds(BodyID inBody) const
 {
     if (!Contains(inBody)) return AABB::Empty();
-    // Acquire: pairs with the release in Build
-    const uint32_t location = mBodyLocation[inBody.GetIndex()].load(std::memory_order_acquire);
-    if (location == cInvalidLocation) return AABB::Empty();
-    return LoadSlot(mNodes[location >> 2], int(location & 3));
+    AABB exact;
+    if (QuadTreeBodyTable::LoadBounds(mBodies[inBody.GetIndex()], exact)) return exact;
+    return GetBodySlotBounds(inBody); // A move is being written: its slot contains the old bounds
 }
 
-template <class NodeTest, class LeafVisit>
-void QuadTree::Walk(const BroadPhaseQueryFilter& inFilter, NodeTest&& inNodeTest, LeafVisit&& inLeaf) const
+template <class Test, class LeafVisit>
+bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) const
 {
+    EpochReclaimer::ReadScope scope(mReclaimer);
+    const bool checkLayers = inMask != cAllObjectLayers;
     NodeStack stack;
-    // Acquire: pairs with the release exchange that published the root and everything below it
+    // Acquire: pairs with the release exchange or store that published the root and everything below it
     stack.Push(mRoot.load(std::memory_order_acquire));
     uint32_t nodeIndex;
     while (stack.Pop(nodeIndex))
     {
-        const Node& node = mNodes[nodeIndex];
+        const Node& node = GetNode(nodeIndex);
         for (int s = 0; s < 4; ++s)
         {
             const AABB box = LoadSlot(node, s);
-            if (IsEmptyBox(box) || !inNodeTest(box)) continue;
+            if (IsEmptyBox(box) || !inTest(box)) continue;
             // Acquire: pairs with the release exchange in LinkSubTree that published a sub-tree here
             const uint32_t child = node.mChild[s].load(std::memory_order_acquire);
             if (child == cInvalidChild) continue;
@@ -433,21 +479,29 @@ void QuadTree::Walk(const BroadPhaseQueryFilter& inFilter, NodeTest&& inNodeTest
                 continue;
             }
             const uint32_t index = child & ~cBodyFlag;
+            const QuadTreeBodyTable::Entry& entry = mBodies[index];
+            // Relaxed: MoveBody set the bit before the release of the growth we may have acquired above
+            if ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u)
+            {
+                // The slot may be wider than the body: test its exact bounds (the slot, which contains the
+                // old bounds, was already tested when a move is being written)
+                AABB exact;
+                if (QuadTreeBodyTable::LoadBounds(entry, exact) && !inTest(exact)) continue;
+            }
             // Relaxed: written before the sub-tree was published (acquired above); a concurrent re-add of
             // the index is reported with its old or new id, both allowed
-            if (!IsInLayerMask(inFilter.mObjectLayers, mBodyLayer[index].load(std::memory_order_relaxed)))
-                continue;
-            const BodyID id(index, mBodySequence[index].load(std::memory_order_relaxed)); // As above
-            if (!inLeaf(id)) return;
+            if (checkLayers && !IsInLayerMask(inMask, entry.mLayer.load(std::memory_order_relaxed))) continue;
+            const BodyID id(index, entry.mSequence.load(std::memory_order_relaxed)); // As above
+            if (!inLeaf(id)) return false;
         }
     }
+    return true;
 }
 
-void QuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
-                            BodyVisitor inVisitor) const
+void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const
 {
     Walk(
-        inFilter, [&](const AABB& inNode) { return AABBsOverlap(inNode, inBox); },
+        inMask, [&](const AABB& inNode) { return AABBsOverlap(inNode, inBox); },
         [&](BodyID inID)
         {
             inVisitor(inID);
@@ -455,11 +509,11 @@ void QuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFi
         });
 }
 
-void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, const BroadPhaseQueryFilter& inFilter,
+void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask,
                              BodyVisitor inVisitor) const
 {
     Walk(
-        inFilter, [&](const AABB& inNode) { return SphereOverlapsAABB(inCenter, inRadius, inNode); },
+        inMask, [&](const AABB& inNode) { return SphereOverlapsAABB(inCenter, inRadius, inNode); },
         [&](BodyID inID)
         {
             inVisitor(inID);
@@ -467,11 +521,10 @@ void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, const BroadPh
         });
 }
 
-void QuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
-                            BodyVisitor inVisitor) const
+void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor) const
 {
     Walk(
-        inFilter, [&](const AABB& inNode) { return AABBContains(inNode, inPoint); },
+        inMask, [&](const AABB& inNode) { return AABBContains(inNode, inPoint); },
         [&](BodyID inID)
         {
             inVisitor(inID);
@@ -479,25 +532,105 @@ void QuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& in
         });
 }
 
-void QuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
+bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMaxFraction,
                        RayBodyVisitor inVisitor) const
 {
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
-    float maxFraction = 1.0f;
-    float fraction = 0.0f; // Entry fraction of the slot last accepted by the node test
-    Walk(
-        inFilter,
-        [&](const AABB& inNode)
+    float fraction = 0.0f; // Entry fraction of the box last accepted by the test
+    return Walk(
+        inMask,
+        [&](const AABB& inBox)
         {
-            fraction = inNode.RayEntryFraction(inRay.mOrigin, invDirection, maxFraction);
-            return fraction <= maxFraction;
+            fraction = inBox.RayEntryFraction(inRay.mOrigin, invDirection, ioMaxFraction);
+            return fraction <= ioMaxFraction;
         },
         [&](BodyID inID)
         {
             // The visitor can only shrink the range, as in the other broad phases
-            maxFraction = std::min(maxFraction, inVisitor(inID, fraction));
-            return maxFraction >= 0.0f;
+            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, fraction));
+            return ioMaxFraction >= 0.0f;
         });
+}
+
+bool QuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
+                         float& ioMaxFraction, RayBodyVisitor inVisitor) const
+{
+    const SweptAABox sweep(inBox, inDisplacement);
+    float fraction = 0.0f; // Entry fraction of the box last accepted by the test
+    return Walk(
+        inMask,
+        [&](const AABB& inTarget)
+        {
+            fraction = sweep.EntryFraction(inTarget, ioMaxFraction);
+            return fraction <= ioMaxFraction;
+        },
+        [&](BodyID inID)
+        {
+            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, fraction));
+            return ioMaxFraction >= 0.0f;
+        });
+}
+
+QuadTree::MemoryStats QuadTree::GetMemoryStats() const
+{
+    MemoryStats stats;
+    stats.mNodesInUse = mAllocator.GetNumAllocated();
+    stats.mNodesRetired = mNumRetired.load(std::memory_order_relaxed); // Statistic only
+    stats.mNodeBytesInUse = size_t(stats.mNodesInUse) * sizeof(Node);
+    const uint32_t numChunks = (mAllocator.GetCapacity() + cChunkSize - 1) >> cChunkShift;
+    for (uint32_t i = 0; i < numChunks; ++i)
+        if (mChunks[i].load(std::memory_order_relaxed) != nullptr) // Statistic only
+            stats.mNodeBytesBacked += size_t(cChunkSize) * sizeof(Node);
+    return stats;
+}
+
+int64_t QuadTree::Validate() const
+{
+    auto BoxContains = [](const AABB& inOuter, const AABB& inInner)
+    {
+        return (inOuter.mMin.array() <= inInner.mMin.array()).all() &&
+               (inInner.mMax.array() <= inOuter.mMax.array()).all();
+    };
+    // Single-threaded (tests): relaxed loads throughout
+    int64_t bodies = 0;
+    NodeStack stack;
+    const uint32_t root = mRoot.load(std::memory_order_relaxed);
+    if (GetNode(root).mParent.load(std::memory_order_relaxed) != cInvalidNode) return -1;
+    stack.Push(root);
+    uint32_t nodeIndex;
+    while (stack.Pop(nodeIndex))
+    {
+        const Node& node = GetNode(nodeIndex);
+        for (int s = 0; s < 4; ++s)
+        {
+            const uint32_t child = node.mChild[s].load(std::memory_order_relaxed);
+            const AABB slot = LoadSlot(node, s);
+            if (child == cInvalidChild) continue;
+            if ((child & cBodyFlag) != 0)
+            {
+                const uint32_t index = child & ~cBodyFlag;
+                if (mBodies[index].mLocation.load(std::memory_order_relaxed) !=
+                    (nodeIndex << 2 | uint32_t(s)))
+                    return -1;
+                AABB exact;
+                if (!QuadTreeBodyTable::LoadBounds(mBodies[index], exact) || !BoxContains(slot, exact))
+                    return -1;
+                ++bodies;
+                continue;
+            }
+            const Node& childNode = GetNode(child);
+            if (childNode.mParent.load(std::memory_order_relaxed) != nodeIndex) return -1;
+            for (int c = 0; c < 4; ++c)
+            {
+                const AABB childSlot = LoadSlot(childNode, c);
+                if (childNode.mChild[c].load(std::memory_order_relaxed) != cInvalidChild &&
+                    !IsEmptyBox(childSlot) && !BoxContains(slot, childSlot))
+                    return -1;
+            }
+            stack.Push(child);
+        }
+    }
+    return bodies;
 }
 
 } // namespace cairn

@@ -4,6 +4,7 @@
 // nothing.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 #include "common/AllocationCounter.h"
 
@@ -103,6 +104,19 @@ TEST(BroadPhaseAllocationTest, BruteForceQueriesDoNotAllocate)
 TEST(BroadPhaseAllocationTest, SortAndSweepQueriesDoNotAllocate)
 {
     BroadPhaseSortAndSweep broadPhase(2000, LayerSetup::CreateDefault());
+    ExpectNoAllocations(broadPhase);
+}
+
+TEST(BroadPhaseAllocationTest, QuadTreeQueriesDoNotAllocate)
+{
+    BroadPhaseQuadTree broadPhase(2000, LayerSetup::CreateDefault());
+    ExpectNoAllocations(broadPhase);
+}
+
+TEST(BroadPhaseAllocationTest, QuadTreeGlobalMutexQueriesDoNotAllocate)
+{
+    BroadPhaseQuadTree broadPhase(2000, LayerSetup::CreateDefault(),
+                                  BroadPhaseQuadTree::LockMode::GlobalMutex);
     ExpectNoAllocations(broadPhase);
 }
 

@@ -4,6 +4,7 @@
 // tested.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 
 #include <algorithm>
@@ -25,6 +26,20 @@ template <> std::unique_ptr<BroadPhase> Make<BroadPhaseBruteForce>()
 template <> std::unique_ptr<BroadPhase> Make<BroadPhaseSortAndSweep>()
 {
     return std::make_unique<BroadPhaseSortAndSweep>(1000, LayerSetup::CreateDefault());
+}
+
+/// The quad tree in its global-mutex mode, as its own type for the typed tests.
+struct QuadTreeGlobalMutex
+{
+};
+template <> std::unique_ptr<BroadPhase> Make<BroadPhaseQuadTree>()
+{
+    return std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault());
+}
+template <> std::unique_ptr<BroadPhase> Make<QuadTreeGlobalMutex>()
+{
+    return std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault(),
+                                                BroadPhaseQuadTree::LockMode::GlobalMutex);
 }
 
 template <class T> class BroadPhaseCasesTest : public ::testing::Test
@@ -83,7 +98,8 @@ protected:
     std::unique_ptr<BroadPhase> mBroadPhase;
 };
 
-using Implementations = ::testing::Types<BroadPhaseBruteForce, BroadPhaseSortAndSweep>;
+using Implementations =
+    ::testing::Types<BroadPhaseBruteForce, BroadPhaseSortAndSweep, BroadPhaseQuadTree, QuadTreeGlobalMutex>;
 TYPED_TEST_SUITE(BroadPhaseCasesTest, Implementations);
 
 const AABB cUnitBox(Vec3(0, 0, 0), Vec3(1, 1, 1));

@@ -12,8 +12,10 @@ namespace cairn
 
 enum class BroadPhaseType : uint8_t
 {
-    BruteForce,   ///< The reference: every query tests every body (tests only)
-    SortAndSweep, ///< Sorted along x, the default until the quad tree lands
+    BruteForce,          ///< The reference: every query tests every body (tests only)
+    SortAndSweep,        ///< Sorted along x: the previous default, kept as a second reference
+    QuadTree,            ///< Lock-free quad trees, one per broad-phase layer: the default
+    QuadTreeGlobalMutex, ///< The same trees behind one global reader-writer mutex (the "before" mode)
 };
 
 struct PhysicsSettings
@@ -25,7 +27,7 @@ struct PhysicsSettings
     bool mAllowSleeping = true;
     float mTimeBeforeSleep = 0.5f; ///< s an island must stay slow before it sleeps
     float mSleepVelocity = 0.05f;  ///< m/s: the fastest point of a body must stay below this
-    BroadPhaseType mBroadPhase = BroadPhaseType::SortAndSweep;
+    BroadPhaseType mBroadPhase = BroadPhaseType::QuadTree;
 };
 
 /// What the last Update did and how long each phase took (summed over its collision steps).

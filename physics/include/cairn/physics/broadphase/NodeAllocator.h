@@ -1,7 +1,9 @@
 #pragma once
 
 // NodeAllocator: a fixed-capacity pool of node indices [0, capacity) with a lock-free free list, so that
-// adding bodies to the quad tree never calls the heap allocator on the hot path.
+// adding bodies to the quad tree never calls the heap allocator on the hot path. Indices never used before
+// come from a high-water mark, so they are handed out in increasing order and the caller can back them with
+// storage lazily (the quad tree allocates node chunks as the mark passes them).
 //
 // Threads: Allocate and Free may be called from any thread at any time, concurrently.
 // Lock-free: the free list is a Treiber stack. The head is one 64-bit atomic holding (tag << 32 | index);
@@ -13,6 +15,7 @@
 // The allocator hands out indices only; the caller owns the node storage and must not free an index that a
 // concurrent reader may still follow (the quad tree frees only nodes that were never published).
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -30,9 +33,8 @@ public:
         : mCapacity(inCapacity), mNext(std::make_unique<std::atomic<uint32_t>[]>(inCapacity))
     {
         // Single-threaded construction: relaxed is enough, the object is published by whoever shares it
-        for (uint32_t i = 0; i < inCapacity; ++i)
-            mNext[i].store(i + 1 < inCapacity ? i + 1 : cInvalidIndex, std::memory_order_relaxed);
-        mHead.store(inCapacity > 0 ? 0 : cInvalidIndex, std::memory_order_relaxed); // Construction: see above
+        mHead.store(cInvalidIndex, std::memory_order_relaxed);
+        mHighWater.store(0, std::memory_order_relaxed);    // Construction: see above
         mNumAllocated.store(0, std::memory_order_relaxed); // Statistic only, see GetNumAllocated
     }
 
@@ -47,7 +49,7 @@ public:
         for (;;)
         {
             const uint32_t index = uint32_t(head);
-            if (index == cInvalidIndex) return cInvalidIndex;
+            if (index == cInvalidIndex) return AllocateFresh();
             // Relaxed: the acquire on the head already ordered this after the push that wrote it; a stale
             // value only happens when the head changed, and then the tagged compare-exchange below fails
             const uint32_t next = mNext[index].load(std::memory_order_relaxed);
@@ -84,6 +86,13 @@ public:
         }
     }
 
+    /// Indices ever handed out are below this (the storage the caller must back).
+    uint32_t GetHighWater() const
+    {
+        // Relaxed: a statistic; Allocate's callers learn their own index directly
+        return std::min(mHighWater.load(std::memory_order_relaxed), mCapacity);
+    }
+
     /// Capacity given at construction.
     uint32_t GetCapacity() const { return mCapacity; }
 
@@ -94,9 +103,25 @@ public:
     }
 
 private:
+    /// An index never handed out before, or cInvalidIndex when the capacity is used up.
+    uint32_t AllocateFresh()
+    {
+        // Relaxed: the counter only has to hand out distinct values; the index's storage is the caller's
+        const uint32_t index = mHighWater.fetch_add(1, std::memory_order_relaxed);
+        if (index >= mCapacity)
+        {
+            mHighWater.store(mCapacity,
+                             std::memory_order_relaxed); // Keep it from wrapping; any order is fine
+            return cInvalidIndex;
+        }
+        mNumAllocated.fetch_add(1, std::memory_order_relaxed); // Statistic only
+        return index;
+    }
+
     uint32_t mCapacity;                             ///< Number of indices managed
     std::unique_ptr<std::atomic<uint32_t>[]> mNext; ///< Free list link of each free index
     std::atomic<uint64_t> mHead;                    ///< (ABA tag << 32) | first free index
+    std::atomic<uint32_t> mHighWater;               ///< Indices below it have been handed out at least once
     std::atomic<uint32_t> mNumAllocated;            ///< Statistic
 };
 

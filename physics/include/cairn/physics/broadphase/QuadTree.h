@@ -1,34 +1,52 @@
 #pragma once
 
-// QuadTree: a lock-free 4-wide bounding volume tree of bodies (the building block of the quad-tree broad
-// phase, after Jolt's design: see ../shared/reference/talk-architecting-jolt-gdc2022.txt).
+// QuadTree: a lock-free 4-wide bounding volume tree of bodies, one per broad-phase layer of
+// BroadPhaseQuadTree (after the design in ../shared/reference/talk-architecting-jolt-gdc2022.txt).
 //
-// Threads:
-//  - BuildSubTree / FreeSubTree: any thread, concurrently with everything; they only touch nodes that are not
-//    reachable from the root yet (allocated from the lock-free NodeAllocator).
-//  - LinkSubTree, RemoveBody, MoveBody, queries: any thread, concurrently with each other. The caller
-//    serialises operations on the same body (add, remove and move of one body index never overlap).
+// Threads and locks:
+//  - Queries (CollideAABox, CollideSphere, CollidePoint, CastRay, CastAABox, GetBodyBounds): any thread, any
+//    time, no lock. A query runs inside an EpochReclaimer read section, so no node it can reach is freed
+//    under it; it never waits.
+//  - BuildSubTree / FreeSubTree: any thread, no lock; they only touch nodes not reachable from the root.
+//  - LinkSubTree, RemoveBody, MoveBody: any thread, concurrently with each other and with queries. They take
+//    this tree's StripedSharedMutex shared (their own stripe: no contention between them) only to keep out of
+//    the rebuild's short commit. The caller serialises operations on one body.
+//  - Rebuild and CollectGarbage: one thread at a time (the physics update), concurrently with everything
+//  else.
+//    A rebuild builds the new tree off the live one with no lock, then commits (relocates the bodies it
+//    moved, re-parents kept nodes, links what was linked meanwhile, swaps the root) under the exclusive side
+//    of the modification lock: modifiers may wait for that commit (measured by the broad-phase benchmark),
+//    queries never do. Old nodes are retired by epoch and freed by a later CollectGarbage.
 // Why lock-free is safe:
 //  - A sub-tree is built privately and published with one compare-exchange (release) of a child slot or of
-//    the root index; readers load child indices with acquire, so they see the fully built nodes.
-//  - A slot being published starts with empty bounds and only grows (atomic min/max), so a reader sees either
-//    no sub-tree or a sub-tree with bounds that contain everything below it once the linker has finished.
-//  - Bounds only ever grow until a rebuild (MoveBody uses atomic min on mins and max on maxes and walks to
-//    the root), so a concurrent query may see bounds that are too wide, never too narrow for the body's
-//    previous or new bounds. Removal sets a slot empty; queries then report the body or not.
-//  - Published nodes are never freed (only a rebuild, not implemented yet, would retire them by generation),
-//    so a reader never follows an index into a recycled node.
+//    the root index; readers load child indices with acquire, so they see fully built nodes.
+//  - A slot being published starts empty and only grows (atomic min/max), so a reader sees either no sub-tree
+//    or one with bounds containing everything below it once the linker has finished.
+//  - Slot bounds only grow until a rebuild (MoveBody: atomic min on mins, max on maxes, up to the root), so a
+//    query may see bounds that are too wide, never too narrow for the body's previous or new bounds. A slot
+//    that grew is marked loose and queries then test the body's exact bounds from the QuadTreeBodyTable.
+//  - Removal empties the slot; a concurrent query reports the body or not.
+//  - Nodes are freed only after every read section that might reach them has ended (EpochReclaimer).
 // Queries allocate nothing: fixed-size traversal stack (spilling to the heap only for degenerate depths).
 
 #include "cairn/physics/broadphase/BroadPhase.h"
+#include "cairn/physics/broadphase/EpochReclaimer.h"
 #include "cairn/physics/broadphase/NodeAllocator.h"
+#include "cairn/physics/broadphase/QuadTreeBodyTable.h"
+#include "cairn/physics/broadphase/StripedSharedMutex.h"
 
 #include <atomic>
 #include <memory>
 #include <span>
+#include <vector>
 
 namespace cairn
 {
+
+namespace quadtree
+{
+struct BuildItem;
+}
 
 class QuadTree
 {
@@ -38,12 +56,11 @@ public:
     static constexpr uint32_t cBodyFlag = 0x80000000u;
     static constexpr uint32_t cInvalidNode = NodeAllocator::cInvalidIndex;
 
-    /// One node: four child slots, each with its bounds. Every field is atomic because readers traverse
-    /// while writers grow bounds and fill slots.
+    /// One node: four child slots, each with its bounds in SIMD layout. Every field is atomic because
+    /// readers traverse while writers grow bounds and fill slots. 120 bytes.
     struct Node
     {
-        std::atomic<float>
-            mMinX[4]; ///< Slot bounds; an empty slot has min = +cLargeFloat, max = -cLargeFloat
+        std::atomic<float> mMinX[4];     ///< Slot bounds; an empty slot has min = +cLargeFloat, max = -large
         std::atomic<float> mMinY[4];     ///< See mMinX
         std::atomic<float> mMinZ[4];     ///< See mMinX
         std::atomic<float> mMaxX[4];     ///< See mMinX
@@ -51,90 +68,162 @@ public:
         std::atomic<float> mMaxZ[4];     ///< See mMinX
         std::atomic<uint32_t> mChild[4]; ///< Tagged child: node index, cBodyFlag | body index, or invalid
         std::atomic<uint32_t> mParent;   ///< Parent node index or cInvalidNode for a root
-        std::atomic<bool> mChanged;      ///< Bounds or children changed since the last rebuild (hint)
+        std::atomic<bool> mChanged;      ///< Bounds or children changed since the last rebuild
+        std::atomic<uint8_t> mLoose;     ///< Bit s: slot s holds a body whose slot bounds may be too wide
     };
 
     /// A prepared, not yet linked sub-tree.
     struct SubTree
     {
-        uint32_t mChild = cInvalidChild; ///< What goes in the slot: a node or a single body
+        uint32_t mChild = cInvalidChild; ///< Root node of the sub-tree, or invalid when empty
         AABB mBounds;                    ///< Bounds of everything in it
+        uint32_t mNumBodies = 0;         ///< Bodies in it
     };
 
-    /// inMaxBodies: body indices must be < inMaxBodies (< cBodyFlag). inMaxNodes: node pool size.
-    QuadTree(uint32_t inMaxBodies, uint32_t inMaxNodes);
+    /// What a rebuild did.
+    struct RebuildStats
+    {
+        bool mRebuilt = false;          ///< False when nothing had changed (or the node pool ran out)
+        bool mOutOfNodes = false;       ///< The pool could not hold the new tree; the old one stays
+        uint32_t mRelocatedBodies = 0;  ///< Bodies moved to new leaves
+        uint32_t mKeptNodes = 0;        ///< Unchanged sub-trees kept whole
+        uint32_t mNewNodes = 0;         ///< Nodes of the new tree
+        uint32_t mRetiredNodes = 0;     ///< Old nodes handed to the reclaimer
+        double mCommitMicroseconds = 0; ///< Time under the exclusive modification lock
+    };
+
+    /// Node memory.
+    struct MemoryStats
+    {
+        uint32_t mNodesInUse = 0;    ///< Allocated (live, prepared or retired)
+        uint32_t mNodesRetired = 0;  ///< Waiting for the reclaimer
+        size_t mNodeBytesInUse = 0;  ///< mNodesInUse * sizeof(Node)
+        size_t mNodeBytesBacked = 0; ///< Storage allocated for nodes (chunks)
+    };
+
+    /// ioBodies: the body table shared by the trees of one broad phase (must outlive the tree). inTreeId:
+    /// this tree's id in the table (distinct per tree sharing it). inMaxNodes: node pool capacity (storage is
+    /// allocated in chunks as the pool's high-water mark grows).
+    QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes);
+    ~QuadTree();
     QuadTree(const QuadTree&) = delete;
     QuadTree& operator=(const QuadTree&) = delete;
 
-    /// Builds a sub-tree of inBodies off the live tree and records each body's location and id. Bodies
-    /// with invalid bounds or indices are skipped. Returns an empty SubTree (mChild invalid) when nothing
-    /// valid was given or the node pool ran out (then nothing is allocated).
+    /// Builds a sub-tree of inBodies off the live tree and records each body's location, id and exact bounds.
+    /// Bodies with invalid bounds, indices or layers, and bodies already present in any tree of the table,
+    /// are skipped. Returns an empty SubTree when nothing valid was given or the node pool ran out.
     SubTree BuildSubTree(std::span<const BroadPhaseBody> inBodies);
-    /// Returns the nodes of an unlinked sub-tree to the pool and forgets its bodies' locations.
+    /// Returns the nodes of an unlinked sub-tree to the pool and forgets its bodies.
     void FreeSubTree(const SubTree& inSubTree);
     /// Makes a built sub-tree visible in O(1). Returns false only if the node pool is exhausted when the
     /// root is full (the sub-tree is then still owned by the caller).
     bool LinkSubTree(const SubTree& inSubTree);
 
-    /// Removes a linked body; ignored when inBody is not in the tree (exact id).
-    void RemoveBody(BodyID inBody);
-    /// Grows the linked body's bounds to encapsulate inBounds (bounds only grow until a rebuild).
+    /// Removes a linked body; false (ignored) when inBody is not in this tree (exact id).
+    bool RemoveBody(BodyID inBody);
+    /// Stores the body's new exact bounds and grows its slot (and the parents') to contain them.
     void MoveBody(BodyID inBody, const AABB& inBounds);
+    /// Sets the object layer of a linked body (same broad-phase layer).
+    void SetBodyLayer(BodyID inBody, ObjectLayer inLayer);
 
-    /// Bodies whose slot bounds overlap inBox.
-    void CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const;
-    /// Bodies whose slot bounds overlap the sphere.
-    void CollideSphere(const Vec3& inCenter, float inRadius, const BroadPhaseQueryFilter& inFilter,
+    /// Rebuilds the changed parts (everything when inFull) into a new tree and swaps it in. Update thread.
+    RebuildStats Rebuild(bool inFull);
+    /// Advances the reclaimer and frees retired nodes that no query can reach any more. Update thread.
+    void CollectGarbage();
+
+    /// Bodies whose exact bounds overlap inBox. inMask: object layers to report.
+    void CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const;
+    /// Bodies whose exact bounds are within inRadius of inCenter.
+    void CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask,
                        BodyVisitor inVisitor) const;
-    /// Bodies whose slot bounds contain inPoint.
-    void CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
-                      BodyVisitor inVisitor) const;
-    /// Bodies whose slot bounds the segment enters before the visitor's current maximum fraction.
-    void CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const;
+    /// Bodies whose exact bounds contain inPoint.
+    void CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor) const;
+    /// Bodies whose exact bounds the segment enters before ioMaxFraction (which the visitor can lower; a
+    /// negative value stops). Returns false when the visitor stopped the cast.
+    bool CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMaxFraction,
+                 RayBodyVisitor inVisitor) const;
+    /// Bodies whose exact bounds the swept box touches before ioMaxFraction; as CastRay.
+    bool CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
+                   float& ioMaxFraction, RayBodyVisitor inVisitor) const;
 
-    /// True when the body (exact id) is in a built or linked sub-tree.
+    /// True when the body (exact id) is in a built or linked sub-tree of this tree.
     bool Contains(BodyID inBody) const;
-    /// Current slot bounds of a body in the tree (empty if absent). For tests and statistics.
+    /// Bounds of a body of this tree: exact when readable, else its slot bounds (a superset); empty if
+    /// absent.
     AABB GetBodyBounds(BodyID inBody) const;
+    /// Current slot bounds of a body (the grown ones). For tests.
+    AABB GetBodySlotBounds(BodyID inBody) const;
     /// Node pool usage.
-    uint32_t GetNumAllocatedNodes() const { return mAllocator.GetNumAllocated(); }
+    MemoryStats GetMemoryStats() const;
+    /// Checks the structure (parents, body locations, slot bounds containing children); for single-threaded
+    /// tests. Returns the number of bodies reachable from the root, or -1 on the first violation.
+    int64_t Validate() const;
 
 private:
-    static constexpr uint32_t cInvalidLocation = 0xffffffffu; ///< mBodyLocation of an absent body
-
-    /// Body entry of the build: index into the input plus its centre.
-    struct BuildItem
+    /// Nodes retired by one rebuild, freed when the reclaimer says no reader can reach them.
+    struct RetiredBatch
     {
-        uint32_t mInput;
-        Vec3 mCenter;
+        uint64_t mEpoch;              ///< Epoch when the nodes became unreachable for new readers
+        std::vector<uint32_t> mNodes; ///< Node indices to free
     };
+    using LeafCallback = FunctionRef<void(const quadtree::BuildItem& inItem, uint32_t inNode, int inSlot)>;
 
-    /// Recursively builds [inBegin, inEnd) (non-empty) and returns the slot value and bounds. Returns an
-    /// invalid child if the pool ran out (nodes allocated so far are listed in the tree and freed by caller).
-    SubTree Build(std::span<const BroadPhaseBody> inBodies, BuildItem* inBegin, BuildItem* inEnd,
-                  uint32_t inParent, bool& ioOutOfNodes);
-    /// Sets a slot of a node that is not published yet.
-    void InitSlot(Node& ioNode, int inSlot, uint32_t inChild, const AABB& inBounds);
-    /// Allocates a node with four empty slots and the given parent.
+    /// Builds private nodes over ioItems (reordered): split at the midpoint of the longest axis of the
+    /// centres, four groups per node, recursively. inOnLeaf is called for every placed item. Returns the root
+    /// and its bounds, or an invalid child when out of nodes. Every allocated node is appended to ioNewNodes.
+    SubTree BuildNodes(std::span<quadtree::BuildItem> ioItems, std::vector<uint32_t>& ioNewNodes,
+                       LeafCallback inOnLeaf);
+    /// Recursive part of BuildNodes for [inBegin, inEnd) (non-empty).
+    SubTree BuildRange(quadtree::BuildItem* inBegin, quadtree::BuildItem* inEnd, uint32_t inParent,
+                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf);
+
+    static constexpr uint32_t cChunkShift = 10; ///< Nodes are stored in chunks of 1,024 (123 KB)
+    static constexpr uint32_t cChunkSize = 1u << cChunkShift;
+
+    Node& GetNode(uint32_t inIndex) const;
+    /// Allocates a node with four empty slots and the given parent (storage backed on demand).
     uint32_t AllocateNode(uint32_t inParent);
+    /// Sets a slot of a node that is not published yet.
+    static void InitSlot(Node& ioNode, int inSlot, uint32_t inChild, const AABB& inBounds);
     /// Grows slot inSlot of inNode by inBounds with atomic min/max.
     static void GrowSlot(Node& ioNode, int inSlot, const AABB& inBounds);
-    /// Slot bounds as read now (each float atomically, relaxed).
+    /// Empties a slot (bounds and child).
+    static void ClearSlot(Node& ioNode, int inSlot);
+    /// Slot bounds as read now (each float atomically).
     static AABB LoadSlot(const Node& inNode, int inSlot);
     /// Grows the slot holding inNode in its parent, and so on up to the root; marks every node changed.
     void PropagateUp(uint32_t inNode, const AABB& inBounds);
-    /// Depth-first walk: inNodeTest(AABB) -> bool decides descent and leaf reports; inLeaf(BodyID) -> bool
-    /// returns false to stop.
-    template <class NodeTest, class LeafVisit>
-    void Walk(const BroadPhaseQueryFilter& inFilter, NodeTest&& inNodeTest, LeafVisit&& inLeaf) const;
+    /// Marks inNode and its ancestors changed.
+    void MarkChangedUp(uint32_t inNode);
+    /// Depth-first walk under a read section. inTest(AABB) -> bool decides descent and, on the exact bounds,
+    /// leaf reports; inLeaf(BodyID) -> bool returns false to stop. Returns false when stopped.
+    template <class Test, class LeafVisit>
+    bool Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) const;
 
-    uint32_t mMaxBodies;                                    ///< Size of the per-body arrays
-    NodeAllocator mAllocator;                               ///< Hands out node indices
-    std::unique_ptr<Node[]> mNodes;                         ///< Node storage, indexed by node index
-    std::atomic<uint32_t> mRoot;                            ///< Current root node
-    std::unique_ptr<std::atomic<uint32_t>[]> mBodyLocation; ///< Body index -> node << 2 | slot, or invalid
-    std::unique_ptr<std::atomic<uint32_t>[]> mBodySequence; ///< Body index -> sequence of the stored id
-    std::unique_ptr<std::atomic<uint8_t>[]> mBodyLayer;     ///< Body index -> object layer
+    /// The body's location when it is in this tree (acquire), else cInvalidLocation.
+    uint32_t LoadOwnLocation(const QuadTreeBodyTable::Entry& inEntry) const;
+    /// Number of sub-trees linked into the root chain since phase 1 of a rebuild. Rebuild commit only.
+    uint32_t CountLateSubTrees(uint32_t inOldRoot) const;
+    /// Links the unmarked sub-trees that linkers put into the old root chain during a rebuild into the new
+    /// (private) root, using the spare nodes for new roots. Rebuild commit only.
+    uint32_t LinkLateSubTrees(uint32_t inOldRoot, uint32_t inNewRoot, std::vector<uint32_t>& ioSpares,
+                              std::vector<uint32_t>& ioRetired);
+    bool IsMarked(uint32_t inNode) const
+    {
+        return inNode < mRebuildMark.size() && mRebuildMark[inNode] == mRebuildStamp;
+    }
+
+    QuadTreeBodyTable& mBodies;                    ///< Shared per-body records
+    uint8_t mTreeId;                               ///< This tree's id in mBodies
+    NodeAllocator mAllocator;                      ///< Hands out node indices
+    std::unique_ptr<std::atomic<Node*>[]> mChunks; ///< Node storage, allocated on demand
+    std::atomic<uint32_t> mRoot;                   ///< Current root node
+    StripedSharedMutex mModificationLock;          ///< Shared: modifiers; exclusive: rebuild commit
+    EpochReclaimer mReclaimer;                     ///< Read sections of queries
+    std::vector<RetiredBatch> mRetired;            ///< Update thread only: nodes waiting to be freed
+    std::atomic<uint32_t> mNumRetired{0};          ///< Statistic: nodes in mRetired
+    std::vector<uint32_t> mRebuildMark;            ///< Update thread only: node -> rebuild stamp
+    uint32_t mRebuildStamp = 0;                    ///< Update thread only
 };
 
 } // namespace cairn

@@ -1,0 +1,136 @@
+#pragma once
+
+// BroadPhaseQuadTree: the engine's broad phase. One lock-free QuadTree per broad-phase layer (static and
+// moving by default), sharing one QuadTreeBodyTable; every query is filtered by object layer and tested
+// against exact body bounds, so it returns exactly what BroadPhaseBruteForce returns.
+//
+// Threads and locks (LockMode::LockFree, the default):
+//  - Queries: any thread, any time, no lock (an epoch read section per tree; never waits).
+//  - AddBodiesPrepare/Abort: any thread, no lock (builds private sub-trees, one per layer of the batch).
+//  - AddBodiesFinalize (O(1) per layer: one compare-exchange), RemoveBodies, NotifyBodiesAABBChanged: any
+//    thread; each tree's modification lock is taken shared (per-thread stripe) only to stay out of a
+//    rebuild's commit. The caller serialises operations on one body.
+//  - Update (rebuild of changed parts + freeing of old nodes) and FindCollidingPairs: the physics step only.
+//    mActiveScratch belongs to FindCollidingPairs.
+// LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
+// and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
+// comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
+//
+// Bad input (the BodyInterface validates first; these are caller bugs) is ignored, never stored: invalid ids,
+// indices >= inMaxBodies, unknown object layers, non-finite or inverted bounds (assert in debug), a body
+// index that is already present or prepared (the first add stays), removing or moving a body that is not
+// present.
+
+#include "cairn/physics/broadphase/BroadPhase.h"
+#include "cairn/physics/broadphase/QuadTree.h"
+#include "cairn/physics/broadphase/WriterFairSharedMutex.h"
+
+#include <array>
+#include <memory>
+#include <vector>
+
+namespace cairn
+{
+
+class BroadPhaseQuadTree final : public BroadPhase
+{
+public:
+    enum class LockMode : uint8_t
+    {
+        LockFree,   ///< Lock-free trees, epoch read sections (the engine's mode)
+        GlobalMutex ///< One reader-writer mutex around the whole broad phase (for comparison)
+    };
+
+    /// What the last Update did, summed over the layers.
+    struct UpdateStats
+    {
+        uint32_t mLayersRebuilt = 0;       ///< Trees that had changes
+        uint32_t mRelocatedBodies = 0;     ///< Bodies put into new leaves
+        uint32_t mKeptNodes = 0;           ///< Unchanged sub-trees kept whole
+        double mMaxCommitMicroseconds = 0; ///< Longest exclusive commit (what a modifier may wait)
+        bool mOutOfNodes = false;          ///< A rebuild was skipped for lack of nodes (retried next update)
+    };
+
+    /// Memory of the whole broad phase.
+    struct MemoryStats
+    {
+        size_t mBodyTableBytes = 0;  ///< Per-body records (sized by inMaxBodies)
+        size_t mNodeBytesInUse = 0;  ///< Nodes allocated, old (retired) trees included
+        size_t mNodeBytesBacked = 0; ///< Node storage allocated (chunks)
+        uint32_t mNodesInUse = 0;    ///< Nodes allocated
+        uint32_t mNodesRetired = 0;  ///< Of which waiting to be freed
+        size_t mNodeSize = 0;        ///< Bytes per node
+    };
+
+    /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +
+    /// 1,024 nodes per layer (the new and old trees of a fully changed layer fit twice over).
+    BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers,
+                       LockMode inMode = LockMode::LockFree);
+    ~BroadPhaseQuadTree() override;
+    BroadPhaseQuadTree(const BroadPhaseQuadTree&) = delete;
+    BroadPhaseQuadTree& operator=(const BroadPhaseQuadTree&) = delete;
+
+    /// Builds one private sub-tree per broad-phase layer of the batch; no lock.
+    AddState AddBodiesPrepare(std::span<const BroadPhaseBody> inBodies) override;
+    /// Links each prepared sub-tree in O(1).
+    void AddBodiesFinalize(AddState inState) override;
+    /// Frees the prepared sub-trees.
+    void AddBodiesAbort(AddState inState) override;
+    /// Empties each body's slot and marks its path changed.
+    void RemoveBodies(std::span<const BodyID> inBodies) override;
+    /// Stores the exact bounds and grows the slots up to the root. A body whose object layer moved it to
+    /// another broad-phase layer is moved to that tree.
+    void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
+    /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
+    void Update() override;
+    /// Update with a full rebuild of every tree (benchmarks, level loads).
+    void RebuildAll();
+
+    void CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
+                      BodyVisitor inVisitor) const override;
+    void CollideSphere(const Vec3& inCenter, float inRadius, const BroadPhaseQueryFilter& inFilter,
+                       BodyVisitor inVisitor) const override;
+    void CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
+                      BodyVisitor inVisitor) const override;
+    void CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
+                 RayBodyVisitor inVisitor) const override;
+    void CastAABox(const AABB& inBox, const Vec3& inDisplacement, const BroadPhaseQueryFilter& inFilter,
+                   RayBodyVisitor inVisitor) const override;
+    /// Each present active body's exact bounds against the trees of the layers it collides with; a pair of
+    /// two active bodies is reported once (by the lower index). Physics step only.
+    void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
+                            BodyPairVisitor inVisitor) const override;
+
+    size_t GetBodyCount() const override;
+
+    LockMode GetLockMode() const { return mMode; }
+    const UpdateStats& GetLastUpdateStats() const { return mLastUpdate; }
+    MemoryStats GetMemoryStats() const;
+    /// Validates every tree (single-threaded tests); false on the first violation or a count mismatch.
+    bool Validate() const;
+
+private:
+    struct Batch;
+
+    /// The tree a body of object layer inLayer lives in.
+    QuadTree& TreeOf(ObjectLayer inLayer) const { return *mTrees[mLayerSetup.GetBroadPhaseLayer(inLayer)]; }
+    /// Object-layer mask to pass to tree inTree for a query filtered by inMask (all layers when the filter
+    /// lets every layer of the tree through, so the tree skips the per-body layer check); 0 to skip the tree.
+    ObjectLayerMask MaskForTree(uint32_t inTree, ObjectLayerMask inMask) const;
+    void UpdateImpl(bool inFull);
+    void RemoveBody(BodyID inBody);
+    void MoveBody(const BroadPhaseBody& inBody);
+
+    const uint32_t mMaxBodies;                     ///< Body indices are below this
+    const LayerSetup mLayerSetup;                  ///< Copy of the constructor's setup; immutable
+    const LockMode mMode;                          ///< Chosen at construction
+    QuadTreeBodyTable mBodies;                     ///< Shared by the trees
+    std::vector<std::unique_ptr<QuadTree>> mTrees; ///< One per broad-phase layer; the vector is immutable
+    std::array<ObjectLayerMask, cMaxBroadPhaseLayers> mObjectLayersOfTree{}; ///< Immutable
+    std::atomic<int64_t> mBodyCount{0};          ///< Bodies linked (relaxed: a statistic)
+    mutable WriterFairSharedMutex mGlobalMutex;  ///< LockMode::GlobalMutex only
+    mutable std::vector<uint8_t> mActiveScratch; ///< FindCollidingPairs only (physics step)
+    UpdateStats mLastUpdate;                     ///< Physics step only
+};
+
+} // namespace cairn

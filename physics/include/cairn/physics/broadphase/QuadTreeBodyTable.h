@@ -1,0 +1,94 @@
+#pragma once
+
+// QuadTreeBodyTable: what the quad-tree broad phase knows of each body index, shared by the trees of all
+// broad-phase layers (a body lives in exactly one of them): where its leaf is, its id's sequence, its object
+// layer and its exact world AABB. The trees' slot bounds may be wider than a body (they only grow until a
+// rebuild); queries test the exact bounds here when a slot is marked loose, so they report exactly the
+// bodies whose current AABB matches.
+//
+// Threads: every field is atomic. A body's entry is written by whoever adds, moves or removes it (the caller
+// serialises operations on one body) and by the rebuild commit (under the tree's exclusive modification
+// lock); it is read by queries on any thread.
+// Exact bounds use a sequence lock that readers never wait on: a writer makes the version odd, writes the six
+// floats, makes it even; a reader that sees an odd or changed version falls back to the slot bounds, which
+// contain the body's old bounds (a move in progress may be reported with its old state, as allowed).
+
+#include "cairn/physics/math/AABB.h"
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+namespace cairn
+{
+
+class QuadTreeBodyTable
+{
+public:
+    static constexpr uint32_t cInvalidLocation = 0xffffffffu; ///< Not in any tree
+    static constexpr uint32_t cPendingLocation = 0xfffffffeu; ///< Claimed by a batch being prepared
+
+    /// Per-body record; 40 bytes.
+    struct Entry
+    {
+        std::atomic<uint32_t> mLocation{cInvalidLocation}; ///< node << 2 | slot, or one of the markers above
+        std::atomic<uint32_t> mSequence{0};                ///< Sequence of the stored id
+        std::atomic<uint32_t> mVersion{0};                 ///< Sequence lock of the bounds; odd while written
+        std::atomic<float> mBounds[6] = {0, 0, 0, 0, 0, 0}; ///< Exact min xyz, max xyz
+        std::atomic<uint8_t> mLayer{0};                     ///< Object layer
+        std::atomic<uint8_t> mTree{0xff};                   ///< Id of the tree whose node mLocation names
+    };
+
+    explicit QuadTreeBodyTable(uint32_t inMaxBodies)
+        : mMaxBodies(inMaxBodies), mEntries(std::make_unique<Entry[]>(inMaxBodies))
+    {
+    }
+
+    uint32_t GetMaxBodies() const { return mMaxBodies; }
+    Entry& operator[](uint32_t inIndex) { return mEntries[inIndex]; }
+    const Entry& operator[](uint32_t inIndex) const { return mEntries[inIndex]; }
+
+    /// Stores exact bounds. Only the thread that owns the body's current operation calls it.
+    static void StoreBounds(Entry& ioEntry, const AABB& inBounds)
+    {
+        // Relaxed load: only this thread writes the version
+        const uint32_t version = ioEntry.mVersion.load(std::memory_order_relaxed);
+        ioEntry.mVersion.store(version + 1, std::memory_order_relaxed);
+        // Release fence: a reader that sees any of the new floats (and then fences) sees the odd version
+        std::atomic_thread_fence(std::memory_order_release);
+        for (int i = 0; i < 3; ++i)
+        {
+            // Relaxed: ordered by the fence above and the release store below
+            ioEntry.mBounds[i].store(inBounds.mMin[i], std::memory_order_relaxed);
+            ioEntry.mBounds[i + 3].store(inBounds.mMax[i], std::memory_order_relaxed);
+        }
+        // Release: a reader that acquires the even version sees the six floats
+        ioEntry.mVersion.store(version + 2, std::memory_order_release);
+    }
+
+    /// Reads exact bounds; false when a write was in progress (the caller then uses a conservative box).
+    static bool LoadBounds(const Entry& inEntry, AABB& outBounds)
+    {
+        // Acquire: pairs with the release store of the even version
+        const uint32_t before = inEntry.mVersion.load(std::memory_order_acquire);
+        if ((before & 1) != 0) return false;
+        for (int i = 0; i < 3; ++i)
+        {
+            // Relaxed: checked by the version re-read below
+            outBounds.mMin[i] = inEntry.mBounds[i].load(std::memory_order_relaxed);
+            outBounds.mMax[i] = inEntry.mBounds[i + 3].load(std::memory_order_relaxed);
+        }
+        // Acquire fence: the float loads above happen before the version re-read below
+        std::atomic_thread_fence(std::memory_order_acquire);
+        return inEntry.mVersion.load(std::memory_order_relaxed) == before; // Ordered by the fence
+    }
+
+    /// Bytes used by the table.
+    size_t GetMemoryBytes() const { return size_t(mMaxBodies) * sizeof(Entry); }
+
+private:
+    uint32_t mMaxBodies;
+    std::unique_ptr<Entry[]> mEntries;
+};
+
+} // namespace cairn

@@ -1,0 +1,297 @@
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+
+#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
+
+#include <cassert>
+#include <mutex>
+#include <shared_mutex>
+
+namespace cairn
+{
+
+/// A prepared batch: one private sub-tree per broad-phase layer. Owned by the caller until finalized/aborted.
+struct BroadPhaseQuadTree::Batch
+{
+    std::array<QuadTree::SubTree, cMaxBroadPhaseLayers> mSubTrees;
+};
+
+namespace
+{
+
+/// Takes the global mutex in GlobalMutex mode, nothing otherwise.
+template <class Lock> Lock LockIf(bool inLock, WriterFairSharedMutex& inMutex)
+{
+    return inLock ? Lock(inMutex) : Lock(inMutex, std::defer_lock);
+}
+
+} // namespace
+
+BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers, LockMode inMode)
+    : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
+      mBodies(mMaxBodies), mActiveScratch(mMaxBodies, 0)
+{
+    const uint32_t maxNodes = uint32_t(std::min<uint64_t>(2ull * mMaxBodies + 1024, 1u << 30));
+    for (uint32_t layer = 0; layer < mLayerSetup.GetNumBroadPhaseLayers(); ++layer)
+    {
+        mTrees.push_back(std::make_unique<QuadTree>(mBodies, uint8_t(layer), maxNodes));
+        mObjectLayersOfTree[layer] = mLayerSetup.GetObjectLayersIn(BroadPhaseLayer(layer));
+    }
+}
+
+BroadPhaseQuadTree::~BroadPhaseQuadTree() = default;
+
+ObjectLayerMask BroadPhaseQuadTree::MaskForTree(uint32_t inTree, ObjectLayerMask inMask) const
+{
+    const ObjectLayerMask inTreeMask = mObjectLayersOfTree[inTree];
+    if ((inTreeMask & inMask) == 0) return 0;
+    return (inTreeMask & ~inMask) == 0 ? cAllObjectLayers : inMask;
+}
+
+BroadPhase::AddState BroadPhaseQuadTree::AddBodiesPrepare(std::span<const BroadPhaseBody> inBodies)
+{
+    // Split by broad-phase layer; off the hot path (loading thread), so the heap is fine here
+    std::array<std::vector<BroadPhaseBody>, cMaxBroadPhaseLayers> perLayer;
+    for (const BroadPhaseBody& body : inBodies)
+    {
+        const bool ok = !body.mID.IsInvalid() && body.mID.GetIndex() < mMaxBodies &&
+                        mLayerSetup.IsValid(body.mLayer) && IsValidBroadPhaseBounds(body.mBounds);
+        assert(ok && "BroadPhaseQuadTree: invalid body id, object layer or bounds");
+        if (ok) perLayer[mLayerSetup.GetBroadPhaseLayer(body.mLayer)].push_back(body);
+    }
+    auto batch = std::make_unique<Batch>();
+    for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
+        if (!perLayer[layer].empty()) batch->mSubTrees[layer] = mTrees[layer]->BuildSubTree(perLayer[layer]);
+    return batch.release();
+}
+
+void BroadPhaseQuadTree::AddBodiesFinalize(AddState inState)
+{
+    if (inState == nullptr) return;
+    std::unique_ptr<Batch> batch(static_cast<Batch*>(inState));
+    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
+    {
+        const QuadTree::SubTree& subTree = batch->mSubTrees[layer];
+        if (subTree.mChild == QuadTree::cInvalidChild) continue;
+        if (!mTrees[layer]->LinkSubTree(subTree))
+        {
+            // The pool (2 nodes per body) cannot run out in practice; never lose bodies silently
+            assert(false && "BroadPhaseQuadTree: node pool exhausted");
+            mTrees[layer]->FreeSubTree(subTree);
+            continue;
+        }
+        mBodyCount.fetch_add(subTree.mNumBodies, std::memory_order_relaxed); // Statistic
+    }
+}
+
+void BroadPhaseQuadTree::AddBodiesAbort(AddState inState)
+{
+    if (inState == nullptr) return;
+    std::unique_ptr<Batch> batch(static_cast<Batch*>(inState));
+    for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
+        mTrees[layer]->FreeSubTree(batch->mSubTrees[layer]);
+}
+
+void BroadPhaseQuadTree::RemoveBody(BodyID inBody)
+{
+    if (inBody.IsInvalid() || inBody.GetIndex() >= mMaxBodies) return;
+    // Relaxed: the caller serialises operations on this body, so its layer is stable
+    const ObjectLayer layer = mBodies[inBody.GetIndex()].mLayer.load(std::memory_order_relaxed);
+    if (!mLayerSetup.IsValid(layer)) return;
+    if (TreeOf(layer).RemoveBody(inBody)) mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Statistic
+}
+
+void BroadPhaseQuadTree::RemoveBodies(std::span<const BodyID> inBodies)
+{
+    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (BodyID id : inBodies)
+        RemoveBody(id);
+}
+
+void BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
+{
+    const uint32_t index = inBody.mID.GetIndex();
+    const bool ok = !inBody.mID.IsInvalid() && index < mMaxBodies && mLayerSetup.IsValid(inBody.mLayer) &&
+                    IsValidBroadPhaseBounds(inBody.mBounds);
+    assert(ok && "BroadPhaseQuadTree: invalid body id, object layer or bounds");
+    if (!ok) return;
+    // Relaxed: the caller serialises operations on this body
+    const ObjectLayer oldLayer = mBodies[index].mLayer.load(std::memory_order_relaxed);
+    if (!mLayerSetup.IsValid(oldLayer)) return;
+    QuadTree& oldTree = TreeOf(oldLayer);
+    if (!oldTree.Contains(inBody.mID)) return;
+    QuadTree& newTree = TreeOf(inBody.mLayer);
+    if (&oldTree == &newTree)
+    {
+        if (oldLayer != inBody.mLayer) oldTree.SetBodyLayer(inBody.mID, inBody.mLayer);
+        oldTree.MoveBody(inBody.mID, inBody.mBounds);
+        return;
+    }
+    // Another broad-phase layer: the slow path, a remove and a one-body add
+    oldTree.RemoveBody(inBody.mID);
+    const QuadTree::SubTree subTree = newTree.BuildSubTree(std::span(&inBody, 1));
+    if (!newTree.LinkSubTree(subTree))
+    {
+        assert(false && "BroadPhaseQuadTree: node pool exhausted");
+        newTree.FreeSubTree(subTree);
+        mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Statistic
+    }
+}
+
+void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
+{
+    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (const BroadPhaseBody& body : inBodies)
+        MoveBody(body);
+}
+
+void BroadPhaseQuadTree::Update()
+{
+    UpdateImpl(false);
+}
+
+void BroadPhaseQuadTree::RebuildAll()
+{
+    UpdateImpl(true);
+}
+
+void BroadPhaseQuadTree::UpdateImpl(bool inFull)
+{
+    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    mLastUpdate = {};
+    for (const std::unique_ptr<QuadTree>& tree : mTrees)
+    {
+        tree->CollectGarbage();
+        const QuadTree::RebuildStats stats = tree->Rebuild(inFull);
+        mLastUpdate.mLayersRebuilt += stats.mRebuilt ? 1 : 0;
+        mLastUpdate.mRelocatedBodies += stats.mRelocatedBodies;
+        mLastUpdate.mKeptNodes += stats.mKeptNodes;
+        mLastUpdate.mMaxCommitMicroseconds =
+            std::max(mLastUpdate.mMaxCommitMicroseconds, stats.mCommitMicroseconds);
+        mLastUpdate.mOutOfNodes |= stats.mOutOfNodes;
+    }
+}
+
+void BroadPhaseQuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
+                                      BodyVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
+            mTrees[tree]->CollideAABox(inBox, mask, inVisitor);
+}
+
+void BroadPhaseQuadTree::CollideSphere(const Vec3& inCenter, float inRadius,
+                                       const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
+            mTrees[tree]->CollideSphere(inCenter, inRadius, mask, inVisitor);
+}
+
+void BroadPhaseQuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
+                                      BodyVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
+            mTrees[tree]->CollidePoint(inPoint, mask, inVisitor);
+}
+
+void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
+                                 RayBodyVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    float maxFraction = 1.0f; // Shared by the trees, so a close hit in one prunes the others
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
+            if (!mTrees[tree]->CastRay(inRay, mask, maxFraction, inVisitor)) return;
+}
+
+void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
+                                   const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    float maxFraction = 1.0f; // As in CastRay
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
+            if (!mTrees[tree]->CastAABox(inBox, inDisplacement, mask, maxFraction, inVisitor)) return;
+}
+
+void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
+                                            const LayerSetup& inLayers, BodyPairVisitor inVisitor) const
+{
+    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    auto isPresent = [&](BodyID inID)
+    {
+        if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies) return false;
+        // Relaxed: the step owns the active bodies' operations while it runs
+        const ObjectLayer layer = mBodies[inID.GetIndex()].mLayer.load(std::memory_order_relaxed);
+        return mLayerSetup.IsValid(layer) && TreeOf(layer).Contains(inID);
+    };
+    // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
+    for (BodyID id : inActiveBodies)
+        if (isPresent(id)) mActiveScratch[id.GetIndex()] = 1;
+
+    for (BodyID id : inActiveBodies)
+    {
+        if (!isPresent(id)) continue;
+        const uint32_t selfIndex = id.GetIndex();
+        const ObjectLayer selfLayer = mBodies[selfIndex].mLayer.load(std::memory_order_relaxed); // See above
+        const AABB bounds = TreeOf(selfLayer).GetBodyBounds(id);
+        const ObjectLayerMask collidesWith = inLayers.GetCollisionMask(selfLayer);
+        for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+        {
+            const ObjectLayerMask mask = MaskForTree(tree, collidesWith);
+            if (mask == 0) continue;
+            mTrees[tree]->CollideAABox(bounds, mask,
+                                       [&](BodyID inOther)
+                                       {
+                                           const uint32_t otherIndex = inOther.GetIndex();
+                                           // Skip itself; of two active bodies the lower index reports
+                                           if (otherIndex != selfIndex &&
+                                               (mActiveScratch[otherIndex] == 0 || otherIndex > selfIndex))
+                                               inVisitor(id, inOther);
+                                       });
+        }
+    }
+
+    for (BodyID id : inActiveBodies)
+        if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mActiveScratch[id.GetIndex()] = 0;
+}
+
+size_t BroadPhaseQuadTree::GetBodyCount() const
+{
+    return size_t(std::max<int64_t>(0, mBodyCount.load(std::memory_order_relaxed))); // Statistic
+}
+
+BroadPhaseQuadTree::MemoryStats BroadPhaseQuadTree::GetMemoryStats() const
+{
+    MemoryStats stats;
+    stats.mBodyTableBytes = mBodies.GetMemoryBytes() + mActiveScratch.size();
+    stats.mNodeSize = sizeof(QuadTree::Node);
+    for (const std::unique_ptr<QuadTree>& tree : mTrees)
+    {
+        const QuadTree::MemoryStats treeStats = tree->GetMemoryStats();
+        stats.mNodeBytesInUse += treeStats.mNodeBytesInUse;
+        stats.mNodeBytesBacked += treeStats.mNodeBytesBacked;
+        stats.mNodesInUse += treeStats.mNodesInUse;
+        stats.mNodesRetired += treeStats.mNodesRetired;
+    }
+    return stats;
+}
+
+bool BroadPhaseQuadTree::Validate() const
+{
+    int64_t total = 0;
+    for (const std::unique_ptr<QuadTree>& tree : mTrees)
+    {
+        const int64_t count = tree->Validate();
+        if (count < 0) return false;
+        total += count;
+    }
+    return total == mBodyCount.load(std::memory_order_relaxed); // Single-threaded: any order
+}
+
+} // namespace cairn

@@ -1,0 +1,297 @@
+// QuadTree::Rebuild and the reclamation of old nodes (see QuadTree.h for the threading rules).
+//
+// A rebuild has two phases:
+//  1. Build, with no lock, concurrently with queries, moves, removes and links: walk the live tree from the
+//     root, descending only into Changed nodes (all of them for a full rebuild). An unchanged node is kept
+//     whole, as one object; a body of a changed node becomes one object with its exact bounds. The objects
+//     are built into new private nodes with the same midpoint split as a batch add.
+//  2. Commit, under the exclusive side of the modification lock (so no move, remove or link runs), in
+//  O(bodies
+//     relocated + nodes kept):
+//     a. kept nodes get their new parents; one that changed during phase 1 pushes its bounds up the new tree;
+//     b. each relocated body that is still where phase 1 found it gets its current exact bounds in its new
+//        slot and its new location; one that was removed meanwhile leaves an empty slot;
+//     c. sub-trees that linkers put into the old root chain during phase 1 are linked into the new root;
+//     d. the root index is swapped (release), and the replaced nodes are retired with the current epoch.
+//  Queries never wait: before the swap they read the old tree, which is complete and unchanged by the commit;
+//  after it the new one, which already holds every modification made before the commit.
+
+#include "QuadTreeInternal.h"
+#include "cairn/physics/broadphase/QuadTree.h"
+
+#include <chrono>
+
+namespace cairn
+{
+
+using quadtree::BuildItem;
+using quadtree::NodeStack;
+
+namespace
+{
+
+/// Union of a node's four slot bounds as read now.
+AABB UnionOfSlots(const QuadTree::Node& inNode)
+{
+    AABB bounds;
+    for (int s = 0; s < 4; ++s)
+    {
+        // Acquire: pairs with the releases of GrowSlot
+        const AABB slot(Vec3(inNode.mMinX[s].load(std::memory_order_acquire),
+                             inNode.mMinY[s].load(std::memory_order_acquire),
+                             inNode.mMinZ[s].load(std::memory_order_acquire)),
+                        Vec3(inNode.mMaxX[s].load(std::memory_order_acquire),
+                             inNode.mMaxY[s].load(std::memory_order_acquire),
+                             inNode.mMaxZ[s].load(std::memory_order_acquire)));
+        if (!quadtree::IsEmptyBox(slot)) bounds.Encapsulate(slot);
+    }
+    return bounds;
+}
+
+} // namespace
+
+QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
+{
+    RebuildStats stats;
+    // Acquire: we read the tree below the root
+    const uint32_t oldRoot = mRoot.load(std::memory_order_acquire);
+    // Relaxed: a hint; a change we miss now is seen by the next rebuild
+    if (!inFull && !GetNode(oldRoot).mChanged.load(std::memory_order_relaxed)) return stats;
+
+    // Phase 1: collect objects (no lock)
+    ++mRebuildStamp;
+    if (mRebuildMark.size() < mAllocator.GetHighWater()) mRebuildMark.resize(mAllocator.GetHighWater(), 0);
+    std::vector<BuildItem> items;
+    std::vector<uint32_t> replaced;
+    NodeStack stack;
+    stack.Push(oldRoot);
+    mRebuildMark[oldRoot] = mRebuildStamp;
+    replaced.push_back(oldRoot);
+    uint32_t nodeIndex;
+    while (stack.Pop(nodeIndex))
+    {
+        const Node& node = GetNode(nodeIndex);
+        for (int s = 0; s < 4; ++s)
+        {
+            // Acquire: pairs with the release exchange in LinkSubTree
+            const uint32_t child = node.mChild[s].load(std::memory_order_acquire);
+            if (child == cInvalidChild) continue;
+            if ((child & cBodyFlag) != 0)
+            {
+                AABB bounds;
+                if (!QuadTreeBodyTable::LoadBounds(mBodies[child & ~cBodyFlag], bounds))
+                    bounds = LoadSlot(node, s); // Being moved: the commit sets the exact bounds
+                items.push_back({child, bounds, bounds.Center(), nodeIndex << 2 | uint32_t(s)});
+                continue;
+            }
+            const Node& childNode = GetNode(child);
+            if (child >= mRebuildMark.size()) mRebuildMark.resize(mAllocator.GetHighWater(), 0);
+            mRebuildMark[child] = mRebuildStamp;
+            // Relaxed: a hint; a node that changes after this read is handled by the commit (step a)
+            const AABB bounds = UnionOfSlots(childNode);
+            if (!inFull && !childNode.mChanged.load(std::memory_order_relaxed) && !bounds.IsEmpty())
+            {
+                items.push_back({child, bounds, bounds.Center(), QuadTreeBodyTable::cInvalidLocation});
+                continue;
+            }
+            replaced.push_back(child);
+            stack.Push(child);
+        }
+    }
+
+    // Build the new tree (no lock): relocations and re-parentings are applied by the commit
+    struct Relocation
+    {
+        uint32_t mBody, mOldLocation, mNewLocation;
+    };
+    struct Reparent
+    {
+        uint32_t mNode, mParent;
+    };
+    std::vector<Relocation> relocations;
+    std::vector<Reparent> reparents;
+    std::vector<uint32_t> newNodes;
+    const SubTree built =
+        BuildNodes(items, newNodes,
+                   [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
+                   {
+                       if ((inItem.mChild & cBodyFlag) != 0)
+                           relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
+                                                  inNode << 2 | uint32_t(inSlot)});
+                       else
+                           reparents.push_back({inItem.mChild, inNode});
+                   });
+    auto freeNew = [&](const std::vector<uint32_t>& inNodes)
+    {
+        for (uint32_t node : inNodes)
+            mAllocator.Free(node); // Never published
+    };
+    if (built.mChild == cInvalidChild)
+    {
+        freeNew(newNodes);
+        stats.mOutOfNodes = true;
+        return stats;
+    }
+
+    // Phase 2: commit
+    const auto commitStart = std::chrono::steady_clock::now();
+    {
+        std::unique_lock lock(mModificationLock);
+        // Nodes for the new root levels that the sub-trees linked during the build may need, allocated before
+        // anything live changes, so that running out of nodes can still abort cleanly
+        std::vector<uint32_t> spares;
+        const uint32_t numLate = CountLateSubTrees(oldRoot);
+        for (uint32_t i = 0; i < (numLate + 2) / 3 + 1; ++i)
+        {
+            const uint32_t spare = AllocateNode(cInvalidNode);
+            if (spare == cInvalidNode)
+            {
+                lock.unlock();
+                freeNew(spares);
+                freeNew(newNodes);
+                stats.mOutOfNodes = true;
+                return stats;
+            }
+            spares.push_back(spare);
+        }
+
+        // a. Kept nodes hang below the new tree now
+        for (const Reparent& reparent : reparents)
+            // Release: a mover walking up (acquire) after the swap finds its new parent's initialised slots
+            GetNode(reparent.mNode).mParent.store(reparent.mParent, std::memory_order_release);
+        for (const Reparent& reparent : reparents)
+        {
+            const Node& kept = GetNode(reparent.mNode);
+            // Relaxed: modifiers are excluded; their writes happened before they released the lock we hold
+            if (kept.mChanged.load(std::memory_order_relaxed))
+                PropagateUp(reparent.mNode, UnionOfSlots(kept));
+        }
+
+        // b. Bodies move to their new leaves with their current bounds
+        for (const Relocation& relocation : relocations)
+        {
+            QuadTreeBodyTable::Entry& entry = mBodies[relocation.mBody];
+            const uint32_t newNode = relocation.mNewLocation >> 2;
+            const int newSlot = int(relocation.mNewLocation & 3);
+            // Relaxed: modifiers are excluded (see above)
+            if (entry.mLocation.load(std::memory_order_relaxed) == relocation.mOldLocation &&
+                entry.mTree.load(std::memory_order_relaxed) == mTreeId)
+            {
+                AABB exact;
+                QuadTreeBodyTable::LoadBounds(entry, exact); // No writer can be inside: always consistent
+                InitSlot(GetNode(newNode), newSlot, cBodyFlag | relocation.mBody, exact);
+                PropagateUp(newNode, exact); // Grows the private ancestors if it moved during the build
+                // Release: a modifier that acquires the location sees the new node's contents
+                entry.mLocation.store(relocation.mNewLocation, std::memory_order_release);
+                ++stats.mRelocatedBodies;
+            }
+            else
+            {
+                ClearSlot(GetNode(newNode), newSlot); // Removed during the build
+                MarkChangedUp(newNode);
+            }
+        }
+
+        // c. Sub-trees linked during the build
+        uint32_t newRoot = built.mChild;
+        newRoot = LinkLateSubTrees(oldRoot, newRoot, spares, replaced);
+
+        // d. Swap; the old nodes are retired, not freed: queries may still be in them
+        // Release: readers that acquire the root see the whole new tree
+        mRoot.store(newRoot, std::memory_order_release);
+        lock.unlock();
+        freeNew(spares); // The ones not used
+    }
+    stats.mCommitMicroseconds =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - commitStart).count();
+    stats.mRebuilt = true;
+    stats.mKeptNodes = uint32_t(reparents.size());
+    stats.mNewNodes = uint32_t(newNodes.size());
+    stats.mRetiredNodes = uint32_t(replaced.size());
+    mNumRetired.fetch_add(uint32_t(replaced.size()), std::memory_order_relaxed); // Statistic only
+    mRetired.push_back({mReclaimer.GetEpoch(), std::move(replaced)});
+    return stats;
+}
+
+uint32_t QuadTree::CountLateSubTrees(uint32_t inOldRoot) const
+{
+    uint32_t count = 0;
+    // Relaxed: called under the commit's exclusive lock, which excludes every other writer
+    for (uint32_t chainNode = mRoot.load(std::memory_order_relaxed);;)
+    {
+        const Node& node = GetNode(chainNode);
+        const bool isOldRoot = chainNode == inOldRoot;
+        for (int s = isOldRoot ? 0 : 1; s < 4; ++s)
+        {
+            const uint32_t child = node.mChild[s].load(std::memory_order_relaxed); // Writers excluded
+            count += child != cInvalidChild && (child & cBodyFlag) == 0 && !IsMarked(child) ? 1 : 0;
+        }
+        if (isOldRoot) return count;
+        chainNode = node.mChild[0].load(std::memory_order_relaxed); // The previous root
+    }
+}
+
+uint32_t QuadTree::LinkLateSubTrees(uint32_t inOldRoot, uint32_t inNewRoot, std::vector<uint32_t>& ioSpares,
+                                    std::vector<uint32_t>& ioRetired)
+{
+    // Linkers only ever put sub-trees into the current root; a full root gets a new root whose slot 0 is the
+    // previous root. So everything linked since phase 1 is in the chain from the live root down to inOldRoot.
+    uint32_t newRoot = inNewRoot;
+    // Relaxed: modifiers (the only writers of the root besides us) are excluded by the commit's lock
+    uint32_t chainNode = mRoot.load(std::memory_order_relaxed);
+    for (;;)
+    {
+        const Node& node = GetNode(chainNode);
+        const bool isOldRoot = chainNode == inOldRoot;
+        if (!isOldRoot) ioRetired.push_back(chainNode);
+        for (int s = isOldRoot ? 0 : 1; s < 4; ++s)
+        {
+            const uint32_t child = node.mChild[s].load(std::memory_order_relaxed); // Writers excluded
+            if (child == cInvalidChild || (child & cBodyFlag) != 0 || IsMarked(child)) continue;
+            const AABB bounds = LoadSlot(node, s);
+            // Put it in a free slot of the new root, or give the new root a parent first
+            Node* root = &GetNode(newRoot);
+            int freeSlot = -1;
+            for (int r = 0; r < 4 && freeSlot < 0; ++r)
+                if (root->mChild[r].load(std::memory_order_relaxed) == cInvalidChild) freeSlot = r; // Private
+            if (freeSlot < 0)
+            {
+                // Never empty: the commit reserved a level for every 3 late sub-trees
+                const uint32_t above = ioSpares.back();
+                ioSpares.pop_back();
+                InitSlot(GetNode(above), 0, newRoot, UnionOfSlots(*root));
+                GetNode(newRoot).mParent.store(above, std::memory_order_relaxed); // Private until the swap
+                newRoot = above;
+                root = &GetNode(newRoot);
+                freeSlot = 1;
+            }
+            InitSlot(*root, freeSlot, child, bounds);
+            // Release: a mover walking up after the swap sees the new root's slot
+            GetNode(child).mParent.store(newRoot, std::memory_order_release);
+        }
+        if (isOldRoot) break;
+        chainNode = node.mChild[0].load(std::memory_order_relaxed); // The previous root
+    }
+    return newRoot;
+}
+
+void QuadTree::CollectGarbage()
+{
+    mReclaimer.TryAdvance();
+    size_t kept = 0;
+    for (RetiredBatch& batch : mRetired)
+    {
+        if (!mReclaimer.IsSafeToFree(batch.mEpoch))
+        {
+            mRetired[kept++] = std::move(batch);
+            continue;
+        }
+        for (uint32_t node : batch.mNodes)
+            mAllocator.Free(node);
+        mNumRetired.fetch_sub(uint32_t(batch.mNodes.size()), std::memory_order_relaxed); // Statistic only
+    }
+    mRetired.resize(kept);
+    mReclaimer.TryAdvance(); // A second step, so that this update's retirees can go at the next one
+}
+
+} // namespace cairn
