@@ -147,16 +147,22 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
             sliceIDs.push_back(mBodies.TryGetBodyAtIndex(index)->GetID());
 
         mPairs.clear();
-        mBroadPhase.FindCollidingPairs(
-            sliceIDs, mLayers,
-            [&](BodyID inActive, BodyID inOther)
-            {
-                const Body* other = mBodies.TryGetBody(inOther);
-                // Pairs with bodies of an earlier round were collided then
-                if (other == nullptr || (other->IsActive() && other->GetActiveIndex() < begin)) return;
-                mPairs.push_back({std::min(inActive.GetIndex(), inOther.GetIndex()),
-                                  std::max(inActive.GetIndex(), inOther.GetIndex())});
-            });
+        mBroadPhase.FindCollidingPairs(sliceIDs, mLayers,
+                                       [&](BodyID inActive, BodyID inOther)
+                                       {
+                                           const Body* other = mBodies.TryGetBody(inOther);
+                                           // A body whose batch another thread is finalizing is already in
+                                           // the broad phase (the link is lock-free) but not yet in the
+                                           // world: its adder waits for the body lock this step holds. It
+                                           // takes part from the next step on. Pairs with bodies of an
+                                           // earlier round were collided then.
+                                           if (other == nullptr || !other->IsInWorld() ||
+                                               (other->IsActive() && other->GetActiveIndex() < begin))
+                                               return;
+                                           mPairs.push_back(
+                                               {std::min(inActive.GetIndex(), inOther.GetIndex()),
+                                                std::max(inActive.GetIndex(), inOther.GetIndex())});
+                                       });
         // Canonical order: the same scene gives the same contacts whatever order the broad phase reports
         std::sort(mPairs.begin(), mPairs.end(),
                   [](const BodyPair& inL, const BodyPair& inR)

@@ -55,7 +55,10 @@ Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
         return MakeError(ErrorCode::AlreadyAdded, "body is already in the world");
     body->UpdateBounds();
     const BroadPhaseBody entry = ToBroadPhase(*body);
-    mBroadPhase.AddBodiesFinalize(mBroadPhase.AddBodiesPrepare({&entry, 1}));
+    BroadPhase::AddState state = mBroadPhase.AddBodiesPrepare({&entry, 1});
+    if (state == nullptr)
+        return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this body");
+    mBroadPhase.AddBodiesFinalize(state);
     body->mInWorld = true;
     if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     return Status::Ok();
@@ -140,6 +143,11 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
         return error;
     }
     batch.mState = mBroadPhase.AddBodiesPrepare(batch.mBodies);
+    if (batch.mState == nullptr)
+    {
+        undo();
+        return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this batch");
+    }
     return batch;
 }
 

@@ -30,10 +30,14 @@ BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& i
     : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
       mBodies(mMaxBodies), mActiveScratch(mMaxBodies, 0)
 {
-    const uint32_t maxNodes = uint32_t(std::min<uint64_t>(2ull * mMaxBodies + 1024, 1u << 30));
+    // A full rebuild needs at most ~1.4 nodes per body (4-wide, at least one body per leaf slot group);
+    // batches may not take the last 2 per body, so a rebuild always finds its nodes. Storage is backed on
+    // demand.
+    const uint32_t rebuildReserve = uint32_t(std::min<uint64_t>(2ull * mMaxBodies + 1024, 1u << 28));
+    const uint32_t maxNodes = 2 * rebuildReserve;
     for (uint32_t layer = 0; layer < mLayerSetup.GetNumBroadPhaseLayers(); ++layer)
     {
-        mTrees.push_back(std::make_unique<QuadTree>(mBodies, uint8_t(layer), maxNodes));
+        mTrees.push_back(std::make_unique<QuadTree>(mBodies, uint8_t(layer), maxNodes, rebuildReserve));
         mObjectLayersOfTree[layer] = mLayerSetup.GetObjectLayersIn(BroadPhaseLayer(layer));
     }
 }
@@ -60,7 +64,22 @@ BroadPhase::AddState BroadPhaseQuadTree::AddBodiesPrepare(std::span<const BroadP
     }
     auto batch = std::make_unique<Batch>();
     for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
-        if (!perLayer[layer].empty()) batch->mSubTrees[layer] = mTrees[layer]->BuildSubTree(perLayer[layer]);
+    {
+        if (perLayer[layer].empty()) continue;
+        batch->mSubTrees[layer] = mTrees[layer]->BuildSubTree(perLayer[layer]);
+        // Valid bodies but no sub-tree: the layer's node pool is out of nodes (bodies already present are
+        // skipped silently, as documented, and give a sub-tree of the others or an empty one)
+        bool anyNew = false;
+        for (const BroadPhaseBody& body : perLayer[layer])
+            // Relaxed: the caller owns these bodies' operations
+            anyNew |= mBodies[body.mID.GetIndex()].mLocation.load(std::memory_order_relaxed) ==
+                      QuadTreeBodyTable::cInvalidLocation;
+        if (batch->mSubTrees[layer].mChild == QuadTree::cInvalidChild && anyNew)
+        {
+            AddBodiesAbort(batch.release());
+            return nullptr;
+        }
+    }
     return batch.release();
 }
 
@@ -73,13 +92,7 @@ void BroadPhaseQuadTree::AddBodiesFinalize(AddState inState)
     {
         const QuadTree::SubTree& subTree = batch->mSubTrees[layer];
         if (subTree.mChild == QuadTree::cInvalidChild) continue;
-        if (!mTrees[layer]->LinkSubTree(subTree))
-        {
-            // The pool (2 nodes per body) cannot run out in practice; never lose bodies silently
-            assert(false && "BroadPhaseQuadTree: node pool exhausted");
-            mTrees[layer]->FreeSubTree(subTree);
-            continue;
-        }
+        mTrees[layer]->LinkSubTree(subTree);
         mBodyCount.fetch_add(subTree.mNumBodies, std::memory_order_relaxed); // Statistic
     }
 }
@@ -130,12 +143,10 @@ void BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
     // Another broad-phase layer: the slow path, a remove and a one-body add
     oldTree.RemoveBody(inBody.mID);
     const QuadTree::SubTree subTree = newTree.BuildSubTree(std::span(&inBody, 1));
-    if (!newTree.LinkSubTree(subTree))
-    {
-        assert(false && "BroadPhaseQuadTree: node pool exhausted");
-        newTree.FreeSubTree(subTree);
-        mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Statistic
-    }
+    if (subTree.mChild == QuadTree::cInvalidChild)
+        mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Out of nodes: the body left the broad phase
+    else
+        newTree.LinkSubTree(subTree);
 }
 
 void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)

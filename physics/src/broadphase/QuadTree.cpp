@@ -13,8 +13,10 @@ using quadtree::BuildItem;
 using quadtree::IsEmptyBox;
 using quadtree::NodeStack;
 
-QuadTree::QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes)
-    : mBodies(ioBodies), mTreeId(inTreeId), mAllocator(std::clamp(inMaxNodes, 1u, 1u << 30)),
+QuadTree::QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes,
+                   uint32_t inRebuildReserve)
+    : mBodies(ioBodies), mTreeId(inTreeId), mRebuildReserve(inRebuildReserve),
+      mAllocator(std::clamp(inMaxNodes, 1u, 1u << 30)),
       mChunks(
           std::make_unique<std::atomic<Node*>[]>((mAllocator.GetCapacity() + cChunkSize - 1) >> cChunkShift))
 {
@@ -39,9 +41,9 @@ QuadTree::Node& QuadTree::GetNode(uint32_t inIndex) const
     return mChunks[inIndex >> cChunkShift].load(std::memory_order_acquire)[inIndex & (cChunkSize - 1)];
 }
 
-uint32_t QuadTree::AllocateNode(uint32_t inParent)
+uint32_t QuadTree::AllocateNode(uint32_t inParent, uint32_t inKeepFree)
 {
-    const uint32_t index = mAllocator.Allocate();
+    const uint32_t index = mAllocator.Allocate(inKeepFree);
     if (index == cInvalidNode) return cInvalidNode;
     std::atomic<Node*>& chunk = mChunks[index >> cChunkShift];
     // Acquire: if another thread installed the chunk, see its initialisation
@@ -54,14 +56,19 @@ uint32_t QuadTree::AllocateNode(uint32_t inParent)
                                            std::memory_order_acquire))
             delete[] fresh;
     }
-    Node& node = GetNode(index);
+    ResetNode(index, inParent);
+    return index;
+}
+
+void QuadTree::ResetNode(uint32_t inNode, uint32_t inParent)
+{
+    Node& node = GetNode(inNode);
     // Relaxed everywhere: the node is private until a release compare-exchange publishes it
     for (int s = 0; s < 4; ++s)
         InitSlot(node, s, cInvalidChild, AABB::Empty());
     node.mParent.store(inParent, std::memory_order_relaxed);
     node.mChanged.store(false, std::memory_order_relaxed);
     node.mLoose.store(0, std::memory_order_relaxed);
-    return index;
 }
 
 void QuadTree::InitSlot(Node& ioNode, int inSlot, uint32_t inChild, const AABB& inBounds)
@@ -116,24 +123,26 @@ AABB QuadTree::LoadSlot(const Node& inNode, int inSlot)
     return box;
 }
 
-QuadTree::SubTree QuadTree::BuildNodes(std::span<BuildItem> ioItems, std::vector<uint32_t>& ioNewNodes,
-                                       LeafCallback inOnLeaf)
+QuadTree::SubTree QuadTree::BuildNodes(std::span<BuildItem> ioItems, uint32_t inKeepFree,
+                                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf)
 {
     if (ioItems.empty())
     {
         SubTree empty;
-        empty.mChild = AllocateNode(cInvalidNode);
+        empty.mChild = AllocateNode(cInvalidNode, inKeepFree);
         if (empty.mChild != cInvalidNode) ioNewNodes.push_back(empty.mChild);
         return empty;
     }
-    return BuildRange(ioItems.data(), ioItems.data() + ioItems.size(), cInvalidNode, ioNewNodes, inOnLeaf);
+    return BuildRange(ioItems.data(), ioItems.data() + ioItems.size(), cInvalidNode, inKeepFree, ioNewNodes,
+                      inOnLeaf);
 }
 
 QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uint32_t inParent,
-                                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf)
+                                       uint32_t inKeepFree, std::vector<uint32_t>& ioNewNodes,
+                                       LeafCallback inOnLeaf)
 {
     SubTree result;
-    const uint32_t nodeIndex = AllocateNode(inParent);
+    const uint32_t nodeIndex = AllocateNode(inParent, inKeepFree);
     if (nodeIndex == cInvalidNode) return result;
     ioNewNodes.push_back(nodeIndex);
     result.mChild = nodeIndex;
@@ -191,7 +200,8 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
         }
         else
         {
-            const SubTree child = BuildRange(groups[g], groups[g + 1], nodeIndex, ioNewNodes, inOnLeaf);
+            const SubTree child =
+                BuildRange(groups[g], groups[g + 1], nodeIndex, inKeepFree, ioNewNodes, inOnLeaf);
             if (child.mChild == cInvalidChild) return SubTree{}; // Out of nodes: the caller frees ioNewNodes
             InitSlot(node, g, child.mChild, child.mBounds);
             result.mBounds.Encapsulate(child.mBounds);
@@ -232,17 +242,25 @@ QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodie
     if (items.empty()) return {};
 
     std::vector<uint32_t> newNodes;
-    const SubTree tree = BuildNodes(items, newNodes,
-                                    [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
-                                    {
-                                        // Release: Remove/Move of this body (acquire) see the node contents
-                                        mBodies[inItem.mChild & ~cBodyFlag].mLocation.store(
-                                            inNode << 2 | uint32_t(inSlot), std::memory_order_release);
-                                    });
+    // The link's spare root first, so that a batch gets everything it needs or nothing; rebuilds keep a
+    // reserve that batches may not take
+    const uint32_t spareRoot = AllocateNode(cInvalidNode, mRebuildReserve);
+    if (spareRoot != cInvalidNode) newNodes.push_back(spareRoot);
+    const SubTree tree = spareRoot == cInvalidNode
+                             ? SubTree{}
+                             : BuildNodes(items, mRebuildReserve, newNodes,
+                                          [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
+                                          {
+                                              // Release: Remove/Move of this body (acquire) see the node
+                                              // contents
+                                              mBodies[inItem.mChild & ~cBodyFlag].mLocation.store(
+                                                  inNode << 2 | uint32_t(inSlot), std::memory_order_release);
+                                          });
     if (tree.mChild != cInvalidChild)
     {
         SubTree result = tree;
         result.mNumBodies = uint32_t(items.size());
+        result.mSpareRoot = spareRoot;
         return result;
     }
     // Out of nodes: give everything back
@@ -257,6 +275,7 @@ QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodie
 
 void QuadTree::FreeSubTree(const SubTree& inSubTree)
 {
+    if (inSubTree.mSpareRoot != cInvalidNode) mAllocator.Free(inSubTree.mSpareRoot); // Never published
     if (inSubTree.mChild == cInvalidChild) return;
     // Iterative, so that deep trees cannot overflow the thread's stack; nodes are private (never linked)
     NodeStack stack;
@@ -279,9 +298,9 @@ void QuadTree::FreeSubTree(const SubTree& inSubTree)
     }
 }
 
-bool QuadTree::LinkSubTree(const SubTree& inSubTree)
+void QuadTree::LinkSubTree(const SubTree& inSubTree)
 {
-    if (inSubTree.mChild == cInvalidChild) return true;
+    if (inSubTree.mChild == cInvalidChild) return;
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     const uint32_t subNode = inSubTree.mChild;
     for (;;)
@@ -305,13 +324,15 @@ bool QuadTree::LinkSubTree(const SubTree& inSubTree)
                 root.mChanged.store(true, std::memory_order_relaxed); // Rebuild hint only
                 // The root may have been replaced meanwhile: keep the new parents' bounds and flags right
                 PropagateUp(rootIndex, inSubTree.mBounds);
-                return true;
+                if (inSubTree.mSpareRoot != cInvalidNode) mAllocator.Free(inSubTree.mSpareRoot); // Unused
+                return;
             }
         }
 
-        // Root full: a new root holding the old one (unbounded: its bounds are not tracked upwards) and ours
-        const uint32_t newRootIndex = AllocateNode(cInvalidNode);
-        if (newRootIndex == cInvalidNode) return false;
+        // Root full: a new root (the batch's spare) holding the old one (unbounded: its bounds are not
+        // tracked upwards) and ours
+        const uint32_t newRootIndex = inSubTree.mSpareRoot;
+        ResetNode(newRootIndex, cInvalidNode); // A failed exchange below may have filled it before
         Node& newRoot = GetNode(newRootIndex);
         InitSlot(newRoot, 0, rootIndex, AABB(Vec3::Constant(-cLargeFloat), Vec3::Constant(cLargeFloat)));
         InitSlot(newRoot, 1, subNode, inSubTree.mBounds);
@@ -325,9 +346,8 @@ bool QuadTree::LinkSubTree(const SubTree& inSubTree)
         {
             // Release: a mover walking up (acquire) finds the new root's fully initialised slots
             root.mParent.store(newRootIndex, std::memory_order_release);
-            return true;
+            return;
         }
-        mAllocator.Free(newRootIndex); // Never published
     }
 }
 

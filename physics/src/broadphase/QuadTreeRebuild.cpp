@@ -112,7 +112,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     std::vector<Reparent> reparents;
     std::vector<uint32_t> newNodes;
     const SubTree built =
-        BuildNodes(items, newNodes,
+        BuildNodes(items, 0, newNodes,
                    [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
                    {
                        if ((inItem.mChild & cBodyFlag) != 0)
@@ -279,11 +279,13 @@ void QuadTree::CollectGarbage()
 {
     mReclaimer.TryAdvance();
     size_t kept = 0;
-    for (RetiredBatch& batch : mRetired)
+    for (size_t i = 0; i < mRetired.size(); ++i)
     {
+        RetiredBatch& batch = mRetired[i];
         if (!mReclaimer.IsSafeToFree(batch.mEpoch))
         {
-            mRetired[kept++] = std::move(batch);
+            if (kept != i) mRetired[kept] = std::move(batch); // A self-move would empty the list
+            ++kept;
             continue;
         }
         for (uint32_t node : batch.mNodes)

@@ -41,9 +41,13 @@ public:
     NodeAllocator(const NodeAllocator&) = delete;
     NodeAllocator& operator=(const NodeAllocator&) = delete;
 
-    /// Pops a free index, or cInvalidIndex when the pool is exhausted.
-    uint32_t Allocate()
+    /// Pops a free index, or cInvalidIndex when the pool is exhausted or fewer than inKeepFree + 1 indices
+    /// are free (a soft reserve for callers that must not run out: approximate under concurrency).
+    uint32_t Allocate(uint32_t inKeepFree = 0)
     {
+        // Relaxed: a statistic used as a soft limit; concurrent allocations may overshoot it by their number
+        if (mCapacity - std::min(mCapacity, mNumAllocated.load(std::memory_order_relaxed)) <= inKeepFree)
+            return cInvalidIndex;
         // Acquire: pairs with the release of Free so that the next link of the head index is visible
         uint64_t head = mHead.load(std::memory_order_acquire);
         for (;;)

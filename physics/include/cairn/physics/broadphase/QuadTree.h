@@ -75,9 +75,10 @@ public:
     /// A prepared, not yet linked sub-tree.
     struct SubTree
     {
-        uint32_t mChild = cInvalidChild; ///< Root node of the sub-tree, or invalid when empty
-        AABB mBounds;                    ///< Bounds of everything in it
-        uint32_t mNumBodies = 0;         ///< Bodies in it
+        uint32_t mChild = cInvalidChild;    ///< Root node of the sub-tree, or invalid when empty
+        AABB mBounds;                       ///< Bounds of everything in it
+        uint32_t mNumBodies = 0;            ///< Bodies in it
+        uint32_t mSpareRoot = cInvalidNode; ///< Reserved for a new root if the root is full when linking
     };
 
     /// What a rebuild did.
@@ -103,8 +104,11 @@ public:
 
     /// ioBodies: the body table shared by the trees of one broad phase (must outlive the tree). inTreeId:
     /// this tree's id in the table (distinct per tree sharing it). inMaxNodes: node pool capacity (storage is
-    /// allocated in chunks as the pool's high-water mark grows).
-    QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes);
+    /// allocated in chunks as the pool's high-water mark grows). inRebuildReserve: nodes that BuildSubTree
+    /// leaves free for rebuilds, so that a tree bloated by adds and removes can always be rebuilt (and its
+    /// old nodes freed) instead of staying stuck at a full pool.
+    QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMaxNodes,
+             uint32_t inRebuildReserve = 0);
     ~QuadTree();
     QuadTree(const QuadTree&) = delete;
     QuadTree& operator=(const QuadTree&) = delete;
@@ -115,9 +119,8 @@ public:
     SubTree BuildSubTree(std::span<const BroadPhaseBody> inBodies);
     /// Returns the nodes of an unlinked sub-tree to the pool and forgets its bodies.
     void FreeSubTree(const SubTree& inSubTree);
-    /// Makes a built sub-tree visible in O(1). Returns false only if the node pool is exhausted when the
-    /// root is full (the sub-tree is then still owned by the caller).
-    bool LinkSubTree(const SubTree& inSubTree);
+    /// Makes a built sub-tree visible in O(1); never fails (a full root uses the sub-tree's spare node).
+    void LinkSubTree(const SubTree& inSubTree);
 
     /// Removes a linked body; false (ignored) when inBody is not in this tree (exact id).
     bool RemoveBody(BodyID inBody);
@@ -171,18 +174,21 @@ private:
     /// Builds private nodes over ioItems (reordered): split at the midpoint of the longest axis of the
     /// centres, four groups per node, recursively. inOnLeaf is called for every placed item. Returns the root
     /// and its bounds, or an invalid child when out of nodes. Every allocated node is appended to ioNewNodes.
-    SubTree BuildNodes(std::span<quadtree::BuildItem> ioItems, std::vector<uint32_t>& ioNewNodes,
-                       LeafCallback inOnLeaf);
+    SubTree BuildNodes(std::span<quadtree::BuildItem> ioItems, uint32_t inKeepFree,
+                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf);
     /// Recursive part of BuildNodes for [inBegin, inEnd) (non-empty).
     SubTree BuildRange(quadtree::BuildItem* inBegin, quadtree::BuildItem* inEnd, uint32_t inParent,
-                       std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf);
+                       uint32_t inKeepFree, std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf);
 
     static constexpr uint32_t cChunkShift = 10; ///< Nodes are stored in chunks of 1,024 (123 KB)
     static constexpr uint32_t cChunkSize = 1u << cChunkShift;
 
     Node& GetNode(uint32_t inIndex) const;
-    /// Allocates a node with four empty slots and the given parent (storage backed on demand).
-    uint32_t AllocateNode(uint32_t inParent);
+    /// Allocates a node with four empty slots and the given parent (storage backed on demand), leaving at
+    /// least inKeepFree nodes in the pool.
+    uint32_t AllocateNode(uint32_t inParent, uint32_t inKeepFree = 0);
+    /// Empties a private node's slots for (re)use.
+    void ResetNode(uint32_t inNode, uint32_t inParent);
     /// Sets a slot of a node that is not published yet.
     static void InitSlot(Node& ioNode, int inSlot, uint32_t inChild, const AABB& inBounds);
     /// Grows slot inSlot of inNode by inBounds with atomic min/max.
@@ -215,6 +221,7 @@ private:
 
     QuadTreeBodyTable& mBodies;                    ///< Shared per-body records
     uint8_t mTreeId;                               ///< This tree's id in mBodies
+    uint32_t mRebuildReserve;                      ///< See the constructor
     NodeAllocator mAllocator;                      ///< Hands out node indices
     std::unique_ptr<std::atomic<Node*>[]> mChunks; ///< Node storage, allocated on demand
     std::atomic<uint32_t> mRoot;                   ///< Current root node

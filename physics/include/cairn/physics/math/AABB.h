@@ -84,12 +84,15 @@ struct AABB
     }
 };
 
-/// Component-wise reciprocal that maps 0 to +/- infinity, for slab tests.
+/// Component-wise reciprocal that maps 0 (of either sign) to +infinity, for slab tests. Always +infinity: the
+/// NaN patch of RayEntryFraction (origin on a slab plane of a parallel ray counts as inside) assumes it; with
+/// -infinity from a -0 component a ray would touch a box but miss a larger box containing it, and a tree
+/// would skip bodies that brute force reports (found by the quad tree's property test).
 inline Vec3 SafeReciprocal(const Vec3& inV)
 {
     Vec3 r;
     for (int i = 0; i < 3; ++i)
-        r[i] = inV[i] != 0.0f ? 1.0f / inV[i] : std::copysign(std::numeric_limits<float>::infinity(), inV[i]);
+        r[i] = inV[i] != 0.0f ? 1.0f / inV[i] : std::numeric_limits<float>::infinity();
     return r;
 }
 

@@ -1,0 +1,414 @@
+// cairn-bench-broadphase: the broad-phase part of the shared workload (../shared/bench/SPEC.md) with Google
+// Benchmark, for the lock-free quad tree, the same trees behind one global mutex, and sort and sweep. Every
+// benchmark reports its figure as a counter (ms, us_per_*) and a checksum: hits for queries and rays (AABB
+// level; the test suite checks the same totals against brute force), bodies for adds and removals.
+//
+// bp_query_contended: Q query threads (1, 2) run bp_query_box for a fixed number of passes while one more
+// thread moves the 2,000 dynamic boxes by a random walk of up to 0.5 m through BodyInterface::SetPosition (a
+// body write lock plus a broad-phase AABB update per move), as fast as it can. Reported: wall-clock us per
+// query per thread, moves per second, and the same queries' time with no mover (uncontended). Wall time on
+// purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2 the mover shares a core.
+
+#include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
+#include "cairn/physics/shapes/BoxShape.h"
+#include "common/SharedBenchData.h"
+
+#include <atomic>
+#include <benchmark/benchmark.h>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <thread>
+
+using namespace cairn;
+
+namespace
+{
+
+using Clock = std::chrono::steady_clock;
+
+enum Kind : int64_t
+{
+    cQuadTree = 0,
+    cQuadTreeGlobalMutex = 1,
+    cSortAndSweep = 2
+};
+
+const char* KindName(int64_t inKind)
+{
+    switch (inKind)
+    {
+    case cQuadTree:
+        return "quad_tree";
+    case cQuadTreeGlobalMutex:
+        return "quad_tree_global_mutex";
+    default:
+        return "sort_and_sweep";
+    }
+}
+
+const SharedBenchData& Data()
+{
+    static const SharedBenchData data = []
+    {
+        auto loaded = LoadSharedBenchData();
+        if (!loaded.IsOk())
+        {
+            std::fprintf(stderr, "cannot load the shared workload: %s\n", loaded.GetError().mMessage.c_str());
+            std::exit(2);
+        }
+        return std::move(loaded).Value();
+    }();
+    return data;
+}
+
+std::vector<BroadPhaseBody> StaticBodies()
+{
+    std::vector<BroadPhaseBody> bodies;
+    for (uint32_t i = 0; i < Data().mStatic.size(); ++i)
+        bodies.push_back({BodyID(i, 1), Data().mStatic[i].GetWorldBounds(), Layers::cStatic});
+    return bodies;
+}
+
+std::unique_ptr<BroadPhase> Make(int64_t inKind, uint32_t inMaxBodies)
+{
+    const LayerSetup layers = LayerSetup::CreateDefault();
+    switch (inKind)
+    {
+    case cQuadTree:
+        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers);
+    case cQuadTreeGlobalMutex:
+        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers,
+                                                    BroadPhaseQuadTree::LockMode::GlobalMutex);
+    default:
+        return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, layers);
+    }
+}
+
+/// The static world added in one batch and optimised (a full rebuild for the quad tree).
+std::unique_ptr<BroadPhase> MakeLoadedWorld(int64_t inKind)
+{
+    const std::vector<BroadPhaseBody> bodies = StaticBodies();
+    std::unique_ptr<BroadPhase> broadPhase = Make(inKind, uint32_t(bodies.size()));
+    broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
+    if (auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get()))
+        quadTree->RebuildAll();
+    else
+        broadPhase->Update();
+    return broadPhase;
+}
+
+double MillisecondsSince(Clock::time_point inStart)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
+}
+
+uint64_t QueryAllBoxes(const BroadPhase& inBroadPhase)
+{
+    uint64_t hits = 0;
+    for (const AABB& box : Data().mQueryBoxes)
+        inBroadPhase.CollideAABox(box, {}, [&](BodyID) { ++hits; });
+    return hits;
+}
+
+void BM_AddBatch(benchmark::State& ioState)
+{
+    const std::vector<BroadPhaseBody> bodies = StaticBodies();
+    double addMs = 0, rebuildMs = 0;
+    BroadPhaseQuadTree::MemoryStats memory;
+    for (auto _ : ioState)
+    {
+        std::unique_ptr<BroadPhase> broadPhase = Make(ioState.range(0), uint32_t(bodies.size()));
+        auto start = Clock::now();
+        broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
+        const double add = MillisecondsSince(start);
+        start = Clock::now();
+        auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get());
+        if (quadTree != nullptr)
+            quadTree->RebuildAll();
+        else
+            broadPhase->Update();
+        const double rebuild = MillisecondsSince(start);
+        ioState.SetIterationTime((add + rebuild) * 1e-3);
+        addMs += add;
+        rebuildMs += rebuild;
+        if (quadTree != nullptr)
+            memory = quadTree->GetMemoryStats(); // Old and new trees both still allocated
+        benchmark::DoNotOptimize(broadPhase->GetBodyCount());
+        ioState.PauseTiming(); // Destruction is not part of the figure
+        broadPhase.reset();
+        ioState.ResumeTiming();
+    }
+    const double iterations = double(ioState.iterations());
+    ioState.counters["add_ms"] = addMs / iterations;
+    ioState.counters["rebuild_ms"] = rebuildMs / iterations;
+    ioState.counters["bodies"] = double(bodies.size());
+    if (memory.mNodeSize != 0)
+    {
+        ioState.counters["bytes_per_body"] =
+            double(memory.mBodyTableBytes + memory.mNodeBytesInUse) / double(bodies.size());
+        ioState.counters["node_bytes"] = double(memory.mNodeSize);
+        ioState.counters["nodes"] = double(memory.mNodesInUse);
+    }
+    ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+void BM_AddSingle(benchmark::State& ioState)
+{
+    const std::vector<BroadPhaseBody> bodies = StaticBodies();
+    double totalMs = 0;
+    for (auto _ : ioState)
+    {
+        std::unique_ptr<BroadPhase> broadPhase = Make(ioState.range(0), uint32_t(bodies.size()));
+        const auto start = Clock::now();
+        for (const BroadPhaseBody& body : bodies)
+            broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare({&body, 1}));
+        const double ms = MillisecondsSince(start);
+        ioState.SetIterationTime(ms * 1e-3);
+        totalMs += ms;
+        benchmark::DoNotOptimize(broadPhase->GetBodyCount());
+        ioState.PauseTiming();
+        broadPhase.reset();
+        ioState.ResumeTiming();
+    }
+    ioState.counters["us_per_body"] =
+        1000.0 * totalMs / (double(ioState.iterations()) * double(bodies.size()));
+    ioState.counters["bodies"] = double(bodies.size());
+    ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+void BM_RemoveOne(benchmark::State& ioState)
+{
+    double totalMs = 0;
+    size_t remaining = 0;
+    for (auto _ : ioState)
+    {
+        ioState.PauseTiming();
+        std::unique_ptr<BroadPhase> broadPhase = MakeLoadedWorld(ioState.range(0));
+        ioState.ResumeTiming();
+        const auto start = Clock::now();
+        for (uint32_t index : Data().mRemovals)
+        {
+            const BodyID id(index, 1);
+            broadPhase->RemoveBodies({&id, 1});
+        }
+        const double ms = MillisecondsSince(start);
+        ioState.SetIterationTime(ms * 1e-3);
+        totalMs += ms;
+        remaining = broadPhase->GetBodyCount();
+        ioState.PauseTiming();
+        broadPhase.reset();
+        ioState.ResumeTiming();
+    }
+    ioState.counters["us_per_removal"] =
+        1000.0 * totalMs / (double(ioState.iterations()) * double(Data().mRemovals.size()));
+    ioState.counters["bodies_left"] = double(remaining);
+    ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+void BM_QueryBox(benchmark::State& ioState)
+{
+    const std::unique_ptr<BroadPhase> broadPhase = MakeLoadedWorld(ioState.range(0));
+    uint64_t hits = 0;
+    double totalMs = 0;
+    for (auto _ : ioState)
+    {
+        const auto start = Clock::now();
+        hits = QueryAllBoxes(*broadPhase);
+        totalMs += MillisecondsSince(start);
+    }
+    ioState.counters["us_per_query"] =
+        1000.0 * totalMs / (double(ioState.iterations()) * double(Data().mQueryBoxes.size()));
+    ioState.counters["hits"] = double(hits);
+    ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+void BM_Raycast(benchmark::State& ioState)
+{
+    const std::unique_ptr<BroadPhase> broadPhase = MakeLoadedWorld(ioState.range(0));
+    uint64_t hits = 0;
+    double totalMs = 0;
+    for (auto _ : ioState)
+    {
+        const auto start = Clock::now();
+        hits = 0;
+        for (const BenchRay& ray : Data().mRays)
+            broadPhase->CastRay({ray.mOrigin, ray.mDisplacement}, {},
+                                [&](BodyID, float)
+                                {
+                                    ++hits;
+                                    return 1.0f;
+                                });
+        totalMs += MillisecondsSince(start);
+    }
+    ioState.counters["us_per_ray"] =
+        1000.0 * totalMs / (double(ioState.iterations()) * double(Data().mRays.size()));
+    ioState.counters["hits"] = double(hits);
+    ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+/// The world of bp_query_contended: a PhysicsSystem whose broad phase is of kind inKind, with the static
+/// world and the dynamic boxes added through the body interface (not simulated).
+struct ContendedWorld
+{
+    explicit ContendedWorld(int64_t inKind)
+    {
+        PhysicsSettings settings;
+        settings.mMaxBodies = uint32_t(Data().mStatic.size() + Data().mDynamic.size());
+        settings.mBroadPhase = inKind == cQuadTree              ? BroadPhaseType::QuadTree
+                               : inKind == cQuadTreeGlobalMutex ? BroadPhaseType::QuadTreeGlobalMutex
+                                                                : BroadPhaseType::SortAndSweep;
+        mSystem = std::make_unique<PhysicsSystem>(settings, LayerSetup::CreateDefault());
+        BodyInterface& bodies = mSystem->GetBodyInterface();
+        auto addAll =
+            [&](const std::vector<BenchBox>& inBoxes, MotionType inMotion, std::vector<BodyID>& outIDs)
+        {
+            for (const BenchBox& box : inBoxes)
+            {
+                BodyCreationSettings body;
+                body.mShape = BoxShape::Create(box.mHalfExtent).Value();
+                body.mPosition = box.mCenter;
+                body.mRotation = Quat(Eigen::AngleAxisf(box.mYaw, Vec3::UnitY()));
+                body.mMotionType = inMotion;
+                body.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
+                outIDs.push_back(bodies.CreateBody(body).Value());
+            }
+            BodyInterface::AddBatch batch = bodies.AddBodiesPrepare(outIDs).Value();
+            (void)bodies.AddBodiesFinalize(batch, Activation::DontActivate);
+        };
+        std::vector<BodyID> statics;
+        addAll(Data().mStatic, MotionType::Static, statics);
+        addAll(Data().mDynamic, MotionType::Dynamic, mDynamic);
+        (void)mSystem->Update(1.0f / 60.0f,
+                              1); // Optimises the broad phase (the dynamic boxes are not active)
+        for (const BodyID& id : mDynamic)
+            mPositions.push_back(bodies.GetPosition(id).Value());
+    }
+
+    std::unique_ptr<PhysicsSystem> mSystem;
+    std::vector<BodyID> mDynamic;
+    std::vector<Vec3> mPositions;
+};
+
+/// Runs inPasses passes of the query boxes on inThreads threads; returns wall-clock us per query per thread.
+double TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPasses, uint64_t& outHits)
+{
+    std::vector<double> microseconds(inThreads);
+    std::vector<uint64_t> hits(inThreads);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < inThreads; ++t)
+        threads.emplace_back(
+            [&, t]
+            {
+                const auto start = Clock::now();
+                for (int pass = 0; pass < inPasses; ++pass)
+                    hits[t] += QueryAllBoxes(inBroadPhase);
+                microseconds[t] = 1000.0 * MillisecondsSince(start);
+            });
+    for (std::thread& thread : threads)
+        thread.join();
+    double sum = 0;
+    outHits = 0;
+    for (int t = 0; t < inThreads; ++t)
+    {
+        sum += microseconds[t];
+        outHits += hits[t];
+    }
+    return sum / (double(inThreads) * double(inPasses) * double(Data().mQueryBoxes.size()));
+}
+
+void BM_QueryContended(benchmark::State& ioState)
+{
+    const int64_t kind = ioState.range(0);
+    const int queryThreads = int(ioState.range(1));
+    const int passes = kind == cQuadTreeGlobalMutex ? 1 : 3;
+    ContendedWorld world(kind);
+    const BroadPhase& broadPhase = world.mSystem->GetBroadPhase();
+    double contended = 0, uncontended = 0, movesPerSecond = 0;
+    uint64_t hits = 0;
+    for (auto _ : ioState)
+    {
+        uncontended = TimeQueries(broadPhase, queryThreads, passes, hits);
+
+        std::atomic<bool> stop{false};
+        std::atomic<uint64_t> moves{0};
+        std::thread mover(
+            [&]
+            {
+                std::mt19937 random(5);
+                std::uniform_real_distribution<float> step(-0.5f, 0.5f);
+                BodyInterface& bodies = world.mSystem->GetBodyInterface();
+                uint64_t count = 0;
+                // Relaxed: a stop flag, nothing is published with it
+                for (size_t i = 0; !stop.load(std::memory_order_relaxed); i = (i + 1) % world.mDynamic.size())
+                {
+                    Vec3& position = world.mPositions[i];
+                    position += Vec3(step(random), step(random) * 0.2f, step(random));
+                    (void)bodies.SetPosition(world.mDynamic[i], position, Activation::DontActivate);
+                    ++count;
+                }
+                moves.store(count, std::memory_order_relaxed); // Read after join
+            });
+        const auto start = Clock::now();
+        uint64_t contendedHits = 0;
+        contended = TimeQueries(broadPhase, queryThreads, passes, contendedHits);
+        const double seconds = MillisecondsSince(start) * 1e-3;
+        stop.store(true, std::memory_order_relaxed);
+        mover.join();
+        movesPerSecond = double(moves.load(std::memory_order_relaxed)) / seconds;
+        ioState.SetIterationTime(seconds);
+        hits = contendedHits;
+        // Let the broad phase rebuild (the bounds grew) so that each iteration starts alike
+        (void)world.mSystem->Update(1.0f / 60.0f, 1);
+    }
+    ioState.counters["us_per_query"] = contended;
+    ioState.counters["us_per_query_uncontended"] = uncontended;
+    ioState.counters["ratio"] = contended / uncontended;
+    ioState.counters["moves_per_s"] = movesPerSecond;
+    ioState.counters["hits"] = double(hits);
+    ioState.SetLabel(std::string(KindName(kind)) + ", " + std::to_string(queryThreads) + " query thread(s)");
+}
+
+} // namespace
+
+BENCHMARK(BM_AddBatch)
+    ->Name("bp_add_batch")
+    ->Arg(cQuadTree)
+    ->Arg(cSortAndSweep)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+BENCHMARK(BM_AddSingle)
+    ->Name("bp_add_single")
+    ->Arg(cQuadTree)
+    ->Arg(cSortAndSweep)
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK(BM_RemoveOne)
+    ->Name("bp_remove_one")
+    ->Arg(cQuadTree)
+    ->Arg(cSortAndSweep)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond)
+    ->Iterations(20);
+BENCHMARK(BM_QueryBox)
+    ->Name("bp_query_box")
+    ->Arg(cQuadTree)
+    ->Arg(cSortAndSweep)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Raycast)->Name("bp_raycast")->Arg(cQuadTree)->Arg(cSortAndSweep)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryContended)
+    ->Name("bp_query_contended")
+    ->Args({cQuadTree, 1})
+    ->Args({cQuadTree, 2})
+    ->Args({cQuadTreeGlobalMutex, 1})
+    ->Args({cQuadTreeGlobalMutex, 2})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+
+BENCHMARK_MAIN();
