@@ -141,8 +141,8 @@ NoMissStressResult RunNoMissStress(BroadPhase& ioBroadPhase, const NoMissStressC
                 ioBroadPhase.Update();
             ioBroadPhase.FindCollidingPairs(active, layers, [&](BodyID, BodyID) { ++pairs; });
             ++count;
+            updates.fetch_add(1, std::memory_order_relaxed); // Paces the churn thread
         }
-        updates.fetch_add(count, std::memory_order_relaxed);
         pairSearches.fetch_add(count, std::memory_order_relaxed);
     };
 
@@ -153,7 +153,7 @@ NoMissStressResult RunNoMissStress(BroadPhase& ioBroadPhase, const NoMissStressC
         std::vector<BodyID> removed;
         std::vector<BroadPhaseBody> added;
         std::vector<bool> chosen(numBodies, false);
-        uint64_t count = 0, refused = 0;
+        uint64_t count = 0, refused = 0, lastUpdates = 0, batchesSinceUpdate = 0;
         while (!stop.load(std::memory_order_relaxed))
         {
             removed.clear();
@@ -176,10 +176,20 @@ NoMissStressResult RunNoMissStress(BroadPhase& ioBroadPhase, const NoMissStressC
             else
                 ioBroadPhase.AddBodiesFinalize(state);
             ++count;
-            // A streaming rate (up to a thousand batches a second, dozens per 60 Hz frame), not a tight loop:
-            // every link between two updates adds a root level that queries walk until the next rebuild,
-            // so a loop that links millions of batches between two updates measures nothing useful
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            // A streaming rate: at most 4 batches per update of the step thread, as a loader finalizes a few
+            // batches per frame. Every link between two updates adds a root level that queries walk until
+            // the next rebuild, so a loop linking thousands of batches per update (easily reached under
+            // ThreadSanitizer, where an update takes tens of ms) would measure nothing useful
+            const uint64_t updatesNow = updates.load(std::memory_order_relaxed);
+            if (updatesNow != lastUpdates)
+            {
+                lastUpdates = updatesNow;
+                batchesSinceUpdate = 0;
+            }
+            ++batchesSinceUpdate;
+            while (batchesSinceUpdate >= 4 && !stop.load(std::memory_order_relaxed) &&
+                   updates.load(std::memory_order_relaxed) == lastUpdates)
+                std::this_thread::sleep_for(std::chrono::microseconds(200));
         }
         churns.fetch_add(count, std::memory_order_relaxed);
         refusedBatches.fetch_add(refused, std::memory_order_relaxed);

@@ -34,13 +34,6 @@ QuadTree::~QuadTree()
         delete[] mChunks[i].load(std::memory_order_relaxed); // No other thread may use a dying tree
 }
 
-QuadTree::Node& QuadTree::GetNode(uint32_t inIndex) const
-{
-    // Acquire: pairs with the release that installed the chunk (a node index reaches another thread only
-    // after a release publication anyway; this keeps the chunk pointer itself ordered too)
-    return mChunks[inIndex >> cChunkShift].load(std::memory_order_acquire)[inIndex & (cChunkSize - 1)];
-}
-
 uint32_t QuadTree::AllocateNode(uint32_t inParent, uint32_t inKeepFree)
 {
     const uint32_t index = mAllocator.Allocate(inKeepFree);
@@ -108,19 +101,6 @@ void QuadTree::ClearSlot(Node& ioNode, int inSlot)
     ioNode.mMaxZ[inSlot].store(-cLargeFloat, std::memory_order_relaxed);
     // Relaxed: a leaf slot is never refilled before a rebuild, which swaps in new nodes
     ioNode.mChild[inSlot].store(cInvalidChild, std::memory_order_relaxed);
-}
-
-AABB QuadTree::LoadSlot(const Node& inNode, int inSlot)
-{
-    AABB box;
-    // Acquire: pairs with the releases in GrowSlot (see there)
-    box.mMin = Vec3(inNode.mMinX[inSlot].load(std::memory_order_acquire),
-                    inNode.mMinY[inSlot].load(std::memory_order_acquire),
-                    inNode.mMinZ[inSlot].load(std::memory_order_acquire));
-    box.mMax = Vec3(inNode.mMaxX[inSlot].load(std::memory_order_acquire),
-                    inNode.mMaxY[inSlot].load(std::memory_order_acquire),
-                    inNode.mMaxZ[inSlot].load(std::memory_order_acquire));
-    return box;
 }
 
 QuadTree::SubTree QuadTree::BuildNodes(std::span<BuildItem> ioItems, uint32_t inKeepFree,
@@ -495,6 +475,11 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) c
             if (child == cInvalidChild) continue;
             if ((child & cBodyFlag) == 0)
             {
+                // Queries are bound by node misses: start fetching both cache lines of the child now, so that
+                // the misses of the siblings pushed with it overlap
+                const Node& childNode = GetNode(child);
+                __builtin_prefetch(&childNode);
+                __builtin_prefetch(reinterpret_cast<const char*>(&childNode) + 64);
                 stack.Push(child);
                 continue;
             }

@@ -57,8 +57,9 @@ public:
     static constexpr uint32_t cInvalidNode = NodeAllocator::cInvalidIndex;
 
     /// One node: four child slots, each with its bounds in SIMD layout. Every field is atomic because
-    /// readers traverse while writers grow bounds and fill slots. 120 bytes.
-    struct Node
+    /// readers traverse while writers grow bounds and fill slots. 128 bytes, aligned: exactly two
+    /// cache lines (at 120 unaligned bytes most nodes straddled three, and queries are bound by node misses).
+    struct alignas(64) Node
     {
         std::atomic<float> mMinX[4];     ///< Slot bounds; an empty slot has min = +cLargeFloat, max = -large
         std::atomic<float> mMinY[4];     ///< See mMinX
@@ -183,7 +184,12 @@ private:
     static constexpr uint32_t cChunkShift = 10; ///< Nodes are stored in chunks of 1,024 (123 KB)
     static constexpr uint32_t cChunkSize = 1u << cChunkShift;
 
-    Node& GetNode(uint32_t inIndex) const;
+    Node& GetNode(uint32_t inIndex) const
+    {
+        // Acquire: pairs with the release that installed the chunk (a node index reaches another thread only
+        // after a release publication anyway; this keeps the chunk pointer itself ordered too)
+        return mChunks[inIndex >> cChunkShift].load(std::memory_order_acquire)[inIndex & (cChunkSize - 1)];
+    }
     /// Allocates a node with four empty slots and the given parent (storage backed on demand), leaving at
     /// least inKeepFree nodes in the pool.
     uint32_t AllocateNode(uint32_t inParent, uint32_t inKeepFree = 0);
@@ -196,7 +202,16 @@ private:
     /// Empties a slot (bounds and child).
     static void ClearSlot(Node& ioNode, int inSlot);
     /// Slot bounds as read now (each float atomically).
-    static AABB LoadSlot(const Node& inNode, int inSlot);
+    static AABB LoadSlot(const Node& inNode, int inSlot)
+    {
+        // Acquire: pairs with the releases in GrowSlot (see there)
+        return AABB(Vec3(inNode.mMinX[inSlot].load(std::memory_order_acquire),
+                         inNode.mMinY[inSlot].load(std::memory_order_acquire),
+                         inNode.mMinZ[inSlot].load(std::memory_order_acquire)),
+                    Vec3(inNode.mMaxX[inSlot].load(std::memory_order_acquire),
+                         inNode.mMaxY[inSlot].load(std::memory_order_acquire),
+                         inNode.mMaxZ[inSlot].load(std::memory_order_acquire)));
+    }
     /// Grows the slot holding inNode in its parent, and so on up to the root; marks every node changed.
     void PropagateUp(uint32_t inNode, const AABB& inBounds);
     /// Marks inNode and its ancestors changed.

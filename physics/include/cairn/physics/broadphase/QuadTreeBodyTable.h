@@ -9,9 +9,10 @@
 // Threads: every field is atomic. A body's entry is written by whoever adds, moves or removes it (the caller
 // serialises operations on one body) and by the rebuild commit (under the tree's exclusive modification
 // lock); it is read by queries on any thread.
-// Exact bounds use a sequence lock that readers never wait on: a writer makes the version odd, writes the six
-// floats, makes it even; a reader that sees an odd or changed version falls back to the slot bounds, which
-// contain the body's old bounds (a move in progress may be reported with its old state, as allowed).
+// Exact bounds use a sequence lock that readers never wait on (fence-free, see StoreBounds): a writer makes
+// the version odd, writes the six floats, makes it even; a reader that sees an odd or changed version falls
+// back to the slot bounds, which contain the body's old bounds (a move in progress may be reported with its
+// old state, as allowed).
 
 #include "cairn/physics/math/AABB.h"
 
@@ -49,18 +50,19 @@ public:
     const Entry& operator[](uint32_t inIndex) const { return mEntries[inIndex]; }
 
     /// Stores exact bounds. Only the thread that owns the body's current operation calls it.
+    /// No fences (ThreadSanitizer does not model them): each float is stored with release, so a reader that
+    /// acquires a new float also sees the odd version stored before it.
     static void StoreBounds(Entry& ioEntry, const AABB& inBounds)
     {
         // Relaxed load: only this thread writes the version
         const uint32_t version = ioEntry.mVersion.load(std::memory_order_relaxed);
+        // Relaxed: published by the release stores of the floats that follow
         ioEntry.mVersion.store(version + 1, std::memory_order_relaxed);
-        // Release fence: a reader that sees any of the new floats (and then fences) sees the odd version
-        std::atomic_thread_fence(std::memory_order_release);
         for (int i = 0; i < 3; ++i)
         {
-            // Relaxed: ordered by the fence above and the release store below
-            ioEntry.mBounds[i].store(inBounds.mMin[i], std::memory_order_relaxed);
-            ioEntry.mBounds[i + 3].store(inBounds.mMax[i], std::memory_order_relaxed);
+            // Release: see above
+            ioEntry.mBounds[i].store(inBounds.mMin[i], std::memory_order_release);
+            ioEntry.mBounds[i + 3].store(inBounds.mMax[i], std::memory_order_release);
         }
         // Release: a reader that acquires the even version sees the six floats
         ioEntry.mVersion.store(version + 2, std::memory_order_release);
@@ -74,13 +76,13 @@ public:
         if ((before & 1) != 0) return false;
         for (int i = 0; i < 3; ++i)
         {
-            // Relaxed: checked by the version re-read below
-            outBounds.mMin[i] = inEntry.mBounds[i].load(std::memory_order_relaxed);
-            outBounds.mMax[i] = inEntry.mBounds[i + 3].load(std::memory_order_relaxed);
+            // Acquire: keeps the version re-read below after these loads, and a new value implies the odd
+            // version is visible to that re-read
+            outBounds.mMin[i] = inEntry.mBounds[i].load(std::memory_order_acquire);
+            outBounds.mMax[i] = inEntry.mBounds[i + 3].load(std::memory_order_acquire);
         }
-        // Acquire fence: the float loads above happen before the version re-read below
-        std::atomic_thread_fence(std::memory_order_acquire);
-        return inEntry.mVersion.load(std::memory_order_relaxed) == before; // Ordered by the fence
+        // Relaxed: ordered after the acquire loads above
+        return inEntry.mVersion.load(std::memory_order_relaxed) == before;
     }
 
     /// Bytes used by the table.
