@@ -4,6 +4,7 @@
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <algorithm>
+#include <bit>
 #include <cassert>
 
 namespace cairn
@@ -128,21 +129,31 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     result.mChild = nodeIndex;
     Node& node = GetNode(nodeIndex);
 
-    // Splits [inB, inE) at the midpoint of the longest axis of the centres; halves when degenerate
-    auto split = [](BuildItem* inB, BuildItem* inE) -> BuildItem*
+    // Bounds of the centres of [inB, inE), with min/max on plain floats (the AABB helpers go through Eigen
+    // reductions, which dominated the build)
+    auto centreBounds = [](const BuildItem* inB, const BuildItem* inE)
+    {
+        Vec3 lo = Vec3::Constant(cLargeFloat), hi = Vec3::Constant(-cLargeFloat);
+        for (const BuildItem* it = inB; it != inE; ++it)
+        {
+            lo = lo.cwiseMin(it->mCenter);
+            hi = hi.cwiseMax(it->mCenter);
+        }
+        return AABB(lo, hi);
+    };
+    // Splits [inB, inE) at the midpoint of the longest axis of the centres (inCentres: their bounds);
+    // halves when degenerate
+    auto splitWith = [](BuildItem* inB, BuildItem* inE, const AABB& inCentres) -> BuildItem*
     {
         if (inE - inB < 2) return inE;
-        AABB centres;
-        for (BuildItem* it = inB; it != inE; ++it)
-            centres.Encapsulate(it->mCenter);
-        const Vec3 size = centres.Size();
+        const Vec3 size = inCentres.mMax - inCentres.mMin;
         int axis = 0;
         if (size.y() > size[axis]) axis = 1;
         if (size.z() > size[axis]) axis = 2;
         BuildItem* mid = inB + (inE - inB) / 2;
         if (size[axis] > 0.0f)
         {
-            const float splitValue = centres.Center()[axis];
+            const float splitValue = 0.5f * (inCentres.mMin[axis] + inCentres.mMax[axis]);
             BuildItem* p = std::partition(
                 inB, inE, [&](const BuildItem& inItem) { return inItem.mCenter[axis] < splitValue; });
             // Rounding can put everything on one side; fall back to halves then
@@ -150,6 +161,7 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
         }
         return mid;
     };
+    auto split = [&](BuildItem* inB, BuildItem* inE) { return splitWith(inB, inE, centreBounds(inB, inE)); };
 
     BuildItem* groups[5];
     const ptrdiff_t count = inEnd - inBegin;
@@ -160,11 +172,62 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     }
     else
     {
+        // Objects much larger than the spread of the centres (a 64 m ground slab among 1 m crates) get a slot
+        // of their own here, up to two: pushed down, each would widen every node on its way to a leaf, and
+        // every query near them would walk those nodes. One pass: centres and the two largest objects
+        const AABB centres = centreBounds(inBegin, inEnd);
+        const float wideLimit = 0.5f * (centres.mMax - centres.mMin).maxCoeff();
+        BuildItem* largest[2] = {nullptr, nullptr};
+        float largestSize[2] = {wideLimit, wideLimit};
+        for (BuildItem* it = inBegin; it != inEnd; ++it)
+        {
+            const Vec3 extent = it->mBounds.mMax - it->mBounds.mMin;
+            const float size = std::max(extent.x(), std::max(extent.y(), extent.z()));
+            if (size <= largestSize[1]) continue;
+            if (size > largestSize[0])
+            {
+                largest[1] = largest[0];
+                largestSize[1] = largestSize[0];
+                largest[0] = it;
+                largestSize[0] = size;
+            }
+            else
+            {
+                largest[1] = it;
+                largestSize[1] = size;
+            }
+        }
+        BuildItem* rest = inBegin;
+        if (largest[0] != nullptr)
+        {
+            // The item at inBegin moves to largest[0]'s place: follow it if it is the second largest
+            if (largest[1] == rest) largest[1] = largest[0];
+            std::swap(*rest, *largest[0]);
+            ++rest;
+            if (largest[1] != nullptr)
+            {
+                std::swap(*rest, *largest[1]);
+                ++rest;
+            }
+        }
         groups[0] = inBegin;
-        groups[2] = split(inBegin, inEnd);
-        groups[1] = split(inBegin, groups[2]);
-        groups[3] = split(groups[2], inEnd);
+        const int numWide = int(rest - inBegin);
+        for (int g = 1; g <= numWide; ++g)
+            groups[g] = inBegin + g;
         groups[4] = inEnd;
+        if (numWide == 0)
+        {
+            groups[2] = splitWith(inBegin, inEnd, centres);
+            groups[1] = split(inBegin, groups[2]);
+            groups[3] = split(groups[2], inEnd);
+        }
+        else if (numWide == 1)
+        {
+            groups[2] = split(rest, inEnd);
+            groups[3] = split(groups[2], inEnd);
+        }
+        else
+            groups[3] = split(rest, inEnd);
     }
 
     for (int g = 0; g < 4; ++g)
@@ -212,7 +275,7 @@ QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodie
             continue;
         QuadTreeBodyTable::Entry& entry = mBodies[index];
         // Relaxed: read by queries only after the sub-tree is published by a release exchange
-        entry.mSequence.store(body.mID.GetSequence(), std::memory_order_relaxed);
+        mBodies.Sequence(index).store(body.mID.GetSequence(), std::memory_order_relaxed);
         entry.mLayer.store(body.mLayer, std::memory_order_relaxed);
         entry.mTree.store(mTreeId, std::memory_order_relaxed); // As above
         QuadTreeBodyTable::StoreBounds(entry, body.mBounds);
@@ -369,7 +432,7 @@ bool QuadTree::RemoveBody(BodyID inBody)
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: same-body operations are serialised by the caller
-    if (entry.mSequence.load(std::memory_order_relaxed) != inBody.GetSequence()) return false;
+    if (mBodies.Sequence(index).load(std::memory_order_relaxed) != inBody.GetSequence()) return false;
     const uint32_t location = LoadOwnLocation(entry);
     if (location == QuadTreeBodyTable::cInvalidLocation) return false;
     const uint32_t nodeIndex = location >> 2;
@@ -390,7 +453,7 @@ void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: same-body operations are serialised by the caller
-    if (entry.mSequence.load(std::memory_order_relaxed) != inBody.GetSequence()) return;
+    if (mBodies.Sequence(index).load(std::memory_order_relaxed) != inBody.GetSequence()) return;
     const uint32_t location = LoadOwnLocation(entry);
     if (location == QuadTreeBodyTable::cInvalidLocation) return;
     const uint32_t nodeIndex = location >> 2;
@@ -412,7 +475,7 @@ void QuadTree::SetBodyLayer(BodyID inBody, ObjectLayer inLayer)
     if (index >= mBodies.GetMaxBodies() || inLayer >= cMaxObjectLayers) return;
     QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: same-body operations are serialised; a query sees the old or the new layer
-    if (entry.mSequence.load(std::memory_order_relaxed) == inBody.GetSequence())
+    if (mBodies.Sequence(index).load(std::memory_order_relaxed) == inBody.GetSequence())
         entry.mLayer.store(inLayer, std::memory_order_relaxed);
 }
 
@@ -422,7 +485,7 @@ bool QuadTree::Contains(BodyID inBody) const
     if (index >= mBodies.GetMaxBodies()) return false;
     const QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Relaxed: a snapshot for tests, statistics and the broad phase's own serialised calls
-    return entry.mSequence.load(std::memory_order_relaxed) == inBody.GetSequence() &&
+    return mBodies.Sequence(index).load(std::memory_order_relaxed) == inBody.GetSequence() &&
            LoadOwnLocation(entry) != QuadTreeBodyTable::cInvalidLocation;
 }
 
@@ -454,8 +517,8 @@ AABB QuadTree::GetBodyBounds(BodyID inBody) const
     return GetBodySlotBounds(inBody); // A move is being written: its slot contains the old bounds
 }
 
-template <class Test, class LeafVisit>
-bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) const
+template <class Test4, class Test, class LeafVisit>
+bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const
 {
     EpochReclaimer::ReadScope scope(mReclaimer);
     const bool checkLayers = inMask != cAllObjectLayers;
@@ -463,13 +526,14 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) c
     // Acquire: pairs with the release exchange or store that published the root and everything below it
     stack.Push(mRoot.load(std::memory_order_acquire));
     uint32_t nodeIndex;
+    Eigen::Array4f fractions = Eigen::Array4f::Zero(); // Ray entry fractions of the slots (casts only)
     while (stack.Pop(nodeIndex))
     {
         const Node& node = GetNode(nodeIndex);
-        for (int s = 0; s < 4; ++s)
+        // One branch-free 4-wide test for the node, then only the slots that passed
+        for (uint32_t hits = inTest4(quadtree::SlotBounds4(node), fractions); hits != 0; hits &= hits - 1)
         {
-            const AABB box = LoadSlot(node, s);
-            if (IsEmptyBox(box) || !inTest(box)) continue;
+            const int s = std::countr_zero(hits);
             // Acquire: pairs with the release exchange in LinkSubTree that published a sub-tree here
             const uint32_t child = node.mChild[s].load(std::memory_order_acquire);
             if (child == cInvalidChild) continue;
@@ -485,19 +549,20 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) c
             }
             const uint32_t index = child & ~cBodyFlag;
             const QuadTreeBodyTable::Entry& entry = mBodies[index];
+            float fraction = fractions[s];
             // Relaxed: MoveBody set the bit before the release of the growth we may have acquired above
             if ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u)
             {
                 // The slot may be wider than the body: test its exact bounds (the slot, which contains the
                 // old bounds, was already tested when a move is being written)
                 AABB exact;
-                if (QuadTreeBodyTable::LoadBounds(entry, exact) && !inTest(exact)) continue;
+                if (QuadTreeBodyTable::LoadBounds(entry, exact) && !inTest(exact, fraction)) continue;
             }
             // Relaxed: written before the sub-tree was published (acquired above); a concurrent re-add of
             // the index is reported with its old or new id, both allowed
             if (checkLayers && !IsInLayerMask(inMask, entry.mLayer.load(std::memory_order_relaxed))) continue;
-            const BodyID id(index, entry.mSequence.load(std::memory_order_relaxed)); // As above
-            if (!inLeaf(id)) return false;
+            const BodyID id(index, mBodies.Sequence(index).load(std::memory_order_relaxed)); // As above
+            if (!inLeaf(id, fraction)) return false;
         }
     }
     return true;
@@ -506,8 +571,11 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) c
 void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const
 {
     Walk(
-        inMask, [&](const AABB& inNode) { return AABBsOverlap(inNode, inBox); },
-        [&](BodyID inID)
+        inMask,
+        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        { return quadtree::OverlapMask(inSlots, inBox); },
+        [&](const AABB& inBody, float&) { return AABBsOverlap(inBody, inBox); },
+        [&](BodyID inID, float)
         {
             inVisitor(inID);
             return true;
@@ -518,8 +586,11 @@ void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMa
                              BodyVisitor inVisitor) const
 {
     Walk(
-        inMask, [&](const AABB& inNode) { return SphereOverlapsAABB(inCenter, inRadius, inNode); },
-        [&](BodyID inID)
+        inMask,
+        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        { return quadtree::SphereMask(inSlots, inCenter, inRadius); },
+        [&](const AABB& inBody, float&) { return SphereOverlapsAABB(inCenter, inRadius, inBody); },
+        [&](BodyID inID, float)
         {
             inVisitor(inID);
             return true;
@@ -528,9 +599,13 @@ void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMa
 
 void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor) const
 {
+    const AABB point(inPoint, inPoint);
     Walk(
-        inMask, [&](const AABB& inNode) { return AABBContains(inNode, inPoint); },
-        [&](BodyID inID)
+        inMask,
+        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        { return quadtree::OverlapMask(inSlots, point); },
+        [&](const AABB& inBody, float&) { return AABBContains(inBody, inPoint); },
+        [&](BodyID inID, float)
         {
             inVisitor(inID);
             return true;
@@ -541,18 +616,21 @@ bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMa
                        RayBodyVisitor inVisitor) const
 {
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
-    float fraction = 0.0f; // Entry fraction of the box last accepted by the test
     return Walk(
         inMask,
-        [&](const AABB& inBox)
+        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f& outFractions)
+        { return quadtree::RayMask(inSlots, inRay.mOrigin, invDirection, ioMaxFraction, outFractions); },
+        [&](const AABB& inBody, float& outFraction)
         {
-            fraction = inBox.RayEntryFraction(inRay.mOrigin, invDirection, ioMaxFraction);
-            return fraction <= ioMaxFraction;
+            outFraction = inBody.RayEntryFraction(inRay.mOrigin, invDirection, ioMaxFraction);
+            return outFraction <= ioMaxFraction;
         },
-        [&](BodyID inID)
+        [&](BodyID inID, float inFraction)
         {
+            // Slots of this node were tested against the range before the visitor may have shrunk it
+            if (inFraction > ioMaxFraction) return true;
             // The visitor can only shrink the range, as in the other broad phases
-            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, fraction));
+            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, inFraction));
             return ioMaxFraction >= 0.0f;
         });
 }
@@ -560,18 +638,33 @@ bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMa
 bool QuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
                          float& ioMaxFraction, RayBodyVisitor inVisitor) const
 {
+    // The box centre is cast against slots grown by the box half extents (see SweptAABox)
     const SweptAABox sweep(inBox, inDisplacement);
-    float fraction = 0.0f; // Entry fraction of the box last accepted by the test
     return Walk(
         inMask,
-        [&](const AABB& inTarget)
+        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f& outFractions)
         {
-            fraction = sweep.EntryFraction(inTarget, ioMaxFraction);
-            return fraction <= ioMaxFraction;
+            quadtree::SlotBounds4 grown = inSlots;
+            grown.mMinX -= sweep.mHalfExtent.x();
+            grown.mMinY -= sweep.mHalfExtent.y();
+            grown.mMinZ -= sweep.mHalfExtent.z();
+            grown.mMaxX += sweep.mHalfExtent.x();
+            grown.mMaxY += sweep.mHalfExtent.y();
+            grown.mMaxZ += sweep.mHalfExtent.z();
+            return quadtree::RayMask(grown, sweep.mCenter, sweep.mInvDisplacement, ioMaxFraction,
+                                     outFractions) &
+                   quadtree::ToMask((inSlots.mMinX <= inSlots.mMaxX) && (inSlots.mMinY <= inSlots.mMaxY) &&
+                                    (inSlots.mMinZ <= inSlots.mMaxZ));
         },
-        [&](BodyID inID)
+        [&](const AABB& inBody, float& outFraction)
         {
-            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, fraction));
+            outFraction = sweep.EntryFraction(inBody, ioMaxFraction);
+            return outFraction <= ioMaxFraction;
+        },
+        [&](BodyID inID, float inFraction)
+        {
+            if (inFraction > ioMaxFraction) return true; // See CastRay
+            ioMaxFraction = std::min(ioMaxFraction, inVisitor(inID, inFraction));
             return ioMaxFraction >= 0.0f;
         });
 }

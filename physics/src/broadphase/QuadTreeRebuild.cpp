@@ -103,6 +103,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     struct Relocation
     {
         uint32_t mBody, mOldLocation, mNewLocation;
+        AABB mBuiltBounds; ///< What phase 1 read and the new slot holds
     };
     struct Reparent
     {
@@ -117,7 +118,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                    {
                        if ((inItem.mChild & cBodyFlag) != 0)
                            relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
-                                                  inNode << 2 | uint32_t(inSlot)});
+                                                  inNode << 2 | uint32_t(inSlot), inItem.mBounds});
                        else
                            reparents.push_back({inItem.mChild, inNode});
                    });
@@ -179,8 +180,13 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             {
                 AABB exact;
                 QuadTreeBodyTable::LoadBounds(entry, exact); // No writer can be inside: always consistent
-                InitSlot(GetNode(newNode), newSlot, cBodyFlag | relocation.mBody, exact);
-                PropagateUp(newNode, exact); // Grows the private ancestors if it moved during the build
+                // Moved during the build: its slot and the private ancestors take the current bounds (the
+                // common case, unchanged, costs no atomic operation: the commit is what modifiers wait for)
+                if (exact.mMin != relocation.mBuiltBounds.mMin || exact.mMax != relocation.mBuiltBounds.mMax)
+                {
+                    InitSlot(GetNode(newNode), newSlot, cBodyFlag | relocation.mBody, exact);
+                    PropagateUp(newNode, exact);
+                }
                 // Release: a modifier that acquires the location sees the new node's contents
                 entry.mLocation.store(relocation.mNewLocation, std::memory_order_release);
                 ++stats.mRelocatedBodies;

@@ -216,10 +216,11 @@ private:
     void PropagateUp(uint32_t inNode, const AABB& inBounds);
     /// Marks inNode and its ancestors changed.
     void MarkChangedUp(uint32_t inNode);
-    /// Depth-first walk under a read section. inTest(AABB) -> bool decides descent and, on the exact bounds,
-    /// leaf reports; inLeaf(BodyID) -> bool returns false to stop. Returns false when stopped.
-    template <class Test, class LeafVisit>
-    bool Walk(ObjectLayerMask inMask, Test&& inTest, LeafVisit&& inLeaf) const;
+    /// Depth-first walk under a read section. inTest4(SlotBounds4, Array4f& fractions) -> slot mask decides
+    /// which slots to descend or report; inTest(exact AABB, float& fraction) -> bool re-tests a body whose
+    /// slot is loose; inLeaf(BodyID, fraction) -> bool returns false to stop. Returns false when stopped.
+    template <class Test4, class Test, class LeafVisit>
+    bool Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const;
 
     /// The body's location when it is in this tree (acquire), else cInvalidLocation.
     uint32_t LoadOwnLocation(const QuadTreeBodyTable::Entry& inEntry) const;

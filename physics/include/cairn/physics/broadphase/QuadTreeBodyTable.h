@@ -29,11 +29,10 @@ public:
     static constexpr uint32_t cInvalidLocation = 0xffffffffu; ///< Not in any tree
     static constexpr uint32_t cPendingLocation = 0xfffffffeu; ///< Claimed by a batch being prepared
 
-    /// Per-body record; 40 bytes.
+    /// Per-body record; 36 bytes (plus the sequence, kept apart: see Sequence()).
     struct Entry
     {
         std::atomic<uint32_t> mLocation{cInvalidLocation}; ///< node << 2 | slot, or one of the markers above
-        std::atomic<uint32_t> mSequence{0};                ///< Sequence of the stored id
         std::atomic<uint32_t> mVersion{0};                 ///< Sequence lock of the bounds; odd while written
         std::atomic<float> mBounds[6] = {0, 0, 0, 0, 0, 0}; ///< Exact min xyz, max xyz
         std::atomic<uint8_t> mLayer{0};                     ///< Object layer
@@ -41,13 +40,21 @@ public:
     };
 
     explicit QuadTreeBodyTable(uint32_t inMaxBodies)
-        : mMaxBodies(inMaxBodies), mEntries(std::make_unique<Entry[]>(inMaxBodies))
+        : mMaxBodies(inMaxBodies), mEntries(std::make_unique<Entry[]>(inMaxBodies)),
+          mSequences(std::make_unique<std::atomic<uint32_t>[]>(inMaxBodies))
     {
+        for (uint32_t i = 0; i < inMaxBodies; ++i)
+            mSequences[i].store(0, std::memory_order_relaxed); // Construction: published by whoever shares it
     }
 
     uint32_t GetMaxBodies() const { return mMaxBodies; }
     Entry& operator[](uint32_t inIndex) { return mEntries[inIndex]; }
     const Entry& operator[](uint32_t inIndex) const { return mEntries[inIndex]; }
+    /// Sequence of the stored id of a body index. A separate array of 4 bytes a body (80 KB for the shared
+    /// 20,020-body world) rather than a field of Entry (800 KB): every query hit reads it, and it then stays
+    /// in the L2 cache; in Entry it was a cache miss per hit (a quarter of a box query's time).
+    std::atomic<uint32_t>& Sequence(uint32_t inIndex) { return mSequences[inIndex]; }
+    const std::atomic<uint32_t>& Sequence(uint32_t inIndex) const { return mSequences[inIndex]; }
 
     /// Stores exact bounds. Only the thread that owns the body's current operation calls it.
     /// No fences (ThreadSanitizer does not model them): each float is stored with release, so a reader that
@@ -86,11 +93,15 @@ public:
     }
 
     /// Bytes used by the table.
-    size_t GetMemoryBytes() const { return size_t(mMaxBodies) * sizeof(Entry); }
+    size_t GetMemoryBytes() const
+    {
+        return size_t(mMaxBodies) * (sizeof(Entry) + sizeof(std::atomic<uint32_t>));
+    }
 
 private:
     uint32_t mMaxBodies;
     std::unique_ptr<Entry[]> mEntries;
+    std::unique_ptr<std::atomic<uint32_t>[]> mSequences;
 };
 
 } // namespace cairn
