@@ -118,7 +118,7 @@ void BM_AddBatch(benchmark::State& ioState)
 {
     const std::vector<BroadPhaseBody> bodies = StaticBodies();
     double addMs = 0, rebuildMs = 0;
-    BroadPhaseQuadTree::MemoryStats memory;
+    BroadPhaseQuadTree::MemoryStats memory, settled;
     std::vector<BodyID> ids;
     for (const BroadPhaseBody& body : bodies)
         ids.push_back(body.mID);
@@ -147,10 +147,15 @@ void BM_AddBatch(benchmark::State& ioState)
         ioState.SetIterationTime((add + rebuild) * 1e-3);
         addMs += add;
         rebuildMs += rebuild;
-        if (quadTree != nullptr)
-            memory = quadTree->GetMemoryStats(); // Old and new trees both still allocated
         benchmark::DoNotOptimize(broadPhase->GetBodyCount());
-        ioState.PauseTiming(); // Destruction is not part of the figure
+        ioState.PauseTiming(); // Memory and destruction are not part of the figure
+        if (quadTree != nullptr)
+        {
+            memory = quadTree->GetMemoryStats(); // Old and new trees both still allocated
+            for (int update = 0; update < 3; ++update)
+                quadTree->Update(); // Frees the old tree once no query can reach it
+            settled = quadTree->GetMemoryStats();
+        }
         broadPhase.reset();
         ioState.ResumeTiming();
     }
@@ -164,6 +169,9 @@ void BM_AddBatch(benchmark::State& ioState)
             double(memory.mBodyTableBytes + memory.mNodeBytesInUse) / double(bodies.size());
         ioState.counters["node_bytes"] = double(memory.mNodeSize);
         ioState.counters["nodes"] = double(memory.mNodesInUse);
+        ioState.counters["bytes_per_body_settled"] =
+            double(settled.mBodyTableBytes + settled.mNodeBytesInUse) / double(bodies.size());
+        ioState.counters["table_bytes_per_body"] = double(settled.mBodyTableBytes) / double(bodies.size());
     }
     ioState.SetLabel(KindName(ioState.range(0)));
 }
