@@ -17,6 +17,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
+#include <gtest/gtest.h>
 #include <random>
 #include <thread>
 #include <vector>
@@ -225,6 +227,25 @@ NoMissStressResult RunNoMissStress(BroadPhase& ioBroadPhase, const NoMissStressC
     result.mPairSearches = pairSearches.load();
     result.mSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+/// The checks every run of the stress makes (gtest expectations), and its figures on stdout.
+inline void ExpectNoMisses(const NoMissStressResult& inResult, const NoMissStressConfig& inConfig,
+                           size_t inBodyCountAfter)
+{
+    EXPECT_EQ(inResult.mMisses, 0u);
+    EXPECT_EQ(inResult.mRefusedBatches, 0u);
+    EXPECT_GE(inResult.mChecks, std::min<uint64_t>(inConfig.mTargetChecks, 1));
+    EXPECT_GT(inResult.mMoves, 0u);
+    EXPECT_GT(inResult.mChurnBatches, 0u);
+    EXPECT_GT(inResult.mUpdates, 16u); // At least one full rebuild ran
+    // Every churned body was re-added after its last removal
+    EXPECT_EQ(inBodyCountAfter, inConfig.mNumPermanent + inConfig.mNumChurned);
+    std::printf(
+        "[ figure   ] %llu checks, %llu misses, %llu moves, %llu churn batches, %llu updates in %.1f s\n",
+        (unsigned long long)inResult.mChecks, (unsigned long long)inResult.mMisses,
+        (unsigned long long)inResult.mMoves, (unsigned long long)inResult.mChurnBatches,
+        (unsigned long long)inResult.mUpdates, inResult.mSeconds);
 }
 
 } // namespace cairn::test
