@@ -96,7 +96,8 @@ std::unique_ptr<BroadPhase> MakeLoadedWorld(int64_t inKind)
     broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
     if (auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get()))
         quadTree->RebuildAll();
-    else
+    // A few steps' updates, as in a running game: the quad tree frees its old nodes
+    for (int update = 0; update < 3; ++update)
         broadPhase->Update();
     return broadPhase;
 }

@@ -526,7 +526,7 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, Leaf
     // Acquire: pairs with the release exchange or store that published the root and everything below it
     stack.Push(mRoot.load(std::memory_order_acquire));
     uint32_t nodeIndex;
-    Eigen::Array4f fractions = Eigen::Array4f::Zero(); // Ray entry fractions of the slots (casts only)
+    float fractions[4] = {0, 0, 0, 0}; // Ray entry fractions of the slots (casts only)
     while (stack.Pop(nodeIndex))
     {
         const Node& node = GetNode(nodeIndex);
@@ -572,7 +572,7 @@ void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisit
 {
     Walk(
         inMask,
-        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::OverlapMask(inSlots, inBox); },
         [&](const AABB& inBody, float&) { return AABBsOverlap(inBody, inBox); },
         [&](BodyID inID, float)
@@ -587,7 +587,7 @@ void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMa
 {
     Walk(
         inMask,
-        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::SphereMask(inSlots, inCenter, inRadius); },
         [&](const AABB& inBody, float&) { return SphereOverlapsAABB(inCenter, inRadius, inBody); },
         [&](BodyID inID, float)
@@ -602,7 +602,7 @@ void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVis
     const AABB point(inPoint, inPoint);
     Walk(
         inMask,
-        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f&)
+        [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::OverlapMask(inSlots, point); },
         [&](const AABB& inBody, float&) { return AABBContains(inBody, inPoint); },
         [&](BodyID inID, float)
@@ -618,7 +618,7 @@ bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMa
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     return Walk(
         inMask,
-        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f& outFractions)
+        [&](const quadtree::SlotBounds4& inSlots, float(&outFractions)[4])
         { return quadtree::RayMask(inSlots, inRay.mOrigin, invDirection, ioMaxFraction, outFractions); },
         [&](const AABB& inBody, float& outFraction)
         {
@@ -642,19 +642,11 @@ bool QuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLa
     const SweptAABox sweep(inBox, inDisplacement);
     return Walk(
         inMask,
-        [&](const quadtree::SlotBounds4& inSlots, Eigen::Array4f& outFractions)
+        [&](const quadtree::SlotBounds4& inSlots, float(&outFractions)[4])
         {
-            quadtree::SlotBounds4 grown = inSlots;
-            grown.mMinX -= sweep.mHalfExtent.x();
-            grown.mMinY -= sweep.mHalfExtent.y();
-            grown.mMinZ -= sweep.mHalfExtent.z();
-            grown.mMaxX += sweep.mHalfExtent.x();
-            grown.mMaxY += sweep.mHalfExtent.y();
-            grown.mMaxZ += sweep.mHalfExtent.z();
-            return quadtree::RayMask(grown, sweep.mCenter, sweep.mInvDisplacement, ioMaxFraction,
-                                     outFractions) &
-                   quadtree::ToMask((inSlots.mMinX <= inSlots.mMaxX) && (inSlots.mMinY <= inSlots.mMaxY) &&
-                                    (inSlots.mMinZ <= inSlots.mMaxZ));
+            // Empty slots stay empty when grown (min > max by about 2 * cLargeFloat)
+            return quadtree::RayMask(inSlots.Grown(sweep.mHalfExtent), sweep.mCenter, sweep.mInvDisplacement,
+                                     ioMaxFraction, outFractions);
         },
         [&](const AABB& inBody, float& outFraction)
         {

@@ -3,7 +3,12 @@
 // Pieces shared by QuadTree.cpp (live tree) and QuadTreeRebuild.cpp (rebuild): the traversal stack, the
 // atomic min/max and the build item. Private to the physics library.
 
+#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 #include "cairn/physics/broadphase/QuadTree.h"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include <vector>
 
@@ -71,82 +76,185 @@ private:
     std::vector<uint32_t> mSpill;           ///< Overflow; empty (never allocates) in normal trees
 };
 
-/// The four slot bounds of a node as read now, one SIMD lane per slot, for branch-free 4-wide tests.
+/// The four slot bounds of a node as read now, one SIMD lane per slot, for branch-free 4-wide tests. The
+/// floats are read one by one from the atomics (acquire, as LoadSlot) straight into registers: storing them
+/// to memory and loading 16 bytes back stalls on store forwarding, which cost a quarter of a box query.
 struct SlotBounds4
 {
-    Eigen::Array4f mMinX, mMinY, mMinZ, mMaxX, mMaxY, mMaxZ;
+#if defined(__SSE2__)
+    __m128 mMinX, mMinY, mMinZ, mMaxX, mMaxY, mMaxZ;
+
+    explicit SlotBounds4(const QuadTree::Node& inNode)
+        : mMinX(Load4(inNode.mMinX)), mMinY(Load4(inNode.mMinY)), mMinZ(Load4(inNode.mMinZ)),
+          mMaxX(Load4(inNode.mMaxX)), mMaxY(Load4(inNode.mMaxY)), mMaxZ(Load4(inNode.mMaxZ))
+    {
+    }
+
+    /// The same bounds grown by inExtent on every side (swept boxes). Empty slots stay empty.
+    SlotBounds4 Grown(const Vec3& inExtent) const
+    {
+        SlotBounds4 grown = *this;
+        grown.mMinX = _mm_sub_ps(mMinX, _mm_set1_ps(inExtent.x()));
+        grown.mMinY = _mm_sub_ps(mMinY, _mm_set1_ps(inExtent.y()));
+        grown.mMinZ = _mm_sub_ps(mMinZ, _mm_set1_ps(inExtent.z()));
+        grown.mMaxX = _mm_add_ps(mMaxX, _mm_set1_ps(inExtent.x()));
+        grown.mMaxY = _mm_add_ps(mMaxY, _mm_set1_ps(inExtent.y()));
+        grown.mMaxZ = _mm_add_ps(mMaxZ, _mm_set1_ps(inExtent.z()));
+        return grown;
+    }
+
+private:
+    static __m128 Load4(const std::atomic<float> (&inValues)[4])
+    {
+        // Acquire: pairs with the releases of GrowSlot, exactly as LoadSlot does per slot
+        return _mm_setr_ps(
+            inValues[0].load(std::memory_order_acquire), inValues[1].load(std::memory_order_acquire),
+            inValues[2].load(std::memory_order_acquire), inValues[3].load(std::memory_order_acquire));
+    }
+#else
+    float mMinX[4], mMinY[4], mMinZ[4], mMaxX[4], mMaxY[4], mMaxZ[4];
 
     explicit SlotBounds4(const QuadTree::Node& inNode)
     {
-        // Acquire on every float: pairs with the releases of GrowSlot, exactly as LoadSlot does per slot
-        auto load4 = [](const std::atomic<float>(&inValues)[4])
+        for (int s = 0; s < 4; ++s)
         {
-            return Eigen::Array4f(
-                inValues[0].load(std::memory_order_acquire), inValues[1].load(std::memory_order_acquire),
-                inValues[2].load(std::memory_order_acquire), inValues[3].load(std::memory_order_acquire));
-        };
-        mMinX = load4(inNode.mMinX);
-        mMinY = load4(inNode.mMinY);
-        mMinZ = load4(inNode.mMinZ);
-        mMaxX = load4(inNode.mMaxX);
-        mMaxY = load4(inNode.mMaxY);
-        mMaxZ = load4(inNode.mMaxZ);
+            const AABB slot = QuadTree::LoadSlot(inNode, s); // Acquire, see there
+            mMinX[s] = slot.mMin.x();
+            mMinY[s] = slot.mMin.y();
+            mMinZ[s] = slot.mMin.z();
+            mMaxX[s] = slot.mMax.x();
+            mMaxY[s] = slot.mMax.y();
+            mMaxZ[s] = slot.mMax.z();
+        }
     }
+
+    AABB Slot(int inSlot) const
+    {
+        return AABB(Vec3(mMinX[inSlot], mMinY[inSlot], mMinZ[inSlot]),
+                    Vec3(mMaxX[inSlot], mMaxY[inSlot], mMaxZ[inSlot]));
+    }
+
+    /// The same bounds grown by inExtent on every side (swept boxes). Empty slots stay empty.
+    SlotBounds4 Grown(const Vec3& inExtent) const
+    {
+        SlotBounds4 grown = *this;
+        for (int s = 0; s < 4; ++s)
+        {
+            grown.mMinX[s] -= inExtent.x();
+            grown.mMinY[s] -= inExtent.y();
+            grown.mMinZ[s] -= inExtent.z();
+            grown.mMaxX[s] += inExtent.x();
+            grown.mMaxY[s] += inExtent.y();
+            grown.mMaxZ[s] += inExtent.z();
+        }
+        return grown;
+    }
+#endif
 };
 
-/// Lanes set in a 4-lane boolean array, as bits 0..3.
-inline uint32_t ToMask(const Eigen::Array<bool, 4, 1>& inLanes)
+// The masks below have an SSE version (x86-64 always has SSE2) and a scalar one with the shared exact tests.
+// Both give the same bits: the SSE versions use the same comparisons and, for rays, the same operations in
+// the same order as AABB::RayEntryFraction. (Eigen's boolean arrays were tried first: turning their lanes
+// into a mask cost a third of a box query.)
+#if defined(__SSE2__)
+
+/// Lanes of a non-empty slot (min <= max on every axis).
+inline __m128 NonEmptyLanes(const SlotBounds4& inSlots)
 {
-    return uint32_t(inLanes[0]) | uint32_t(inLanes[1]) << 1 | uint32_t(inLanes[2]) << 2 |
-           uint32_t(inLanes[3]) << 3;
+    return _mm_and_ps(
+        _mm_and_ps(_mm_cmple_ps(inSlots.mMinX, inSlots.mMaxX), _mm_cmple_ps(inSlots.mMinY, inSlots.mMaxY)),
+        _mm_cmple_ps(inSlots.mMinZ, inSlots.mMaxZ));
 }
 
-/// Slots whose bounds overlap inBox (closed intervals, the same comparisons as AABBsOverlap). Empty slots
-/// fail for any query below cLargeFloat; the walk skips invalid children anyway.
+/// Slots whose bounds overlap inBox (closed intervals, the comparisons of AABBsOverlap). Empty slots fail for
+/// any query below cLargeFloat; the walk skips invalid children anyway.
 inline uint32_t OverlapMask(const SlotBounds4& inSlots, const AABB& inBox)
 {
-    return ToMask((inSlots.mMinX <= inBox.mMax.x()) && (inSlots.mMaxX >= inBox.mMin.x()) &&
-                  (inSlots.mMinY <= inBox.mMax.y()) && (inSlots.mMaxY >= inBox.mMin.y()) &&
-                  (inSlots.mMinZ <= inBox.mMax.z()) && (inSlots.mMaxZ >= inBox.mMin.z()));
+    const __m128 x = _mm_and_ps(_mm_cmple_ps(inSlots.mMinX, _mm_set1_ps(inBox.mMax.x())),
+                                _mm_cmpge_ps(inSlots.mMaxX, _mm_set1_ps(inBox.mMin.x())));
+    const __m128 y = _mm_and_ps(_mm_cmple_ps(inSlots.mMinY, _mm_set1_ps(inBox.mMax.y())),
+                                _mm_cmpge_ps(inSlots.mMaxY, _mm_set1_ps(inBox.mMin.y())));
+    const __m128 z = _mm_and_ps(_mm_cmple_ps(inSlots.mMinZ, _mm_set1_ps(inBox.mMax.z())),
+                                _mm_cmpge_ps(inSlots.mMaxZ, _mm_set1_ps(inBox.mMin.z())));
+    return uint32_t(_mm_movemask_ps(_mm_and_ps(_mm_and_ps(x, y), z)));
 }
 
-/// Slots whose bounds are within inRadius of inCenter (the same arithmetic as SphereOverlapsAABB).
+/// Slots whose bounds are within inRadius of inCenter (the arithmetic of SphereOverlapsAABB).
 inline uint32_t SphereMask(const SlotBounds4& inSlots, const Vec3& inCenter, float inRadius)
 {
-    const Eigen::Array4f dx = inSlots.mMinX.max(inCenter.x()).min(inSlots.mMaxX) - inCenter.x();
-    const Eigen::Array4f dy = inSlots.mMinY.max(inCenter.y()).min(inSlots.mMaxY) - inCenter.y();
-    const Eigen::Array4f dz = inSlots.mMinZ.max(inCenter.z()).min(inSlots.mMaxZ) - inCenter.z();
-    return ToMask(dx * dx + dy * dy + dz * dz <= inRadius * inRadius) &
-           ToMask((inSlots.mMinX <= inSlots.mMaxX) && (inSlots.mMinY <= inSlots.mMaxY) &&
-                  (inSlots.mMinZ <= inSlots.mMaxZ));
+    auto axis = [](__m128 inMin, __m128 inMax, float inC)
+    {
+        const __m128 c = _mm_set1_ps(inC);
+        const __m128 d = _mm_sub_ps(c, _mm_min_ps(_mm_max_ps(c, inMin), inMax));
+        return _mm_mul_ps(d, d);
+    };
+    const __m128 distanceSq = _mm_add_ps(_mm_add_ps(axis(inSlots.mMinX, inSlots.mMaxX, inCenter.x()),
+                                                    axis(inSlots.mMinY, inSlots.mMaxY, inCenter.y())),
+                                         axis(inSlots.mMinZ, inSlots.mMaxZ, inCenter.z()));
+    return uint32_t(_mm_movemask_ps(
+        _mm_and_ps(_mm_cmple_ps(distanceSq, _mm_set1_ps(inRadius * inRadius)), NonEmptyLanes(inSlots))));
 }
 
-/// Slots whose bounds the ray enters at or before inMaxFraction; outFractions gets the entry fractions. The
-/// same operations, in the same order per lane, as AABB::RayEntryFraction, so the fractions are
-/// bit-identical.
+/// Slots whose bounds the ray enters at or before inMaxFraction; outFractions gets the entry fractions.
 inline uint32_t RayMask(const SlotBounds4& inSlots, const Vec3& inOrigin, const Vec3& inInvDirection,
-                        float inMaxFraction, Eigen::Array4f& outFractions)
+                        float inMaxFraction, float (&outFractions)[4])
 {
-    Eigen::Array4f tMin = Eigen::Array4f::Zero();
-    Eigen::Array4f tMax = Eigen::Array4f::Constant(inMaxFraction);
-    auto axis = [&](const Eigen::Array4f& inMin, const Eigen::Array4f& inMax, float inO, float inInv)
+    __m128 tMin = _mm_setzero_ps();
+    __m128 tMax = _mm_set1_ps(inMaxFraction);
+    auto axis = [&](__m128 inMin, __m128 inMax, float inO, float inInv)
     {
-        Eigen::Array4f t1 = (inMin - inO) * inInv;
-        Eigen::Array4f t2 = (inMax - inO) * inInv;
+        const __m128 o = _mm_set1_ps(inO), inv = _mm_set1_ps(inInv);
+        __m128 t1 = _mm_mul_ps(_mm_sub_ps(inMin, o), inv);
+        __m128 t2 = _mm_mul_ps(_mm_sub_ps(inMax, o), inv);
         // 0 * inf gives NaN when the origin lies on a slab plane of a parallel ray; treat it as inside
-        t1 = t1.isNaN().select(Eigen::Array4f::Constant(-cLargeFloat), t1);
-        t2 = t2.isNaN().select(Eigen::Array4f::Constant(cLargeFloat), t2);
-        tMin = tMin.max(t1.min(t2));
-        tMax = tMax.min(t1.max(t2));
+        const __m128 nan1 = _mm_cmpunord_ps(t1, t1), nan2 = _mm_cmpunord_ps(t2, t2);
+        t1 = _mm_or_ps(_mm_andnot_ps(nan1, t1), _mm_and_ps(nan1, _mm_set1_ps(-cLargeFloat)));
+        t2 = _mm_or_ps(_mm_andnot_ps(nan2, t2), _mm_and_ps(nan2, _mm_set1_ps(cLargeFloat)));
+        tMin = _mm_max_ps(tMin, _mm_min_ps(t1, t2));
+        tMax = _mm_min_ps(tMax, _mm_max_ps(t1, t2));
     };
     axis(inSlots.mMinX, inSlots.mMaxX, inOrigin.x(), inInvDirection.x());
     axis(inSlots.mMinY, inSlots.mMaxY, inOrigin.y(), inInvDirection.y());
     axis(inSlots.mMinZ, inSlots.mMaxZ, inOrigin.z(), inInvDirection.z());
-    outFractions = tMin;
-    return ToMask(tMin <= tMax) &
-           ToMask((inSlots.mMinX <= inSlots.mMaxX) && (inSlots.mMinY <= inSlots.mMaxY) &&
-                  (inSlots.mMinZ <= inSlots.mMaxZ));
+    _mm_storeu_ps(outFractions, tMin);
+    return uint32_t(_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(tMin, tMax), NonEmptyLanes(inSlots))));
 }
+
+#else
+
+inline uint32_t OverlapMask(const SlotBounds4& inSlots, const AABB& inBox)
+{
+    uint32_t mask = 0;
+    for (int s = 0; s < 4; ++s)
+        mask |= uint32_t(AABBsOverlap(inSlots.Slot(s), inBox)) << s;
+    return mask;
+}
+
+inline uint32_t SphereMask(const SlotBounds4& inSlots, const Vec3& inCenter, float inRadius)
+{
+    uint32_t mask = 0;
+    for (int s = 0; s < 4; ++s)
+    {
+        const AABB slot = inSlots.Slot(s);
+        mask |= uint32_t(!IsEmptyBox(slot) && SphereOverlapsAABB(inCenter, inRadius, slot)) << s;
+    }
+    return mask;
+}
+
+inline uint32_t RayMask(const SlotBounds4& inSlots, const Vec3& inOrigin, const Vec3& inInvDirection,
+                        float inMaxFraction, float (&outFractions)[4])
+{
+    uint32_t mask = 0;
+    for (int s = 0; s < 4; ++s)
+    {
+        const AABB slot = inSlots.Slot(s);
+        outFractions[s] = slot.RayEntryFraction(inOrigin, inInvDirection, inMaxFraction);
+        mask |= uint32_t(!IsEmptyBox(slot) && outFractions[s] <= inMaxFraction) << s;
+    }
+    return mask;
+}
+
+#endif
 
 /// An object to place in a tree being built: a body (cBodyFlag | index) or a kept node, with its bounds.
 struct BuildItem
