@@ -26,6 +26,32 @@ template <class Lock> Lock LockIf(bool inLock, WriterFairSharedMutex& inMutex)
 
 } // namespace
 
+/// Admits one physics-step call (Update, RebuildAll, FindCollidingPairs) at a time; a second one that
+/// overlaps it is a caller bug (two threads stepping one world) and is refused and counted instead of racing
+/// on the rebuild state and the active scratch.
+class BroadPhaseQuadTree::StepCallGuard
+{
+public:
+    explicit StepCallGuard(const BroadPhaseQuadTree& inBroadPhase) : mBroadPhase(inBroadPhase)
+    {
+        // Acquire: we take over the state the previous step call left behind (released below)
+        mOwner = !mBroadPhase.mStepCallActive.exchange(true, std::memory_order_acquire);
+        if (!mOwner) mBroadPhase.mRefusedStepCalls.fetch_add(1, std::memory_order_relaxed); // Statistic
+    }
+    ~StepCallGuard()
+    {
+        // Release: the next step call sees everything this one wrote
+        if (mOwner) mBroadPhase.mStepCallActive.store(false, std::memory_order_release);
+    }
+    StepCallGuard(const StepCallGuard&) = delete;
+    StepCallGuard& operator=(const StepCallGuard&) = delete;
+    bool IsOwner() const { return mOwner; }
+
+private:
+    const BroadPhaseQuadTree& mBroadPhase;
+    bool mOwner;
+};
+
 BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers, LockMode inMode)
     : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
       mBodies(mMaxBodies), mActiveScratch(mMaxBodies, 0)
@@ -168,6 +194,8 @@ void BroadPhaseQuadTree::RebuildAll()
 
 void BroadPhaseQuadTree::UpdateImpl(bool inFull)
 {
+    const StepCallGuard guard(*this);
+    if (!guard.IsOwner()) return;
     auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     mLastUpdate = {};
     for (const std::unique_ptr<QuadTree>& tree : mTrees)
@@ -233,6 +261,8 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
 void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
                                             const LayerSetup& inLayers, BodyPairVisitor inVisitor) const
 {
+    const StepCallGuard guard(*this);
+    if (!guard.IsOwner()) return;
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     auto isPresent = [&](BodyID inID)
     {

@@ -11,7 +11,8 @@
 //    thread; each tree's modification lock is taken shared (per-thread stripe) only to stay out of a
 //    rebuild's commit. The caller serialises operations on one body.
 //  - Update (rebuild of changed parts + freeing of old nodes) and FindCollidingPairs: the physics step only.
-//    mActiveScratch belongs to FindCollidingPairs.
+//    mActiveScratch belongs to FindCollidingPairs. A second step call that overlaps a running one (two
+//    threads stepping one world) is refused and counted (GetRefusedStepCalls), never run concurrently.
 // LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
 // and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
 // comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
@@ -109,8 +110,16 @@ public:
     /// Validates every tree (single-threaded tests); false on the first violation or a count mismatch.
     bool Validate() const;
 
+    /// Step calls (Update, RebuildAll, FindCollidingPairs) refused because another one was running: two
+    /// threads stepping one world. Such a call returns without doing anything.
+    uint64_t GetRefusedStepCalls() const
+    {
+        return mRefusedStepCalls.load(std::memory_order_relaxed); // Statistic
+    }
+
 private:
     struct Batch;
+    class StepCallGuard;
 
     /// The tree a body of object layer inLayer lives in.
     QuadTree& TreeOf(ObjectLayer inLayer) const { return *mTrees[mLayerSetup.GetBroadPhaseLayer(inLayer)]; }
@@ -127,10 +136,12 @@ private:
     QuadTreeBodyTable mBodies;                     ///< Shared by the trees
     std::vector<std::unique_ptr<QuadTree>> mTrees; ///< One per broad-phase layer; the vector is immutable
     std::array<ObjectLayerMask, cMaxBroadPhaseLayers> mObjectLayersOfTree{}; ///< Immutable
-    std::atomic<int64_t> mBodyCount{0};          ///< Bodies linked (relaxed: a statistic)
-    mutable WriterFairSharedMutex mGlobalMutex;  ///< LockMode::GlobalMutex only
-    mutable std::vector<uint8_t> mActiveScratch; ///< FindCollidingPairs only (physics step)
-    UpdateStats mLastUpdate;                     ///< Physics step only
+    std::atomic<int64_t> mBodyCount{0};                 ///< Bodies linked (relaxed: a statistic)
+    mutable WriterFairSharedMutex mGlobalMutex;         ///< LockMode::GlobalMutex only
+    mutable std::vector<uint8_t> mActiveScratch;        ///< FindCollidingPairs only (physics step)
+    UpdateStats mLastUpdate;                            ///< Physics step only
+    mutable std::atomic<bool> mStepCallActive{false};   ///< A step call is running (see StepCallGuard)
+    mutable std::atomic<uint64_t> mRefusedStepCalls{0}; ///< Statistic
 };
 
 } // namespace cairn

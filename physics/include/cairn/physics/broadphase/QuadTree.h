@@ -11,12 +11,11 @@
 //  - LinkSubTree, RemoveBody, MoveBody: any thread, concurrently with each other and with queries. They take
 //    this tree's StripedSharedMutex shared (their own stripe: no contention between them) only to keep out of
 //    the rebuild's short commit. The caller serialises operations on one body.
-//  - Rebuild and CollectGarbage: one thread at a time (the physics update), concurrently with everything
-//  else.
-//    A rebuild builds the new tree off the live one with no lock, then commits (relocates the bodies it
-//    moved, re-parents kept nodes, links what was linked meanwhile, swaps the root) under the exclusive side
-//    of the modification lock: modifiers may wait for that commit (measured by the broad-phase benchmark),
-//    queries never do. Old nodes are retired by epoch and freed by a later CollectGarbage.
+//  - Rebuild and CollectGarbage: one thread at a time (the physics update), concurrently with the rest. A
+//    rebuild builds the new tree off the live one with no lock, then commits (relocates the bodies it moved,
+//    re-parents kept nodes, links what was linked meanwhile, swaps the root) under the exclusive side of the
+//    modification lock: modifiers may wait for that commit (measured by the broad-phase benchmark), queries
+//    never do. Old nodes are retired by epoch and freed by a later CollectGarbage.
 // Why lock-free is safe:
 //  - A sub-tree is built privately and published with one compare-exchange (release) of a child slot or of
 //    the root index; readers load child indices with acquire, so they see fully built nodes.
@@ -27,6 +26,9 @@
 //    that grew is marked loose and queries then test the body's exact bounds from the QuadTreeBodyTable.
 //  - Removal empties the slot; a concurrent query reports the body or not.
 //  - Nodes are freed only after every read section that might reach them has ended (EpochReclaimer).
+//    Modifiers need no read section: they reach nodes only through body locations and parent links, which
+//    the commit points at the new tree before it releases the exclusive lock, so a modification that starts
+//    after a commit never touches a node that commit retired.
 // Queries allocate nothing: fixed-size traversal stack (spilling to the heap only for degenerate depths).
 
 #include "cairn/physics/broadphase/BroadPhase.h"
