@@ -88,11 +88,15 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             if (child >= mRebuildMark.size()) mRebuildMark.resize(mAllocator.GetHighWater(), 0);
             mRebuildMark[child] = mRebuildStamp;
             // Relaxed: a hint; a node that changes after this read is handled by the commit (step a)
-            const AABB bounds = UnionOfSlots(childNode);
-            if (!inFull && !childNode.mChanged.load(std::memory_order_relaxed) && !bounds.IsEmpty())
+            if (!inFull && !childNode.mChanged.load(std::memory_order_relaxed))
             {
-                items.push_back({child, bounds, bounds.Center(), QuadTreeBodyTable::cInvalidLocation});
-                continue;
+                // Kept whole, unless it is empty (then it is retired like a changed node)
+                const AABB bounds = UnionOfSlots(childNode);
+                if (!bounds.IsEmpty())
+                {
+                    items.push_back({child, bounds, bounds.Center(), QuadTreeBodyTable::cInvalidLocation});
+                    continue;
+                }
             }
             replaced.push_back(child);
             stack.Push(child);
