@@ -7,7 +7,8 @@
 // thread moves the 2,000 dynamic boxes by a random walk of up to 0.5 m through BodyInterface::SetPosition (a
 // body write lock plus a broad-phase AABB update per move), as fast as it can. Reported: wall-clock us per
 // query per thread, moves per second, and the same queries' time with no mover (uncontended). Wall time on
-// purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2 the mover shares a core.
+// purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2 the mover shares a core;
+// the threads' CPU time per query is printed too, to tell time descheduled or blocked from work.
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
@@ -19,6 +20,7 @@
 #include <benchmark/benchmark.h>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <memory>
 #include <random>
 #include <thread>
@@ -94,8 +96,7 @@ std::unique_ptr<BroadPhase> MakeLoadedWorld(int64_t inKind)
     const std::vector<BroadPhaseBody> bodies = StaticBodies();
     std::unique_ptr<BroadPhase> broadPhase = Make(inKind, uint32_t(bodies.size()));
     broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
-    if (auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get()))
-        quadTree->RebuildAll();
+    if (auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get())) quadTree->RebuildAll();
     // A few steps' updates, as in a running game: the quad tree frees its old nodes
     for (int update = 0; update < 3; ++update)
         broadPhase->Update();
@@ -315,9 +316,26 @@ struct ContendedWorld
 };
 
 /// Runs inPasses passes of the query boxes on inThreads threads; returns wall-clock us per query per thread.
-double TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPasses, uint64_t& outHits)
+/// Per query, per thread: wall-clock time (waiting for a lock counts) and the thread's CPU time (it does not:
+/// on 2 cores with 3 busy threads, the gap between the two is time spent descheduled or blocked).
+struct QueryTiming
 {
-    std::vector<double> microseconds(inThreads);
+    double mWallMicroseconds = 0;
+    double mCpuMicroseconds = 0;
+};
+
+/// Microseconds of CPU this thread has used.
+double ThreadCpuMicroseconds()
+{
+    timespec time{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &time);
+    return double(time.tv_sec) * 1.0e6 + double(time.tv_nsec) * 1.0e-3;
+}
+
+/// Runs inPasses passes of the query boxes on inThreads threads.
+QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPasses, uint64_t& outHits)
+{
+    std::vector<QueryTiming> timings(inThreads);
     std::vector<uint64_t> hits(inThreads);
     std::vector<std::thread> threads;
     for (int t = 0; t < inThreads; ++t)
@@ -325,20 +343,24 @@ double TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPasses, 
             [&, t]
             {
                 const auto start = Clock::now();
+                const double cpuStart = ThreadCpuMicroseconds();
                 for (int pass = 0; pass < inPasses; ++pass)
                     hits[t] += QueryAllBoxes(inBroadPhase);
-                microseconds[t] = 1000.0 * MillisecondsSince(start);
+                timings[t].mCpuMicroseconds = ThreadCpuMicroseconds() - cpuStart;
+                timings[t].mWallMicroseconds = 1000.0 * MillisecondsSince(start);
             });
     for (std::thread& thread : threads)
         thread.join();
-    double sum = 0;
+    QueryTiming perQuery;
     outHits = 0;
+    const double queries = double(inThreads) * double(inPasses) * double(Data().mQueryBoxes.size());
     for (int t = 0; t < inThreads; ++t)
     {
-        sum += microseconds[t];
+        perQuery.mWallMicroseconds += timings[t].mWallMicroseconds / queries;
+        perQuery.mCpuMicroseconds += timings[t].mCpuMicroseconds / queries;
         outHits += hits[t];
     }
-    return sum / (double(inThreads) * double(inPasses) * double(Data().mQueryBoxes.size()));
+    return perQuery;
 }
 
 void BM_QueryContended(benchmark::State& ioState)
@@ -348,7 +370,8 @@ void BM_QueryContended(benchmark::State& ioState)
     const int passes = kind == cQuadTreeGlobalMutex ? 1 : 3;
     ContendedWorld world(kind);
     const BroadPhase& broadPhase = world.mSystem->GetBroadPhase();
-    double contended = 0, uncontended = 0, movesPerSecond = 0;
+    QueryTiming contended, uncontended;
+    double movesPerSecond = 0;
     uint64_t hits = 0;
     for (auto _ : ioState)
     {
@@ -385,9 +408,11 @@ void BM_QueryContended(benchmark::State& ioState)
         // Let the broad phase rebuild (the bounds grew) so that each iteration starts alike
         (void)world.mSystem->Update(1.0f / 60.0f, 1);
     }
-    ioState.counters["us_per_query"] = contended;
-    ioState.counters["us_per_query_uncontended"] = uncontended;
-    ioState.counters["ratio"] = contended / uncontended;
+    ioState.counters["us_per_query"] = contended.mWallMicroseconds;
+    ioState.counters["us_per_query_uncontended"] = uncontended.mWallMicroseconds;
+    ioState.counters["ratio"] = contended.mWallMicroseconds / uncontended.mWallMicroseconds;
+    ioState.counters["cpu_us_per_query"] = contended.mCpuMicroseconds;
+    ioState.counters["cpu_us_per_query_uncontended"] = uncontended.mCpuMicroseconds;
     ioState.counters["moves_per_s"] = movesPerSecond;
     ioState.counters["hits"] = double(hits);
     ioState.SetLabel(std::string(KindName(kind)) + ", " + std::to_string(queryThreads) + " query thread(s)");
