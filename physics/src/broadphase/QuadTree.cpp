@@ -129,15 +129,16 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     result.mChild = nodeIndex;
     Node& node = GetNode(nodeIndex);
 
-    // Bounds of the centres of [inB, inE), with min/max on plain floats (the AABB helpers go through Eigen
-    // reductions, which dominated the build)
+    // Bounds of the doubled centres (min + max) of [inB, inE), with min/max on plain floats (the AABB helpers
+    // go through Eigen reductions, which dominated the build)
     auto centreBounds = [](const BuildItem* inB, const BuildItem* inE)
     {
         Vec3 lo = Vec3::Constant(cLargeFloat), hi = Vec3::Constant(-cLargeFloat);
         for (const BuildItem* it = inB; it != inE; ++it)
         {
-            lo = lo.cwiseMin(it->mCenter);
-            hi = hi.cwiseMax(it->mCenter);
+            const Vec3 centre2 = it->mBounds.mMin + it->mBounds.mMax;
+            lo = lo.cwiseMin(centre2);
+            hi = hi.cwiseMax(centre2);
         }
         return AABB(lo, hi);
     };
@@ -154,8 +155,11 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
         if (size[axis] > 0.0f)
         {
             const float splitValue = 0.5f * (inCentres.mMin[axis] + inCentres.mMax[axis]);
-            BuildItem* p = std::partition(
-                inB, inE, [&](const BuildItem& inItem) { return inItem.mCenter[axis] < splitValue; });
+            BuildItem* p =
+                std::partition(inB, inE,
+                               [&](const BuildItem& inItem) {
+                                   return inItem.mBounds.mMin[axis] + inItem.mBounds.mMax[axis] < splitValue;
+                               });
             // Rounding can put everything on one side; fall back to halves then
             if (p != inB && p != inE) return p;
         }
@@ -176,7 +180,8 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
         // of their own here, up to two: pushed down, each would widen every node on its way to a leaf, and
         // every query near them would walk those nodes. One pass: centres and the two largest objects
         const AABB centres = centreBounds(inBegin, inEnd);
-        const float wideLimit = 0.5f * (centres.mMax - centres.mMin).maxCoeff();
+        const float wideLimit =
+            0.25f * (centres.mMax - centres.mMin).maxCoeff(); // Half the spread: centres are doubled
         BuildItem* largest[2] = {nullptr, nullptr};
         float largestSize[2] = {wideLimit, wideLimit};
         for (BuildItem* it = inBegin; it != inEnd; ++it)
@@ -279,8 +284,7 @@ QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodie
         entry.mLayer.store(body.mLayer, std::memory_order_relaxed);
         entry.mTree.store(mTreeId, std::memory_order_relaxed); // As above
         QuadTreeBodyTable::StoreBounds(entry, body.mBounds);
-        items.push_back(
-            {cBodyFlag | index, body.mBounds, body.mBounds.Center(), QuadTreeBodyTable::cInvalidLocation});
+        items.push_back({cBodyFlag | index, body.mBounds, QuadTreeBodyTable::cInvalidLocation});
     }
     if (items.empty()) return {};
 

@@ -81,7 +81,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 AABB bounds;
                 if (!QuadTreeBodyTable::LoadBounds(mBodies[child & ~cBodyFlag], bounds))
                     bounds = LoadSlot(node, s); // Being moved: the commit sets the exact bounds
-                items.push_back({child, bounds, bounds.Center(), nodeIndex << 2 | uint32_t(s)});
+                items.push_back({child, bounds, nodeIndex << 2 | uint32_t(s)});
                 continue;
             }
             const Node& childNode = GetNode(child);
@@ -94,7 +94,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 const AABB bounds = UnionOfSlots(childNode);
                 if (!bounds.IsEmpty())
                 {
-                    items.push_back({child, bounds, bounds.Center(), QuadTreeBodyTable::cInvalidLocation});
+                    items.push_back({child, bounds, QuadTreeBodyTable::cInvalidLocation});
                     continue;
                 }
             }
