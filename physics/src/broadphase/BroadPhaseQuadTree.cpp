@@ -208,6 +208,7 @@ void BroadPhaseQuadTree::UpdateImpl(bool inFull)
         mLastUpdate.mMaxCommitMicroseconds =
             std::max(mLastUpdate.mMaxCommitMicroseconds, stats.mCommitMicroseconds);
         mLastUpdate.mOutOfNodes |= stats.mOutOfNodes;
+        mLastUpdate.mDeferred |= stats.mDeferred;
     }
 }
 

@@ -26,6 +26,7 @@ QuadTree::QuadTree(QuadTreeBodyTable& ioBodies, uint8_t inTreeId, uint32_t inMax
     for (uint32_t i = 0; i < numChunks; ++i)
         mChunks[i].store(nullptr, std::memory_order_relaxed);
     mRoot.store(AllocateNode(cInvalidNode), std::memory_order_relaxed); // Construction: see above
+    mRebuildScratch = std::make_unique<quadtree::RebuildScratch>();
 }
 
 QuadTree::~QuadTree()

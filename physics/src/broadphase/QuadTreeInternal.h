@@ -265,4 +265,27 @@ struct BuildItem
     uint32_t mOldLocation; ///< Rebuild: where a body was found (node << 2 | slot); unused otherwise
 };
 
+/// A body that a rebuild moves to a new leaf.
+struct Relocation
+{
+    uint32_t mBody, mOldLocation, mNewLocation;
+    AABB mBuiltBounds; ///< What phase 1 read and the new slot holds
+};
+
+/// A kept node and its parent in the new tree.
+struct Reparent
+{
+    uint32_t mNode, mParent;
+};
+
+/// The rebuild's working arrays, kept from one rebuild to the next (update thread only): as fresh vectors
+/// they were allocated and page-faulted in every rebuild (1.4 MB for the shared world's full rebuild).
+struct RebuildScratch
+{
+    std::vector<BuildItem> mItems;
+    std::vector<Relocation> mRelocations;
+    std::vector<Reparent> mReparents;
+    std::vector<uint32_t> mNewNodes;
+};
+
 } // namespace cairn::quadtree

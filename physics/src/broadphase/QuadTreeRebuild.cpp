@@ -57,12 +57,23 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     const uint32_t oldRoot = mRoot.load(std::memory_order_acquire);
     // Relaxed: a hint; a change we miss now is seen by the next rebuild
     if (!inFull && !GetNode(oldRoot).mChanged.load(std::memory_order_relaxed)) return stats;
+    // Reclamation lags (a query thread descheduled inside its read section holds the epoch back): another
+    // rebuild would retire another tree's worth of nodes and could leave batches without room. The current
+    // tree stays valid, only looser; try again at the next update. Relaxed: only this thread changes the
+    // count upwards, and a stale low value only lets one more rebuild through
+    if (mNumRetired.load(std::memory_order_relaxed) > mAllocator.GetCapacity() / 4)
+    {
+        stats.mDeferred = true;
+        return stats;
+    }
 
     // Phase 1: collect objects (no lock)
     ++mRebuildStamp;
     if (mRebuildMark.size() < mAllocator.GetHighWater()) mRebuildMark.resize(mAllocator.GetHighWater(), 0);
-    std::vector<BuildItem> items;
-    std::vector<uint32_t> replaced;
+    quadtree::RebuildScratch& scratch = *mRebuildScratch;
+    std::vector<BuildItem>& items = scratch.mItems;
+    items.clear();
+    std::vector<uint32_t> replaced; // Handed to the retired list, so not scratch
     NodeStack stack;
     stack.Push(oldRoot);
     mRebuildMark[oldRoot] = mRebuildStamp;
@@ -104,18 +115,12 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     }
 
     // Build the new tree (no lock): relocations and re-parentings are applied by the commit
-    struct Relocation
-    {
-        uint32_t mBody, mOldLocation, mNewLocation;
-        AABB mBuiltBounds; ///< What phase 1 read and the new slot holds
-    };
-    struct Reparent
-    {
-        uint32_t mNode, mParent;
-    };
-    std::vector<Relocation> relocations;
-    std::vector<Reparent> reparents;
-    std::vector<uint32_t> newNodes;
+    std::vector<quadtree::Relocation>& relocations = scratch.mRelocations;
+    std::vector<quadtree::Reparent>& reparents = scratch.mReparents;
+    std::vector<uint32_t>& newNodes = scratch.mNewNodes;
+    relocations.clear();
+    reparents.clear();
+    newNodes.clear();
     const SubTree built =
         BuildNodes(items, 0, newNodes,
                    [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
@@ -161,10 +166,10 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
         }
 
         // a. Kept nodes hang below the new tree now
-        for (const Reparent& reparent : reparents)
+        for (const quadtree::Reparent& reparent : reparents)
             // Release: a mover walking up (acquire) after the swap finds its new parent's initialised slots
             GetNode(reparent.mNode).mParent.store(reparent.mParent, std::memory_order_release);
-        for (const Reparent& reparent : reparents)
+        for (const quadtree::Reparent& reparent : reparents)
         {
             const Node& kept = GetNode(reparent.mNode);
             // Relaxed: modifiers are excluded; their writes happened before they released the lock we hold
@@ -173,7 +178,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
         }
 
         // b. Bodies move to their new leaves with their current bounds
-        for (const Relocation& relocation : relocations)
+        for (const quadtree::Relocation& relocation : relocations)
         {
             QuadTreeBodyTable::Entry& entry = mBodies[relocation.mBody];
             const uint32_t newNode = relocation.mNewLocation >> 2;

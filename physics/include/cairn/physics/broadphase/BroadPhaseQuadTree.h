@@ -50,6 +50,8 @@ public:
         uint32_t mKeptNodes = 0;           ///< Unchanged sub-trees kept whole
         double mMaxCommitMicroseconds = 0; ///< Longest exclusive commit (what a modifier may wait)
         bool mOutOfNodes = false;          ///< A rebuild was skipped for lack of nodes (retried next update)
+        bool mDeferred =
+            false; ///< A rebuild was put off while old nodes wait for slow readers (retried next update)
     };
 
     /// Memory of the whole broad phase.

@@ -48,7 +48,8 @@ namespace cairn
 namespace quadtree
 {
 struct BuildItem;
-}
+struct RebuildScratch;
+} // namespace quadtree
 
 class QuadTree
 {
@@ -89,6 +90,7 @@ public:
     {
         bool mRebuilt = false;          ///< False when nothing had changed (or the node pool ran out)
         bool mOutOfNodes = false;       ///< The pool could not hold the new tree; the old one stays
+        bool mDeferred = false;         ///< Skipped: too many retired nodes wait for slow readers
         uint32_t mRelocatedBodies = 0;  ///< Bodies moved to new leaves
         uint32_t mKeptNodes = 0;        ///< Unchanged sub-trees kept whole
         uint32_t mNewNodes = 0;         ///< Nodes of the new tree
@@ -247,8 +249,9 @@ private:
     EpochReclaimer mReclaimer;                     ///< Read sections of queries
     std::vector<RetiredBatch> mRetired;            ///< Update thread only: nodes waiting to be freed
     std::atomic<uint32_t> mNumRetired{0};          ///< Statistic: nodes in mRetired
-    std::vector<uint32_t> mRebuildMark;            ///< Update thread only: node -> rebuild stamp
-    uint32_t mRebuildStamp = 0;                    ///< Update thread only
+    std::unique_ptr<quadtree::RebuildScratch> mRebuildScratch; ///< Update thread only: reused arrays
+    std::vector<uint32_t> mRebuildMark;                        ///< Update thread only: node -> rebuild stamp
+    uint32_t mRebuildStamp = 0;                                ///< Update thread only
 };
 
 } // namespace cairn
