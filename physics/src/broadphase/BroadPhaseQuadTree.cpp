@@ -216,27 +216,36 @@ void BroadPhaseQuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFi
                                       BodyVisitor inVisitor) const
 {
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
-    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
-            mTrees[tree]->CollideAABox(inBox, mask, inVisitor);
+    ForEachTree(inFilter.mObjectLayers,
+                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                {
+                    inTree.CollideAABox(inBox, inMask, inVisitor);
+                    return true;
+                });
 }
 
 void BroadPhaseQuadTree::CollideSphere(const Vec3& inCenter, float inRadius,
                                        const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const
 {
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
-    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
-            mTrees[tree]->CollideSphere(inCenter, inRadius, mask, inVisitor);
+    ForEachTree(inFilter.mObjectLayers,
+                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                {
+                    inTree.CollideSphere(inCenter, inRadius, inMask, inVisitor);
+                    return true;
+                });
 }
 
 void BroadPhaseQuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
                                       BodyVisitor inVisitor) const
 {
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
-    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
-            mTrees[tree]->CollidePoint(inPoint, mask, inVisitor);
+    ForEachTree(inFilter.mObjectLayers,
+                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                {
+                    inTree.CollidePoint(inPoint, inMask, inVisitor);
+                    return true;
+                });
 }
 
 void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
@@ -244,9 +253,8 @@ void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilt
 {
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // Shared by the trees, so a close hit in one prunes the others
-    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
-            if (!mTrees[tree]->CastRay(inRay, mask, maxFraction, inVisitor)) return;
+    ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                { return inTree.CastRay(inRay, inMask, maxFraction, inVisitor); });
 }
 
 void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
@@ -254,9 +262,8 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
 {
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // As in CastRay
-    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        if (const ObjectLayerMask mask = MaskForTree(tree, inFilter.mObjectLayers); mask != 0)
-            if (!mTrees[tree]->CastAABox(inBox, inDisplacement, mask, maxFraction, inVisitor)) return;
+    ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                { return inTree.CastAABox(inBox, inDisplacement, inMask, maxFraction, inVisitor); });
 }
 
 void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
@@ -283,20 +290,21 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
         const ObjectLayer selfLayer = mBodies[selfIndex].mLayer.load(std::memory_order_relaxed); // See above
         const AABB bounds = TreeOf(selfLayer).GetBodyBounds(id);
         const ObjectLayerMask collidesWith = inLayers.GetCollisionMask(selfLayer);
-        for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-        {
-            const ObjectLayerMask mask = MaskForTree(tree, collidesWith);
-            if (mask == 0) continue;
-            mTrees[tree]->CollideAABox(bounds, mask,
-                                       [&](BodyID inOther)
-                                       {
-                                           const uint32_t otherIndex = inOther.GetIndex();
-                                           // Skip itself; of two active bodies the lower index reports
-                                           if (otherIndex != selfIndex &&
-                                               (mActiveScratch[otherIndex] == 0 || otherIndex > selfIndex))
-                                               inVisitor(id, inOther);
-                                       });
-        }
+        ForEachTree(collidesWith,
+                    [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                    {
+                        inTree.CollideAABox(
+                            bounds, inMask,
+                            [&](BodyID inOther)
+                            {
+                                const uint32_t otherIndex = inOther.GetIndex();
+                                // Skip itself; of two active bodies the lower index reports
+                                if (otherIndex != selfIndex &&
+                                    (mActiveScratch[otherIndex] == 0 || otherIndex > selfIndex))
+                                    inVisitor(id, inOther);
+                            });
+                        return true;
+                    });
     }
 
     for (BodyID id : inActiveBodies)

@@ -436,9 +436,7 @@ bool QuadTree::RemoveBody(BodyID inBody)
     if (index >= mBodies.GetMaxBodies()) return false;
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     QuadTreeBodyTable::Entry& entry = mBodies[index];
-    // Relaxed: same-body operations are serialised by the caller
-    if (mBodies.Sequence(index).load(std::memory_order_relaxed) != inBody.GetSequence()) return false;
-    const uint32_t location = LoadOwnLocation(entry);
+    const uint32_t location = FindLocation(inBody);
     if (location == QuadTreeBodyTable::cInvalidLocation) return false;
     const uint32_t nodeIndex = location >> 2;
     const int slot = int(location & 3);
@@ -457,9 +455,7 @@ void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
     if (index >= mBodies.GetMaxBodies() || !IsValidBroadPhaseBounds(inBounds)) return;
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     QuadTreeBodyTable::Entry& entry = mBodies[index];
-    // Relaxed: same-body operations are serialised by the caller
-    if (mBodies.Sequence(index).load(std::memory_order_relaxed) != inBody.GetSequence()) return;
-    const uint32_t location = LoadOwnLocation(entry);
+    const uint32_t location = FindLocation(inBody);
     if (location == QuadTreeBodyTable::cInvalidLocation) return;
     const uint32_t nodeIndex = location >> 2;
     const int slot = int(location & 3);
@@ -486,30 +482,30 @@ void QuadTree::SetBodyLayer(BodyID inBody, ObjectLayer inLayer)
 
 bool QuadTree::Contains(BodyID inBody) const
 {
-    const uint32_t index = inBody.GetIndex();
-    if (index >= mBodies.GetMaxBodies()) return false;
-    const QuadTreeBodyTable::Entry& entry = mBodies[index];
-    // Relaxed: a snapshot for tests, statistics and the broad phase's own serialised calls
-    return mBodies.Sequence(index).load(std::memory_order_relaxed) == inBody.GetSequence() &&
-           LoadOwnLocation(entry) != QuadTreeBodyTable::cInvalidLocation;
+    return FindLocation(inBody) != QuadTreeBodyTable::cInvalidLocation;
 }
 
-uint32_t QuadTree::LoadOwnLocation(const QuadTreeBodyTable::Entry& inEntry) const
+uint32_t QuadTree::FindLocation(BodyID inBody) const
 {
+    const uint32_t index = inBody.GetIndex();
+    if (index >= mBodies.GetMaxBodies()) return QuadTreeBodyTable::cInvalidLocation;
+    // Relaxed: same-body operations are serialised by the caller (or this is a snapshot for tests/statistics)
+    if (mBodies.Sequence(index).load(std::memory_order_relaxed) != inBody.GetSequence())
+        return QuadTreeBodyTable::cInvalidLocation;
+    const QuadTreeBodyTable::Entry& entry = mBodies[index];
     // Acquire: pairs with the release in BuildSubTree and the rebuild commit, so the node is seen initialised
-    const uint32_t location = inEntry.mLocation.load(std::memory_order_acquire);
+    const uint32_t location = entry.mLocation.load(std::memory_order_acquire);
     // Relaxed: written with the location by the same serialised operations, before its release
     if (location >= QuadTreeBodyTable::cPendingLocation ||
-        inEntry.mTree.load(std::memory_order_relaxed) != mTreeId)
+        entry.mTree.load(std::memory_order_relaxed) != mTreeId)
         return QuadTreeBodyTable::cInvalidLocation;
     return location;
 }
 
 AABB QuadTree::GetBodySlotBounds(BodyID inBody) const
 {
-    if (!Contains(inBody)) return AABB::Empty();
     EpochReclaimer::ReadScope scope(mReclaimer);
-    const uint32_t location = LoadOwnLocation(mBodies[inBody.GetIndex()]);
+    const uint32_t location = FindLocation(inBody);
     if (location == QuadTreeBodyTable::cInvalidLocation) return AABB::Empty();
     return LoadSlot(GetNode(location >> 2), int(location & 3));
 }

@@ -128,6 +128,14 @@ private:
     /// Object-layer mask to pass to tree inTree for a query filtered by inMask (all layers when the filter
     /// lets every layer of the tree through, so the tree skips the per-body layer check); 0 to skip the tree.
     ObjectLayerMask MaskForTree(uint32_t inTree, ObjectLayerMask inMask) const;
+    /// Calls inQuery(tree, mask) for every tree that a query filtered by inMask must walk, until it returns
+    /// false.
+    template <class Query> void ForEachTree(ObjectLayerMask inMask, Query&& inQuery) const
+    {
+        for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+            if (const ObjectLayerMask mask = MaskForTree(tree, inMask); mask != 0)
+                if (!inQuery(*mTrees[tree], mask)) return;
+    }
     void UpdateImpl(bool inFull);
     void RemoveBody(BodyID inBody);
     void MoveBody(const BroadPhaseBody& inBody);

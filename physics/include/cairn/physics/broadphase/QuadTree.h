@@ -226,8 +226,9 @@ private:
     template <class Test4, class Test, class LeafVisit>
     bool Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const;
 
-    /// The body's location when it is in this tree (acquire), else cInvalidLocation.
-    uint32_t LoadOwnLocation(const QuadTreeBodyTable::Entry& inEntry) const;
+    /// The body's location when this exact id (index and sequence) is linked in this tree or in a sub-tree
+    /// built for it (acquire), else cInvalidLocation.
+    uint32_t FindLocation(BodyID inBody) const;
     /// Number of sub-trees linked into the root chain since phase 1 of a rebuild. Rebuild commit only.
     uint32_t CountLateSubTrees(uint32_t inOldRoot) const;
     /// Links the unmarked sub-trees that linkers put into the old root chain during a rebuild into the new
