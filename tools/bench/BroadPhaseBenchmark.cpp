@@ -131,7 +131,10 @@ void BM_AddBatch(benchmark::State& ioState)
         // and warm, so the figure is the add itself, not the kernel's page faults
         std::unique_ptr<BroadPhase> broadPhase = Make(ioState.range(0), uint32_t(bodies.size()));
         broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
-        broadPhase->Update();
+        if (auto* quadTree = dynamic_cast<BroadPhaseQuadTree*>(broadPhase.get()))
+            quadTree->RebuildAll(); // As timed below: the old and new trees' nodes have been backed before
+        else
+            broadPhase->Update();
         broadPhase->RemoveBodies(ids);
         for (int update = 0; update < 4; ++update)
             broadPhase->Update();
@@ -176,6 +179,60 @@ void BM_AddBatch(benchmark::State& ioState)
         ioState.counters["table_bytes_per_body"] = double(settled.mBodyTableBytes) / double(bodies.size());
     }
     ioState.SetLabel(KindName(ioState.range(0)));
+}
+
+/// bp_memory_running: the quad tree's memory in a running game: the static world plus the 2,000 dynamic boxes
+/// (moving layer), every box moved by up to 0.5 m each step, then Update. The peak is taken right after an
+/// Update, when the moving tree's old nodes wait for the reclaimer next to the new ones (old and new trees);
+/// the static tree is kept whole, as nothing in it changed. Per body of the whole world (22,020).
+void BM_MemoryRunning(benchmark::State& ioState)
+{
+    std::vector<BroadPhaseBody> bodies = StaticBodies();
+    std::vector<BroadPhaseBody> moving;
+    for (uint32_t i = 0; i < Data().mDynamic.size(); ++i)
+        moving.push_back(
+            {BodyID(uint32_t(bodies.size()) + i, 1), Data().mDynamic[i].GetWorldBounds(), Layers::cMoving});
+    const uint32_t maxBodies = uint32_t(bodies.size() + moving.size());
+    size_t peakBytes = 0, settledBytes = 0, tableBytes = 0;
+    uint32_t peakNodes = 0;
+    for (auto _ : ioState)
+    {
+        BroadPhaseQuadTree broadPhase(maxBodies, LayerSetup::CreateDefault());
+        broadPhase.AddBodiesFinalize(broadPhase.AddBodiesPrepare(bodies));
+        broadPhase.AddBodiesFinalize(broadPhase.AddBodiesPrepare(moving));
+        broadPhase.RebuildAll();
+        for (int update = 0; update < 3; ++update)
+            broadPhase.Update(); // The loading's old nodes are freed before the game runs
+        std::mt19937 random(7);
+        std::uniform_real_distribution<float> step(-0.5f, 0.5f);
+        for (int frame = 0; frame < 10; ++frame)
+        {
+            for (BroadPhaseBody& body : moving)
+            {
+                const Vec3 offset(step(random), step(random), step(random));
+                body.mBounds = AABB(body.mBounds.mMin + offset, body.mBounds.mMax + offset);
+            }
+            broadPhase.NotifyBodiesAABBChanged(moving);
+            broadPhase.Update();
+            const BroadPhaseQuadTree::MemoryStats stats = broadPhase.GetMemoryStats();
+            if (stats.mBodyTableBytes + stats.mNodeBytesInUse > peakBytes)
+            {
+                peakBytes = stats.mBodyTableBytes + stats.mNodeBytesInUse;
+                peakNodes = stats.mNodesInUse;
+            }
+        }
+        for (int update = 0; update < 3; ++update)
+            broadPhase.Update(); // Nothing moves: the old nodes are freed
+        const BroadPhaseQuadTree::MemoryStats settled = broadPhase.GetMemoryStats();
+        settledBytes = settled.mBodyTableBytes + settled.mNodeBytesInUse;
+        tableBytes = settled.mBodyTableBytes;
+    }
+    ioState.counters["bodies"] = double(maxBodies);
+    ioState.counters["peak_bytes_per_body"] = double(peakBytes) / double(maxBodies);
+    ioState.counters["peak_nodes"] = double(peakNodes);
+    ioState.counters["settled_bytes_per_body"] = double(settledBytes) / double(maxBodies);
+    ioState.counters["table_bytes_per_body"] = double(tableBytes) / double(maxBodies);
+    ioState.SetLabel("quad_tree");
 }
 
 void BM_AddSingle(benchmark::State& ioState)
@@ -427,6 +484,7 @@ BENCHMARK(BM_AddBatch)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
+BENCHMARK(BM_MemoryRunning)->Name("bp_memory_running")->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AddSingle)
     ->Name("bp_add_single")
     ->Arg(cQuadTree)

@@ -54,7 +54,7 @@ private:
 
 BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers, LockMode inMode)
     : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
-      mBodies(mMaxBodies), mActiveScratch(mMaxBodies, 0)
+      mBodies(mMaxBodies)
 {
     // A full rebuild needs at most ~1.4 nodes per body (4-wide, at least one body per leaf slot group);
     // batches may not take the last 2 per body, so a rebuild always finds its nodes. Storage is backed on
@@ -281,7 +281,7 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
     };
     // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
     for (BodyID id : inActiveBodies)
-        if (isPresent(id)) mActiveScratch[id.GetIndex()] = 1;
+        if (isPresent(id)) mBodies[id.GetIndex()].mActiveInStep = 1;
 
     for (BodyID id : inActiveBodies)
     {
@@ -300,7 +300,7 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
                                 const uint32_t otherIndex = inOther.GetIndex();
                                 // Skip itself; of two active bodies the lower index reports
                                 if (otherIndex != selfIndex &&
-                                    (mActiveScratch[otherIndex] == 0 || otherIndex > selfIndex))
+                                    (mBodies[otherIndex].mActiveInStep == 0 || otherIndex > selfIndex))
                                     inVisitor(id, inOther);
                             });
                         return true;
@@ -308,7 +308,7 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
     }
 
     for (BodyID id : inActiveBodies)
-        if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mActiveScratch[id.GetIndex()] = 0;
+        if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mBodies[id.GetIndex()].mActiveInStep = 0;
 }
 
 size_t BroadPhaseQuadTree::GetBodyCount() const
@@ -319,7 +319,7 @@ size_t BroadPhaseQuadTree::GetBodyCount() const
 BroadPhaseQuadTree::MemoryStats BroadPhaseQuadTree::GetMemoryStats() const
 {
     MemoryStats stats;
-    stats.mBodyTableBytes = mBodies.GetMemoryBytes() + mActiveScratch.size();
+    stats.mBodyTableBytes = mBodies.GetMemoryBytes();
     stats.mNodeSize = sizeof(QuadTree::Node);
     for (const std::unique_ptr<QuadTree>& tree : mTrees)
     {

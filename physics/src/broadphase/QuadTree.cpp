@@ -4,8 +4,10 @@
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
+#include <utility>
 
 namespace cairn
 {
@@ -168,12 +170,15 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     };
     auto split = [&](BuildItem* inB, BuildItem* inE) { return splitWith(inB, inE, centreBounds(inB, inE)); };
 
-    BuildItem* groups[5];
+    // The node's slots as ranges of items: each becomes one slot, or several when pulled up (see below)
+    using Range = std::pair<BuildItem*, BuildItem*>;
+    std::array<Range, 4> ranges;
+    int numRanges = 0;
     const ptrdiff_t count = inEnd - inBegin;
     if (count <= 4)
     {
-        for (int g = 0; g < 5; ++g)
-            groups[g] = inBegin + std::min<ptrdiff_t>(g, count);
+        for (BuildItem* it = inBegin; it != inEnd; ++it)
+            ranges[numRanges++] = {it, it + 1};
     }
     else
     {
@@ -216,45 +221,82 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
                 ++rest;
             }
         }
-        groups[0] = inBegin;
-        const int numWide = int(rest - inBegin);
-        for (int g = 1; g <= numWide; ++g)
-            groups[g] = inBegin + g;
-        groups[4] = inEnd;
-        if (numWide == 0)
+        for (BuildItem* it = inBegin; it != rest; ++it)
+            ranges[numRanges++] = {it, it + 1};
+        // The rest: split at the midpoint of the longest axis of the centres, then each half again
+        ranges[numRanges++] = {rest, inEnd};
+        // Breadth first: the rest, then each of its halves (the first split reuses the centre bounds above)
+        bool topSplit = true;
+        for (int next = numRanges - 1; numRanges < 4 && next < numRanges;)
         {
-            groups[2] = splitWith(inBegin, inEnd, centres);
-            groups[1] = split(inBegin, groups[2]);
-            groups[3] = split(groups[2], inEnd);
+            const auto [begin, end] = ranges[next];
+            if (end - begin <= 4) // Fits a leaf: more parts would only add half-empty nodes
+            {
+                ++next;
+                continue;
+            }
+            BuildItem* mid = topSplit && rest == inBegin ? splitWith(begin, end, centres) : split(begin, end);
+            ranges[next] = {begin, mid};
+            ranges[numRanges++] = {mid, end};
+            if (topSplit)
+                topSplit = false; // Its lower half, now at [next], is split next
+            else
+                ++next;
         }
-        else if (numWide == 1)
-        {
-            groups[2] = split(rest, inEnd);
-            groups[3] = split(groups[2], inEnd);
-        }
-        else
-            groups[3] = split(rest, inEnd);
     }
 
-    for (int g = 0; g < 4; ++g)
+    // Neighbouring parts that would both become leaf nodes (2 to 4 items) and fit one leaf together are
+    // merged: the midpoint splits know nothing of counts, and half-empty leaves were a third of the nodes
+    // Insertion sort by position: neighbours in the array are neighbours in space (each split is a partition)
+    for (int i = 1; i < numRanges; ++i)
+        for (int j = i; j > 0 && ranges[j].first < ranges[j - 1].first; --j)
+            std::swap(ranges[j], ranges[j - 1]);
+    for (int r = 0; r + 1 < numRanges;)
     {
-        const ptrdiff_t n = groups[g + 1] - groups[g];
-        if (n == 0) continue;
-        if (n == 1)
+        const ptrdiff_t a = ranges[r].second - ranges[r].first,
+                        b = ranges[r + 1].second - ranges[r + 1].first;
+        if (a >= 2 && b >= 2 && a + b <= 4)
         {
-            const BuildItem& item = *groups[g];
-            InitSlot(node, g, item.mChild, item.mBounds);
-            result.mBounds.Encapsulate(item.mBounds);
-            inOnLeaf(item, nodeIndex, g);
+            ranges[r].second = ranges[r + 1].second;
+            for (int k = r + 1; k + 1 < numRanges; ++k)
+                ranges[k] = ranges[k + 1];
+            --numRanges;
         }
         else
+            ++r;
+    }
+
+    // Groups of a few items are pulled up into the slots that the splits left empty, smallest first, when all
+    // of their items fit: a node holding two bodies costs 128 bytes and a step of every query that reaches it
+    // Insertion sort by size (std::sort on 4 elements trips GCC 12's -Warray-bounds)
+    for (int i = 1; i < numRanges; ++i)
+        for (int j = i;
+             j > 0 && ranges[j].second - ranges[j].first < ranges[j - 1].second - ranges[j - 1].first; --j)
+            std::swap(ranges[j], ranges[j - 1]);
+    int freeSlots = 4 - numRanges;
+    int slot = 0;
+    auto fillSlot = [&](const BuildItem& inItem)
+    {
+        InitSlot(node, slot, inItem.mChild, inItem.mBounds);
+        result.mBounds.Encapsulate(inItem.mBounds);
+        inOnLeaf(inItem, nodeIndex, slot);
+        ++slot;
+    };
+    for (int r = 0; r < numRanges; ++r)
+    {
+        auto [begin, end] = ranges[r];
+        const int n = int(end - begin);
+        if (n == 1 || n - 1 <= freeSlots)
         {
-            const SubTree child =
-                BuildRange(groups[g], groups[g + 1], nodeIndex, inKeepFree, ioNewNodes, inOnLeaf);
-            if (child.mChild == cInvalidChild) return SubTree{}; // Out of nodes: the caller frees ioNewNodes
-            InitSlot(node, g, child.mChild, child.mBounds);
-            result.mBounds.Encapsulate(child.mBounds);
+            freeSlots -= n - 1;
+            for (const BuildItem* it = begin; it != end; ++it)
+                fillSlot(*it);
+            continue;
         }
+        const SubTree child = BuildRange(begin, end, nodeIndex, inKeepFree, ioNewNodes, inOnLeaf);
+        if (child.mChild == cInvalidChild) return SubTree{}; // Out of nodes: the caller frees ioNewNodes
+        InitSlot(node, slot++, child.mChild, child.mBounds);
+        result.mBounds.Encapsulate(child.mBounds);
     }
     return result;
 }

@@ -19,7 +19,9 @@
 #include "QuadTreeInternal.h"
 #include "cairn/physics/broadphase/QuadTree.h"
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 
 namespace cairn
 {
@@ -292,7 +294,17 @@ uint32_t QuadTree::LinkLateSubTrees(uint32_t inOldRoot, uint32_t inNewRoot, std:
 
 void QuadTree::CollectGarbage()
 {
-    mReclaimer.TryAdvance();
+    // Two steps of the epoch, each followed by freeing what became safe: the last update's retirees (stamped
+    // with the epoch after its second step) are then freed here, one update later, when no reader lags
+    for (int step = 0; step < 2; ++step)
+    {
+        mReclaimer.TryAdvance();
+        FreeReclaimableNodes();
+    }
+}
+
+void QuadTree::FreeReclaimableNodes()
+{
     size_t kept = 0;
     for (size_t i = 0; i < mRetired.size(); ++i)
     {
@@ -303,12 +315,14 @@ void QuadTree::CollectGarbage()
             ++kept;
             continue;
         }
+        // Pushed from the highest index down, so the free list hands them out in ascending order: the next
+        // build writes (and later queries read) nodes that neighbour each other in memory
+        std::sort(batch.mNodes.begin(), batch.mNodes.end(), std::greater<uint32_t>());
         for (uint32_t node : batch.mNodes)
             mAllocator.Free(node);
         mNumRetired.fetch_sub(uint32_t(batch.mNodes.size()), std::memory_order_relaxed); // Statistic only
     }
     mRetired.resize(kept);
-    mReclaimer.TryAdvance(); // A second step, so that this update's retirees can go at the next one
 }
 
 } // namespace cairn

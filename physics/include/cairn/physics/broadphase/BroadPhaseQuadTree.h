@@ -11,8 +11,9 @@
 //    thread; each tree's modification lock is taken shared (per-thread stripe) only to stay out of a
 //    rebuild's commit. The caller serialises operations on one body.
 //  - Update (rebuild of changed parts + freeing of old nodes) and FindCollidingPairs: the physics step only.
-//    mActiveScratch belongs to FindCollidingPairs. A second step call that overlaps a running one (two
-//    threads stepping one world) is refused and counted (GetRefusedStepCalls), never run concurrently.
+//    The table's mActiveInStep bytes belong to FindCollidingPairs. A second step call that overlaps a running
+//    one (two threads stepping one world) is refused and counted (GetRefusedStepCalls), never run
+//    concurrently.
 // LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
 // and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
 // comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
@@ -148,7 +149,6 @@ private:
     std::array<ObjectLayerMask, cMaxBroadPhaseLayers> mObjectLayersOfTree{}; ///< Immutable
     std::atomic<int64_t> mBodyCount{0};                 ///< Bodies linked (relaxed: a statistic)
     mutable WriterFairSharedMutex mGlobalMutex;         ///< LockMode::GlobalMutex only
-    mutable std::vector<uint8_t> mActiveScratch;        ///< FindCollidingPairs only (physics step)
     UpdateStats mLastUpdate;                            ///< Physics step only
     mutable std::atomic<bool> mStepCallActive{false};   ///< A step call is running (see StepCallGuard)
     mutable std::atomic<uint64_t> mRefusedStepCalls{0}; ///< Statistic

@@ -176,8 +176,13 @@ private:
     };
     using LeafCallback = FunctionRef<void(const quadtree::BuildItem& inItem, uint32_t inNode, int inSlot)>;
 
+    /// Frees the retired batches that the reclaimer's current epoch makes safe. Update thread.
+    void FreeReclaimableNodes();
+
     /// Builds private nodes over ioItems (reordered): split at the midpoint of the longest axis of the
-    /// centres, four groups per node, recursively. inOnLeaf is called for every placed item. Returns the root
+    /// centres, then the largest part again, up to four parts per node, recursively; parts that fit a leaf
+    /// are not split further, neighbouring small parts are merged and small parts are pulled up into free
+    /// slots, so that leaves are full. inOnLeaf is called for every placed item. Returns the root
     /// and its bounds, or an invalid child when out of nodes. Every allocated node is appended to ioNewNodes.
     SubTree BuildNodes(std::span<quadtree::BuildItem> ioItems, uint32_t inKeepFree,
                        std::vector<uint32_t>& ioNewNodes, LeafCallback inOnLeaf);

@@ -37,6 +37,9 @@ public:
         std::atomic<float> mBounds[6] = {0, 0, 0, 0, 0, 0}; ///< Exact min xyz, max xyz
         std::atomic<uint8_t> mLayer{0};                     ///< Object layer
         std::atomic<uint8_t> mTree{0xff};                   ///< Id of the tree whose node mLocation names
+        /// 1 while BroadPhaseQuadTree::FindCollidingPairs runs and the body is active. Plain: only the
+        /// physics step touches it, one call at a time; it fills padding, so it costs no memory.
+        mutable uint8_t mActiveInStep = 0;
     };
 
     explicit QuadTreeBodyTable(uint32_t inMaxBodies)
@@ -95,6 +98,7 @@ public:
     /// Bytes used by the table.
     size_t GetMemoryBytes() const
     {
+        static_assert(sizeof(Entry) == 36, "the per-body record grew: update the memory figures");
         return size_t(mMaxBodies) * (sizeof(Entry) + sizeof(std::atomic<uint32_t>));
     }
 
