@@ -1,0 +1,202 @@
+#pragma once
+
+// JobSystem: the frame's worker pool. A job is a small callable with prerequisites (other jobs); it is queued
+// when the last of them finishes, and run by a worker or by a thread that waits (waiting threads help, so the
+// caller of Wait is one of the frame's threads and a pool of N threads has N - 1 workers). ParallelFor splits
+// a loop over the pool. Multi-frame work (navmesh tiles, streaming) goes to the BackgroundQueue instead,
+// which stands aside while frame jobs are in flight.
+//
+// Threads: every member function may be called from any thread, including from inside a job, except the
+// destructor (the owner, once no other thread uses the system). Jobs must not throw: an escaping exception
+// terminates, as from any thread.
+//
+// Locking (who touches what):
+//  - mSlots[i]: its function and name are written by the scheduling thread before the slot is published
+//    (queued, under mQueueMutex) and read by the running thread after it pops it; mDependents is guarded by
+//    the slot's mutex, which also orders a completion (generation bump) against a registration.
+//  - mFree (free slot indices): mFreeMutex. mReady (ready ring): mQueueMutex; workers and waiting threads
+//  sleep
+//    on mWake with it.
+//  - Counters: atomics, each with its memory order's reason where it is used.
+//
+// Capacity: at most Settings::mMaxJobs jobs exist at once (no allocation after construction). Scheduling when
+// all are in use runs the job at once on the calling thread, after its prerequisites (the caller helps them
+// finish); GetStats counts it. A job can have at most cMaxDependents jobs waiting on it; a further one makes
+// the scheduling thread wait for the prerequisite itself (helping) before it queues the new job.
+
+#include "cairn/jobs/InlineFunction.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <thread>
+#include <vector>
+
+namespace cairn::jobs
+{
+
+/// Names a scheduled job. A default handle, or one of a job that has finished, counts as done.
+struct JobHandle
+{
+    static constexpr uint32_t cInvalidIndex = 0xffffffffu;
+    uint32_t mIndex = cInvalidIndex;
+    uint32_t mGeneration = 0;
+
+    bool IsValid() const { return mIndex != cInvalidIndex; }
+};
+
+class JobSystem
+{
+public:
+    static constexpr size_t cFunctionCapacity = 64; ///< Bytes of captures a job may carry
+    static constexpr uint32_t cMaxDependents = 16;  ///< Jobs that can wait on one job through the queue
+    static constexpr uint32_t cMaxThreads = 64;
+
+    struct Settings
+    {
+        uint32_t mNumThreads = 0; ///< Threads that run frame jobs, the waiting caller included; 0: all cores
+        uint32_t mMaxJobs = 4096; ///< Jobs that may exist at once
+    };
+
+    struct Stats
+    {
+        uint64_t mJobsRun = 0;           ///< Jobs run through the queue
+        uint64_t mJobsRunInline = 0;     ///< Jobs run at once because every slot was in use
+        uint64_t mDependentOverflow = 0; ///< Prerequisites waited for because cMaxDependents was reached
+    };
+
+    JobSystem(); ///< Default settings
+    explicit JobSystem(const Settings& inSettings);
+    JobSystem(const JobSystem&) = delete;
+    JobSystem& operator=(const JobSystem&) = delete;
+    /// Runs what is still queued, then stops the workers.
+    ~JobSystem();
+
+    /// Threads that run frame jobs: the workers plus the one that waits.
+    uint32_t GetNumThreads() const { return uint32_t(mWorkers.size()) + 1; }
+
+    /// Queues inFunction to run once every job of inPrerequisites has finished. inName must outlive the job
+    /// (a string literal).
+    template <class Function>
+    JobHandle Schedule(const char* inName, Function&& inFunction,
+                       std::span<const JobHandle> inPrerequisites = {})
+    {
+        const uint32_t index = AllocateSlot();
+        if (index == JobHandle::cInvalidIndex)
+        {
+            for (const JobHandle& prerequisite : inPrerequisites)
+                Wait(prerequisite);
+            inFunction();
+            mJobsRunInline.fetch_add(1, std::memory_order_relaxed); // Statistic only
+            return {};
+        }
+        mSlots[index].mFunction.Set(std::forward<Function>(inFunction));
+        return Publish(index, inName, inPrerequisites);
+    }
+    template <class Function>
+    JobHandle Schedule(const char* inName, Function&& inFunction,
+                       std::initializer_list<JobHandle> inPrerequisites)
+    {
+        return Schedule(inName, std::forward<Function>(inFunction),
+                        std::span<const JobHandle>(inPrerequisites.begin(), inPrerequisites.size()));
+    }
+
+    /// True once the job has finished (its effects are then visible to this thread).
+    bool IsDone(const JobHandle& inJob) const;
+    /// Returns when the job has finished, running queued jobs meanwhile.
+    void Wait(const JobHandle& inJob);
+    void WaitAll(std::span<const JobHandle> inJobs);
+    /// Returns when no frame job is queued or running, running queued jobs meanwhile.
+    void WaitIdle();
+
+    /// inBody(begin, end) over [0, inCount) in chunks of inGrain, on up to GetNumThreads() threads; the
+    /// caller takes part and returns when every chunk is done. Chunks are claimed from a shared cursor, so
+    /// uneven work balances itself.
+    template <class Body> void ParallelFor(uint32_t inCount, uint32_t inGrain, const Body& inBody)
+    {
+        if (inCount == 0) return;
+        const uint64_t grain = std::max<uint32_t>(1, inGrain);
+        const uint64_t chunks = (uint64_t(inCount) + grain - 1) / grain;
+        const uint32_t helpers = uint32_t(std::min<uint64_t>(chunks, GetNumThreads())) - 1;
+        // Relaxed: the fetch_add hands out each chunk once; the results reach the caller through Wait
+        std::atomic<uint64_t> cursor{0};
+        auto work = [&cursor, &inBody, grain, inCount]
+        {
+            for (;;)
+            {
+                const uint64_t begin = cursor.fetch_add(grain, std::memory_order_relaxed);
+                if (begin >= inCount) return;
+                inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
+            }
+        };
+        JobHandle handles[cMaxThreads];
+        for (uint32_t i = 0; i < helpers; ++i)
+            handles[i] = Schedule("ParallelFor", work);
+        work();
+        WaitAll({handles, helpers});
+    }
+
+    /// Frame jobs scheduled and not yet finished.
+    uint32_t GetNumJobsInFlight() const
+    {
+        return mJobsInFlight.load(std::memory_order_relaxed); // A snapshot for schedulers and statistics
+    }
+    /// Blocks until no frame job is in flight or inTimeout passes; false on timeout. For background threads.
+    bool WaitForFrameIdle(std::chrono::microseconds inTimeout) const;
+
+    Stats GetStats() const;
+
+private:
+    struct JobSlot
+    {
+        InlineFunction<cFunctionCapacity> mFunction;
+        const char* mName = "";
+        /// Bumped when the job finishes: a handle of an older generation names a finished job
+        std::atomic<uint32_t> mGeneration{0};
+        /// Unfinished prerequisites, plus one held by Publish until every prerequisite is registered
+        std::atomic<int32_t> mPending{0};
+        std::mutex mMutex; ///< Guards mDependents/mNumDependents and orders the generation bump against them
+        uint32_t mDependents[cMaxDependents] = {};
+        uint32_t mNumDependents = 0;
+    };
+
+    uint32_t AllocateSlot();
+    void FreeSlot(uint32_t inIndex);
+    JobHandle Publish(uint32_t inIndex, const char* inName, std::span<const JobHandle> inPrerequisites);
+    void Enqueue(uint32_t inIndex);
+    bool TryPopReady(uint32_t& outIndex);
+    void Run(uint32_t inIndex);
+    void WorkerMain();
+
+    std::unique_ptr<JobSlot[]> mSlots;
+    uint32_t mMaxJobs;
+
+    std::mutex mFreeMutex;
+    std::vector<uint32_t> mFree; ///< Free slot indices (a stack); mFreeMutex
+
+    std::mutex mQueueMutex;
+    std::condition_variable mWake; ///< Workers and waiters: a job was queued or finished, or stopping
+    std::vector<uint32_t> mReady;  ///< Ring of queued slot indices (capacity mMaxJobs: never overflows)
+    uint32_t mReadyHead = 0;       ///< mQueueMutex
+    uint32_t mReadyCount = 0;      ///< mQueueMutex
+    bool mStopping = false;        ///< mQueueMutex
+
+    std::atomic<uint32_t> mJobsInFlight{0};
+    std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
+    mutable std::mutex mIdleMutex;
+    mutable std::condition_variable mIdle; ///< Notified when mJobsInFlight drops to zero
+
+    std::atomic<uint64_t> mJobsRun{0};
+    std::atomic<uint64_t> mJobsRunInline{0};
+    std::atomic<uint64_t> mDependentOverflow{0};
+
+    std::vector<std::thread> mWorkers;
+};
+
+} // namespace cairn::jobs

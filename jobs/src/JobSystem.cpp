@@ -1,0 +1,235 @@
+#include "cairn/jobs/JobSystem.h"
+
+#include <cassert>
+
+namespace cairn::jobs
+{
+
+JobSystem::JobSystem() : JobSystem(Settings{}) {}
+
+JobSystem::JobSystem(const Settings& inSettings)
+    : mSlots(std::make_unique<JobSlot[]>(std::max<uint32_t>(1, inSettings.mMaxJobs))),
+      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs)
+{
+    mFree.reserve(mMaxJobs);
+    for (uint32_t i = mMaxJobs; i-- > 0;)
+        mFree.push_back(i); // Slot 0 is handed out first
+    uint32_t numThreads = inSettings.mNumThreads;
+    if (numThreads == 0) numThreads = std::max(1u, std::thread::hardware_concurrency());
+    numThreads = std::min(numThreads, cMaxThreads);
+    mWorkers.reserve(numThreads - 1);
+    for (uint32_t i = 1; i < numThreads; ++i)
+        mWorkers.emplace_back([this] { WorkerMain(); });
+}
+
+JobSystem::~JobSystem()
+{
+    WaitIdle();
+    {
+        std::lock_guard lock(mQueueMutex);
+        mStopping = true;
+    }
+    mWake.notify_all();
+    for (std::thread& worker : mWorkers)
+        worker.join();
+}
+
+uint32_t JobSystem::AllocateSlot()
+{
+    std::lock_guard lock(mFreeMutex);
+    if (mFree.empty()) return JobHandle::cInvalidIndex;
+    const uint32_t index = mFree.back();
+    mFree.pop_back();
+    return index;
+}
+
+void JobSystem::FreeSlot(uint32_t inIndex)
+{
+    std::lock_guard lock(mFreeMutex);
+    mFree.push_back(inIndex); // Never grows past mMaxJobs: reserved in the constructor
+}
+
+JobHandle JobSystem::Publish(uint32_t inIndex, const char* inName, std::span<const JobHandle> inPrerequisites)
+{
+    JobSlot& slot = mSlots[inIndex];
+    slot.mName = inName;
+    // Relaxed: only a completion changes the generation, and this slot's job has not been queued yet
+    const uint32_t generation = slot.mGeneration.load(std::memory_order_relaxed);
+    // Relaxed: the slot is private until queued; the hold keeps it from being queued while prerequisites are
+    // registered
+    slot.mPending.store(1, std::memory_order_relaxed);
+    // Relaxed: a counter; WaitIdle/WaitForFrameIdle read it with its decrement's ordering (see Run)
+    mJobsInFlight.fetch_add(1, std::memory_order_relaxed);
+    for (const JobHandle& prerequisite : inPrerequisites)
+    {
+        if (!prerequisite.IsValid() || prerequisite.mIndex >= mMaxJobs) continue;
+        JobSlot& before = mSlots[prerequisite.mIndex];
+        std::unique_lock lock(before.mMutex);
+        // Relaxed: the slot mutex orders this against the completion's bump
+        if (before.mGeneration.load(std::memory_order_relaxed) != prerequisite.mGeneration) continue; // Done
+        if (before.mNumDependents == cMaxDependents)
+        {
+            lock.unlock();
+            mDependentOverflow.fetch_add(1, std::memory_order_relaxed); // Statistic only
+            Wait(prerequisite);
+            continue;
+        }
+        before.mDependents[before.mNumDependents++] = inIndex;
+        // Relaxed: the prerequisite's decrement (acq_rel) is what orders its effects before this job
+        slot.mPending.fetch_add(1, std::memory_order_relaxed);
+    }
+    // Acq_rel: if this drops the last hold, it acquires the prerequisites' releases before queueing the job
+    if (slot.mPending.fetch_sub(1, std::memory_order_acq_rel) == 1) Enqueue(inIndex);
+    return {inIndex, generation};
+}
+
+void JobSystem::Enqueue(uint32_t inIndex)
+{
+    {
+        std::lock_guard lock(mQueueMutex);
+        assert(mReadyCount < mMaxJobs);
+        mReady[(mReadyHead + mReadyCount) % mMaxJobs] = inIndex;
+        ++mReadyCount;
+    }
+    mWake.notify_one();
+}
+
+bool JobSystem::TryPopReady(uint32_t& outIndex)
+{
+    std::lock_guard lock(mQueueMutex);
+    if (mReadyCount == 0) return false;
+    outIndex = mReady[mReadyHead];
+    mReadyHead = (mReadyHead + 1) % mMaxJobs;
+    --mReadyCount;
+    return true;
+}
+
+void JobSystem::Run(uint32_t inIndex)
+{
+    JobSlot& slot = mSlots[inIndex];
+    slot.mFunction();
+    slot.mFunction.Reset();
+    uint32_t dependents[cMaxDependents];
+    uint32_t numDependents;
+    {
+        std::lock_guard lock(slot.mMutex);
+        numDependents = slot.mNumDependents;
+        std::copy_n(slot.mDependents, numDependents, dependents);
+        slot.mNumDependents = 0;
+        // Seq_cst: a waiter stores mNumWaiters and then loads the generation; this stores the generation and
+        // then loads mNumWaiters (below). Seq_cst on both sides means one of them sees the other, so a waiter
+        // cannot sleep through the finish. It also releases the job's effects to IsDone's load
+        slot.mGeneration.fetch_add(1, std::memory_order_seq_cst);
+    }
+    for (uint32_t i = 0; i < numDependents; ++i)
+    {
+        JobSlot& after = mSlots[dependents[i]];
+        // Acq_rel: releases this job's effects to whoever drops the last hold and queues the dependent
+        if (after.mPending.fetch_sub(1, std::memory_order_acq_rel) == 1) Enqueue(dependents[i]);
+    }
+    FreeSlot(inIndex);
+    mJobsRun.fetch_add(1, std::memory_order_relaxed); // Statistic only
+    // Seq_cst: as the generation bump above, against WaitIdle's sleepers
+    const bool nowIdle = mJobsInFlight.fetch_sub(1, std::memory_order_seq_cst) == 1;
+    if (mNumWaiters.load(std::memory_order_seq_cst) > 0)
+    {
+        // Taking the mutex puts this notify after a sleeper's predicate check or before it
+        {
+            std::lock_guard lock(mQueueMutex);
+        }
+        mWake.notify_all();
+    }
+    if (nowIdle)
+    {
+        {
+            std::lock_guard lock(mIdleMutex);
+        }
+        mIdle.notify_all();
+    }
+}
+
+bool JobSystem::IsDone(const JobHandle& inJob) const
+{
+    if (!inJob.IsValid() || inJob.mIndex >= mMaxJobs) return true;
+    // Seq_cst: see Run (acquire would order the job's effects; the waiter protocol needs seq_cst)
+    return mSlots[inJob.mIndex].mGeneration.load(std::memory_order_seq_cst) != inJob.mGeneration;
+}
+
+void JobSystem::Wait(const JobHandle& inJob)
+{
+    while (!IsDone(inJob))
+    {
+        uint32_t index;
+        if (TryPopReady(index))
+        {
+            Run(index);
+            continue;
+        }
+        std::unique_lock lock(mQueueMutex);
+        mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
+        mWake.wait(lock, [&] { return mReadyCount > 0 || IsDone(inJob); });
+        mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // Only ever compared with zero by Run
+    }
+}
+
+void JobSystem::WaitAll(std::span<const JobHandle> inJobs)
+{
+    for (const JobHandle& job : inJobs)
+        Wait(job);
+}
+
+void JobSystem::WaitIdle()
+{
+    // Seq_cst loads: see Run
+    while (mJobsInFlight.load(std::memory_order_seq_cst) != 0)
+    {
+        uint32_t index;
+        if (TryPopReady(index))
+        {
+            Run(index);
+            continue;
+        }
+        std::unique_lock lock(mQueueMutex);
+        mNumWaiters.fetch_add(1, std::memory_order_seq_cst);
+        mWake.wait(lock,
+                   [&] { return mReadyCount > 0 || mJobsInFlight.load(std::memory_order_seq_cst) == 0; });
+        mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // As in Wait
+    }
+}
+
+bool JobSystem::WaitForFrameIdle(std::chrono::microseconds inTimeout) const
+{
+    std::unique_lock lock(mIdleMutex);
+    // Acquire: a background thread that sees zero also sees the frame's writes (it may read them next)
+    return mIdle.wait_for(lock, inTimeout,
+                          [&] { return mJobsInFlight.load(std::memory_order_acquire) == 0; });
+}
+
+void JobSystem::WorkerMain()
+{
+    for (;;)
+    {
+        uint32_t index;
+        {
+            std::unique_lock lock(mQueueMutex);
+            mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
+            if (mReadyCount == 0) return; // Stopping, and nothing left
+            index = mReady[mReadyHead];
+            mReadyHead = (mReadyHead + 1) % mMaxJobs;
+            --mReadyCount;
+        }
+        Run(index);
+    }
+}
+
+JobSystem::Stats JobSystem::GetStats() const
+{
+    Stats stats;
+    // Relaxed: statistics
+    stats.mJobsRun = mJobsRun.load(std::memory_order_relaxed);
+    stats.mJobsRunInline = mJobsRunInline.load(std::memory_order_relaxed);
+    stats.mDependentOverflow = mDependentOverflow.load(std::memory_order_relaxed);
+    return stats;
+}
+
+} // namespace cairn::jobs

@@ -1,0 +1,236 @@
+// JobSystem: prerequisites order jobs, waiting threads help, ParallelFor covers every index once, a full pool
+// or too many dependents degrade to running in place instead of failing, and scheduling allocates nothing.
+
+#include "cairn/jobs/JobSystem.h"
+
+#include "common/AllocationCounter.h"
+
+#include <atomic>
+#include <gtest/gtest.h>
+#include <random>
+#include <thread>
+#include <vector>
+
+namespace cairn::jobs
+{
+namespace
+{
+
+class JobSystemThreads : public ::testing::TestWithParam<uint32_t>
+{
+protected:
+    JobSystem::Settings MakeSettings() const
+    {
+        JobSystem::Settings settings;
+        settings.mNumThreads = GetParam();
+        return settings;
+    }
+};
+
+TEST_P(JobSystemThreads, ThreadCountIsTheOneAskedFor)
+{
+    JobSystem jobs(MakeSettings());
+    EXPECT_EQ(jobs.GetNumThreads(), GetParam());
+}
+
+TEST_P(JobSystemThreads, AJobRunsAndItsEffectsAreVisibleAfterWait)
+{
+    JobSystem jobs(MakeSettings());
+    int value = 0; // Plain: Wait orders the job's write before the read
+    const JobHandle job = jobs.Schedule("set", [&] { value = 42; });
+    jobs.Wait(job);
+    EXPECT_TRUE(jobs.IsDone(job));
+    EXPECT_EQ(value, 42);
+}
+
+TEST_P(JobSystemThreads, RandomGraphsRunEveryJobAfterItsPrerequisites)
+{
+    JobSystem jobs(MakeSettings());
+    std::mt19937 random(11);
+    for (int graph = 0; graph < 20; ++graph)
+    {
+        constexpr int cNumJobs = 300;
+        std::vector<std::vector<int>> prerequisites(cNumJobs);
+        for (int j = 1; j < cNumJobs; ++j)
+        {
+            const int count = std::uniform_int_distribution<int>(0, 4)(random);
+            for (int k = 0; k < count; ++k)
+                prerequisites[j].push_back(std::uniform_int_distribution<int>(0, j - 1)(random));
+        }
+        std::atomic<int> clock{0};
+        std::vector<int> finishedAt(cNumJobs, -1);
+        std::vector<JobHandle> handles(cNumJobs);
+        for (int j = 0; j < cNumJobs; ++j)
+        {
+            std::vector<JobHandle> before;
+            for (int p : prerequisites[j])
+                before.push_back(handles[p]);
+            handles[j] = jobs.Schedule(
+                "node", [&, j] { finishedAt[j] = clock.fetch_add(1, std::memory_order_relaxed); }, before);
+        }
+        jobs.WaitAll(handles);
+        for (int j = 0; j < cNumJobs; ++j)
+        {
+            ASSERT_GE(finishedAt[j], 0) << "job " << j << " did not run";
+            for (int p : prerequisites[j])
+                ASSERT_LT(finishedAt[p], finishedAt[j])
+                    << "job " << j << " ran before its prerequisite " << p;
+        }
+    }
+}
+
+TEST_P(JobSystemThreads, FinishedAndInvalidPrerequisitesDoNotBlock)
+{
+    JobSystem jobs(MakeSettings());
+    const JobHandle first = jobs.Schedule("first", [] {});
+    jobs.Wait(first);
+    bool ran = false;
+    const JobHandle invalid{};
+    const JobHandle outOfRange{123456789u, 0};
+    const JobHandle second = jobs.Schedule("second", [&] { ran = true; }, {first, invalid, outOfRange});
+    jobs.Wait(second);
+    EXPECT_TRUE(ran);
+    EXPECT_TRUE(jobs.IsDone(invalid));
+    EXPECT_TRUE(jobs.IsDone(outOfRange));
+}
+
+TEST_P(JobSystemThreads, ManyDependentsOfOneJobAllRunAfterIt)
+{
+    JobSystem jobs(MakeSettings());
+    std::atomic<bool> release{false};
+    std::atomic<bool> firstDone{false};
+    const JobHandle first = jobs.Schedule("first",
+                                          [&]
+                                          {
+                                              while (!release.load(std::memory_order_acquire))
+                                                  std::this_thread::yield();
+                                              firstDone.store(true, std::memory_order_relaxed);
+                                          });
+    // With one thread the first job cannot start before Wait: release it from a helper thread
+    std::thread releaser(
+        [&]
+        {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            release.store(true, std::memory_order_release);
+        });
+    constexpr int cDependents = JobSystem::cMaxDependents + 10;
+    std::atomic<int> sawFirstDone{0};
+    std::vector<JobHandle> handles;
+    for (int i = 0; i < cDependents; ++i)
+        handles.push_back(jobs.Schedule("dependent",
+                                        [&]
+                                        {
+                                            if (firstDone.load(std::memory_order_relaxed))
+                                                sawFirstDone.fetch_add(1, std::memory_order_relaxed);
+                                        },
+                                        {first}));
+    jobs.WaitAll(handles);
+    releaser.join();
+    EXPECT_EQ(sawFirstDone.load(), cDependents);
+    EXPECT_GE(jobs.GetStats().mDependentOverflow, 1u) << "more dependents than slots: the scheduler waited";
+}
+
+TEST_P(JobSystemThreads, ParallelForVisitsEveryIndexOnce)
+{
+    JobSystem jobs(MakeSettings());
+    for (uint32_t count : {0u, 1u, 7u, 1000u, 100000u})
+        for (uint32_t grain : {0u, 1u, 64u, 5000u, 1000000u})
+        {
+            std::vector<std::atomic<int>> visits(count);
+            jobs.ParallelFor(count, grain,
+                             [&](uint32_t inBegin, uint32_t inEnd)
+                             {
+                                 ASSERT_LT(inBegin, inEnd);
+                                 ASSERT_LE(inEnd, count);
+                                 for (uint32_t i = inBegin; i < inEnd; ++i)
+                                     visits[i].fetch_add(1, std::memory_order_relaxed);
+                             });
+            for (uint32_t i = 0; i < count; ++i)
+                ASSERT_EQ(visits[i].load(), 1) << "count " << count << " grain " << grain << " index " << i;
+        }
+}
+
+TEST_P(JobSystemThreads, JobsCanScheduleAndWaitForJobs)
+{
+    JobSystem jobs(MakeSettings());
+    std::atomic<int> leaves{0};
+    std::vector<JobHandle> parents;
+    for (int p = 0; p < 8; ++p)
+        parents.push_back(jobs.Schedule(
+            "parent",
+            [&]
+            {
+                JobHandle children[8];
+                for (JobHandle& child : children)
+                    child = jobs.Schedule("child", [&] { leaves.fetch_add(1, std::memory_order_relaxed); });
+                jobs.WaitAll(children);
+                jobs.ParallelFor(
+                    64, 4, [&](uint32_t inBegin, uint32_t inEnd) { leaves.fetch_add(int(inEnd - inBegin)); });
+            }));
+    jobs.WaitAll(parents);
+    EXPECT_EQ(leaves.load(), 8 * (8 + 64));
+}
+
+TEST_P(JobSystemThreads, WaitIdleRunsEverything)
+{
+    std::atomic<int> ran{0};
+    {
+        JobSystem jobs(MakeSettings());
+        for (int i = 0; i < 100; ++i)
+            jobs.Schedule("fire and forget", [&] { ran.fetch_add(1, std::memory_order_relaxed); });
+        jobs.WaitIdle();
+        EXPECT_EQ(ran.load(), 100);
+        EXPECT_EQ(jobs.GetNumJobsInFlight(), 0u);
+        for (int i = 0; i < 50; ++i)
+            jobs.Schedule("left to the destructor", [&] { ran.fetch_add(1, std::memory_order_relaxed); });
+    }
+    EXPECT_EQ(ran.load(), 150);
+}
+
+INSTANTIATE_TEST_SUITE_P(Threads, JobSystemThreads, ::testing::Values(1u, 2u, 4u),
+                         [](const auto& inInfo) { return std::to_string(inInfo.param) + "Threads"; });
+
+TEST(JobSystemTest, AFullPoolRunsJobsInPlace)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 1; // No workers: queued jobs wait for Wait, so the pool stays full
+    settings.mMaxJobs = 4;
+    JobSystem jobs(settings);
+    std::vector<int> order;
+    std::vector<JobHandle> queued;
+    for (int i = 0; i < 4; ++i)
+        queued.push_back(jobs.Schedule("queued", [&, i] { order.push_back(i); }));
+    // The fifth finds no slot: it runs now, after its prerequisite (which the caller runs first)
+    const JobHandle inPlace = jobs.Schedule("in place", [&] { order.push_back(100); }, {queued[2]});
+    EXPECT_FALSE(inPlace.IsValid());
+    EXPECT_EQ(jobs.GetStats().mJobsRunInline, 1u);
+    ASSERT_FALSE(order.empty());
+    EXPECT_EQ(order.back(), 100);
+    EXPECT_NE(std::find(order.begin(), order.end(), 2), order.end()) << "its prerequisite ran first";
+    jobs.WaitAll(queued);
+    EXPECT_EQ(order.size(), 5u);
+}
+
+TEST(JobSystemTest, SchedulingAndRunningAllocateNothing)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    // Warm: threads started, every structure sized in the constructor
+    jobs.Wait(jobs.Schedule("warm", [] {}));
+    std::atomic<int> sum{0};
+    const test::AllocationScope scope;
+    for (int frame = 0; frame < 20; ++frame)
+    {
+        JobHandle a = jobs.Schedule("a", [&] { sum.fetch_add(1, std::memory_order_relaxed); });
+        JobHandle b = jobs.Schedule("b", [&] { sum.fetch_add(1, std::memory_order_relaxed); }, {a});
+        jobs.ParallelFor(1000, 100,
+                         [&](uint32_t inBegin, uint32_t inEnd) { sum.fetch_add(int(inEnd - inBegin)); });
+        jobs.Wait(b);
+    }
+    EXPECT_EQ(scope.GetCount(), 0u);
+    EXPECT_EQ(sum.load(), 20 * 1002);
+}
+
+} // namespace
+} // namespace cairn::jobs
