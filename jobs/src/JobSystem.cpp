@@ -1,9 +1,39 @@
 #include "cairn/jobs/JobSystem.h"
 
 #include <cassert>
+#include <chrono>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 namespace cairn::jobs
 {
+
+namespace
+{
+void CpuRelax()
+{
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_pause();
+#else
+    std::this_thread::yield();
+#endif
+}
+} // namespace
+
+template <class Done> bool JobSystem::SpinUntil(const Done& inDone) const
+{
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::microseconds(cSpinMicroseconds);
+    for (uint32_t i = 0;; ++i)
+    {
+        if (inDone()) return true;
+        // Relaxed: a hint to stop spinning; the queue itself is read under its mutex
+        if (mNumReady.load(std::memory_order_relaxed) != 0) return false;
+        if ((i & 63) == 63 && std::chrono::steady_clock::now() > deadline) return false;
+        CpuRelax();
+    }
+}
 
 JobSystem::JobSystem() : JobSystem(Settings{}) {}
 
@@ -90,6 +120,7 @@ void JobSystem::Enqueue(uint32_t inIndex)
         assert(mReadyCount < mMaxJobs);
         mReady[(mReadyHead + mReadyCount) % mMaxJobs] = inIndex;
         ++mReadyCount;
+        mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners, see SpinUntil
     }
     mWake.notify_one();
 }
@@ -101,6 +132,7 @@ bool JobSystem::TryPopReady(uint32_t& outIndex)
     outIndex = mReady[mReadyHead];
     mReadyHead = (mReadyHead + 1) % mMaxJobs;
     --mReadyCount;
+    mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners
     return true;
 }
 
@@ -165,6 +197,8 @@ void JobSystem::Wait(const JobHandle& inJob)
             Run(index);
             continue;
         }
+        if (SpinUntil([&] { return IsDone(inJob); })) return;
+        if (mNumReady.load(std::memory_order_relaxed) != 0) continue; // Relaxed: a hint, rechecked by the pop
         std::unique_lock lock(mQueueMutex);
         mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
         mWake.wait(lock, [&] { return mReadyCount > 0 || IsDone(inJob); });
@@ -210,14 +244,22 @@ void JobSystem::WorkerMain()
     for (;;)
     {
         uint32_t index;
+        if (TryPopReady(index))
         {
-            std::unique_lock lock(mQueueMutex);
-            mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
-            if (mReadyCount == 0) return; // Stopping, and nothing left
-            index = mReady[mReadyHead];
-            mReadyHead = (mReadyHead + 1) % mMaxJobs;
-            --mReadyCount;
+            Run(index);
+            continue;
         }
+        // Relaxed: hints; the wait below rechecks under the mutex
+        SpinUntil([] { return false; }); // Returns early when a job is queued
+        if (mNumReady.load(std::memory_order_relaxed) != 0) continue;
+        std::unique_lock lock(mQueueMutex);
+        mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
+        if (mReadyCount == 0) return; // Stopping, and nothing left
+        index = mReady[mReadyHead];
+        mReadyHead = (mReadyHead + 1) % mMaxJobs;
+        --mReadyCount;
+        mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners
+        lock.unlock();
         Run(index);
     }
 }

@@ -45,8 +45,9 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 {
 }
 
-void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics)
+void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs)
 {
+    mJobs = ioJobs;
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
     mBroadPhase.Update();
@@ -57,6 +58,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics)
     mNumBodyPairs = 0;
     mNumWarmStartedPoints = 0;
     WakeIslandsOfWokenBodies();
+    mIslands.Reset(uint32_t(mBodies.GetActiveBodiesForStep().size()));
     CollideNewlyActive(0, inDeltaTime);
     ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
 
@@ -67,12 +69,25 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics)
     for (uint32_t index : active)
         if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
             IntegratePositions(body, inDeltaTime);
-    uint32_t largestIsland = 0;
-    for (uint32_t island = 0; island < mIslands.GetNumIslands(); ++island)
-    {
-        SolveIsland(island, inDeltaTime);
-        largestIsland = std::max(largestIsland, uint32_t(mIslands.GetBodies(island).size()));
-    }
+    // Islands share no dynamic body and no constraint: they are solved at once, the largest first so that the
+    // longest one starts early and the small ones fill in around it
+    const uint32_t numIslands = mIslands.GetNumIslands();
+    mIslandOrder.resize(numIslands);
+    for (uint32_t island = 0; island < numIslands; ++island)
+        mIslandOrder[island] = island;
+    std::sort(mIslandOrder.begin(), mIslandOrder.end(),
+              [&](uint32_t inL, uint32_t inR)
+              {
+                  const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
+                  return l > r || (l == r && inL < inR);
+              });
+    ParallelFor(numIslands, 1,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        SolveIsland(mIslandOrder[i], inDeltaTime);
+                });
+    const uint32_t largestIsland = numIslands == 0 ? 0 : uint32_t(mIslands.GetBodies(mIslandOrder[0]).size());
     mContactCache.EndStep();
     ioStatistics.mSolveMs += MillisecondsSince(phase);
 
@@ -134,48 +149,102 @@ void PhysicsStep::ApplyForces(std::span<const uint32_t> inBodies, float inDeltaT
 void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
 {
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
-    thread_local std::vector<BodyID> sliceIDs;
-    // Bodies woken by a contact join the active list during the narrow phase; they get forces and pairs of
+    // Bodies woken by a contact join the active list after the narrow phase; they get forces and pairs of
     // their own in the next round, so a sleeping pile wakes as a whole within one step
     for (size_t begin = inBegin; begin < active.size();)
     {
         const size_t end = active.size();
         const std::span<const uint32_t> slice(active.data() + begin, end - begin);
-        ApplyForces(slice, inDeltaTime);
-        sliceIDs.clear();
-        for (uint32_t index : slice)
-            sliceIDs.push_back(mBodies.TryGetBodyAtIndex(index)->GetID());
-
-        mPairs.clear();
-        mBroadPhase.FindCollidingPairs(sliceIDs, mLayers,
-                                       [&](BodyID inActive, BodyID inOther)
-                                       {
-                                           const Body* other = mBodies.TryGetBody(inOther);
-                                           // A body whose batch another thread is finalizing is already in
-                                           // the broad phase (the link is lock-free) but not yet in the
-                                           // world: its adder waits for the body lock this step holds. It
-                                           // takes part from the next step on. Pairs with bodies of an
-                                           // earlier round were collided then.
-                                           if (other == nullptr || !other->IsInWorld() ||
-                                               (other->IsActive() && other->GetActiveIndex() < begin))
-                                               return;
-                                           mPairs.push_back(
-                                               {std::min(inActive.GetIndex(), inOther.GetIndex()),
-                                                std::max(inActive.GetIndex(), inOther.GetIndex())});
-                                       });
-        // Canonical order: the same scene gives the same contacts whatever order the broad phase reports
-        std::sort(mPairs.begin(), mPairs.end(),
-                  [](const BodyPair& inL, const BodyPair& inR)
-                  { return inL.mA < inR.mA || (inL.mA == inR.mA && inL.mB < inR.mB); });
+        ParallelFor(uint32_t(slice.size()), 256,
+                    [&](uint32_t inB, uint32_t inE)
+                    { ApplyForces(slice.subspan(inB, inE - inB), inDeltaTime); });
+        FindPairs(begin);
         mNumBodyPairs += uint32_t(mPairs.size());
-        for (const BodyPair& pair : mPairs)
-            CollidePair(*mBodies.TryGetBodyAtIndex(pair.mA), *mBodies.TryGetBodyAtIndex(pair.mB),
-                        inDeltaTime);
+
+        // Narrow phase: chunks of pairs in parallel, each into its own output
+        constexpr uint32_t cPairsPerChunk = 32;
+        const uint32_t numChunks = uint32_t((mPairs.size() + cPairsPerChunk - 1) / cPairsPerChunk);
+        if (mNarrowPhaseChunks.size() < numChunks) mNarrowPhaseChunks.resize(numChunks);
+        ParallelFor(numChunks, 1,
+                    [&](uint32_t inB, uint32_t inE)
+                    {
+                        for (uint32_t chunk = inB; chunk < inE; ++chunk)
+                        {
+                            NarrowPhaseChunk& out = mNarrowPhaseChunks[chunk];
+                            out.Clear();
+                            const size_t last = std::min(mPairs.size(), size_t(chunk + 1) * cPairsPerChunk);
+                            for (size_t p = size_t(chunk) * cPairsPerChunk; p < last; ++p)
+                                CollidePair(*mBodies.TryGetBodyAtIndex(mPairs[p].mA),
+                                            *mBodies.TryGetBodyAtIndex(mPairs[p].mB), inDeltaTime, out);
+                        }
+                    });
+        // Merge in pair order: the same constraints, cache entries and wake order whatever the threads did
+        for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+        {
+            NarrowPhaseChunk& out = mNarrowPhaseChunks[chunk];
+            for (size_t i = 0; i < out.mConstraints.size(); ++i)
+            {
+                ContactConstraint& c = mConstraints.emplace_back(out.mConstraints[i]);
+                c.mCacheIndex = mContactCache.Add(out.mCached[i]);
+            }
+            // Touching an active body wakes a sleeping one
+            for (uint32_t index : out.mToWake)
+                if (Body& body = *mBodies.TryGetBodyAtIndex(index); !body.IsActive())
+                    mBodies.ActivateBody(body);
+            mNumWarmStartedPoints += out.mNumWarmStartedPoints;
+        }
+        mIslands.Grow(uint32_t(active.size())); // The woken bodies, before their links
+        for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+            for (const BodyPair& link : mNarrowPhaseChunks[chunk].mDeferredLinks)
+                mIslands.Union(mBodies.TryGetBodyAtIndex(link.mA)->GetActiveIndex(),
+                               mBodies.TryGetBodyAtIndex(link.mB)->GetActiveIndex());
         begin = end;
     }
 }
 
-void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime)
+void PhysicsStep::FindPairs(size_t inBegin)
+{
+    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    thread_local std::vector<BodyID> sliceIDs;
+    sliceIDs.clear();
+    for (size_t i = inBegin; i < active.size(); ++i)
+        sliceIDs.push_back(mBodies.TryGetBodyAtIndex(active[i])->GetID());
+
+    // Each chunk of active bodies collects its pairs apart; the chunk of a pair is that of its active body
+    constexpr uint32_t cBodiesPerChunk = 64;
+    const uint32_t numChunks = uint32_t((sliceIDs.size() + cBodiesPerChunk - 1) / cBodiesPerChunk);
+    if (mPairChunks.size() < numChunks) mPairChunks.resize(numChunks);
+    for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+        mPairChunks[chunk].clear();
+    const ParallelRanges ranges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
+    { ParallelFor(inCount, cBodiesPerChunk, inRange); };
+    mBroadPhase.FindCollidingPairs(
+        sliceIDs, mLayers,
+        [&](BodyID inActive, BodyID inOther)
+        {
+            const Body* self = mBodies.TryGetBody(inActive);
+            const Body* other = mBodies.TryGetBody(inOther);
+            // A body whose batch another thread is finalizing is already in the broad phase (the link is
+            // lock-free) but not yet in the world: its adder waits for the body lock this step holds. It
+            // takes part from the next step on. Pairs with bodies of an earlier round were collided then.
+            if (self == nullptr || other == nullptr || !other->IsInWorld() ||
+                (other->IsActive() && other->GetActiveIndex() < inBegin))
+                return;
+            mPairChunks[(self->GetActiveIndex() - inBegin) / cBodiesPerChunk].push_back(
+                {std::min(inActive.GetIndex(), inOther.GetIndex()),
+                 std::max(inActive.GetIndex(), inOther.GetIndex())});
+        },
+        &ranges);
+    mPairs.clear();
+    for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+        mPairs.insert(mPairs.end(), mPairChunks[chunk].begin(), mPairChunks[chunk].end());
+    // Canonical order: the same scene gives the same contacts whatever order the broad phase reports
+    std::sort(mPairs.begin(), mPairs.end(),
+              [](const BodyPair& inL, const BodyPair& inR)
+              { return inL.mA < inR.mA || (inL.mA == inR.mA && inL.mB < inR.mB); });
+}
+
+void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPhaseChunk& ioOut)
 {
     if (!ioA.IsDynamic() && !ioB.IsDynamic()) return;
     // Look ahead by how far the bodies can close in this step, so fast bodies get speculative contacts before
@@ -184,22 +253,34 @@ void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime)
     settings.mMaxSeparation =
         mSettings.mSpeculativeDistance + inDeltaTime * (ioB.mLinearVelocity - ioA.mLinearVelocity).norm();
     int numManifolds = 0;
+    const size_t constraintsBefore = ioOut.mConstraints.size();
     CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
                   [&](const ContactManifold& inManifold)
                   {
-                      AddConstraint(ioA, ioB, inManifold, inDeltaTime);
+                      AddConstraint(ioA, ioB, inManifold, inDeltaTime, ioOut);
                       ++numManifolds;
                   });
     if (numManifolds == 0) return;
-    // Touching an active body wakes a sleeping one
-    if (!ioA.IsActive() && ioA.IsDynamic()) mBodies.ActivateBody(ioA);
-    if (!ioB.IsActive() && ioB.IsDynamic()) mBodies.ActivateBody(ioB);
+    // Islands: only a contact between two dynamic bodies links (a static or kinematic body would merge
+    // everything that touches it). Linked now, lock-free, while other threads find other contacts; a body
+    // still asleep has no active index yet, so its link waits for the merge that wakes it
+    if (ioOut.mConstraints.size() > constraintsBefore && ioA.IsDynamic() && ioB.IsDynamic())
+    {
+        if (ioA.IsActive() && ioB.IsActive())
+            mIslands.Union(ioA.GetActiveIndex(), ioB.GetActiveIndex());
+        else
+            ioOut.mDeferredLinks.push_back({ioA.GetID().GetIndex(), ioB.GetID().GetIndex()});
+    }
+    // Touching an active body wakes a sleeping one: at the merge, in pair order (the active list is shared)
+    if (!ioA.IsActive() && ioA.IsDynamic()) ioOut.mToWake.push_back(ioA.GetID().GetIndex());
+    if (!ioB.IsActive() && ioB.IsDynamic()) ioOut.mToWake.push_back(ioB.GetID().GetIndex());
 }
 
-void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime)
+void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
+                                NarrowPhaseChunk& ioOut) const
 {
     if (inManifold.mNumPoints <= 0) return;
-    ContactConstraint& c = mConstraints.emplace_back();
+    ContactConstraint& c = ioOut.mConstraints.emplace_back();
     SequentialImpulseSolver::InitConstraint(ioA, ioB, inManifold, inDeltaTime, c);
 
     CachedManifold cached;
@@ -227,23 +308,18 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
                 p.mNormal.mAccumulated = previous->mNormalImpulse[j];
                 // A bounce deferred by last step (its point was still a gap away) happens now
                 p.mApproachVelocity = std::min(p.mApproachVelocity, previous->mDeferredBounce[j]);
-                ++mNumWarmStartedPoints;
+                ++ioOut.mNumWarmStartedPoints;
                 break;
             }
     }
-    c.mCacheIndex = mContactCache.Add(cached);
+    ioOut.mCached.push_back(cached);
     c.mOrderKey = MixBits((uint64_t(ioA.GetID().GetIndex()) << 32 | ioB.GetID().GetIndex()) ^
                           (uint64_t(inManifold.mSubShapeA) << 40) ^ inManifold.mSubShapeB);
 }
 
 void PhysicsStep::BuildIslands()
 {
-    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
-    mIslands.Prepare(uint32_t(active.size()));
-    // Only dynamic-dynamic contacts link: a static or kinematic body would merge everything that touches it
-    for (const ContactConstraint& c : mConstraints)
-        if (c.mBodyA->IsDynamic() && c.mBodyB->IsDynamic())
-            mIslands.Link(c.mBodyA->GetActiveIndex(), c.mBodyB->GetActiveIndex());
+    // The links were made during the narrow phase; what is left is numbering, in O(N) on this thread
     mIslands.Finalize();
 
     const uint32_t numIslands = mIslands.GetNumIslands();
@@ -317,25 +393,33 @@ void PhysicsStep::IntegratePositions(Body& ioBody, float inDeltaTime)
 void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
 {
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
-    mMovedBodies.clear();
-    for (uint32_t index : active)
-    {
-        Body& body = *mBodies.TryGetBodyAtIndex(index);
-        body.UpdateBounds();
-        // The broad phase gets the bounds swept over the next step plus the speculative distance, so the next
-        // step finds the pairs this body can reach
-        AABB swept = body.mBounds;
-        swept.Encapsulate(AABB(body.mBounds.mMin + inDeltaTime * body.mLinearVelocity,
-                               body.mBounds.mMax + inDeltaTime * body.mLinearVelocity));
-        mMovedBodies.push_back(
-            {body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance), body.GetObjectLayer()});
+    mMovedBodies.resize(active.size());
+    ParallelFor(uint32_t(active.size()), 256,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                    {
+                        Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+                        body.UpdateBounds();
+                        // The broad phase gets the bounds swept over the next step plus the speculative
+                        // distance, so the next step finds the pairs this body can reach
+                        AABB swept = body.mBounds;
+                        swept.Encapsulate(AABB(body.mBounds.mMin + inDeltaTime * body.mLinearVelocity,
+                                               body.mBounds.mMax + inDeltaTime * body.mLinearVelocity));
+                        mMovedBodies[i] = {body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance),
+                                           body.GetObjectLayer()};
 
-        const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
-        const float speed = body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
-        const bool slow = mSettings.mAllowSleeping && body.mAllowSleeping && speed < mSettings.mSleepVelocity;
-        body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
-    }
-    mBroadPhase.NotifyBodiesAABBChanged(mMovedBodies);
+                        const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
+                        const float speed =
+                            body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
+                        const bool slow = mSettings.mAllowSleeping && body.mAllowSleeping &&
+                                          speed < mSettings.mSleepVelocity;
+                        body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
+                    }
+                    // Any thread may move bodies in the broad phase (each body here is in one range only)
+                    mBroadPhase.NotifyBodiesAABBChanged(
+                        std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
+                });
 
     // An island sleeps as a whole when every body in it has been slow long enough
     mSleepingIslands.clear();

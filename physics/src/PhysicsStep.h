@@ -3,14 +3,22 @@
 // PhysicsStep: the work of one collision step, and the scratch memory it reuses from step to step (so a warm
 // scene allocates nothing). Owned by PhysicsSystem; runs on the thread that called Update, which holds every
 // body mutex for the whole step: nothing here takes a lock except the broad phase's own.
+//
+// With a job system, the parallel phases run on its threads (ParallelFor; the updating thread takes part):
+// velocities, pair finding (per active body), the narrow phase (per chunk of pairs), islands (largest first),
+// bounds and the broad-phase notify. Each parallel task writes only its own bodies or its own chunk's output;
+// everything shared (the constraint list, the contact cache, the active list, waking) is merged afterwards on
+// the updating thread in pair order, so results do not depend on the number of threads or their timing.
 
+#include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
-#include "cairn/physics/islands/IslandBuilder.h"
+#include "cairn/physics/islands/AtomicUnionFind.h"
 #include "cairn/physics/solver/ContactCache.h"
 #include "cairn/physics/solver/ContactConstraint.h"
 
+#include <algorithm>
 #include <vector>
 
 namespace cairn
@@ -22,8 +30,9 @@ public:
     PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& inLayers, BodyManager& ioBodies,
                 BroadPhase& ioBroadPhase);
 
-    /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics.
-    void Run(float inDeltaTime, StepStatistics& ioStatistics);
+    /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics. ioJobs (may be null: all
+    /// on this thread) runs the parallel phases.
+    void Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs);
 
 private:
     struct BodyPair
@@ -32,13 +41,44 @@ private:
         uint32_t mB;
     };
 
+    /// What the narrow phase of one chunk of pairs produced, merged in chunk order afterwards.
+    struct NarrowPhaseChunk
+    {
+        std::vector<ContactConstraint> mConstraints; ///< mCacheIndex set at the merge
+        std::vector<CachedManifold> mCached;         ///< One per constraint
+        std::vector<uint32_t> mToWake;               ///< Sleeping dynamic bodies touched, in pair order
+        std::vector<BodyPair> mDeferredLinks;        ///< Island links with a body woken at the merge
+        uint32_t mNumWarmStartedPoints = 0;
+        void Clear()
+        {
+            mConstraints.clear();
+            mCached.clear();
+            mToWake.clear();
+            mDeferredLinks.clear();
+            mNumWarmStartedPoints = 0;
+        }
+    };
+
+    /// inBody(begin, end) over [0, inCount) in chunks of inGrain: on the job system's threads, or here.
+    template <class Body> void ParallelFor(uint32_t inCount, uint32_t inGrain, const Body& inBody)
+    {
+        if (mJobs != nullptr && inCount > inGrain)
+            mJobs->ParallelFor(inCount, inGrain, inBody);
+        else if (inCount > 0)
+            for (uint32_t begin = 0; begin < inCount; begin += inGrain)
+                inBody(begin, std::min(inCount, begin + inGrain));
+    }
+
     /// Wakes the sleeping islands of bodies that were woken from outside the step since the last one.
     void WakeIslandsOfWokenBodies();
     void ApplyForces(std::span<const uint32_t> inBodies, float inDeltaTime);
     /// Finds pairs for active-list entries [inBegin, end) and collides them; may activate more bodies.
     void CollideNewlyActive(size_t inBegin, float inDeltaTime);
-    void CollidePair(Body& ioA, Body& ioB, float inDeltaTime);
-    void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime);
+    /// Finds the pairs of active-list entries [inBegin, end) into mPairs, sorted.
+    void FindPairs(size_t inBegin);
+    void CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPhaseChunk& ioOut);
+    void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
+                       NarrowPhaseChunk& ioOut) const;
     void BuildIslands();
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
     void IntegratePositions(Body& ioBody, float inDeltaTime);
@@ -50,8 +90,12 @@ private:
     BroadPhase& mBroadPhase;
 
     ContactCache mContactCache;
-    IslandBuilder mIslands;
-    std::vector<BodyPair> mPairs;                       ///< Scratch: pairs of the slice being collided
+    AtomicUnionFind mIslands;         ///< Linked by the narrow phase's threads as they find contacts
+    jobs::JobSystem* mJobs = nullptr; ///< During Run only
+    std::vector<BodyPair> mPairs;     ///< Scratch: pairs of the slice being collided
+    std::vector<std::vector<BodyPair>> mPairChunks;     ///< Scratch: pairs found per chunk of active bodies
+    std::vector<NarrowPhaseChunk> mNarrowPhaseChunks;   ///< Scratch: per chunk of pairs
+    std::vector<uint32_t> mIslandOrder;                 ///< Scratch: islands, largest first
     std::vector<ContactConstraint> mConstraints;        ///< This step's contacts
     std::vector<uint32_t> mConstraintStart;             ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island

@@ -42,6 +42,16 @@ PhysicsSystem::~PhysicsSystem() = default;
 
 Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
 {
+    return UpdateImpl(inDeltaTime, inCollisionSteps, nullptr);
+}
+
+Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobSystem& ioJobs)
+{
+    return UpdateImpl(inDeltaTime, inCollisionSteps, &ioJobs);
+}
+
+Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobSystem* ioJobs)
+{
     if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)
         return MakeError(ErrorCode::InvalidArgument, "time step must be in (0, 1] s");
     if (inCollisionSteps < 1 || inCollisionSteps > 16)
@@ -59,7 +69,7 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
     mLastStatistics = {};
     const float stepTime = inDeltaTime / float(inCollisionSteps);
     for (int step = 0; step < inCollisionSteps; ++step)
-        mStep->Run(stepTime, mLastStatistics);
+        mStep->Run(stepTime, mLastStatistics, ioJobs);
     mBodies->UnlockAllBodies();
 
     mUpdating.store(false, std::memory_order_release);

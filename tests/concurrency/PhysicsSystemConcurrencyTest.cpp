@@ -1,14 +1,17 @@
-// The physics step on one thread while other threads query the world, move and push bodies, and add and
-// remove them: nothing crashes, no data race (this suite runs under ThreadSanitizer), and a query never
-// misses the static floor, whatever the step is doing.
+// The physics step (on one thread, or on a job system of 2 threads) while other threads query the world, move
+// and push bodies, and add and remove them: nothing crashes, no data race (this suite runs under
+// ThreadSanitizer), and a query never misses the static floor, whatever the step is doing.
 
+#include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
 #include <atomic>
 #include <gtest/gtest.h>
+#include <memory>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -17,8 +20,15 @@ namespace cairn
 namespace
 {
 
-TEST(PhysicsSystemConcurrencyTest, StepWhileOtherThreadsQueryMoveAddAndRemove)
+/// Job-system threads of the step: 0 steps on the calling thread alone.
+class PhysicsSystemStepThreads : public ::testing::TestWithParam<uint32_t>
 {
+};
+
+TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
+{
+    std::unique_ptr<jobs::JobSystem> jobSystem;
+    if (GetParam() > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{GetParam()});
     PhysicsSystem system;
     BodyInterface& bodies = system.GetBodyInterface();
     BodyCreationSettings floor;
@@ -106,7 +116,8 @@ TEST(PhysicsSystemConcurrencyTest, StepWhileOtherThreadsQueryMoveAddAndRemove)
         });
 
     for (int step = 0; step < 240; ++step)
-        ASSERT_TRUE(system.Update(1.0f / 60.0f).IsOk());
+        ASSERT_TRUE(
+            (jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f)).IsOk());
     stop.store(true, std::memory_order_relaxed);
     querier.join();
     mover.join();
@@ -117,6 +128,12 @@ TEST(PhysicsSystemConcurrencyTest, StepWhileOtherThreadsQueryMoveAddAndRemove)
     EXPECT_GT(queries.load(), 0);
     EXPECT_EQ(system.GetBodyManager().GetNumBodies(), 61u) << "every streamed body was destroyed again";
 }
+
+INSTANTIATE_TEST_SUITE_P(PhysicsSystemConcurrencyTest, PhysicsSystemStepThreads, ::testing::Values(0u, 2u),
+                         [](const auto& inInfo) {
+                             return inInfo.param == 0 ? std::string("NoJobSystem")
+                                                      : std::to_string(inInfo.param) + "JobThreads";
+                         });
 
 TEST(PhysicsSystemConcurrencyTest, SecondConcurrentUpdateIsRefused)
 {

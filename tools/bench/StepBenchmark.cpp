@@ -2,8 +2,11 @@
 //  step_pile2k   2,000 dynamic boxes fall onto the 20,020 static boxes: 600 steps of 1/60 s.
 //  step_pyramid  a 3D pyramid of 1,240 boxes on a static floor: 500 steps, sleeping disabled.
 // Prints ms per step (mean, p99, max) for each repetition and the median over repetitions, the mean time per
-// phase, and a checksum (sum of final body heights and contact points) that proves the work was done.
+// phase, and a checksum (sum of final body heights and contact points) that proves the work was done; for
+// each thread count of --threads (default 1,2: a job system of that many threads), then the speed-up. The
+// checksum must not change with the thread count (the step is deterministic across thread counts).
 
+#include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/FrameTimes.h"
@@ -57,7 +60,8 @@ void AddBatch(BodyInterface& ioBodies, const std::vector<BodyCreationSettings>& 
     outIDs.insert(outIDs.end(), ids.begin(), ids.end());
 }
 
-RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic, int inSteps)
+RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic, int inSteps,
+                   jobs::JobSystem& ioJobs)
 {
     RunResult result;
     result.mSteps = inSteps;
@@ -66,7 +70,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     for (int step = 0; step < inSteps; ++step)
     {
         const auto start = std::chrono::steady_clock::now();
-        (void)ioSystem.Update(1.0f / 60.0f, 1);
+        (void)ioSystem.Update(1.0f / 60.0f, 1, ioJobs);
         stepMs.push_back(
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         const StepStatistics& stats = ioSystem.GetLastStepStatistics();
@@ -93,7 +97,7 @@ PhysicsSettings BenchSettings(bool inAllowSleeping)
     return settings;
 }
 
-RunResult RunPile2k(const SharedBenchData& inData)
+RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 {
     PhysicsSystem system(BenchSettings(true));
     std::vector<BodyCreationSettings> statics, dynamics;
@@ -104,10 +108,10 @@ RunResult RunPile2k(const SharedBenchData& inData)
     std::vector<BodyID> staticIDs, dynamicIDs;
     AddBatch(system.GetBodyInterface(), statics, Activation::DontActivate, staticIDs);
     AddBatch(system.GetBodyInterface(), dynamics, Activation::Activate, dynamicIDs);
-    return RunScene(system, dynamicIDs, 600);
+    return RunScene(system, dynamicIDs, 600, ioJobs);
 }
 
-RunResult RunPyramid()
+RunResult RunPyramid(jobs::JobSystem& ioJobs)
 {
     PhysicsSystem system(BenchSettings(false));
     std::vector<BodyCreationSettings> boxes;
@@ -125,19 +129,21 @@ RunResult RunPyramid()
                                             Vec3(1, 1, 1), 0, MotionType::Dynamic, 0.2f));
             }
     AddBatch(system.GetBodyInterface(), boxes, Activation::Activate, boxIDs);
-    return RunScene(system, boxIDs, 500);
+    return RunScene(system, boxIDs, 500, ioJobs);
 }
 
-void Print(const char* inName, const std::vector<RunResult>& inRuns)
+/// Prints the repetitions and returns the median of the mean step times.
+double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult>& inRuns)
 {
     std::vector<double> means, p99s, maxes;
     for (size_t i = 0; i < inRuns.size(); ++i)
     {
         const RunResult& run = inRuns[i];
-        std::printf("%s rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: broadphase-update %.3f  "
+        std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
+                    "broadphase-update %.3f  "
                     "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
                     "contacts %llu\n",
-                    inName, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
+                    inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
                     run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
                     run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
                     run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
@@ -151,8 +157,9 @@ void Print(const char* inName, const std::vector<RunResult>& inRuns)
         std::sort(inValues.begin(), inValues.end());
         return inValues[inValues.size() / 2];
     };
-    std::printf("%s threads=1 median of %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms per step\n", inName,
-                inRuns.size(), median(means), median(p99s), median(maxes));
+    std::printf("%s threads=%u median of %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms per step\n", inName,
+                inThreads, inRuns.size(), median(means), median(p99s), median(maxes));
+    return median(means);
 }
 } // namespace
 
@@ -160,16 +167,33 @@ int main(int inArgc, char** inArgv)
 {
     int repetitions = 3;
     std::string only;
+    std::vector<uint32_t> threadCounts = {1, 2};
     for (int i = 1; i < inArgc; ++i)
     {
         if (std::strcmp(inArgv[i], "--repetitions") == 0 && i + 1 < inArgc)
             repetitions = std::max(1, std::atoi(inArgv[++i]));
         else if (std::strcmp(inArgv[i], "--only") == 0 && i + 1 < inArgc)
             only = inArgv[++i];
+        else if (std::strcmp(inArgv[i], "--threads") == 0 && i + 1 < inArgc)
+        {
+            threadCounts.clear();
+            for (const char* p = inArgv[++i]; *p != 0;)
+            {
+                char* end = nullptr;
+                const long count = std::strtol(p, &end, 10);
+                if (end == p || count < 1 || count > 64)
+                {
+                    std::fprintf(stderr, "--threads: a comma-separated list of counts in 1..64\n");
+                    return 2;
+                }
+                threadCounts.push_back(uint32_t(count));
+                p = *end == ',' ? end + 1 : end;
+            }
+        }
         else
         {
-            std::fprintf(stderr,
-                         "usage: cairn-bench-step [--repetitions N] [--only step_pile2k|step_pyramid]\n");
+            std::fprintf(stderr, "usage: cairn-bench-step [--repetitions N] [--only "
+                                 "step_pile2k|step_pyramid] [--threads 1,2]\n");
             return 2;
         }
     }
@@ -178,7 +202,13 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf("cairn-bench-step: build %s, 1 thread, %d repetitions\n", buildType, repetitions);
+    std::printf("cairn-bench-step: build %s, %d repetitions\n", buildType, repetitions);
+    auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
+    {
+        for (size_t t = 1; t < inMeans.size(); ++t)
+            std::printf("%s speed-up %u -> %u threads: %.2fx\n", inName, threadCounts[0], threadCounts[t],
+                        inMeans[0] / inMeans[t]);
+    };
 
     if (only.empty() || only == "step_pile2k")
     {
@@ -187,18 +217,30 @@ int main(int inArgc, char** inArgv)
             std::printf("step_pile2k skipped: %s\n", data.GetError().mMessage.c_str());
         else
         {
-            std::vector<RunResult> runs;
-            for (int i = 0; i < repetitions; ++i)
-                runs.push_back(RunPile2k(data.Value()));
-            Print("step_pile2k", runs);
+            std::vector<double> means;
+            for (uint32_t threads : threadCounts)
+            {
+                jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+                std::vector<RunResult> runs;
+                for (int i = 0; i < repetitions; ++i)
+                    runs.push_back(RunPile2k(data.Value(), jobSystem));
+                means.push_back(Print("step_pile2k", threads, runs));
+            }
+            speedUps("step_pile2k", means);
         }
     }
     if (only.empty() || only == "step_pyramid")
     {
-        std::vector<RunResult> runs;
-        for (int i = 0; i < repetitions; ++i)
-            runs.push_back(RunPyramid());
-        Print("step_pyramid", runs);
+        std::vector<double> means;
+        for (uint32_t threads : threadCounts)
+        {
+            jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+            std::vector<RunResult> runs;
+            for (int i = 0; i < repetitions; ++i)
+                runs.push_back(RunPyramid(jobSystem));
+            means.push_back(Print("step_pyramid", threads, runs));
+        }
+        speedUps("step_pyramid", means);
     }
     return 0;
 }

@@ -155,7 +155,8 @@ void BroadPhaseBruteForce::CastAABox(const AABB& inBox, const Vec3& inDisplaceme
 }
 
 void BroadPhaseBruteForce::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
-                                              const LayerSetup& inLayers, BodyPairVisitor inVisitor) const
+                                              const LayerSetup& inLayers, BodyPairVisitor inVisitor,
+                                              const ParallelRanges* /*inParallel: runs serially*/) const
 {
     std::shared_lock lock(mMutex);
 

@@ -267,7 +267,8 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
 }
 
 void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
-                                            const LayerSetup& inLayers, BodyPairVisitor inVisitor) const
+                                            const LayerSetup& inLayers, BodyPairVisitor inVisitor,
+                                            const ParallelRanges* inParallel) const
 {
     const StepCallGuard guard(*this);
     if (!guard.IsOwner()) return;
@@ -283,29 +284,40 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
     for (BodyID id : inActiveBodies)
         if (isPresent(id)) mBodies[id.GetIndex()].mActiveInStep = 1;
 
-    for (BodyID id : inActiveBodies)
+    auto findRange = [&](uint32_t inBegin, uint32_t inEnd)
     {
-        if (!isPresent(id)) continue;
-        const uint32_t selfIndex = id.GetIndex();
-        const ObjectLayer selfLayer = mBodies[selfIndex].mLayer.load(std::memory_order_relaxed); // See above
-        const AABB bounds = TreeOf(selfLayer).GetBodyBounds(id);
-        const ObjectLayerMask collidesWith = inLayers.GetCollisionMask(selfLayer);
-        ForEachTree(collidesWith,
-                    [&](const QuadTree& inTree, ObjectLayerMask inMask)
-                    {
-                        inTree.CollideAABox(
-                            bounds, inMask,
-                            [&](BodyID inOther)
-                            {
-                                const uint32_t otherIndex = inOther.GetIndex();
-                                // Skip itself; of two active bodies the lower index reports
-                                if (otherIndex != selfIndex &&
-                                    (mBodies[otherIndex].mActiveInStep == 0 || otherIndex > selfIndex))
-                                    inVisitor(id, inOther);
-                            });
-                        return true;
-                    });
-    }
+        for (uint32_t position = inBegin; position < inEnd; ++position)
+        {
+            const BodyID id = inActiveBodies[position];
+            if (!isPresent(id)) continue;
+            const uint32_t selfIndex = id.GetIndex();
+            const ObjectLayer selfLayer =
+                mBodies[selfIndex].mLayer.load(std::memory_order_relaxed); // See above
+            const AABB bounds = TreeOf(selfLayer).GetBodyBounds(id);
+            const ObjectLayerMask collidesWith = inLayers.GetCollisionMask(selfLayer);
+            ForEachTree(collidesWith,
+                        [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                        {
+                            inTree.CollideAABox(
+                                bounds, inMask,
+                                [&](BodyID inOther)
+                                {
+                                    const uint32_t otherIndex = inOther.GetIndex();
+                                    // Skip itself; of two active bodies the lower index reports
+                                    if (otherIndex != selfIndex &&
+                                        (mBodies[otherIndex].mActiveInStep == 0 || otherIndex > selfIndex))
+                                        inVisitor(id, inOther);
+                                });
+                            return true;
+                        });
+        }
+    };
+    // The trees are queried from several threads at once (queries are lock-free); the marks above are only
+    // read
+    if (inParallel != nullptr)
+        (*inParallel)(uint32_t(inActiveBodies.size()), findRange);
+    else
+        findRange(0, uint32_t(inActiveBodies.size()));
 
     for (BodyID id : inActiveBodies)
         if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mBodies[id.GetIndex()].mActiveInStep = 0;

@@ -688,7 +688,8 @@ void BroadPhaseSortAndSweep::CastAABox(const AABB& inBox, const Vec3& inDisplace
 }
 
 void BroadPhaseSortAndSweep::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
-                                                const LayerSetup& inLayers, BodyPairVisitor inVisitor) const
+                                                const LayerSetup& inLayers, BodyPairVisitor inVisitor,
+                                                const ParallelRanges* /*inParallel: runs serially*/) const
 {
     std::shared_lock lock(mMutex);
 

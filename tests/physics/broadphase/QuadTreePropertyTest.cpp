@@ -1082,7 +1082,7 @@ public:
         mInner.CastAABox(inBox, inDisplacement, inFilter, inVisitor);
     }
     void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
-                            BodyPairVisitor inVisitor) const override
+                            BodyPairVisitor inVisitor, const ParallelRanges* = nullptr) const override
     {
         if (mFault != Fault::PairsFromBothSides)
             return mInner.FindCollidingPairs(inActiveBodies, inLayers, inVisitor);

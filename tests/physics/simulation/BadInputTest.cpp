@@ -143,7 +143,7 @@ TEST_F(BadInputTest, CallsThatWouldDeadlockWhileHoldingABodyLockAreRefused)
         BodyLockRead lock(System().GetBodyManager(), mBox);
         ASSERT_TRUE(lock.Succeeded());
         // Each of these would wait for a lock this thread holds, or take a second one: refused, not hung
-        EXPECT_EQ(System().Update(cDeltaTime).GetError().mCode, ErrorCode::WrongThread);
+        EXPECT_EQ(UpdateWorld(cDeltaTime).GetError().mCode, ErrorCode::WrongThread);
         EXPECT_EQ(Bodies().GetPosition(mFloor).GetError().mCode, ErrorCode::WrongThread);
         EXPECT_EQ(Bodies().SetLinearVelocity(mBox, Vec3(1, 0, 0)).GetError().mCode, ErrorCode::WrongThread);
         BodyLockWrite second(System().GetBodyManager(), mFloor);
@@ -151,17 +151,17 @@ TEST_F(BadInputTest, CallsThatWouldDeadlockWhileHoldingABodyLockAreRefused)
         EXPECT_TRUE(second.WasWrongThread());
     }
     // Released: everything works again
-    EXPECT_TRUE(System().Update(cDeltaTime).IsOk());
+    EXPECT_TRUE(UpdateWorld(cDeltaTime).IsOk());
     EXPECT_TRUE(Bodies().GetPosition(mFloor).IsOk());
     EXPECT_EQ(System().GetBodyManager().GetNumBodies(), 2u);
 }
 
 TEST_F(BadInputTest, BadTimeStepsAreRejected)
 {
-    EXPECT_FALSE(System().Update(0.0f).IsOk());
-    EXPECT_FALSE(System().Update(-1.0f).IsOk());
-    EXPECT_FALSE(System().Update(std::numeric_limits<float>::quiet_NaN()).IsOk());
-    EXPECT_FALSE(System().Update(cDeltaTime, 0).IsOk());
+    EXPECT_FALSE(UpdateWorld(0.0f).IsOk());
+    EXPECT_FALSE(UpdateWorld(-1.0f).IsOk());
+    EXPECT_FALSE(UpdateWorld(std::numeric_limits<float>::quiet_NaN()).IsOk());
+    EXPECT_FALSE(UpdateWorld(cDeltaTime, 0).IsOk());
     ExpectWorldUnchanged();
 }
 

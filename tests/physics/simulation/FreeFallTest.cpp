@@ -30,7 +30,7 @@ TEST_F(FreeFallTest, CollisionStepsSplitTheUpdate)
     const BodyID sphere = AddDynamic(settings);
     // 30 updates of 1/30 s in 2 collision steps each = 60 steps of 1/60 s
     for (int i = 0; i < 30; ++i)
-        ASSERT_TRUE(System().Update(2.0f * cDeltaTime, 2).IsOk());
+        ASSERT_TRUE(UpdateWorld(2.0f * cDeltaTime, 2).IsOk());
     const double dt = cDeltaTime;
     EXPECT_NEAR(Position(sphere).y(), 10.0 - 9.81 * dt * dt * 60 * 61 / 2.0, 1.0e-4);
 }

@@ -1,12 +1,17 @@
 #pragma once
 
 // A small world and helpers to build test scenes: every simulation test starts from here.
+// The world steps on this thread, or on a job system of CAIRN_TEST_PHYSICS_THREADS threads when that is set
+// (ctest runs the simulation tests once more with 1, 2 and 4 threads: tests/CMakeLists.txt).
 
+#include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
+#include <cstdlib>
 #include <gtest/gtest.h>
+#include <memory>
 
 namespace cairn::test
 {
@@ -64,10 +69,36 @@ protected:
         return Bodies().CreateAndAddBody(inSettings, Activation::Activate).Value();
     }
 
+    /// The job system the tests step on, or null (CAIRN_TEST_PHYSICS_THREADS unset or not a number > 0).
+    static jobs::JobSystem* TestJobSystem()
+    {
+        static const std::unique_ptr<jobs::JobSystem> jobSystem = []() -> std::unique_ptr<jobs::JobSystem>
+        {
+            const char* value = std::getenv("CAIRN_TEST_PHYSICS_THREADS");
+            const int threads = value != nullptr ? std::atoi(value) : 0;
+            if (threads <= 0) return nullptr;
+            jobs::JobSystem::Settings settings;
+            settings.mNumThreads = uint32_t(threads);
+            return std::make_unique<jobs::JobSystem>(settings);
+        }();
+        return jobSystem.get();
+    }
+
+    static Status UpdateWorld(PhysicsSystem& ioSystem, float inDeltaTime, int inCollisionSteps = 1)
+    {
+        jobs::JobSystem* jobSystem = TestJobSystem();
+        return jobSystem != nullptr ? ioSystem.Update(inDeltaTime, inCollisionSteps, *jobSystem)
+                                    : ioSystem.Update(inDeltaTime, inCollisionSteps);
+    }
+    Status UpdateWorld(float inDeltaTime, int inCollisionSteps = 1)
+    {
+        return UpdateWorld(System(), inDeltaTime, inCollisionSteps);
+    }
+
     void Step(int inSteps)
     {
         for (int i = 0; i < inSteps; ++i)
-            ASSERT_TRUE(System().Update(cDeltaTime).IsOk());
+            ASSERT_TRUE(UpdateWorld(cDeltaTime).IsOk());
     }
 
     Vec3 Position(const BodyID& inID) { return Bodies().GetPosition(inID).Value(); }

@@ -63,7 +63,7 @@ TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
             ids.push_back(bodies.CreateAndAddBody(box, Activation::Activate).Value());
         }
         for (int step = 0; step < 300; ++step)
-            (void)system.Update(1.0f / 60.0f);
+            (void)UpdateWorld(system, 1.0f / 60.0f);
         for (const BodyID& id : ids)
             outPositions.push_back(bodies.GetPosition(id).Value());
     };

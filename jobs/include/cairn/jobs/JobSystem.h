@@ -57,6 +57,9 @@ public:
     static constexpr size_t cFunctionCapacity = 64; ///< Bytes of captures a job may carry
     static constexpr uint32_t cMaxDependents = 16;  ///< Jobs that can wait on one job through the queue
     static constexpr uint32_t cMaxThreads = 64;
+    /// A thread that runs out of work spins this long before it sleeps: the frame's parallel phases follow
+    /// each other within microseconds, and waking a sleeping thread costs tens of them
+    static constexpr uint32_t cSpinMicroseconds = 50;
 
     struct Settings
     {
@@ -173,6 +176,9 @@ private:
     bool TryPopReady(uint32_t& outIndex);
     void Run(uint32_t inIndex);
     void WorkerMain();
+    /// Spins for up to about cSpinMicroseconds while inDone() is false and nothing is queued; true if
+    /// inDone().
+    template <class Done> bool SpinUntil(const Done& inDone) const;
 
     std::unique_ptr<JobSlot[]> mSlots;
     uint32_t mMaxJobs;
@@ -181,11 +187,12 @@ private:
     std::vector<uint32_t> mFree; ///< Free slot indices (a stack); mFreeMutex
 
     std::mutex mQueueMutex;
-    std::condition_variable mWake; ///< Workers and waiters: a job was queued or finished, or stopping
-    std::vector<uint32_t> mReady;  ///< Ring of queued slot indices (capacity mMaxJobs: never overflows)
-    uint32_t mReadyHead = 0;       ///< mQueueMutex
-    uint32_t mReadyCount = 0;      ///< mQueueMutex
-    bool mStopping = false;        ///< mQueueMutex
+    std::condition_variable mWake;      ///< Workers and waiters: a job was queued or finished, or stopping
+    std::vector<uint32_t> mReady;       ///< Ring of queued slot indices (capacity mMaxJobs: never overflows)
+    std::atomic<uint32_t> mNumReady{0}; ///< mReadyCount's mirror, for spinning without the mutex
+    uint32_t mReadyHead = 0;            ///< mQueueMutex
+    uint32_t mReadyCount = 0;           ///< mQueueMutex
+    bool mStopping = false;             ///< mQueueMutex
 
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)

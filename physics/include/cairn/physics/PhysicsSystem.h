@@ -18,6 +18,11 @@
 #include <atomic>
 #include <memory>
 
+namespace cairn::jobs
+{
+class JobSystem;
+}
+
 namespace cairn
 {
 
@@ -32,8 +37,12 @@ public:
     PhysicsSystem(const PhysicsSystem&) = delete;
     PhysicsSystem& operator=(const PhysicsSystem&) = delete;
 
-    /// Advances the world by inDeltaTime seconds in inCollisionSteps equal steps (1..16).
+    /// Advances the world by inDeltaTime seconds in inCollisionSteps equal steps (1..16), on this thread.
     Status Update(float inDeltaTime, int inCollisionSteps = 1);
+    /// The same, with the parallel phases on ioJobs's threads (this thread takes part). Bodies end
+    /// bit-identical to the single-threaded Update, whatever the number of threads. While it runs, this
+    /// thread may run other queued jobs; those must not call BodyInterface (they get WrongThread).
+    Status Update(float inDeltaTime, int inCollisionSteps, jobs::JobSystem& ioJobs);
 
     BodyInterface& GetBodyInterface() { return *mBodyInterface; }
     const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
@@ -52,6 +61,8 @@ private:
     std::unique_ptr<BodyInterface> mBodyInterface;
     std::unique_ptr<WorldQuery> mWorldQuery;
     std::unique_ptr<PhysicsStep> mStep;
+
+    Status UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobSystem* ioJobs);
     std::atomic<bool> mUpdating{false}; ///< Guards against concurrent Update calls (acquire/release below)
     StepStatistics mLastStatistics;     ///< Written by the updating thread only
 };

@@ -47,6 +47,10 @@ using BodyVisitor = FunctionRef<void(BodyID)>;
 using RayBodyVisitor = FunctionRef<float(BodyID inBody, float inFraction)>;
 /// Receives a potentially colliding pair; inActive is the active body whose AABB was queried.
 using BodyPairVisitor = FunctionRef<void(BodyID inActive, BodyID inOther)>;
+/// Runs inBody over [0, inCount) split into ranges, possibly several at once on different threads, and
+/// returns when every range is done (the physics step passes its job system's ParallelFor).
+using ParallelRanges =
+    FunctionRef<void(uint32_t inCount, FunctionRef<void(uint32_t inBegin, uint32_t inEnd)> inBody)>;
 
 class BroadPhase
 {
@@ -92,9 +96,12 @@ public:
                            const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const = 0;
 
     /// Every pair (active body, other body) whose AABBs overlap and whose object layers collide according to
-    /// inLayers; a pair of two active bodies is reported once. Physics step only.
+    /// inLayers; a pair of two active bodies is reported once. Physics step only. With inParallel, the active
+    /// bodies may be split into ranges run at once on several threads: inVisitor is then called concurrently,
+    /// all pairs of one active body from the same thread (a broad phase may also ignore inParallel).
     virtual void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
-                                    BodyPairVisitor inVisitor) const = 0;
+                                    BodyPairVisitor inVisitor,
+                                    const ParallelRanges* inParallel = nullptr) const = 0;
 
     /// Number of bodies currently added (for statistics and tests).
     virtual size_t GetBodyCount() const = 0;

@@ -60,7 +60,8 @@ public:
                    RayBodyVisitor inVisitor) const override;
     /// Every active body against every body.
     void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
-                            BodyPairVisitor inVisitor) const override;
+                            BodyPairVisitor inVisitor,
+                            const ParallelRanges* inParallel = nullptr) const override;
 
     /// Number of bodies stored.
     size_t GetBodyCount() const override;

@@ -103,7 +103,8 @@ public:
     /// Each present active body's exact bounds against the trees of the layers it collides with; a pair of
     /// two active bodies is reported once (by the lower index). Physics step only.
     void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
-                            BodyPairVisitor inVisitor) const override;
+                            BodyPairVisitor inVisitor,
+                            const ParallelRanges* inParallel = nullptr) const override;
 
     size_t GetBodyCount() const override;
 

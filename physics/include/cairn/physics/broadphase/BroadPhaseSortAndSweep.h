@@ -99,7 +99,8 @@ public:
     /// Each active body (listed once each) against the layers it collides with. Call Update() first: dirty
     /// entries are scanned linearly by every active body.
     void FindCollidingPairs(std::span<const BodyID> inActiveBodies, const LayerSetup& inLayers,
-                            BodyPairVisitor inVisitor) const override;
+                            BodyPairVisitor inVisitor,
+                            const ParallelRanges* inParallel = nullptr) const override;
 
     /// Number of bodies stored.
     size_t GetBodyCount() const override;
