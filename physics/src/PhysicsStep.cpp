@@ -4,6 +4,7 @@
 #include "cairn/physics/solver/SequentialImpulseSolver.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 
 namespace cairn
@@ -69,8 +70,9 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     for (uint32_t index : active)
         if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
             IntegratePositions(body, inDeltaTime);
-    // Islands share no dynamic body and no constraint: they are solved at once, the largest first so that the
-    // longest one starts early and the small ones fill in around it
+    // Islands share no dynamic body and no constraint. Large (colored) islands first, one at a time with
+    // every thread on each; then the others at once, the largest first so that the longest starts early and
+    // the small ones fill in around it
     const uint32_t numIslands = mIslands.GetNumIslands();
     mIslandOrder.resize(numIslands);
     for (uint32_t island = 0; island < numIslands; ++island)
@@ -81,11 +83,19 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
                   const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
                   return l > r || (l == r && inL < inR);
               });
-    ParallelFor(numIslands, 1,
+    for (uint32_t island : mColoredIslands)
+        SolveColoredIsland(island, inDeltaTime);
+    const uint32_t firstUncolored =
+        uint32_t(std::find_if(mIslandOrder.begin(), mIslandOrder.end(),
+                              [&](uint32_t inIsland) { return mIslandFirstColor[inIsland] == UINT32_MAX; }) -
+                 mIslandOrder.begin());
+    ParallelFor(numIslands - firstUncolored, 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        SolveIsland(mIslandOrder[i], inDeltaTime);
+                        if (const uint32_t island = mIslandOrder[firstUncolored + i];
+                            mIslandFirstColor[island] == UINT32_MAX)
+                            SolveIsland(island, inDeltaTime);
                 });
     const uint32_t largestIsland = numIslands == 0 ? 0 : uint32_t(mIslands.GetBodies(mIslandOrder[0]).size());
     mContactCache.EndStep();
@@ -348,6 +358,122 @@ void PhysicsStep::BuildIslands()
                       return inL->mOrderKey < inR->mOrderKey ||
                              (inL->mOrderKey == inR->mOrderKey && inL->mCacheIndex < inR->mCacheIndex);
                   });
+
+    mIslandFirstColor.assign(numIslands, UINT32_MAX);
+    mColorStart.clear();
+    mColorIsSerial.clear();
+    mColoredIslands.clear();
+    for (uint32_t island = 0; island < numIslands; ++island)
+        if (mConstraintStart[island + 1] - mConstraintStart[island] >= cColoredIslandMinConstraints)
+            mColoredIslands.push_back(island);
+    std::sort(mColoredIslands.begin(), mColoredIslands.end(),
+              [&](uint32_t inL, uint32_t inR)
+              {
+                  const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
+                  return l > r || (l == r && inL < inR);
+              });
+    for (uint32_t island : mColoredIslands)
+        ColorIsland(island);
+}
+
+void PhysicsStep::ColorIsland(uint32_t inIsland)
+{
+    const uint32_t begin = mConstraintStart[inIsland], end = mConstraintStart[inIsland + 1];
+    mBodyColors.resize(mBodies.GetActiveBodiesForStep().size(), 0);
+    mConstraintColor.resize(end - begin);
+    uint32_t count[cSerialColor + 1] = {};
+    // Greedy, in the hashed solve order: each constraint takes the lowest color that neither of its dynamic
+    // bodies has yet (static and kinematic bodies are only read by the solver, so they may repeat in a color)
+    for (uint32_t i = begin; i < end; ++i)
+    {
+        const ContactConstraint& c = *mIslandConstraints[i];
+        const bool dynamicA = c.mBodyA->IsDynamic(), dynamicB = c.mBodyB->IsDynamic();
+        uint64_t& colorsA = mBodyColors[dynamicA ? c.mBodyA->GetActiveIndex() : 0];
+        uint64_t& colorsB = mBodyColors[dynamicB ? c.mBodyB->GetActiveIndex() : 0];
+        const uint64_t taken = (dynamicA ? colorsA : 0) | (dynamicB ? colorsB : 0);
+        const uint32_t color = taken == ~uint64_t(0) ? cSerialColor : uint32_t(std::countr_zero(~taken));
+        if (color != cSerialColor)
+        {
+            if (dynamicA) colorsA |= uint64_t(1) << color;
+            if (dynamicB) colorsB |= uint64_t(1) << color;
+        }
+        mConstraintColor[i - begin] = uint8_t(color);
+        ++count[color];
+    }
+    // Stable counting sort by color: within a color the hashed order stays
+    mIslandFirstColor[inIsland] = uint32_t(mColorStart.size());
+    uint32_t offsets[cSerialColor + 1];
+    uint32_t offset = begin;
+    for (uint32_t color = 0; color <= cSerialColor; ++color)
+    {
+        offsets[color] = offset;
+        if (count[color] != 0)
+        {
+            mColorStart.push_back(offset);
+            mColorIsSerial.push_back(color == cSerialColor ? 1 : 0);
+        }
+        offset += count[color];
+    }
+    mColorStart.push_back(end);
+    mColorIsSerial.push_back(0); // The end marker
+    mColorScratch.resize(end - begin);
+    for (uint32_t i = begin; i < end; ++i)
+        mColorScratch[offsets[mConstraintColor[i - begin]]++ - begin] = mIslandConstraints[i];
+    std::copy(mColorScratch.begin(), mColorScratch.end(), mIslandConstraints.begin() + begin);
+    for (uint32_t activeIndex : mIslands.GetBodies(inIsland))
+        mBodyColors[activeIndex] = 0;
+}
+
+void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
+{
+    const uint32_t firstColor = mIslandFirstColor[inIsland];
+    // The island's colors are the ranges [mColorStart[k], mColorStart[k + 1]) up to its end
+    uint32_t lastColor = firstColor;
+    while (mColorStart[lastColor + 1] != mConstraintStart[inIsland + 1])
+        ++lastColor;
+    constexpr uint32_t cConstraintsPerChunk = 64;
+    auto forEachColor = [&](const auto& inSolve)
+    {
+        for (uint32_t color = firstColor; color <= lastColor; ++color)
+        {
+            const std::span<ContactConstraint* const> constraints(
+                mIslandConstraints.data() + mColorStart[color],
+                mIslandConstraints.data() + mColorStart[color + 1]);
+            // Within a color no two constraints share a dynamic body, so its chunks may run at once; the
+            // range of constraints that found no color shares bodies and runs as one chunk
+            const uint32_t grain = mColorIsSerial[color] != 0 ? std::max(1u, uint32_t(constraints.size()))
+                                                              : cConstraintsPerChunk;
+            ParallelFor(uint32_t(constraints.size()), grain,
+                        [&](uint32_t inBegin, uint32_t inEnd)
+                        { inSolve(constraints.subspan(inBegin, inEnd - inBegin)); });
+        }
+    };
+    const SolverSettings& solver = mSettings.mSolver;
+    forEachColor([](std::span<ContactConstraint* const> inC) { SequentialImpulseSolver::WarmStart(inC); });
+    for (int i = 0; i < solver.mVelocityIterations; ++i)
+        forEachColor([](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::SolveVelocities(inC); });
+    forEachColor([&](std::span<ContactConstraint* const> inC)
+                 { SequentialImpulseSolver::ApplyRestitution(inC, solver); });
+
+    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    const std::span<const uint32_t> bodies = mIslands.GetBodies(inIsland);
+    ParallelFor(uint32_t(bodies.size()), 256,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        if (Body& body = *mBodies.TryGetBodyAtIndex(active[bodies[i]]); body.IsDynamic())
+                            IntegratePositions(body, inDeltaTime);
+                });
+    for (int i = 0; i < solver.mPositionIterations; ++i)
+        forEachColor([&](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::SolvePositions(inC, solver); });
+
+    const std::span<ContactConstraint* const> all(mIslandConstraints.data() + mConstraintStart[inIsland],
+                                                  mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    ParallelFor(uint32_t(all.size()), 256,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                { StoreImpulses(all.subspan(inBegin, inEnd - inBegin)); });
 }
 
 void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
@@ -369,7 +495,12 @@ void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
     for (int i = 0; i < solver.mPositionIterations; ++i)
         SequentialImpulseSolver::SolvePositions(constraints, solver);
 
-    for (const ContactConstraint* c : constraints)
+    StoreImpulses(constraints);
+}
+
+void PhysicsStep::StoreImpulses(std::span<ContactConstraint* const> inConstraints)
+{
+    for (const ContactConstraint* c : inConstraints)
     {
         CachedManifold& cached = mContactCache.Get(c->mCacheIndex);
         for (int i = 0; i < c->mNumPoints; ++i)

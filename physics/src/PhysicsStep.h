@@ -19,6 +19,7 @@
 #include "cairn/physics/solver/ContactConstraint.h"
 
 #include <algorithm>
+#include <span>
 #include <vector>
 
 namespace cairn
@@ -81,6 +82,12 @@ private:
                        NarrowPhaseChunk& ioOut) const;
     void BuildIslands();
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
+    /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
+    void ColorIsland(uint32_t inIsland);
+    /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn.
+    void SolveColoredIsland(uint32_t inIsland, float inDeltaTime);
+    /// Stores the constraints' impulses in the contact cache for next step's warm start.
+    void StoreImpulses(std::span<ContactConstraint* const> inConstraints);
     void IntegratePositions(Body& ioBody, float inDeltaTime);
     void UpdateBoundsAndSleep(float inDeltaTime);
 
@@ -93,11 +100,24 @@ private:
     AtomicUnionFind mIslands;         ///< Linked by the narrow phase's threads as they find contacts
     jobs::JobSystem* mJobs = nullptr; ///< During Run only
     std::vector<BodyPair> mPairs;     ///< Scratch: pairs of the slice being collided
-    std::vector<std::vector<BodyPair>> mPairChunks;     ///< Scratch: pairs found per chunk of active bodies
-    std::vector<NarrowPhaseChunk> mNarrowPhaseChunks;   ///< Scratch: per chunk of pairs
-    std::vector<uint32_t> mIslandOrder;                 ///< Scratch: islands, largest first
-    std::vector<ContactConstraint> mConstraints;        ///< This step's contacts
-    std::vector<uint32_t> mConstraintStart;             ///< Per island offsets into mIslandConstraints
+    std::vector<std::vector<BodyPair>> mPairChunks;   ///< Scratch: pairs found per chunk of active bodies
+    std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs
+    std::vector<uint32_t> mIslandOrder;               ///< Scratch: islands, largest first
+    /// Islands with this many constraints or more are colored and solved by all threads together, whatever
+    /// the number of threads (so results do not depend on it): one large island must not serialise the step
+    static constexpr uint32_t cColoredIslandMinConstraints = 128;
+    static constexpr uint32_t cSerialColor =
+        64;                                  ///< Constraints that found no free color among 64: solved alone
+    std::vector<uint32_t> mColoredIslands;   ///< This step's colored islands, largest first
+    std::vector<uint32_t> mIslandFirstColor; ///< Per island: first entry in mColorStart (colored ones)
+    std::vector<uint32_t>
+        mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
+    std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
+    std::vector<uint64_t> mBodyColors;   ///< Scratch per active body: colors its constraints took
+    std::vector<uint8_t> mConstraintColor;         ///< Scratch per constraint of the island being colored
+    std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
+    std::vector<ContactConstraint> mConstraints;   ///< This step's contacts
+    std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island
     std::vector<BroadPhaseBody> mMovedBodies;           ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;             ///< Scratch
