@@ -70,6 +70,26 @@ private:
                 inBody(begin, std::min(inCount, begin + inGrain));
     }
 
+    /// inBody(begin, end) over [0, inCount) split into one contiguous part per thread: part 0 on this thread,
+    /// part t on the t-th job, so with a stable assignment the same thread sees the same part every time.
+    template <class Body> void ForEachThreadPart(uint32_t inCount, const Body& inBody)
+    {
+        const uint32_t parts =
+            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / 16));
+        if (parts <= 1)
+        {
+            if (inCount > 0) inBody(0, inCount);
+            return;
+        }
+        jobs::JobHandle handles[jobs::JobSystem::cMaxThreads];
+        for (uint32_t part = 1; part < parts; ++part)
+            handles[part] =
+                mJobs->Schedule("part", [&inBody, part, parts, inCount]
+                                { inBody(part * inCount / parts, (part + 1) * inCount / parts); });
+        inBody(0, inCount / parts);
+        mJobs->WaitAll({handles + 1, parts - 1});
+    }
+
     /// Wakes the sleeping islands of bodies that were woken from outside the step since the last one.
     void WakeIslandsOfWokenBodies();
     void ApplyForces(std::span<const uint32_t> inBodies, float inDeltaTime);
@@ -114,11 +134,17 @@ private:
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
     std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
     std::vector<uint64_t> mBodyColors;   ///< Scratch per active body: colors its constraints took
-    std::vector<uint8_t> mConstraintColor;         ///< Scratch per constraint of the island being colored
+    struct ColorItem
+    {
+        uint64_t mKey;      ///< color << 32 | lowest dynamic active index
+        uint32_t mPosition; ///< In the island's hashed order
+    };
+    std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
     std::vector<ContactConstraint> mConstraints;   ///< This step's contacts
     std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
-    std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island
+    std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
+    std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
     std::vector<BroadPhaseBody> mMovedBodies;           ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;             ///< Scratch
     uint32_t mNumBodyPairs = 0;                         ///< Counters of the running step
