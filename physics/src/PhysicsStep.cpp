@@ -373,12 +373,16 @@ void PhysicsStep::BuildIslands()
                              (inL->mOrderKey == inR->mOrderKey && inL->mCacheIndex < inR->mCacheIndex);
                   });
 
+    // Only an island that holds a good share of the step's work is colored: smaller ones are better solved
+    // whole, several at once. Both limits ignore the thread count, so results do not depend on it
+    const uint32_t coloredMin =
+        std::max(cColoredIslandMinConstraints, uint32_t(mConstraints.size() / cColoredIslandMinShare));
     mIslandFirstColor.assign(numIslands, UINT32_MAX);
     mColorStart.clear();
     mColorIsSerial.clear();
     mColoredIslands.clear();
     for (uint32_t island = 0; island < numIslands; ++island)
-        if (mConstraintStart[island + 1] - mConstraintStart[island] >= cColoredIslandMinConstraints)
+        if (mConstraintStart[island + 1] - mConstraintStart[island] >= coloredMin)
             mColoredIslands.push_back(island);
     std::sort(mColoredIslands.begin(), mColoredIslands.end(),
               [&](uint32_t inL, uint32_t inR)

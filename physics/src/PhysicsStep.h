@@ -74,8 +74,9 @@ private:
     /// part t on the t-th job, so with a stable assignment the same thread sees the same part every time.
     template <class Body> void ForEachThreadPart(uint32_t inCount, const Body& inBody)
     {
+        // At least 32 items a part: below that a job costs more than it saves
         const uint32_t parts =
-            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / 16));
+            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / 32));
         if (parts <= 1)
         {
             if (inCount > 0) inBody(0, inCount);
@@ -126,6 +127,7 @@ private:
     /// Islands with this many constraints or more are colored and solved by all threads together, whatever
     /// the number of threads (so results do not depend on it): one large island must not serialise the step
     static constexpr uint32_t cColoredIslandMinConstraints = 128;
+    static constexpr uint32_t cColoredIslandMinShare = 4; ///< ... and at least 1/4 of the step's constraints
     static constexpr uint32_t cSerialColor =
         64;                                  ///< Constraints that found no free color among 64: solved alone
     std::vector<uint32_t> mColoredIslands;   ///< This step's colored islands, largest first
