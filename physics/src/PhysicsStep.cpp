@@ -56,6 +56,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
 
     mContactCache.BeginStep();
     mConstraints.clear();
+    mNumChunksUsed = 0;
     mNumBodyPairs = 0;
     mNumWarmStartedPoints = 0;
     WakeIslandsOfWokenBodies();
@@ -118,8 +119,8 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mNumBodyPairs += mNumBodyPairs;
     ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
     ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
-    for (const ContactConstraint& c : mConstraints)
-        ioStatistics.mNumContactPoints += uint32_t(c.mNumPoints);
+    for (const ContactConstraint* c : mConstraints)
+        ioStatistics.mNumContactPoints += uint32_t(c->mNumPoints);
     ioStatistics.mNumIslands += mIslands.GetNumIslands();
     ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
 
@@ -188,13 +189,17 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         // Narrow phase: chunks of pairs in parallel, each into its own output
         constexpr uint32_t cPairsPerChunk = 32;
         const uint32_t numChunks = uint32_t((mPairs.size() + cPairsPerChunk - 1) / cPairsPerChunk);
-        if (mNarrowPhaseChunks.size() < numChunks) mNarrowPhaseChunks.resize(numChunks);
+        // Each round has chunks of its own: the constraints stay where the narrow phase wrote them until the
+        // step ends (moving the chunk objects keeps their buffers)
+        const uint32_t firstChunk = mNumChunksUsed;
+        mNumChunksUsed += numChunks;
+        if (mNarrowPhaseChunks.size() < mNumChunksUsed) mNarrowPhaseChunks.resize(mNumChunksUsed);
         ParallelFor(numChunks, 1,
                     [&](uint32_t inB, uint32_t inE)
                     {
                         for (uint32_t chunk = inB; chunk < inE; ++chunk)
                         {
-                            NarrowPhaseChunk& out = mNarrowPhaseChunks[chunk];
+                            NarrowPhaseChunk& out = mNarrowPhaseChunks[firstChunk + chunk];
                             out.Clear();
                             const size_t last = std::min(mPairs.size(), size_t(chunk + 1) * cPairsPerChunk);
                             for (size_t p = size_t(chunk) * cPairsPerChunk; p < last; ++p)
@@ -205,11 +210,12 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         // Merge in pair order: the same constraints, cache entries and wake order whatever the threads did
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
         {
-            NarrowPhaseChunk& out = mNarrowPhaseChunks[chunk];
+            NarrowPhaseChunk& out = mNarrowPhaseChunks[firstChunk + chunk];
             for (size_t i = 0; i < out.mConstraints.size(); ++i)
             {
-                ContactConstraint& c = mConstraints.emplace_back(out.mConstraints[i]);
+                ContactConstraint& c = out.mConstraints[i];
                 c.mCacheIndex = mContactCache.Add(out.mCached[i]);
+                mConstraints.push_back(&c);
             }
             // Touching an active body wakes a sleeping one
             for (uint32_t index : out.mToWake)
@@ -219,7 +225,7 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         }
         mIslands.Grow(uint32_t(active.size())); // The woken bodies, before their links
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
-            for (const BodyPair& link : mNarrowPhaseChunks[chunk].mDeferredLinks)
+            for (const BodyPair& link : mNarrowPhaseChunks[firstChunk + chunk].mDeferredLinks)
                 mIslands.Union(mBodies.TryGetBodyAtIndex(link.mA)->GetActiveIndex(),
                                mBodies.TryGetBodyAtIndex(link.mB)->GetActiveIndex());
         begin = end;
@@ -348,19 +354,19 @@ void PhysicsStep::BuildIslands()
 
     const uint32_t numIslands = mIslands.GetNumIslands();
     mConstraintStart.assign(numIslands + 1, 0);
-    for (ContactConstraint& c : mConstraints)
+    for (ContactConstraint* c : mConstraints)
     {
-        const Body& dynamicBody = c.mBodyA->IsDynamic() ? *c.mBodyA : *c.mBodyB;
-        c.mIsland = mIslands.GetIsland(dynamicBody.GetActiveIndex());
-        ++mConstraintStart[c.mIsland + 1];
+        const Body& dynamicBody = c->mBodyA->IsDynamic() ? *c->mBodyA : *c->mBodyB;
+        c->mIsland = mIslands.GetIsland(dynamicBody.GetActiveIndex());
+        ++mConstraintStart[c->mIsland + 1];
     }
     for (uint32_t i = 0; i < numIslands; ++i)
         mConstraintStart[i + 1] += mConstraintStart[i];
     mIslandConstraints.resize(mConstraints.size());
     thread_local std::vector<uint32_t> cursor;
     cursor.assign(mConstraintStart.begin(), mConstraintStart.end() - 1);
-    for (ContactConstraint& c : mConstraints)
-        mIslandConstraints[cursor[c.mIsland]++] = &c;
+    for (ContactConstraint* c : mConstraints)
+        mIslandConstraints[cursor[c->mIsland]++] = c;
     // Solve order: a hash of the bodies and sub-shapes, the same on every run. Creation order follows body
     // indices, which usually follow the geometry (a stack is built bottom-up); a solver sweeping in geometric
     // order drifts in that direction, and a wall of boxes leaned over

@@ -143,7 +143,8 @@ private:
     };
     std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
-    std::vector<ContactConstraint> mConstraints;   ///< This step's contacts
+    std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks
+    uint32_t mNumChunksUsed = 0;                   ///< Narrow-phase chunks used by this step's rounds
     std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
     std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
