@@ -101,7 +101,10 @@ private:
     void CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPhaseChunk& ioOut);
     void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
                        NarrowPhaseChunk& ioOut) const;
+    /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
     void BuildIslands();
+    /// The solver's order: hashed within each island; large islands colored. Counted as solver time.
+    void OrderConstraints();
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
     /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
     void ColorIsland(uint32_t inIsland);
@@ -136,6 +139,13 @@ private:
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
     std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
     std::vector<uint64_t> mBodyColors;   ///< Scratch per active body: colors its constraints took
+    struct OrderItem
+    {
+        uint64_t mOrderKey;
+        uint32_t mCacheIndex; ///< Tie-break (unique)
+        ContactConstraint* mConstraint;
+    };
+    std::vector<OrderItem> mOrderItems; ///< Scratch: the hashed solve order's sort
     struct ColorItem
     {
         uint64_t mKey;      ///< color << 32 | lowest dynamic active index
