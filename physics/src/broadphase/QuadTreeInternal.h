@@ -106,10 +106,22 @@ struct SlotBounds4
 private:
     static __m128 Load4(const std::atomic<float> (&inValues)[4])
     {
+#if defined(__x86_64__) && !defined(__SANITIZE_THREAD__)
+        // One aligned 16-byte load for the four slots. On x86 every load has acquire order (TSO) and an aligned
+        // 4-byte element is read whole, so this reads what four acquire loads would, without 4 loads and 3
+        // shuffles a row (the SIMD test was spending most of its time assembling its inputs); the fence keeps the
+        // compiler from moving later loads (the children) above it, as acquire would. ThreadSanitizer builds take
+        // the portable path below, so the protocol is still checked with real atomic loads.
+        static_assert(sizeof(std::atomic<float>) == sizeof(float) && std::atomic<float>::is_always_lock_free);
+        const __m128 values = _mm_load_ps(reinterpret_cast<const float*>(&inValues[0]));
+        std::atomic_signal_fence(std::memory_order_acquire);
+        return values;
+#else
         // Acquire: pairs with the releases of GrowSlot, exactly as LoadSlot does per slot
         return _mm_setr_ps(
             inValues[0].load(std::memory_order_acquire), inValues[1].load(std::memory_order_acquire),
             inValues[2].load(std::memory_order_acquire), inValues[3].load(std::memory_order_acquire));
+#endif
     }
 #else
     float mMinX[4], mMinY[4], mMinZ[4], mMaxX[4], mMaxY[4], mMaxZ[4];

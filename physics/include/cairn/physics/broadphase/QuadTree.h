@@ -38,6 +38,7 @@
 #include "cairn/physics/broadphase/StripedSharedMutex.h"
 
 #include <atomic>
+#include <cstddef>
 #include <memory>
 #include <span>
 #include <vector>
@@ -75,6 +76,8 @@ public:
         std::atomic<bool> mChanged;      ///< Bounds or children changed since the last rebuild
         std::atomic<uint8_t> mLoose;     ///< Bit s: slot s holds a body whose slot bounds may be too wide
     };
+    // The bound rows are 16-byte aligned: queries read each as one SIMD load (QuadTreeInternal.h)
+    static_assert(offsetof(Node, mMinY) % 16 == 0 && offsetof(Node, mMaxZ) % 16 == 0 && alignof(Node) % 16 == 0);
 
     /// A prepared, not yet linked sub-tree.
     struct SubTree
