@@ -441,6 +441,15 @@ void QuadTree::LinkSubTree(const SubTree& inSubTree)
     }
 }
 
+void QuadTree::MarkChanged(Node& ioNode)
+{
+    // Relaxed: a rebuild hint. Read first: a move that stays inside its bounds then writes nothing on its way
+    // to the root, and the top nodes' cache lines stay shared with the query threads (they were invalidated
+    // by every move before, a cache miss per query on each)
+    if (!ioNode.mChanged.load(std::memory_order_relaxed))
+        ioNode.mChanged.store(true, std::memory_order_relaxed);
+}
+
 void QuadTree::PropagateUp(uint32_t inNode, const AABB& inBounds)
 {
     uint32_t nodeIndex = inNode;
@@ -457,7 +466,7 @@ void QuadTree::PropagateUp(uint32_t inNode, const AABB& inBounds)
             if (parent.mChild[s].load(std::memory_order_relaxed) == nodeIndex) slot = s;
         if (slot < 0) return; // Cannot happen for a linked node; be safe
         GrowSlot(parent, slot, inBounds);
-        parent.mChanged.store(true, std::memory_order_relaxed); // Rebuild hint only
+        MarkChanged(parent);
         nodeIndex = parentIndex;
     }
 }
@@ -467,8 +476,8 @@ void QuadTree::MarkChangedUp(uint32_t inNode)
     for (uint32_t n = inNode; n != cInvalidNode;)
     {
         Node& node = GetNode(n);
-        node.mChanged.store(true, std::memory_order_relaxed); // Hint only
-        n = node.mParent.load(std::memory_order_acquire);     // Pairs with the release in LinkSubTree
+        MarkChanged(node);
+        n = node.mParent.load(std::memory_order_acquire); // Pairs with the release in LinkSubTree
     }
 }
 
@@ -503,10 +512,14 @@ void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
     const int slot = int(location & 3);
     Node& node = GetNode(nodeIndex);
     QuadTreeBodyTable::StoreBounds(entry, inBounds);
-    // Relaxed: ordered before the release of GrowSlot's first exchange, which readers acquire
-    node.mLoose.fetch_or(uint8_t(1u << slot), std::memory_order_relaxed);
+    // Relaxed: ordered before the release of GrowSlot's first exchange, which readers acquire. Only when not
+    // yet set (only this body's serialised operations set it; a bit already set was published by an earlier
+    // growth): a write would take the node's cache line away from every core that queries through it
+    const uint8_t looseBit = uint8_t(1u << slot);
+    if ((node.mLoose.load(std::memory_order_relaxed) & looseBit) == 0)
+        node.mLoose.fetch_or(looseBit, std::memory_order_relaxed);
     GrowSlot(node, slot, inBounds);
-    node.mChanged.store(true, std::memory_order_relaxed); // Rebuild hint only
+    MarkChanged(node);
     // Always walk to the root (no early out when a parent already contains the box): another mover may have
     // grown a slot below without having reached the parent yet, and our bounds must be visible when we return
     PropagateUp(nodeIndex, inBounds);

@@ -77,7 +77,8 @@ public:
         std::atomic<uint8_t> mLoose;     ///< Bit s: slot s holds a body whose slot bounds may be too wide
     };
     // The bound rows are 16-byte aligned: queries read each as one SIMD load (QuadTreeInternal.h)
-    static_assert(offsetof(Node, mMinY) % 16 == 0 && offsetof(Node, mMaxZ) % 16 == 0 && alignof(Node) % 16 == 0);
+    static_assert(offsetof(Node, mMinY) % 16 == 0 && offsetof(Node, mMaxZ) % 16 == 0 &&
+                  alignof(Node) % 16 == 0);
 
     /// A prepared, not yet linked sub-tree.
     struct SubTree
@@ -205,6 +206,8 @@ private:
     /// Allocates a node with four empty slots and the given parent (storage backed on demand), leaving at
     /// least inKeepFree nodes in the pool.
     uint32_t AllocateNode(uint32_t inParent, uint32_t inKeepFree = 0);
+    /// Sets the node's Changed flag unless it is set (no write then).
+    static void MarkChanged(Node& ioNode);
     /// Empties a private node's slots for (re)use.
     void ResetNode(uint32_t inNode, uint32_t inParent);
     /// Sets a slot of a node that is not published yet.
