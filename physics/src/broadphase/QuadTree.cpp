@@ -391,6 +391,7 @@ void QuadTree::FreeSubTree(const SubTree& inSubTree)
 void QuadTree::LinkSubTree(const SubTree& inSubTree)
 {
     if (inSubTree.mChild == cInvalidChild) return;
+    mNumBodies.fetch_add(inSubTree.mNumBodies, std::memory_order_relaxed); // Before the link: see mNumBodies
     StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     const uint32_t subNode = inSubTree.mChild;
     for (;;)
@@ -497,6 +498,7 @@ bool QuadTree::RemoveBody(BodyID inBody)
     entry.mLocation.store(QuadTreeBodyTable::cInvalidLocation, std::memory_order_relaxed);
     ClearSlot(node, slot);
     MarkChangedUp(nodeIndex);
+    mNumBodies.fetch_sub(1, std::memory_order_relaxed); // After the unlink: see mNumBodies
     return true;
 }
 
@@ -576,6 +578,7 @@ AABB QuadTree::GetBodyBounds(BodyID inBody) const
 template <class Test4, class Test, class LeafVisit>
 bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const
 {
+    if (mNumBodies.load(std::memory_order_relaxed) == 0) return true; // See mNumBodies
     EpochReclaimer::ReadScope scope(mReclaimer);
     const bool checkLayers = inMask != cAllObjectLayers;
     NodeStack stack;

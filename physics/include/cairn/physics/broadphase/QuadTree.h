@@ -261,6 +261,10 @@ private:
     EpochReclaimer mReclaimer;                     ///< Read sections of queries
     std::vector<RetiredBatch> mRetired;            ///< Update thread only: nodes waiting to be freed
     std::atomic<uint32_t> mNumRetired{0};          ///< Statistic: nodes in mRetired
+    /// Bodies linked: queries skip an empty tree without entering its read section (relaxed: a body whose
+    /// link finished before a query started is counted in the same thread before its link, so the query sees
+    /// it)
+    std::atomic<uint32_t> mNumBodies{0};
     std::unique_ptr<quadtree::RebuildScratch> mRebuildScratch; ///< Update thread only: reused arrays
     std::vector<uint32_t> mRebuildMark;                        ///< Update thread only: node -> rebuild stamp
     uint32_t mRebuildStamp = 0;                                ///< Update thread only
