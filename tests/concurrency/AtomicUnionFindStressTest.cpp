@@ -9,6 +9,7 @@
 // it, the groups and clusters runs lost links in each of 12 release runs tried.
 
 #include "cairn/physics/islands/AtomicUnionFind.h"
+#include "common/SequentialIslands.h"
 
 #include <algorithm>
 #include <atomic>
@@ -25,7 +26,7 @@ namespace cairn
 namespace
 {
 
-using Edge = std::pair<uint32_t, uint32_t>;
+using test::Edge;
 
 constexpr uint32_t cNumBodies = 100000;
 constexpr uint32_t cNumEdges = 300000;
@@ -152,30 +153,6 @@ const std::vector<Graph>& Graphs()
     return graphs;
 }
 
-/// Island per body from a plain sequential union-find, numbered in order of each island's lowest body.
-std::vector<uint32_t> ReferenceIslands(const std::vector<Edge>& inEdges)
-{
-    std::vector<uint32_t> parent(cNumBodies);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t inBody)
-    {
-        while (parent[inBody] != inBody)
-            inBody = parent[inBody] = parent[parent[inBody]];
-        return inBody;
-    };
-    for (auto [a, b] : inEdges)
-    {
-        const uint32_t rootA = find(a);
-        const uint32_t rootB = find(b);
-        parent[std::max(rootA, rootB)] = std::min(rootA, rootB);
-    }
-    std::vector<uint32_t> island(cNumBodies);
-    uint32_t numIslands = 0;
-    for (uint32_t i = 0; i < cNumBodies; ++i)
-        island[i] = find(i) == i ? numIslands++ : island[find(i)];
-    return island;
-}
-
 /// Runs inWork(thread) on inNumThreads threads released together, and joins them.
 template <class Work> void RunTogether(uint32_t inNumThreads, const Work& inWork)
 {
@@ -206,7 +183,7 @@ TEST(AtomicUnionFindStress, ConcurrentUnionsGiveTheSequentialIslands)
     for (const Graph& graph : Graphs())
     {
         ASSERT_GE(graph.mEdges.size(), cNumEdges);
-        const std::vector<uint32_t> reference = ReferenceIslands(graph.mEdges);
+        const std::vector<uint32_t> reference = test::SequentialIslands(cNumBodies, graph.mEdges);
         const uint32_t numIslands = *std::max_element(reference.begin(), reference.end()) + 1;
         for (uint32_t numThreads : {2u, 4u, 8u})
             for (int round = 0; round < cRounds; ++round)
@@ -264,7 +241,7 @@ TEST(AtomicUnionFindStress, FindDuringUnionsStaysInTheSetAndNeverGoesUp)
                     });
         unionFind.Finalize();
         EXPECT_EQ(numAbove.load(std::memory_order_relaxed), 0u) << numThreads << " threads";
-        const std::vector<uint32_t> reference = ReferenceIslands(graph.mEdges);
+        const std::vector<uint32_t> reference = test::SequentialIslands(cNumBodies, graph.mEdges);
         for (uint32_t i = 0; i < cNumBodies; ++i)
             ASSERT_EQ(unionFind.GetIsland(i), reference[i])
                 << "body " << i << ", " << numThreads << " threads";

@@ -6,6 +6,7 @@
 #include "cairn/physics/islands/AtomicUnionFind.h"
 
 #include "common/AllocationCounter.h"
+#include "common/SequentialIslands.h"
 #include "common/TestRandom.h"
 
 #include <algorithm>
@@ -21,31 +22,7 @@ namespace cairn
 namespace
 {
 
-using Edge = std::pair<uint32_t, uint32_t>;
-
-/// Island per body from a plain sequential union-find, numbered in order of each island's lowest body.
-std::vector<uint32_t> ReferenceIslands(uint32_t inNumBodies, const std::vector<Edge>& inEdges)
-{
-    std::vector<uint32_t> parent(inNumBodies);
-    std::iota(parent.begin(), parent.end(), 0u);
-    auto find = [&](uint32_t inBody)
-    {
-        while (parent[inBody] != inBody)
-            inBody = parent[inBody];
-        return inBody;
-    };
-    for (auto [a, b] : inEdges)
-    {
-        const uint32_t rootA = find(a);
-        const uint32_t rootB = find(b);
-        parent[std::max(rootA, rootB)] = std::min(rootA, rootB);
-    }
-    std::vector<uint32_t> island(inNumBodies);
-    uint32_t numIslands = 0;
-    for (uint32_t i = 0; i < inNumBodies; ++i)
-        island[i] = find(i) == i ? numIslands++ : island[find(i)];
-    return island;
-}
+using test::Edge;
 
 /// The first difference between the finalized islands and the reference, or "" when they agree. Also checks
 /// that each island lists exactly its bodies, ascending, and that islands are ordered by their lowest body.
@@ -99,7 +76,7 @@ RC_GTEST_PROP(AtomicUnionFind, MatchesSequentialUnionFindOnRandomGraphs, ())
     for (auto [a, b] : edges)
         unionFind.Union(a, b);
     unionFind.Finalize();
-    RC_ASSERT(FindMismatch(unionFind, ReferenceIslands(n, edges)) == "");
+    RC_ASSERT(FindMismatch(unionFind, test::SequentialIslands(n, edges)) == "");
 }
 
 TEST(AtomicUnionFind, MatchesSequentialUnionFindOnLargeRandomGraphs)
@@ -113,7 +90,7 @@ TEST(AtomicUnionFind, MatchesSequentialUnionFindOnLargeRandomGraphs)
         for (auto [a, b] : edges)
             unionFind.Union(a, b);
         unionFind.Finalize();
-        EXPECT_EQ(FindMismatch(unionFind, ReferenceIslands(10000, edges)), "") << numEdges << " edges";
+        EXPECT_EQ(FindMismatch(unionFind, test::SequentialIslands(10000, edges)), "") << numEdges << " edges";
     }
 }
 
@@ -182,7 +159,7 @@ TEST(AtomicUnionFind, ResetReusesItsStorageAndForgetsThePreviousStep)
             unionFind.Union(a, b);
         unionFind.Finalize();
         EXPECT_EQ(allocations.GetCount(), 0u) << n << " bodies";
-        EXPECT_EQ(FindMismatch(unionFind, ReferenceIslands(n, edges)), "");
+        EXPECT_EQ(FindMismatch(unionFind, test::SequentialIslands(n, edges)), "");
     }
 
     // Growing works too
@@ -206,7 +183,7 @@ TEST(AtomicUnionFind, CountingUnionGivesTheSameIslands)
         numUnions += a != b ? 1 : 0;
     }
     unionFind.Finalize();
-    EXPECT_EQ(FindMismatch(unionFind, ReferenceIslands(5000, edges)), "");
+    EXPECT_EQ(FindMismatch(unionFind, test::SequentialIslands(5000, edges)), "");
     EXPECT_EQ(statistics.mNumUnions, numUnions);
     EXPECT_GE(statistics.mNumFinds, 2 * numUnions);
     EXPECT_GT(statistics.mFindLoops, 0u);
