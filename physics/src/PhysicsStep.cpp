@@ -68,6 +68,28 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mIslandsMs += MillisecondsSince(phase);
 
     OrderConstraints();
+    SolveIslands(inDeltaTime);
+    const uint32_t numIslands = mIslands.GetNumIslands();
+    const uint32_t largestIsland = numIslands == 0 ? 0 : uint32_t(mIslands.GetBodies(mIslandOrder[0]).size());
+    mContactCache.EndStep();
+    ioStatistics.mSolveMs += MillisecondsSince(phase);
+
+    ioStatistics.mNumBodyPairs += mNumBodyPairs;
+    ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
+    ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
+    for (const ContactConstraint* c : mConstraints)
+        ioStatistics.mNumContactPoints += uint32_t(c->mNumPoints);
+    ioStatistics.mNumIslands += numIslands;
+    ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
+
+    UpdateBoundsAndSleep(inDeltaTime);
+    ioStatistics.mFinishMs += MillisecondsSince(phase);
+    ioStatistics.mNumActiveBodies = uint32_t(mBodies.GetActiveBodiesForStep().size());
+    ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+void PhysicsStep::SolveIslands(float inDeltaTime)
+{
     // The solver walks each island's constraints ten times and more: copied into solve order they are read
     // front to back (the hardware prefetcher streams them), where through the pointers they were a cache miss
     // each (a third of the solver's time)
@@ -101,34 +123,13 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
               });
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime);
-    const uint32_t firstUncolored =
-        uint32_t(std::find_if(mIslandOrder.begin(), mIslandOrder.end(),
-                              [&](uint32_t inIsland) { return mIslandFirstColor[inIsland] == UINT32_MAX; }) -
-                 mIslandOrder.begin());
-    ParallelFor(numIslands - firstUncolored, 1,
+    ParallelFor(numIslands, 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        if (const uint32_t island = mIslandOrder[firstUncolored + i];
-                            mIslandFirstColor[island] == UINT32_MAX)
+                        if (const uint32_t island = mIslandOrder[i]; mIslandFirstColor[island] == UINT32_MAX)
                             SolveIsland(island, inDeltaTime);
                 });
-    const uint32_t largestIsland = numIslands == 0 ? 0 : uint32_t(mIslands.GetBodies(mIslandOrder[0]).size());
-    mContactCache.EndStep();
-    ioStatistics.mSolveMs += MillisecondsSince(phase);
-
-    ioStatistics.mNumBodyPairs += mNumBodyPairs;
-    ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
-    ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
-    for (const ContactConstraint* c : mConstraints)
-        ioStatistics.mNumContactPoints += uint32_t(c->mNumPoints);
-    ioStatistics.mNumIslands += mIslands.GetNumIslands();
-    ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
-
-    UpdateBoundsAndSleep(inDeltaTime);
-    ioStatistics.mFinishMs += MillisecondsSince(phase);
-    ioStatistics.mNumActiveBodies = uint32_t(active.size());
-    ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
 void PhysicsStep::WakeIslandsOfWokenBodies()

@@ -105,6 +105,9 @@ private:
     void BuildIslands();
     /// The solver's order: hashed within each island; large islands colored. Counted as solver time.
     void OrderConstraints();
+    /// Integrates kinematic bodies and solves every island: colored ones first, each by all threads, then the
+    /// others at once, largest first.
+    void SolveIslands(float inDeltaTime);
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
     /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
     void ColorIsland(uint32_t inIsland);
