@@ -112,15 +112,6 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // every thread on each; then the others at once, the largest first so that the longest starts early and
     // the small ones fill in around it
     const uint32_t numIslands = mIslands.GetNumIslands();
-    mIslandOrder.resize(numIslands);
-    for (uint32_t island = 0; island < numIslands; ++island)
-        mIslandOrder[island] = island;
-    std::sort(mIslandOrder.begin(), mIslandOrder.end(),
-              [&](uint32_t inL, uint32_t inR)
-              {
-                  const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
-                  return l > r || (l == r && inL < inR);
-              });
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime);
     ParallelFor(numIslands, 1,
@@ -398,19 +389,24 @@ void PhysicsStep::OrderConstraints()
     // whole, several at once. Both limits ignore the thread count, so results do not depend on it
     const uint32_t coloredMin =
         std::max(cColoredIslandMinConstraints, uint32_t(mConstraints.size() / cColoredIslandMinShare));
-    mIslandFirstColor.assign(numIslands, UINT32_MAX);
-    mColorStart.clear();
-    mColorIsSerial.clear();
-    mColoredIslands.clear();
+    // Islands by size, largest first (ties by number): the order both the colored ones and the others are
+    // solved in
+    mIslandOrder.resize(numIslands);
     for (uint32_t island = 0; island < numIslands; ++island)
-        if (mConstraintStart[island + 1] - mConstraintStart[island] >= coloredMin)
-            mColoredIslands.push_back(island);
-    std::sort(mColoredIslands.begin(), mColoredIslands.end(),
+        mIslandOrder[island] = island;
+    std::sort(mIslandOrder.begin(), mIslandOrder.end(),
               [&](uint32_t inL, uint32_t inR)
               {
                   const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
                   return l > r || (l == r && inL < inR);
               });
+    mIslandFirstColor.assign(numIslands, UINT32_MAX);
+    mColorStart.clear();
+    mColorIsSerial.clear();
+    mColoredIslands.clear();
+    for (uint32_t island : mIslandOrder)
+        if (mConstraintStart[island + 1] - mConstraintStart[island] >= coloredMin)
+            mColoredIslands.push_back(island);
     for (uint32_t island : mColoredIslands)
         ColorIsland(island);
 }
