@@ -90,6 +90,20 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
 
 void PhysicsStep::SolveIslands(float inDeltaTime)
 {
+    // The velocity solver works on packed copies of the velocities (SolverBody): one block per active body,
+    // at its active index, and after those one private block per constraint side that is static or
+    // kinematic. Such a body is shared between islands; with a block of its own per constraint and zero
+    // inverse mass, the solver may write to it without a test and without a race
+    const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
+    const uint32_t numActive = uint32_t(active.size());
+    mSolverBodies.resize(numActive + 2 * mIslandConstraints.size());
+    ParallelFor(numActive, 512,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        LoadSolverBody(*mBodies.TryGetBodyAtIndex(active[i]), mSolverBodies[i]);
+                });
+
     // The solver walks each island's constraints ten times and more: copied into solve order they are read
     // front to back (the hardware prefetcher streams them), where through the pointers they were a cache miss
     // each (a third of the solver's time)
@@ -99,12 +113,14 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
-                        mSolveOrder[i] = *mIslandConstraints[i];
-                        mIslandConstraints[i] = &mSolveOrder[i];
+                        ContactConstraint& c = mSolveOrder[i];
+                        c = *mIslandConstraints[i];
+                        mIslandConstraints[i] = &c;
+                        c.mSolverBodyA = SolverBodyIndex(*c.mBodyA, numActive + 2 * i);
+                        c.mSolverBodyB = SolverBodyIndex(*c.mBodyB, numActive + 2 * i + 1);
                     }
                 });
 
-    std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     for (uint32_t index : active)
         if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
             IntegratePositions(body, inDeltaTime);
@@ -121,6 +137,30 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
                         if (const uint32_t island = mIslandOrder[i]; mIslandFirstColor[island] == UINT32_MAX)
                             SolveIsland(island, inDeltaTime);
                 });
+}
+
+void PhysicsStep::LoadSolverBody(const Body& inBody, SolverBody& outBlock)
+{
+    outBlock.mLinearVelocity = inBody.mLinearVelocity;
+    outBlock.mAngularVelocity = inBody.mAngularVelocity;
+    outBlock.mInverseMass = inBody.IsDynamic() ? inBody.mInvMass : 0.0f;
+    outBlock.mPadding = 0.0f;
+}
+
+uint32_t PhysicsStep::SolverBodyIndex(const Body& inBody, uint32_t inPrivateBlock)
+{
+    if (inBody.IsDynamic()) return inBody.GetActiveIndex();
+    LoadSolverBody(inBody, mSolverBodies[inPrivateBlock]);
+    return inPrivateBlock;
+}
+
+void PhysicsStep::StoreVelocitiesAndIntegrate(Body& ioBody, float inDeltaTime)
+{
+    if (!ioBody.IsDynamic()) return;
+    const SolverBody& block = mSolverBodies[ioBody.GetActiveIndex()];
+    ioBody.mLinearVelocity = block.mLinearVelocity;
+    ioBody.mAngularVelocity = block.mAngularVelocity;
+    IntegratePositions(ioBody, inDeltaTime);
 }
 
 void PhysicsStep::WakeIslandsOfWokenBodies()
@@ -489,12 +529,14 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
         }
     };
     const SolverSettings& solver = mSettings.mSolver;
-    forEachColor([](std::span<ContactConstraint* const> inC) { SequentialImpulseSolver::WarmStart(inC); });
-    for (int i = 0; i < solver.mVelocityIterations; ++i)
-        forEachColor([](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::SolveVelocities(inC); });
+    const std::span<SolverBody> solverBodies(mSolverBodies);
     forEachColor([&](std::span<ContactConstraint* const> inC)
-                 { SequentialImpulseSolver::ApplyRestitution(inC, solver); });
+                 { SequentialImpulseSolver::WarmStart(inC, solverBodies); });
+    for (int i = 0; i < solver.mVelocityIterations; ++i)
+        forEachColor([&](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::SolveVelocities(inC, solverBodies); });
+    forEachColor([&](std::span<ContactConstraint* const> inC)
+                 { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const std::span<const uint32_t> bodies = mIslands.GetBodies(inIsland);
@@ -502,8 +544,8 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        if (Body& body = *mBodies.TryGetBodyAtIndex(active[bodies[i]]); body.IsDynamic())
-                            IntegratePositions(body, inDeltaTime);
+                        StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[bodies[i]]),
+                                                    inDeltaTime);
                 });
     for (int i = 0; i < solver.mPositionIterations; ++i)
         forEachColor([&](std::span<ContactConstraint* const> inC)
@@ -522,15 +564,15 @@ void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
         mIslandConstraints.data() + mConstraintStart[inIsland],
         mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
     const SolverSettings& solver = mSettings.mSolver;
-    SequentialImpulseSolver::WarmStart(constraints);
+    const std::span<SolverBody> solverBodies(mSolverBodies);
+    SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
-        SequentialImpulseSolver::SolveVelocities(constraints);
-    SequentialImpulseSolver::ApplyRestitution(constraints, solver);
+        SequentialImpulseSolver::SolveVelocities(constraints, solverBodies);
+    SequentialImpulseSolver::ApplyRestitution(constraints, solverBodies, solver);
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     for (uint32_t activeIndex : mIslands.GetBodies(inIsland))
-        if (Body& body = *mBodies.TryGetBodyAtIndex(active[activeIndex]); body.IsDynamic())
-            IntegratePositions(body, inDeltaTime);
+        StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[activeIndex]), inDeltaTime);
 
     for (int i = 0; i < solver.mPositionIterations; ++i)
         SequentialImpulseSolver::SolvePositions(constraints, solver);

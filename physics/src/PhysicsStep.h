@@ -17,6 +17,7 @@
 #include "cairn/physics/islands/AtomicUnionFind.h"
 #include "cairn/physics/solver/ContactCache.h"
 #include "cairn/physics/solver/ContactConstraint.h"
+#include "cairn/physics/solver/SolverBody.h"
 
 #include <algorithm>
 #include <span>
@@ -116,6 +117,11 @@ private:
     /// Stores the constraints' impulses in the contact cache for next step's warm start.
     void StoreImpulses(std::span<ContactConstraint* const> inConstraints);
     void IntegratePositions(Body& ioBody, float inDeltaTime);
+    static void LoadSolverBody(const Body& inBody, SolverBody& outBlock);
+    /// Where the solver finds inBody's velocities: its active index if dynamic, else inPrivateBlock (loaded).
+    uint32_t SolverBodyIndex(const Body& inBody, uint32_t inPrivateBlock);
+    /// Copies a dynamic body's solved velocities back and integrates its position (others: nothing).
+    void StoreVelocitiesAndIntegrate(Body& ioBody, float inDeltaTime);
     void UpdateBoundsAndSleep(float inDeltaTime);
 
     const PhysicsSettings& mSettings;
@@ -161,6 +167,7 @@ private:
     std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
     std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
+    std::vector<SolverBody> mSolverBodies;              ///< Velocities being solved: see SolveIslands
     std::vector<BroadPhaseBody> mMovedBodies;           ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;             ///< Scratch
     uint32_t mNumBodyPairs = 0;                         ///< Counters of the running step

@@ -16,6 +16,7 @@
 // Runs inside the step, by the one thread that owns the island: no locks.
 
 #include "cairn/physics/solver/ContactConstraint.h"
+#include "cairn/physics/solver/SolverBody.h"
 #include "cairn/physics/solver/SolverSettings.h"
 
 #include <span>
@@ -28,15 +29,20 @@ namespace SequentialImpulseSolver
 /// Fills a constraint from a manifold between A and B (world space). Impulses start at zero.
 void InitConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
                     ContactConstraint& outConstraint);
+// The velocity passes work on ioBodies, indexed by each constraint's mSolverBodyA/B; a static or kinematic
+// body must have an inverse mass of 0 there (and a zero inverse inertia in the constraint, as InitConstraint
+// gives it), so that impulses leave it unchanged.
+
 /// Applies the accumulated (warm-start) impulses.
-void WarmStart(std::span<ContactConstraint* const> ioConstraints);
+void WarmStart(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies);
 /// One velocity iteration over the constraints, in the order given. Each manifold's points are swept forwards
 /// then backwards: a single fixed order biases which corner of a resting face takes the load first, and in a
 /// tall stack that bias tilts every joint the same way until the column leans over (a 10-box column leaned
 /// 0.5 m in 10 s; with the double sweep, 2 cm).
-void SolveVelocities(std::span<ContactConstraint* const> ioConstraints);
+void SolveVelocities(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies);
 /// The restitution pass, after the velocity iterations.
-void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, const SolverSettings& inSettings);
+void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies,
+                      const SolverSettings& inSettings);
 /// One position iteration; returns the largest remaining penetration beyond the slop.
 float SolvePositions(std::span<ContactConstraint* const> ioConstraints, const SolverSettings& inSettings);
 } // namespace SequentialImpulseSolver
