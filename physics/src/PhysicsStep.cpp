@@ -42,7 +42,8 @@ Vec3 ClampLength(const Vec3& inV, float inMax)
 
 PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& inLayers, BodyManager& ioBodies,
                          BroadPhase& ioBroadPhase)
-    : mSettings(inSettings), mLayers(inLayers), mBodies(ioBodies), mBroadPhase(ioBroadPhase)
+    : mSettings(inSettings), mLayers(inLayers), mBodies(ioBodies), mBroadPhase(ioBroadPhase),
+      mPairCacheCosHalfMaxAngle(std::cos(0.5f * inSettings.mPairCacheMaxDeltaAngle))
 {
 }
 
@@ -59,6 +60,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     mNumChunksUsed = 0;
     mNumBodyPairs = 0;
     mNumWarmStartedPoints = 0;
+    mNumReusedPairs = 0;
     WakeIslandsOfWokenBodies();
     mIslands.Reset(uint32_t(mBodies.GetActiveBodiesForStep().size()));
     CollideNewlyActive(0, inDeltaTime);
@@ -76,6 +78,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
 
     ioStatistics.mNumBodyPairs += mNumBodyPairs;
     ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
+    ioStatistics.mNumReusedBodyPairs += mNumReusedPairs;
     ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
     for (const ContactConstraint* c : mConstraints)
         ioStatistics.mNumContactPoints += uint32_t(c->mNumPoints);
@@ -194,7 +197,10 @@ void PhysicsStep::ApplyForces(std::span<const uint32_t> inBodies, float inDeltaT
         // velocity
         body.mLinearVelocity +=
             inDeltaTime * (body.mGravityFactor * mSettings.mGravity + body.mInvMass * body.mForce);
-        body.mAngularVelocity += inDeltaTime * (body.GetInverseInertiaWorld() * body.mTorque);
+        // Kept for the narrow phase: every constraint of the body needs it, and the rotation stays until the
+        // solver
+        const Mat3& inverseInertia = mInverseInertia[body.GetActiveIndex()] = body.GetInverseInertiaWorld();
+        body.mAngularVelocity += inDeltaTime * (inverseInertia * body.mTorque);
         body.mLinearVelocity *= std::max(0.0f, 1.0f - body.mLinearDamping * inDeltaTime);
         body.mAngularVelocity *= std::max(0.0f, 1.0f - body.mAngularDamping * inDeltaTime);
         body.mLinearVelocity = ClampLength(body.mLinearVelocity, body.mMaxLinearVelocity);
@@ -213,6 +219,7 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
     {
         const size_t end = active.size();
         const std::span<const uint32_t> slice(active.data() + begin, end - begin);
+        mInverseInertia.resize(end);
         ParallelFor(uint32_t(slice.size()), 256,
                     [&](uint32_t inB, uint32_t inE)
                     { ApplyForces(slice.subspan(inB, inE - inB), inDeltaTime); });
@@ -244,6 +251,8 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
         {
             NarrowPhaseChunk& out = mNarrowPhaseChunks[firstChunk + chunk];
+            for (const CachedBodyPair& pair : out.mCachedPairs)
+                mContactCache.AddPair(pair);
             for (size_t i = 0; i < out.mConstraints.size(); ++i)
             {
                 ContactConstraint& c = out.mConstraints[i];
@@ -255,6 +264,7 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
                 if (Body& body = *mBodies.TryGetBodyAtIndex(index); !body.IsActive())
                     mBodies.ActivateBody(body);
             mNumWarmStartedPoints += out.mNumWarmStartedPoints;
+            mNumReusedPairs += out.mNumReusedPairs;
         }
         mIslands.Grow(uint32_t(active.size())); // The woken bodies, before their links
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
@@ -315,19 +325,22 @@ void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPha
     CollideSettings settings;
     settings.mMaxSeparation =
         mSettings.mSpeculativeDistance + inDeltaTime * (ioB.mLinearVelocity - ioA.mLinearVelocity).norm();
-    int numManifolds = 0;
     const size_t constraintsBefore = ioOut.mConstraints.size();
-    CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
-                  [&](const ContactManifold& inManifold)
-                  {
-                      AddConstraint(ioA, ioB, inManifold, inDeltaTime, ioOut);
-                      ++numManifolds;
-                  });
-    if (numManifolds == 0) return;
+    const Quat inverseRotationA = ioA.mRotation.conjugate();
+    CachedBodyPair record{ioA.GetID(), ioB.GetID(), inverseRotationA * (ioB.mPosition - ioA.mPosition),
+                          inverseRotationA * ioB.mRotation, settings.mMaxSeparation};
+    if (!ReuseManifolds(ioA, ioB, inDeltaTime, record, ioOut))
+        CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
+                      [&](const ContactManifold& inManifold)
+                      { AddConstraint(ioA, ioB, inManifold, inDeltaTime, ioOut); });
+    // Recorded even without manifolds: a pair that stays apart is not collided again either
+    record.mNumManifolds = uint32_t(ioOut.mConstraints.size() - constraintsBefore);
+    ioOut.mCachedPairs.push_back(record);
+    if (record.mNumManifolds == 0) return;
     // Islands: only a contact between two dynamic bodies links (a static or kinematic body would merge
     // everything that touches it). Linked now, lock-free, while other threads find other contacts; a body
     // still asleep has no active index yet, so its link waits for the merge that wakes it
-    if (ioOut.mConstraints.size() > constraintsBefore && ioA.IsDynamic() && ioB.IsDynamic())
+    if (ioA.IsDynamic() && ioB.IsDynamic())
     {
         if (ioA.IsActive() && ioB.IsActive())
             mIslands.Union(ioA.GetActiveIndex(), ioB.GetActiveIndex());
@@ -339,16 +352,61 @@ void PhysicsStep::CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPha
     if (!ioB.IsActive() && ioB.IsDynamic()) ioOut.mToWake.push_back(ioB.GetID().GetIndex());
 }
 
+Mat3 PhysicsStep::InverseInertiaOf(const Body& inBody) const
+{
+    if (!inBody.IsDynamic()) return Mat3::Zero();
+    // A body still asleep (woken by this contact at the merge) had no forces applied: nothing kept for it
+    return inBody.IsActive() ? mInverseInertia[inBody.GetActiveIndex()] : inBody.GetInverseInertiaWorld();
+}
+
+bool PhysicsStep::ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, CachedBodyPair& ioRecord,
+                                 NarrowPhaseChunk& ioOut) const
+{
+    if (mSettings.mPairCacheMaxDeltaPosition <= 0.0f) return false;
+    const CachedBodyPair* previous = mContactCache.FindPreviousPair(ioRecord.mBodyA, ioRecord.mBodyB);
+    if (previous == nullptr) return false;
+    // Compared with the pose the manifolds were made at, not last step's: slow drift adds up and is caught.
+    // The look-ahead grows with the closing speed: a pair that starts to move fast needs speculative points
+    // further out than the old manifolds have (up to the same tolerance)
+    const float maxDelta = mSettings.mPairCacheMaxDeltaPosition;
+    if ((ioRecord.mDeltaPosition - previous->mDeltaPosition).squaredNorm() > maxDelta * maxDelta ||
+        std::abs(ioRecord.mDeltaRotation.dot(previous->mDeltaRotation)) < mPairCacheCosHalfMaxAngle ||
+        ioRecord.mMaxSeparation > previous->mMaxSeparation + maxDelta)
+        return false;
+    ioRecord = *previous;
+    // The points stay fixed on both bodies; where they are now, and how far apart, follows from the poses
+    for (const CachedManifold& cached : mContactCache.GetPreviousManifolds(*previous))
+    {
+        ContactManifold manifold;
+        manifold.mNormal = ioA.mRotation * cached.mNormalOnA;
+        manifold.mNumPoints = cached.mNumPoints;
+        manifold.mSubShapeA = cached.mKey.mSubShapeA;
+        manifold.mSubShapeB = cached.mKey.mSubShapeB;
+        for (int i = 0; i < cached.mNumPoints; ++i)
+        {
+            ContactPoint& point = manifold.mPoints[i];
+            point.mPositionOnA = ioA.mPosition + ioA.mRotation * cached.mLocalOnA[i];
+            point.mPositionOnB = ioB.mPosition + ioB.mRotation * cached.mLocalOnB[i];
+            point.mPenetration = (point.mPositionOnA - point.mPositionOnB).dot(manifold.mNormal);
+        }
+        AddConstraint(ioA, ioB, manifold, inDeltaTime, ioOut);
+    }
+    ++ioOut.mNumReusedPairs;
+    return true;
+}
+
 void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
                                 NarrowPhaseChunk& ioOut) const
 {
     if (inManifold.mNumPoints <= 0) return;
     ContactConstraint& c = ioOut.mConstraints.emplace_back();
-    SequentialImpulseSolver::InitConstraint(ioA, ioB, inManifold, inDeltaTime, c);
+    SequentialImpulseSolver::InitConstraint(ioA, ioB, InverseInertiaOf(ioA), InverseInertiaOf(ioB),
+                                            inManifold, inDeltaTime, c);
 
     CachedManifold cached;
     cached.mKey = {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB};
     cached.mNumPoints = c.mNumPoints;
+    cached.mNormalOnA = ioA.mRotation.conjugate() * c.mNormal;
     const CachedManifold* previous = mContactCache.FindPrevious(cached.mKey);
     if (previous != nullptr)
     {
@@ -360,6 +418,7 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
     {
         ContactConstraintPoint& p = c.mPoints[i];
         cached.mLocalOnA[i] = p.mLocalOnA;
+        cached.mLocalOnB[i] = p.mLocalOnB;
         cached.mNormalImpulse[i] = 0.0f;
         cached.mDeferredBounce[i] = 0.0f;
         if (previous == nullptr) continue;

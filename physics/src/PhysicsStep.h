@@ -48,13 +48,17 @@ private:
     {
         std::vector<ContactConstraint> mConstraints; ///< mCacheIndex set at the merge
         std::vector<CachedManifold> mCached;         ///< One per constraint
+        std::vector<CachedBodyPair> mCachedPairs;    ///< One per pair collided, with its count of constraints
         std::vector<uint32_t> mToWake;               ///< Sleeping dynamic bodies touched, in pair order
         std::vector<BodyPair> mDeferredLinks;        ///< Island links with a body woken at the merge
         uint32_t mNumWarmStartedPoints = 0;
+        uint32_t mNumReusedPairs = 0;
         void Clear()
         {
             mConstraints.clear();
             mCached.clear();
+            mCachedPairs.clear();
+            mNumReusedPairs = 0;
             mToWake.clear();
             mDeferredLinks.clear();
             mNumWarmStartedPoints = 0;
@@ -100,6 +104,12 @@ private:
     /// Finds the pairs of active-list entries [inBegin, end) into mPairs, sorted.
     void FindPairs(size_t inBegin);
     void CollidePair(Body& ioA, Body& ioB, float inDeltaTime, NarrowPhaseChunk& ioOut);
+    /// World inverse inertia of a body at the start of the step: zero unless dynamic.
+    Mat3 InverseInertiaOf(const Body& inBody) const;
+    /// Adds last step's manifolds of the pair if its relative pose has barely changed since they were made;
+    /// false if the shapes must be collided. ioRecord: the pose recorded with them.
+    bool ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, CachedBodyPair& ioRecord,
+                        NarrowPhaseChunk& ioOut) const;
     void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
                        NarrowPhaseChunk& ioOut) const;
     /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
@@ -167,11 +177,15 @@ private:
     std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
     std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
-    std::vector<SolverBody> mSolverBodies;              ///< Velocities being solved: see SolveIslands
-    std::vector<BroadPhaseBody> mMovedBodies;           ///< Scratch for the broad-phase notify
-    std::vector<uint32_t> mSleepingIslands;             ///< Scratch
-    uint32_t mNumBodyPairs = 0;                         ///< Counters of the running step
+    std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
+    std::vector<SolverBody> mSolverBodies;    ///< Velocities being solved: see SolveIslands
+    std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
+    std::vector<uint32_t> mSleepingIslands;   ///< Scratch
+    uint32_t mNumBodyPairs = 0;               ///< Counters of the running step
     uint32_t mNumWarmStartedPoints = 0;
+    uint32_t mNumReusedPairs = 0;
+    float mPairCacheCosHalfMaxAngle =
+        1.0f; ///< cos(mPairCacheMaxDeltaAngle / 2): compared to a quaternion dot
 };
 
 } // namespace cairn

@@ -27,9 +27,11 @@ namespace
 struct RunResult
 {
     tools::TimingSummary mStep;
-    StepStatistics mPhaseSums;    ///< Phase times summed over all steps
-    double mHeightChecksum = 0.0; ///< Sum of final y of the dynamic bodies
-    uint64_t mContactPoints = 0;  ///< Contact points summed over all steps
+    StepStatistics mPhaseSums;     ///< Phase times summed over all steps
+    double mHeightChecksum = 0.0;  ///< Sum of final y of the dynamic bodies
+    uint64_t mContactPoints = 0;   ///< Contact points summed over all steps
+    uint64_t mBodyPairs = 0;       ///< Broad-phase pairs summed over all steps
+    uint64_t mReusedBodyPairs = 0; ///< ... of which took last step's manifolds over
     int mSteps = 0;
 };
 
@@ -80,6 +82,8 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mPhaseSums.mSolveMs += stats.mSolveMs;
         result.mPhaseSums.mFinishMs += stats.mFinishMs;
         result.mContactPoints += stats.mNumContactPoints;
+        result.mBodyPairs += stats.mNumBodyPairs;
+        result.mReusedBodyPairs += stats.mNumReusedBodyPairs;
     }
     result.mStep = tools::Summarize(stepMs);
     for (const BodyID& id : inDynamic)
@@ -142,12 +146,13 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
         std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
                     "broadphase-update %.3f  "
                     "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
-                    "contacts %llu\n",
+                    "contacts %llu  | pairs reused %.1f%%\n",
                     inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
                     run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
                     run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
                     run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
-                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints));
+                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints),
+                    100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)));
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

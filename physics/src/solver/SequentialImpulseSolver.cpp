@@ -133,8 +133,9 @@ void SolvePatchFriction(ContactConstraint& ioC, const BodyPair& ioBodies)
 }
 } // namespace
 
-void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold,
-                                             float inDeltaTime, ContactConstraint& outConstraint)
+void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Mat3& inInvIA, const Mat3& inInvIB,
+                                             const ContactManifold& inManifold, float inDeltaTime,
+                                             ContactConstraint& outConstraint)
 {
     ContactConstraint& c = outConstraint;
     c.mBodyA = &ioA;
@@ -148,8 +149,8 @@ void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Contact
     c.mRestitution = std::max(ioA.GetRestitution(), ioB.GetRestitution());
     c.mNumPoints = inManifold.mNumPoints;
 
-    const Mat3 invIA = ioA.GetInverseInertiaWorld();
-    const Mat3 invIB = ioB.GetInverseInertiaWorld();
+    const Mat3& invIA = inInvIA;
+    const Mat3& invIB = inInvIB;
     const Vec3& xA = ioA.GetCenterOfMassPosition();
     const Vec3& xB = ioB.GetCenterOfMassPosition();
     Vec3 centroid = Vec3::Zero();

@@ -28,6 +28,11 @@ struct PhysicsSettings
     float mTimeBeforeSleep = 0.5f; ///< s an island must stay slow before it sleeps
     float mSleepVelocity = 0.05f;  ///< m/s: the fastest point of a body must stay below this
     BroadPhaseType mBroadPhase = BroadPhaseType::QuadTree;
+    /// A body pair whose relative pose moved less than this (m, and radians) since its manifolds were made
+    /// takes them over instead of colliding its shapes again; 0 turns the reuse off. Jolt's defaults: small
+    /// enough that a contact point moves by at most a few millimetres on a metre-sized body
+    float mPairCacheMaxDeltaPosition = 0.001f;
+    float mPairCacheMaxDeltaAngle = 2.0f * cPi / 180.0f;
 };
 
 /// What the last Update did and how long each phase took (summed over its collision steps).
@@ -35,6 +40,8 @@ struct StepStatistics
 {
     uint32_t mNumActiveBodies = 0;
     uint32_t mNumBodyPairs = 0; ///< Broad-phase pairs
+    uint32_t mNumReusedBodyPairs =
+        0; ///< Pairs that took last step's manifolds over (see mPairCacheMaxDelta*)
     uint32_t mNumManifolds = 0;
     uint32_t mNumContactPoints = 0;
     uint32_t mNumWarmStartedPoints = 0; ///< Contact points that took over last step's impulses

@@ -2,12 +2,17 @@
 
 // ContactCache: remembers each manifold's accumulated impulses from one step to the next, so the solver can
 // warm-start. Keyed by (body A, body B, sub-shape A, sub-shape B); points are matched by their position on
-// body A (within cPointMatchDistance). Two flat arrays are swapped each step and reused, so a warm scene
-// allocates nothing. Physics step only (one thread): no locks.
+// body A (within cPointMatchDistance). It also remembers each body pair the narrow phase saw, with the pose
+// of B relative to A when its manifolds were made, so that a pair that has not moved relative to itself takes
+// its manifolds over without colliding the shapes again (a resting pile is most of a game's pairs).
+// Flat arrays are swapped each step and reused, so a warm scene allocates nothing. Written by the physics
+// step's updating thread only (merge and EndStep); the narrow phase's threads read the previous step's
+// arrays, which nothing writes until the next BeginStep: no locks.
 
 #include "cairn/physics/body/BodyID.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
+#include <span>
 #include <vector>
 
 namespace cairn
@@ -26,13 +31,27 @@ struct CachedManifold
 {
     ContactKey mKey;
     int mNumPoints = 0;
+    Vec3 mNormalOnA = Vec3::UnitY();             ///< The manifold's normal in A's rotation frame
     Vec3 mLocalOnA[ContactManifold::cMaxPoints]; ///< In A's centre-of-mass frame
+    Vec3 mLocalOnB[ContactManifold::cMaxPoints]; ///< In B's centre-of-mass frame
     float mNormalImpulse[ContactManifold::cMaxPoints];
     float mDeferredBounce[ContactManifold::cMaxPoints]; ///< Approach velocity of a bounce that happens next
                                                         ///< step
     Vec3 mFrictionImpulse =
         Vec3::Zero();           ///< Patch friction as a world vector, so a new tangent basis can take it over
     float mTwistImpulse = 0.0f; ///< Patch twist friction about the normal
+};
+
+/// A pair of bodies the narrow phase collided, and the manifolds it found (perhaps none).
+struct CachedBodyPair
+{
+    BodyID mBodyA;
+    BodyID mBodyB;
+    Vec3 mDeltaPosition;         ///< B's centre of mass minus A's, in A's frame, when the manifolds were made
+    Quat mDeltaRotation;         ///< conjugate(A's rotation) * B's rotation, then
+    float mMaxSeparation;        ///< How far apart the shapes could be and still make contact points, then
+    uint32_t mFirstManifold = 0; ///< Into the same step's manifolds (valid after EndStep)
+    uint32_t mNumManifolds = 0;
 };
 
 class ContactCache
@@ -48,14 +67,25 @@ public:
     /// Stores a manifold of this step; returns its index for Get().
     uint32_t Add(const CachedManifold& inManifold);
     CachedManifold& Get(uint32_t inIndex) { return mCurrent[inIndex]; }
-    /// Sorts this step's manifolds for lookup next step. Indices from Add() are invalid afterwards.
+    /// Last step's record of the pair (A, B), or nullptr.
+    const CachedBodyPair* FindPreviousPair(BodyID inBodyA, BodyID inBodyB) const;
+    /// Last step's manifolds of a pair from FindPreviousPair.
+    std::span<const CachedManifold> GetPreviousManifolds(const CachedBodyPair& inPair) const
+    {
+        return {mPrevious.data() + inPair.mFirstManifold, inPair.mNumManifolds};
+    }
+    /// Stores a body pair of this step: its manifolds are the next inPair.mNumManifolds given to Add().
+    void AddPair(const CachedBodyPair& inPair) { mCurrentPairs.push_back(inPair); }
+    /// Sorts this step's manifolds and pairs for lookup next step. Indices from Add() are invalid afterwards.
     void EndStep();
     size_t GetNumManifolds() const { return mCurrent.size(); }
     void Clear();
 
 private:
-    std::vector<CachedManifold> mPrevious; ///< Sorted by key
-    std::vector<CachedManifold> mCurrent;  ///< In creation order until EndStep
+    std::vector<CachedManifold> mPrevious;      ///< Sorted by key
+    std::vector<CachedManifold> mCurrent;       ///< In creation order until EndStep
+    std::vector<CachedBodyPair> mPreviousPairs; ///< Sorted by bodies, each with its manifolds in mPrevious
+    std::vector<CachedBodyPair> mCurrentPairs;  ///< In creation order until EndStep
 };
 
 } // namespace cairn

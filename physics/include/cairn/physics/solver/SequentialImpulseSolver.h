@@ -26,9 +26,10 @@ namespace cairn
 
 namespace SequentialImpulseSolver
 {
-/// Fills a constraint from a manifold between A and B (world space). Impulses start at zero.
-void InitConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
-                    ContactConstraint& outConstraint);
+/// Fills a constraint from a manifold between A and B (world space). Impulses start at zero. inInvIA/B: the
+/// bodies' world inverse inertia (zero for static and kinematic ones).
+void InitConstraint(Body& ioA, Body& ioB, const Mat3& inInvIA, const Mat3& inInvIB,
+                    const ContactManifold& inManifold, float inDeltaTime, ContactConstraint& outConstraint);
 // The velocity passes work on ioBodies, indexed by each constraint's mSolverBodyA/B; a static or kinematic
 // body must have an inverse mass of 0 there (and a zero inverse inertia in the constraint, as InitConstraint
 // gives it), so that impulses leave it unchanged.
