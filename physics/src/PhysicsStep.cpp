@@ -99,7 +99,8 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // inverse mass, the solver may write to it without a test and without a race
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const uint32_t numActive = uint32_t(active.size());
-    mSolverBodies.resize(numActive + 2 * mIslandConstraints.size());
+    mPaddingBlocksFirst = numActive + 2 * uint32_t(mIslandConstraints.size());
+    mSolverBodies.resize(mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * mColorStart.size());
     ParallelFor(numActive, 512,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
@@ -591,9 +592,12 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     const std::span<SolverBody> solverBodies(mSolverBodies);
     forEachColor([&](std::span<ContactConstraint* const> inC)
                  { SequentialImpulseSolver::WarmStart(inC, solverBodies); });
-    for (int i = 0; i < solver.mVelocityIterations; ++i)
-        forEachColor([&](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::SolveVelocities(inC, solverBodies); });
+    if (CAIRN_WIDE_SOLVER && solver.mWideColoredIslands)
+        SolveColoredVelocitiesWide(firstColor, lastColor);
+    else
+        for (int i = 0; i < solver.mVelocityIterations; ++i)
+            forEachColor([&](std::span<ContactConstraint* const> inC)
+                         { SequentialImpulseSolver::SolveVelocities(inC, solverBodies); });
     forEachColor([&](std::span<ContactConstraint* const> inC)
                  { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
@@ -615,6 +619,79 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     ParallelFor(uint32_t(all.size()), 256,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 { StoreImpulses(all.subspan(inBegin, inEnd - inBegin)); });
+}
+
+void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstColor,
+                                             [[maybe_unused]] uint32_t inLastColor)
+{
+#if CAIRN_WIDE_SOLVER
+    // Each color's constraints in batches of four, in order; the last batch of a color may be partial
+    mColorBatchStart.clear();
+    uint32_t numBatches = 0;
+    for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+    {
+        mColorBatchStart.push_back(numBatches);
+        if (mColorIsSerial[color] == 0) numBatches += (mColorStart[color + 1] - mColorStart[color] + 3) / 4;
+    }
+    mColorBatchStart.push_back(numBatches);
+    mWideBatches.resize(numBatches);
+    for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+    {
+        const uint32_t firstBatch = mColorBatchStart[color - inFirstColor];
+        const uint32_t lastBatch = mColorBatchStart[color - inFirstColor + 1];
+        for (uint32_t batch = firstBatch; batch < lastBatch; ++batch)
+        {
+            WideContactBatch& b = mWideBatches[batch];
+            b.mFirst = mColorStart[color] + 4 * (batch - firstBatch);
+            b.mCount = std::min(4u, mColorStart[color + 1] - b.mFirst);
+            b.mPaddingFirst = mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * color;
+        }
+    }
+    const std::span<SolverBody> solverBodies(mSolverBodies);
+    auto constraintsOf = [&](const WideContactBatch& inBatch) {
+        return std::span<ContactConstraint* const>(mIslandConstraints.data() + inBatch.mFirst,
+                                                   inBatch.mCount);
+    };
+    ParallelFor(numBatches, 64,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        WideContactSolver::Pack(constraintsOf(mWideBatches[i]), solverBodies,
+                                                mWideBatches[i]);
+                });
+
+    for (int iteration = 0; iteration < mSettings.mSolver.mVelocityIterations; ++iteration)
+        for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+        {
+            if (mColorIsSerial[color] != 0)
+            {
+                SequentialImpulseSolver::SolveVelocities(
+                    std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[color],
+                                                        mIslandConstraints.data() + mColorStart[color + 1]),
+                    solverBodies);
+                continue;
+            }
+            // The batches of one color share no dynamic body: one contiguous part per thread, as in
+            // SolveColoredIsland (8 batches are the 32 constraints a part needs to pay)
+            const std::span<WideContactBatch> batches(
+                mWideBatches.data() + mColorBatchStart[color - inFirstColor],
+                mWideBatches.data() + mColorBatchStart[color - inFirstColor + 1]);
+            ForEachThreadPart(
+                uint32_t(batches.size()),
+                [&](uint32_t inBegin, uint32_t inEnd) {
+                    WideContactSolver::SolveVelocities(batches.subspan(inBegin, inEnd - inBegin),
+                                                       solverBodies);
+                },
+                8);
+        }
+
+    ParallelFor(numBatches, 64,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
+                });
+#endif
 }
 
 void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)

@@ -18,6 +18,7 @@
 #include "cairn/physics/solver/ContactCache.h"
 #include "cairn/physics/solver/ContactConstraint.h"
 #include "cairn/physics/solver/SolverBody.h"
+#include "solver/WideContactSolver.h"
 
 #include <algorithm>
 #include <span>
@@ -77,11 +78,12 @@ private:
 
     /// inBody(begin, end) over [0, inCount) split into one contiguous part per thread: part 0 on this thread,
     /// part t on the t-th job, so with a stable assignment the same thread sees the same part every time.
-    template <class Body> void ForEachThreadPart(uint32_t inCount, const Body& inBody)
+    /// At least inMinPerPart items a part: below that a job costs more than it saves.
+    template <class Body>
+    void ForEachThreadPart(uint32_t inCount, const Body& inBody, uint32_t inMinPerPart = 32)
     {
-        // At least 32 items a part: below that a job costs more than it saves
         const uint32_t parts =
-            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / 32));
+            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / inMinPerPart));
         if (parts <= 1)
         {
             if (inCount > 0) inBody(0, inCount);
@@ -124,6 +126,9 @@ private:
     void ColorIsland(uint32_t inIsland);
     /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn.
     void SolveColoredIsland(uint32_t inIsland, float inDeltaTime);
+    /// The velocity iterations of a colored island whose colors are [inFirstColor, inLastColor], four
+    /// manifolds at a time (WideContactSolver).
+    void SolveColoredVelocitiesWide(uint32_t inFirstColor, uint32_t inLastColor);
     /// Stores the constraints' impulses in the contact cache for next step's warm start.
     void StoreImpulses(std::span<ContactConstraint* const> inConstraints);
     void IntegratePositions(Body& ioBody, float inDeltaTime);
@@ -178,7 +183,13 @@ private:
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
     std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
     std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
-    std::vector<SolverBody> mSolverBodies;    ///< Velocities being solved: see SolveIslands
+    std::vector<SolverBody> mSolverBodies;
+    uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
+#if CAIRN_WIDE_SOLVER
+    std::vector<WideContactBatch> mWideBatches; ///< Scratch: the colored island being solved, color by color
+#endif
+    std::vector<uint32_t> mColorBatchStart;   ///< Scratch: per color of that island, its first batch    ///<
+                                              ///< Velocities being solved: see SolveIslands
     std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;   ///< Scratch
     uint32_t mNumBodyPairs = 0;               ///< Counters of the running step

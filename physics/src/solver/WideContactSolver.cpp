@@ -1,0 +1,275 @@
+#include "WideContactSolver.h"
+
+#if CAIRN_WIDE_SOLVER
+
+#include <algorithm>
+#include <cstring>
+
+namespace cairn
+{
+namespace
+{
+static_assert(sizeof(SolverBody) == 32 && alignof(SolverBody) == 32, "two aligned 16-byte rows per body");
+
+/// A 3-vector for four lanes.
+struct Vec3x4
+{
+    __m128 mX, mY, mZ;
+};
+
+/// Velocities of the four lanes' A or B bodies.
+struct BodiesX4
+{
+    Vec3x4 mLinear;
+    Vec3x4 mAngular;
+    __m128 mInverseMass;
+    __m128 mPadding; ///< Carried so the store writes back what it loaded
+};
+
+float* Floats(SolverBody& ioBody)
+{
+    return reinterpret_cast<float*>(&ioBody);
+}
+
+/// Rows (v.xyz, 1/m) and (w.xyz, pad) of four blocks, turned into columns.
+[[gnu::always_inline]] inline BodiesX4 Gather(std::span<SolverBody> inBodies, const uint32_t inIndex[4])
+{
+    __m128 l0 = _mm_load_ps(Floats(inBodies[inIndex[0]]));
+    __m128 l1 = _mm_load_ps(Floats(inBodies[inIndex[1]]));
+    __m128 l2 = _mm_load_ps(Floats(inBodies[inIndex[2]]));
+    __m128 l3 = _mm_load_ps(Floats(inBodies[inIndex[3]]));
+    __m128 a0 = _mm_load_ps(Floats(inBodies[inIndex[0]]) + 4);
+    __m128 a1 = _mm_load_ps(Floats(inBodies[inIndex[1]]) + 4);
+    __m128 a2 = _mm_load_ps(Floats(inBodies[inIndex[2]]) + 4);
+    __m128 a3 = _mm_load_ps(Floats(inBodies[inIndex[3]]) + 4);
+    _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+    return {{l0, l1, l2}, {a0, a1, a2}, l3, a3};
+}
+
+[[gnu::always_inline]] inline void Scatter(BodiesX4 inValues, std::span<SolverBody> ioBodies,
+                                           const uint32_t inIndex[4])
+{
+    __m128 l0 = inValues.mLinear.mX, l1 = inValues.mLinear.mY, l2 = inValues.mLinear.mZ,
+           l3 = inValues.mInverseMass;
+    __m128 a0 = inValues.mAngular.mX, a1 = inValues.mAngular.mY, a2 = inValues.mAngular.mZ,
+           a3 = inValues.mPadding;
+    _MM_TRANSPOSE4_PS(l0, l1, l2, l3);
+    _MM_TRANSPOSE4_PS(a0, a1, a2, a3);
+    _mm_store_ps(Floats(ioBodies[inIndex[0]]), l0);
+    _mm_store_ps(Floats(ioBodies[inIndex[1]]), l1);
+    _mm_store_ps(Floats(ioBodies[inIndex[2]]), l2);
+    _mm_store_ps(Floats(ioBodies[inIndex[3]]), l3);
+    _mm_store_ps(Floats(ioBodies[inIndex[0]]) + 4, a0);
+    _mm_store_ps(Floats(ioBodies[inIndex[1]]) + 4, a1);
+    _mm_store_ps(Floats(ioBodies[inIndex[2]]) + 4, a2);
+    _mm_store_ps(Floats(ioBodies[inIndex[3]]) + 4, a3);
+}
+
+// The arithmetic below follows the scalar solver operation by operation. Eigen's dot product of 3-vectors
+// sums as x0 y0 + (x1 y1 + x2 y2), and that grouping is kept here
+
+[[gnu::always_inline]] inline __m128 Dot(const __m128 inA[3], __m128 inX, __m128 inY, __m128 inZ)
+{
+    return _mm_add_ps(_mm_mul_ps(inA[0], inX), _mm_add_ps(_mm_mul_ps(inA[1], inY), _mm_mul_ps(inA[2], inZ)));
+}
+
+[[gnu::always_inline]] inline __m128 RelativeVelocity(const BodiesX4& inA, const BodiesX4& inB,
+                                                      const __m128 inAxis[3], const WideAxis& inPart)
+{
+    const __m128 along =
+        Dot(inAxis, _mm_sub_ps(inB.mLinear.mX, inA.mLinear.mX), _mm_sub_ps(inB.mLinear.mY, inA.mLinear.mY),
+            _mm_sub_ps(inB.mLinear.mZ, inA.mLinear.mZ));
+    const __m128 turnB = Dot(inPart.mRBxAxis, inB.mAngular.mX, inB.mAngular.mY, inB.mAngular.mZ);
+    const __m128 turnA = Dot(inPart.mRAxAxis, inA.mAngular.mX, inA.mAngular.mY, inA.mAngular.mZ);
+    return _mm_sub_ps(_mm_add_ps(along, turnB), turnA);
+}
+
+[[gnu::always_inline]] inline void ApplyImpulse(BodiesX4& ioA, BodiesX4& ioB, const __m128 inAxis[3],
+                                                const WideAxis& inPart, __m128 inLambda)
+{
+    const __m128 linearA = _mm_mul_ps(ioA.mInverseMass, inLambda);
+    ioA.mLinear.mX = _mm_sub_ps(ioA.mLinear.mX, _mm_mul_ps(linearA, inAxis[0]));
+    ioA.mLinear.mY = _mm_sub_ps(ioA.mLinear.mY, _mm_mul_ps(linearA, inAxis[1]));
+    ioA.mLinear.mZ = _mm_sub_ps(ioA.mLinear.mZ, _mm_mul_ps(linearA, inAxis[2]));
+    ioA.mAngular.mX = _mm_sub_ps(ioA.mAngular.mX, _mm_mul_ps(inLambda, inPart.mInvIA_RAxAxis[0]));
+    ioA.mAngular.mY = _mm_sub_ps(ioA.mAngular.mY, _mm_mul_ps(inLambda, inPart.mInvIA_RAxAxis[1]));
+    ioA.mAngular.mZ = _mm_sub_ps(ioA.mAngular.mZ, _mm_mul_ps(inLambda, inPart.mInvIA_RAxAxis[2]));
+    const __m128 linearB = _mm_mul_ps(ioB.mInverseMass, inLambda);
+    ioB.mLinear.mX = _mm_add_ps(ioB.mLinear.mX, _mm_mul_ps(linearB, inAxis[0]));
+    ioB.mLinear.mY = _mm_add_ps(ioB.mLinear.mY, _mm_mul_ps(linearB, inAxis[1]));
+    ioB.mLinear.mZ = _mm_add_ps(ioB.mLinear.mZ, _mm_mul_ps(linearB, inAxis[2]));
+    ioB.mAngular.mX = _mm_add_ps(ioB.mAngular.mX, _mm_mul_ps(inLambda, inPart.mInvIB_RBxAxis[0]));
+    ioB.mAngular.mY = _mm_add_ps(ioB.mAngular.mY, _mm_mul_ps(inLambda, inPart.mInvIB_RBxAxis[1]));
+    ioB.mAngular.mZ = _mm_add_ps(ioB.mAngular.mZ, _mm_mul_ps(inLambda, inPart.mInvIB_RBxAxis[2]));
+}
+
+[[gnu::always_inline]] inline void SolvePatchFriction(WideContactBatch& ioC, BodiesX4& ioA, BodiesX4& ioB)
+{
+    // The points' accumulated impulses summed in order (padding points are zero and change nothing)
+    __m128 normalTotal = ioC.mPoint[0].mAccumulated;
+    for (int i = 1; i < ContactManifold::cMaxPoints; ++i)
+        normalTotal = _mm_add_ps(normalTotal, ioC.mPoint[i].mAccumulated);
+    const __m128 maxFriction = _mm_mul_ps(ioC.mFriction, normalTotal);
+    __m128 total[2];
+    for (int t = 0; t < 2; ++t)
+        total[t] = _mm_sub_ps(ioC.mTangentAxis[t].mAccumulated,
+                              _mm_mul_ps(ioC.mTangentAxis[t].mEffectiveMass,
+                                         RelativeVelocity(ioA, ioB, ioC.mTangent[t], ioC.mTangentAxis[t])));
+    // Clamped to the friction circle in the lanes that leave it. There maxFriction^2 < lengthSq, so the
+    // length is not zero and the scalar solver's guard against it never applies
+    const __m128 lengthSq = _mm_add_ps(_mm_mul_ps(total[0], total[0]), _mm_mul_ps(total[1], total[1]));
+    const __m128 outside = _mm_cmpgt_ps(lengthSq, _mm_mul_ps(maxFriction, maxFriction));
+    const __m128 scale = _mm_div_ps(maxFriction, _mm_sqrt_ps(lengthSq));
+    for (int t = 0; t < 2; ++t)
+    {
+        total[t] =
+            _mm_or_ps(_mm_and_ps(outside, _mm_mul_ps(total[t], scale)), _mm_andnot_ps(outside, total[t]));
+        const __m128 applied = _mm_sub_ps(total[t], ioC.mTangentAxis[t].mAccumulated);
+        ioC.mTangentAxis[t].mAccumulated = total[t];
+        ApplyImpulse(ioA, ioB, ioC.mTangent[t], ioC.mTangentAxis[t], applied);
+    }
+
+    const __m128 maxTwist = _mm_mul_ps(maxFriction, ioC.mTwistRadius);
+    const __m128 minTwist = _mm_xor_ps(maxTwist, _mm_set1_ps(-0.0f)); // Negated, as -maxTwist
+    const __m128 relativeTwist =
+        Dot(ioC.mNormal, _mm_sub_ps(ioB.mAngular.mX, ioA.mAngular.mX),
+            _mm_sub_ps(ioB.mAngular.mY, ioA.mAngular.mY), _mm_sub_ps(ioB.mAngular.mZ, ioA.mAngular.mZ));
+    const __m128 unclamped =
+        _mm_sub_ps(ioC.mTwistAccumulated, _mm_mul_ps(ioC.mTwistEffectiveMass, relativeTwist));
+    // std::clamp(v, lo, hi) is v < lo ? lo : (hi < v ? hi : v); _mm_max_ps(a, b) is a > b ? a : b
+    const __m128 twist = _mm_min_ps(maxTwist, _mm_max_ps(minTwist, unclamped));
+    const __m128 applied = _mm_sub_ps(twist, ioC.mTwistAccumulated);
+    ioA.mAngular.mX = _mm_sub_ps(ioA.mAngular.mX, _mm_mul_ps(applied, ioC.mInvIA_Normal[0]));
+    ioA.mAngular.mY = _mm_sub_ps(ioA.mAngular.mY, _mm_mul_ps(applied, ioC.mInvIA_Normal[1]));
+    ioA.mAngular.mZ = _mm_sub_ps(ioA.mAngular.mZ, _mm_mul_ps(applied, ioC.mInvIA_Normal[2]));
+    ioB.mAngular.mX = _mm_add_ps(ioB.mAngular.mX, _mm_mul_ps(applied, ioC.mInvIB_Normal[0]));
+    ioB.mAngular.mY = _mm_add_ps(ioB.mAngular.mY, _mm_mul_ps(applied, ioC.mInvIB_Normal[1]));
+    ioB.mAngular.mZ = _mm_add_ps(ioB.mAngular.mZ, _mm_mul_ps(applied, ioC.mInvIB_Normal[2]));
+    ioC.mTwistAccumulated = twist;
+}
+
+[[gnu::always_inline]] inline void SolveNormal(WideContactBatch& ioC, int inPoint, BodiesX4& ioA,
+                                               BodiesX4& ioB)
+{
+    WideAxis& axis = ioC.mPoint[inPoint];
+    const __m128 vn = RelativeVelocity(ioA, ioB, ioC.mNormal, axis);
+    // std::max(x, 0) is x < 0 ? 0 : x, which _mm_max_ps(0, x) matches (NaN included)
+    const __m128 total =
+        _mm_max_ps(_mm_setzero_ps(),
+                   _mm_add_ps(axis.mAccumulated,
+                              _mm_mul_ps(axis.mEffectiveMass, _mm_sub_ps(ioC.mVelocityBias[inPoint], vn))));
+    const __m128 applied = _mm_sub_ps(total, axis.mAccumulated);
+    axis.mAccumulated = total;
+    ioC.mMaxNormalImpulse[inPoint] = _mm_max_ps(total, ioC.mMaxNormalImpulse[inPoint]);
+    ApplyImpulse(ioA, ioB, ioC.mNormal, axis, applied);
+}
+
+void SetLane(__m128& ioVector, int inLane, float inValue)
+{
+    reinterpret_cast<float*>(&ioVector)[inLane] = inValue;
+}
+float GetLane(const __m128& inVector, int inLane)
+{
+    return reinterpret_cast<const float*>(&inVector)[inLane];
+}
+
+void SetLane(__m128 (&ioVector)[3], int inLane, const Vec3& inValue)
+{
+    for (int i = 0; i < 3; ++i)
+        SetLane(ioVector[i], inLane, inValue[i]);
+}
+
+void SetLane(WideAxis& ioAxis, int inLane, const AxisImpulse& inValue)
+{
+    SetLane(ioAxis.mRAxAxis, inLane, inValue.mRAxAxis);
+    SetLane(ioAxis.mRBxAxis, inLane, inValue.mRBxAxis);
+    SetLane(ioAxis.mInvIA_RAxAxis, inLane, inValue.mInvIA_RAxAxis);
+    SetLane(ioAxis.mInvIB_RBxAxis, inLane, inValue.mInvIB_RBxAxis);
+    SetLane(ioAxis.mEffectiveMass, inLane, inValue.mEffectiveMass);
+    SetLane(ioAxis.mAccumulated, inLane, inValue.mAccumulated);
+}
+} // namespace
+
+void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
+                             std::span<SolverBody> ioBodies, WideContactBatch& ioBatch)
+{
+    const uint32_t first = ioBatch.mFirst, count = ioBatch.mCount, paddingFirst = ioBatch.mPaddingFirst;
+    // All zero: padding lanes and padding points stay so, and an impulse of zero moves nothing
+    std::memset(static_cast<void*>(&ioBatch), 0, sizeof(ioBatch));
+    ioBatch.mFirst = first;
+    ioBatch.mCount = count;
+    ioBatch.mPaddingFirst = paddingFirst;
+    for (uint32_t lane = 0; lane < 4; ++lane)
+    {
+        if (lane >= count)
+        {
+            ioBatch.mBodyA[lane] = paddingFirst + 2 * lane;
+            ioBatch.mBodyB[lane] = paddingFirst + 2 * lane + 1;
+            std::memset(static_cast<void*>(&ioBodies[ioBatch.mBodyA[lane]]), 0, sizeof(SolverBody));
+            std::memset(static_cast<void*>(&ioBodies[ioBatch.mBodyB[lane]]), 0, sizeof(SolverBody));
+            continue;
+        }
+        const ContactConstraint& c = *inConstraints[lane];
+        const int l = int(lane);
+        ioBatch.mBodyA[lane] = c.mSolverBodyA;
+        ioBatch.mBodyB[lane] = c.mSolverBodyB;
+        SetLane(ioBatch.mNormal, l, c.mNormal);
+        SetLane(ioBatch.mTangent[0], l, c.mTangent[0]);
+        SetLane(ioBatch.mTangent[1], l, c.mTangent[1]);
+        SetLane(ioBatch.mInvIA_Normal, l, c.mInvIA_Normal);
+        SetLane(ioBatch.mInvIB_Normal, l, c.mInvIB_Normal);
+        SetLane(ioBatch.mFriction, l, c.mFriction);
+        SetLane(ioBatch.mTwistEffectiveMass, l, c.mPatch.mTwistEffectiveMass);
+        SetLane(ioBatch.mTwistAccumulated, l, c.mPatch.mTwistAccumulated);
+        SetLane(ioBatch.mTwistRadius, l, c.mPatch.mTwistRadius);
+        SetLane(ioBatch.mTangentAxis[0], l, c.mPatch.mTangent[0]);
+        SetLane(ioBatch.mTangentAxis[1], l, c.mPatch.mTangent[1]);
+        for (int i = 0; i < c.mNumPoints; ++i)
+        {
+            SetLane(ioBatch.mPoint[i], l, c.mPoints[i].mNormal);
+            SetLane(ioBatch.mVelocityBias[i], l, c.mPoints[i].mVelocityBias);
+            SetLane(ioBatch.mMaxNormalImpulse[i], l, c.mPoints[i].mMaxNormalImpulse);
+        }
+    }
+}
+
+void WideContactSolver::SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies)
+{
+    for (WideContactBatch& batch : ioBatches)
+    {
+        BodiesX4 a = Gather(ioBodies, batch.mBodyA);
+        BodiesX4 b = Gather(ioBodies, batch.mBodyB);
+        // As the scalar solver: friction against last iteration's normal impulses, then the points forwards
+        // and backwards
+        SolvePatchFriction(batch, a, b);
+        for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+            SolveNormal(batch, i, a, b);
+        for (int i = ContactManifold::cMaxPoints - 1; i >= 0; --i)
+            SolveNormal(batch, i, a, b);
+        Scatter(a, ioBodies, batch.mBodyA);
+        Scatter(b, ioBodies, batch.mBodyB);
+    }
+}
+
+void WideContactSolver::Unpack(const WideContactBatch& inBatch,
+                               std::span<ContactConstraint* const> ioConstraints)
+{
+    for (uint32_t lane = 0; lane < inBatch.mCount; ++lane)
+    {
+        ContactConstraint& c = *ioConstraints[lane];
+        const int l = int(lane);
+        c.mPatch.mTwistAccumulated = GetLane(inBatch.mTwistAccumulated, l);
+        for (int t = 0; t < 2; ++t)
+            c.mPatch.mTangent[t].mAccumulated = GetLane(inBatch.mTangentAxis[t].mAccumulated, l);
+        for (int i = 0; i < c.mNumPoints; ++i)
+        {
+            c.mPoints[i].mNormal.mAccumulated = GetLane(inBatch.mPoint[i].mAccumulated, l);
+            c.mPoints[i].mMaxNormalImpulse = GetLane(inBatch.mMaxNormalImpulse[i], l);
+        }
+    }
+}
+
+} // namespace cairn
+
+#endif
