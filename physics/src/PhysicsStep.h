@@ -112,8 +112,9 @@ private:
     /// false if the shapes must be collided. ioRecord: the pose recorded with them.
     bool ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, CachedBodyPair& ioRecord,
                         NarrowPhaseChunk& ioOut) const;
+    /// inPrevious: last step's manifold with the same key (for the warm start), or null.
     void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
-                       NarrowPhaseChunk& ioOut) const;
+                       const CachedManifold* inPrevious, NarrowPhaseChunk& ioOut) const;
     /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
     void BuildIslands();
     /// The solver's order: hashed within each island; large islands colored. Counted as solver time.
