@@ -60,6 +60,7 @@ Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
         return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this body");
     mBroadPhase.AddBodiesFinalize(state);
     body->mInWorld = true;
+    mBodies.NotifyChange(BodyChangeKind::Added, *body, AABB::Empty());
     if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     return Status::Ok();
 }
@@ -90,6 +91,7 @@ Status BodyInterface::RemoveBody(const BodyID& inID)
         mBodies.DeactivateBody(*body);
         body->mInWorld = false;
         bounds = body->GetWorldBounds();
+        mBodies.NotifyChange(BodyChangeKind::Removed, *body, bounds);
     }
     // Bodies resting on the removed one must fall: wake them (with the removed body's lock released, since a
     // thread may hold only one body lock at a time)
@@ -166,6 +168,7 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
         assert(body != nullptr && body->mAddPending);
         body->mAddPending = false;
         body->mInWorld = true;
+        mBodies.NotifyChange(BodyChangeKind::Added, *body, AABB::Empty());
         if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     }
     ioBatch.mBodies.clear();
@@ -205,11 +208,13 @@ template <class T, class F> Result<T> BodyInterface::ReadBody(const BodyID& inID
 
 void BodyInterface::OnBodyMoved(Body& ioBody, Activation inActivation)
 {
+    const AABB oldBounds = ioBody.mBounds;
     ioBody.UpdateBounds();
     if (ioBody.mInWorld)
     {
         const BroadPhaseBody entry = ToBroadPhase(ioBody);
         mBroadPhase.NotifyBodiesAABBChanged({&entry, 1});
+        mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, oldBounds);
         if (inActivation == Activation::Activate) mBodies.ActivateBody(ioBody);
     }
 }

@@ -88,6 +88,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
     }
 
     std::unique_lock lock(GetMutexForBody(index));
+    std::unique_lock staticLock(GetStaticMutexForBody(index));
     Body& body = mBodies[index];
     const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
@@ -104,6 +105,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
     {
         std::unique_lock lock(GetMutexForBody(inID.GetIndex()));
+        std::unique_lock staticLock(GetStaticMutexForBody(inID.GetIndex()));
         Body* body = TryGetBody(inID);
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
         if (body->mInWorld || body->mAddPending)
@@ -147,6 +149,7 @@ void BodyManager::ActivateBody(Body& ioBody)
     }
     ioBody.SetActiveIndex(uint32_t(mActiveBodies.size()));
     mActiveBodies.push_back(ioBody.mID.GetIndex());
+    NotifyChange(BodyChangeKind::Woke, ioBody, ioBody.mBounds);
 }
 
 void BodyManager::DeactivateBody(Body& ioBody)
@@ -164,6 +167,16 @@ void BodyManager::DeactivateBody(Body& ioBody)
     ioBody.mLinearVelocity.setZero();
     ioBody.mAngularVelocity.setZero();
     ioBody.mSleepTimer = 0.0f;
+    NotifyChange(BodyChangeKind::FellAsleep, ioBody, ioBody.mBounds);
+}
+
+void BodyManager::NotifyChange(BodyChangeKind inKind, const Body& inBody, const AABB& inOldBounds) const
+{
+    // Acquire: pairs with the release in SetChangeListener
+    BodyChangeListener* listener = mChangeListener.load(std::memory_order_acquire);
+    if (listener == nullptr) return;
+    listener->OnBodyChanged({inKind, inBody.mID, inBody.mMotionType, inBody.mObjectLayer, inBody.IsActive(),
+                             inOldBounds, inBody.mInWorld ? inBody.mBounds : AABB::Empty()});
 }
 
 void BodyManager::LockAllBodies() const

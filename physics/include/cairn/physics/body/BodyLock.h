@@ -1,7 +1,8 @@
 #pragma once
 
 // Scoped body locks for code outside the physics step. Each takes the body's shard mutex (shared for read,
-// exclusive for write) and checks the id, so a stale id gives no body instead of another body.
+// exclusive for write; a write lock takes the shard's static mutex too, see BodyManager.h) and checks the id,
+// so a stale id gives no body instead of another body.
 // Taking one inside a step callback (where the step already holds every body mutex), or while this thread
 // already holds one (two locks held in any order can deadlock against the step, which takes all of them),
 // would risk a deadlock: it is refused instead (GetBody() returns nullptr, WasWrongThread() is true).
@@ -14,22 +15,42 @@
 namespace cairn
 {
 
+/// Asks a read lock not to wait: if the body's mutex is held for writing (by the physics step, most often),
+/// the lock fails at once and WasBusy() is true.
+struct TryLock
+{
+};
+
 template <bool Write> class BodyLock
 {
 public:
     BodyLock(const BodyManager& inManager, const BodyID& inID)
     {
-        if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
-        {
-            mWrongThread = true;
-            return;
-        }
-        if (inID.IsInvalid() || inID.GetIndex() >= inManager.GetMaxBodies()) return;
+        if (!Prepare(inManager, inID)) return;
         mMutex = &inManager.GetMutexForBody(inID.GetIndex());
         if constexpr (Write)
+        {
             mMutex->lock();
+            mStaticMutex = &inManager.GetStaticMutexForBody(inID.GetIndex());
+            mStaticMutex->lock();
+        }
         else
             mMutex->lock_shared();
+        BodyManager::NoteBodyLockHeld(+1);
+        mBody = inManager.TryGetBody(inID);
+    }
+
+    /// A read lock that does not wait.
+    BodyLock(const BodyManager& inManager, const BodyID& inID, TryLock) requires(!Write)
+    {
+        if (!Prepare(inManager, inID)) return;
+        std::shared_mutex& mutex = inManager.GetMutexForBody(inID.GetIndex());
+        if (!mutex.try_lock_shared())
+        {
+            mBusy = true;
+            return;
+        }
+        mMutex = &mutex;
         BodyManager::NoteBodyLockHeld(+1);
         mBody = inManager.TryGetBody(inID);
     }
@@ -42,26 +63,93 @@ public:
     {
         if (mMutex == nullptr) return;
         if constexpr (Write)
+        {
+            mStaticMutex->unlock();
             mMutex->unlock();
+        }
         else
             mMutex->unlock_shared();
         BodyManager::NoteBodyLockHeld(-1);
         mMutex = nullptr;
+        mStaticMutex = nullptr;
         mBody = nullptr;
     }
 
     bool Succeeded() const { return mBody != nullptr; }
     bool WasWrongThread() const { return mWrongThread; }
+    /// A TryLock found the body locked for writing.
+    bool WasBusy() const { return mBusy; }
     /// The locked body, or nullptr for an unknown or stale id.
     std::conditional_t<Write, Body*, const Body*> GetBody() const { return mBody; }
 
 private:
+    /// False when this thread may not lock (inside the step, or holding a lock already) or the id is invalid.
+    bool Prepare(const BodyManager& inManager, const BodyID& inID)
+    {
+        if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        {
+            mWrongThread = true;
+            return false;
+        }
+        return !inID.IsInvalid() && inID.GetIndex() < inManager.GetMaxBodies();
+    }
+
     std::shared_mutex* mMutex = nullptr;
+    std::shared_mutex* mStaticMutex = nullptr; ///< Write locks only
     Body* mBody = nullptr;
     bool mWrongThread = false;
+    bool mBusy = false;
 };
 
 using BodyLockRead = BodyLock<false>;
 using BodyLockWrite = BodyLock<true>;
+
+/// Reads a static body without waiting for the physics step: takes only the shard's static mutex (shared),
+/// which the step does not hold (see BodyManager.h). GetBody() is null for a stale id and for a body that is
+/// not static (its fields may be changing in the step: read it with BodyLockRead). Same thread rules as
+/// BodyLock: not inside the step, not while holding another body lock.
+class StaticBodyLockRead
+{
+public:
+    StaticBodyLockRead(const BodyManager& inManager, const BodyID& inID)
+    {
+        if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        {
+            mWrongThread = true;
+            return;
+        }
+        if (inID.IsInvalid() || inID.GetIndex() >= inManager.GetMaxBodies()) return;
+        mMutex = &inManager.GetStaticMutexForBody(inID.GetIndex());
+        mMutex->lock_shared();
+        BodyManager::NoteBodyLockHeld(+1);
+        const Body* body = inManager.TryGetBody(inID);
+        if (body != nullptr && body->IsStatic()) mBody = body;
+        mNotStatic = body != nullptr && !body->IsStatic();
+    }
+    ~StaticBodyLockRead() { Release(); }
+    StaticBodyLockRead(const StaticBodyLockRead&) = delete;
+    StaticBodyLockRead& operator=(const StaticBodyLockRead&) = delete;
+
+    void Release()
+    {
+        if (mMutex == nullptr) return;
+        mMutex->unlock_shared();
+        BodyManager::NoteBodyLockHeld(-1);
+        mMutex = nullptr;
+        mBody = nullptr;
+    }
+
+    /// The locked static body, or nullptr.
+    const Body* GetBody() const { return mBody; }
+    bool WasWrongThread() const { return mWrongThread; }
+    /// The body exists but is not static: nothing was read.
+    bool WasNotStatic() const { return mNotStatic; }
+
+private:
+    std::shared_mutex* mMutex = nullptr;
+    const Body* mBody = nullptr;
+    bool mWrongThread = false;
+    bool mNotStatic = false;
+};
 
 } // namespace cairn

@@ -11,10 +11,17 @@
 //  - Active list: mActiveListMutex, taken by threads that (de)activate a body while holding its body mutex;
 //    the step holds every body mutex, so it may read and change the list without taking mActiveListMutex.
 //  - A thread never holds two body mutexes except LockAllBodies (in index order, so no cycle).
+//  - Each shard has a second mutex, its static mutex, which the step does not take. Every write to a body
+//    outside the step (BodyLockWrite, CreateBody, DestroyBody) holds it exclusively as well, taken after the
+//    body mutex; the step never writes a static body. So a thread holding only the static mutex (shared) may
+//    read a static body while the step runs: StaticBodyLockRead, with which background navmesh jobs read
+//    level geometry without waiting for a whole step.
 
 #include "cairn/physics/body/Body.h"
+#include "cairn/physics/body/BodyChangeListener.h"
 #include "cairn/physics/math/Result.h"
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <shared_mutex>
@@ -47,12 +54,27 @@ public:
         return mBodyMutexes[inIndex % cNumBodyMutexes].mMutex;
     }
 
+    /// The shard's static mutex (see above).
+    std::shared_mutex& GetStaticMutexForBody(uint32_t inIndex) const
+    {
+        return mStaticMutexes[inIndex % cNumBodyMutexes].mMutex;
+    }
+
     /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the
     /// body's mutex (or be the physics step).
     Body* TryGetBody(const BodyID& inID) const;
     /// The body in slot inIndex whatever its sequence, or nullptr when the slot is free. Same locking as
     /// TryGetBody.
     Body* TryGetBodyAtIndex(uint32_t inIndex) const;
+
+    /// The listener told about bodies added, removed, moved, falling asleep and waking (null: none). Set it
+    /// before other threads change bodies, and keep it alive while it is set.
+    void SetChangeListener(BodyChangeListener* inListener)
+    {
+        mChangeListener.store(inListener, std::memory_order_release); // Publishes the listener's construction
+    }
+    /// Tells the listener, if any, about a change of inBody (whose lock the caller holds, or the step).
+    void NotifyChange(BodyChangeKind inKind, const Body& inBody, const AABB& inOldBounds) const;
 
     /// Puts a dynamic or kinematic body in the world into the active list. Caller holds the body's mutex
     /// exclusively, or is the step.
@@ -89,6 +111,8 @@ private:
     std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
+    mutable PaddedMutex mStaticMutexes[cNumBodyMutexes]; ///< Also held by writers outside the step
+    std::atomic<BodyChangeListener*> mChangeListener{nullptr};
 
     mutable std::mutex mFreeListMutex;
     std::vector<uint32_t> mFreeList; ///< Guarded by mFreeListMutex
