@@ -7,6 +7,7 @@ packages=(
     cmake ninja-build g++ pkg-config
     libeigen3-dev         # all math
     librecast-dev         # Recast/Detour navmesh
+    libtinyobjloader-dev  # OBJ level meshes
     libgtest-dev libgmock-dev
     libbenchmark-dev      # benchmarks
     librapidcheck-dev     # property tests

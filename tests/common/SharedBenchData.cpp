@@ -85,6 +85,12 @@ std::string GetSharedBenchDir()
 #endif
 }
 
+std::string GetSharedDataDir()
+{
+    const std::string bench = GetSharedBenchDir();
+    return bench.substr(0, bench.size() - std::string("/bench").size()) + "/data";
+}
+
 Result<std::vector<BenchBox>> LoadBenchBoxes(const std::string& inPath, bool inWithTile)
 {
     auto rows = ReadCsv(inPath, inWithTile ? "tile,cx,cy,cz,hx,hy,hz,yaw" : "cx,cy,cz,hx,hy,hz,yaw");

@@ -47,6 +47,8 @@ struct SharedBenchData
 /// The directory holding the workload: $CAIRN_SHARED_DIR/bench if that variable is set, else the
 /// CAIRN_SHARED_DIR compile definition + /bench, else /work/shared/bench.
 std::string GetSharedBenchDir();
+/// ../shared/data (CAIRN_SHARED_DIR overrides ../shared): the Recast demo meshes and other level data.
+std::string GetSharedDataDir();
 
 /// world20k_static.csv (with tile column) or world20k_dynamic.csv (without), chosen by inWithTile.
 Result<std::vector<BenchBox>> LoadBenchBoxes(const std::string& inPath, bool inWithTile);

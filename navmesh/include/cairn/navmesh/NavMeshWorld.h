@@ -1,0 +1,97 @@
+#pragma once
+
+// NavMeshWorld: stage 4, the published navmesh. Owns a tiled Detour dtNavMesh on a TileGrid and answers path
+// queries from any thread.
+//
+// Detour's navmesh is not thread-safe, so tiles are published at a sync point: tile jobs hand finished tiles
+// in with SubmitTile (any thread, under mPendingMutex), and Publish (the game's sync point, once a frame)
+// swaps them all in under mNavMeshMutex held exclusively. Path queries hold mNavMeshMutex shared for their
+// whole length, so a query never sees a half-added tile: it sees the navmesh as of the last Publish. Each
+// thread keeps its own dtNavMeshQuery (Detour's query objects hold per-query scratch).
+// Lock order: mNavMeshMutex < mPendingMutex. Neither is ever held while a body lock is taken.
+
+#include "cairn/navmesh/TileBuilder.h"
+#include "cairn/navmesh/TileGrid.h"
+#include "cairn/physics/math/Result.h"
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <span>
+#include <vector>
+
+class dtNavMesh;
+
+namespace cairn::navmesh
+{
+
+/// Which areas a path may cross and what each costs (a multiplier on distance).
+struct PathFilter
+{
+    PathFilter() { mAreaCost.fill(1.0f); }
+    std::array<float, cMaxAreaId + 1> mAreaCost; ///< Per Cairn area id
+    uint64_t mExcludedAreas = 0;                 ///< Bit per area id: never crossed
+};
+
+struct PathResult
+{
+    bool mReachedEnd = false;        ///< False: the path ends at the reachable point nearest the end
+    int mNumPolygons = 0;            ///< Length of the polygon corridor
+    std::vector<Vec3> mStraightPath; ///< Corner points from start to (reachable) end
+};
+
+class NavMeshWorld
+{
+public:
+    /// inMaxTiles: how many tiles may be loaded at once (a power of two is best).
+    static Result<std::unique_ptr<NavMeshWorld>> Create(const TileGrid& inGrid, const AgentProfile& inProfile,
+                                                        int inMaxTiles = 4096);
+    ~NavMeshWorld();
+    NavMeshWorld(const NavMeshWorld&) = delete;
+    NavMeshWorld& operator=(const NavMeshWorld&) = delete;
+
+    const TileGrid& GetGrid() const { return mGrid; }
+    const AgentProfile& GetProfile() const { return mProfile; }
+
+    /// Queues a built tile (an empty one removes the tile) for the next Publish. Any thread.
+    void SubmitTile(BuiltTile&& inTile);
+    /// Queues the removal of a tile for the next Publish. Any thread.
+    void SubmitRemoval(const TileCoord& inTile);
+    /// The sync point: swaps every queued tile in (or out). Returns how many tiles changed. Any thread, but
+    /// meant for one place in the frame; it waits for path queries in progress.
+    int Publish();
+
+    /// A path for an agent from inStart to inEnd (each snapped to the navmesh within inSearchExtent). Error
+    /// when either point is off the navmesh or not finite. Any thread.
+    Result<PathResult> FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter = {},
+                                const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+
+    /// Published tiles.
+    int GetNumTiles() const;
+    bool HasTile(const TileCoord& inTile) const;
+    /// Polygons of a published tile (0 when absent).
+    int GetTilePolygonCount(const TileCoord& inTile) const;
+    /// A copy of every published tile's Detour data, by tile: to compare two navmeshes.
+    std::map<TileCoord, std::vector<unsigned char>> SnapshotTiles() const;
+
+private:
+    NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile);
+
+    const TileGrid mGrid;
+    const AgentProfile mProfile;
+    const uint64_t mSerial;                  ///< Tells apart worlds for the per-thread query objects
+    mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish; shared: queries
+    dtNavMesh* mNavMesh = nullptr;           ///< Guarded by mNavMeshMutex
+    std::map<TileCoord, int> mTilePolygons;  ///< Guarded by mNavMeshMutex
+    std::mutex mPendingMutex;
+    struct Pending
+    {
+        BuiltTile mTile; ///< mData null: remove
+    };
+    std::map<TileCoord, Pending> mPending; ///< Guarded by mPendingMutex; the latest submission per tile wins
+};
+
+} // namespace cairn::navmesh

@@ -1,0 +1,42 @@
+#pragma once
+
+// TileBuilder: stage 3 of a tile job. Runs Recast over one tile's triangles (rasterise; filter low-hanging
+// obstacles, ledges and low spans; compact; erode by the agent radius; regions; contours; polygon mesh;
+// detail mesh) and makes Detour tile data. A pure function of its inputs: no locks, no shared state, so any
+// number of tiles may be built at once on any threads.
+
+#include "cairn/navmesh/AgentProfile.h"
+#include "cairn/navmesh/TileGeometry.h"
+#include "cairn/navmesh/TileGrid.h"
+
+#include <memory>
+
+namespace cairn::navmesh
+{
+
+/// Detour tile data (dtAlloc'ed), freed with dtFree unless handed to a dtNavMesh.
+struct DetourFree
+{
+    void operator()(unsigned char* inData) const;
+};
+using TileDataPtr = std::unique_ptr<unsigned char, DetourFree>;
+
+/// Polygon flags set on every navmesh polygon; path filters include or exclude them.
+inline constexpr uint16_t cPolyFlagWalk = 1;
+
+struct BuiltTile
+{
+    TileCoord mTile;
+    TileDataPtr mData; ///< Null when the tile has no walkable polygon (an empty tile)
+    int mDataSize = 0;
+    int mNumPolygons = 0;
+    int mNumVertices = 0;
+    double mBuildMs = 0.0; ///< Time spent in Recast and Detour
+};
+
+/// Builds tile inTile of inGrid from inGeometry (world space, covering at least the tile's bordered area).
+/// Errors: invalid profile, non-finite vertices, bad indices, or Recast running out of memory.
+Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGrid, const TileCoord& inTile,
+                            const TileGeometry& inGeometry);
+
+} // namespace cairn::navmesh

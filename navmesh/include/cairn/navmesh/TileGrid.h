@@ -1,0 +1,94 @@
+#pragma once
+
+// TileGrid: the world cut into square navmesh tiles on the x-z plane, from an origin. Tile (x, z) covers
+// [origin + x * size, origin + (x + 1) * size) on each axis. Plain value type.
+
+#include "cairn/physics/math/AABB.h"
+
+#include <cmath>
+#include <compare>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace cairn::navmesh
+{
+
+struct TileCoord
+{
+    int32_t mX = 0;
+    int32_t mZ = 0;
+    auto operator<=>(const TileCoord&) const = default;
+};
+
+class TileGrid
+{
+public:
+    /// inMinY, inMaxY: the height range every tile covers (the world's).
+    TileGrid(float inOriginX, float inOriginZ, float inTileSize, float inMinY, float inMaxY)
+        : mOriginX(inOriginX), mOriginZ(inOriginZ), mTileSize(inTileSize), mMinY(inMinY), mMaxY(inMaxY)
+    {
+    }
+
+    float GetTileSize() const { return mTileSize; }
+    float GetOriginX() const { return mOriginX; }
+    float GetOriginZ() const { return mOriginZ; }
+
+    TileCoord TileAt(float inX, float inZ) const
+    {
+        return {int32_t(std::floor((inX - mOriginX) / mTileSize)),
+                int32_t(std::floor((inZ - mOriginZ) / mTileSize))};
+    }
+
+    /// The tile's own area over the height range.
+    AABB GetTileBounds(const TileCoord& inTile) const
+    {
+        const float x = mOriginX + float(inTile.mX) * mTileSize, z = mOriginZ + float(inTile.mZ) * mTileSize;
+        return AABB(Vec3(x, mMinY, z), Vec3(x + mTileSize, mMaxY, z + mTileSize));
+    }
+
+    /// The tile's area grown by inBorder on the four sides: the geometry a tile build needs.
+    AABB GetTileBoundsWithBorder(const TileCoord& inTile, float inBorder) const
+    {
+        AABB box = GetTileBounds(inTile);
+        box.mMin.x() -= inBorder;
+        box.mMin.z() -= inBorder;
+        box.mMax.x() += inBorder;
+        box.mMax.z() += inBorder;
+        return box;
+    }
+
+    /// Every tile whose bordered area (inBorder) overlaps inBox, appended to outTiles. At most inMaxTiles (a
+    /// huge box gives a clear cut-off rather than millions of tiles); returns false when it cut off.
+    bool TilesOverlapping(const AABB& inBox, float inBorder, std::vector<TileCoord>& outTiles,
+                          size_t inMaxTiles = 65536) const
+    {
+        if (inBox.IsEmpty() || !std::isfinite(inBox.mMin.x()) || !std::isfinite(inBox.mMax.x()) ||
+            !std::isfinite(inBox.mMin.z()) || !std::isfinite(inBox.mMax.z()))
+            return true;
+        const TileCoord lo = TileAt(inBox.mMin.x() - inBorder, inBox.mMin.z() - inBorder);
+        const TileCoord hi = TileAt(inBox.mMax.x() + inBorder, inBox.mMax.z() + inBorder);
+        if (double(hi.mX - lo.mX + 1) * double(hi.mZ - lo.mZ + 1) > double(inMaxTiles)) return false;
+        for (int32_t z = lo.mZ; z <= hi.mZ; ++z)
+            for (int32_t x = lo.mX; x <= hi.mX; ++x)
+                outTiles.push_back({x, z});
+        return true;
+    }
+
+private:
+    float mOriginX;
+    float mOriginZ;
+    float mTileSize;
+    float mMinY;
+    float mMaxY;
+};
+
+} // namespace cairn::navmesh
+
+template <> struct std::hash<cairn::navmesh::TileCoord>
+{
+    size_t operator()(const cairn::navmesh::TileCoord& inTile) const noexcept
+    {
+        return std::hash<uint64_t>()((uint64_t(uint32_t(inTile.mX)) << 32) | uint32_t(inTile.mZ));
+    }
+};

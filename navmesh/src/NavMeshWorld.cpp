@@ -1,0 +1,247 @@
+#include "cairn/navmesh/NavMeshWorld.h"
+
+#include <DetourNavMesh.h>
+#include <DetourNavMeshQuery.h>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+
+namespace cairn::navmesh
+{
+
+namespace
+{
+std::atomic<uint64_t> sNextSerial{1}; // Relaxed: only uniqueness matters
+
+constexpr int cMaxQueryNodes = 4096;
+constexpr int cMaxPathPolygons = 1024;
+constexpr int cMaxStraightPoints = 256;
+
+unsigned char ToDetourArea(int inArea)
+{
+    return inArea == cDefaultArea ? 63 : (unsigned char)inArea; // RC_WALKABLE_AREA is 63
+}
+
+/// This thread's query object for a world, made on first use.
+dtNavMeshQuery* QueryFor(uint64_t inSerial, const dtNavMesh* inNavMesh)
+{
+    struct PerThread
+    {
+        uint64_t mSerial = 0;
+        std::unique_ptr<dtNavMeshQuery, void (*)(dtNavMeshQuery*)> mQuery{nullptr, dtFreeNavMeshQuery};
+    };
+    thread_local PerThread perThread;
+    if (perThread.mSerial != inSerial || perThread.mQuery == nullptr)
+    {
+        perThread.mQuery.reset(dtAllocNavMeshQuery());
+        if (perThread.mQuery == nullptr || dtStatusFailed(perThread.mQuery->init(inNavMesh, cMaxQueryNodes)))
+        {
+            perThread.mQuery.reset();
+            perThread.mSerial = 0;
+            return nullptr;
+        }
+        perThread.mSerial = inSerial;
+    }
+    return perThread.mQuery.get();
+}
+} // namespace
+
+NavMeshWorld::NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile)
+    : mGrid(inGrid), mProfile(inProfile), mSerial(sNextSerial.fetch_add(1, std::memory_order_relaxed))
+{
+}
+
+Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGrid,
+                                                           const AgentProfile& inProfile, int inMaxTiles)
+{
+    if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
+    if (inMaxTiles < 1 || inMaxTiles > (1 << 20))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: max tiles must be 1 to 2^20");
+    std::unique_ptr<NavMeshWorld> world(new NavMeshWorld(inGrid, inProfile));
+    // A 32-bit polygon reference holds salt, tile and polygon bits: tiles take what they need, polygons get
+    // the rest up to 22 (10 bits of salt, as Detour's samples leave)
+    int tileBits = 0;
+    while ((1 << tileBits) < inMaxTiles)
+        ++tileBits;
+    const int polyBits = std::min(22 - tileBits, 14);
+    if (polyBits < 8)
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: too many tiles for 32-bit polygon references");
+    dtNavMeshParams params{};
+    params.orig[0] = inGrid.GetOriginX();
+    params.orig[1] = 0.0f;
+    params.orig[2] = inGrid.GetOriginZ();
+    params.tileWidth = inGrid.GetTileSize();
+    params.tileHeight = inGrid.GetTileSize();
+    params.maxTiles = 1 << tileBits;
+    params.maxPolys = 1 << polyBits;
+    world->mNavMesh = dtAllocNavMesh();
+    if (world->mNavMesh == nullptr || dtStatusFailed(world->mNavMesh->init(&params)))
+        return MakeError(ErrorCode::OutOfCapacity, "navmesh: Detour could not allocate the navmesh");
+    return world;
+}
+
+NavMeshWorld::~NavMeshWorld()
+{
+    dtFreeNavMesh(mNavMesh);
+}
+
+void NavMeshWorld::SubmitTile(BuiltTile&& inTile)
+{
+    std::lock_guard lock(mPendingMutex);
+    const TileCoord tile = inTile.mTile;
+    mPending[tile] = Pending{std::move(inTile)};
+}
+
+void NavMeshWorld::SubmitRemoval(const TileCoord& inTile)
+{
+    BuiltTile empty;
+    empty.mTile = inTile;
+    SubmitTile(std::move(empty));
+}
+
+int NavMeshWorld::Publish()
+{
+    std::map<TileCoord, Pending> pending;
+    {
+        std::lock_guard lock(mPendingMutex);
+        pending.swap(mPending);
+    }
+    if (pending.empty()) return 0;
+    std::unique_lock lock(mNavMeshMutex);
+    int changed = 0;
+    for (auto& [coord, entry] : pending)
+    {
+        if (const dtTileRef old = mNavMesh->getTileRefAt(coord.mX, coord.mZ, 0); old != 0)
+        {
+            mNavMesh->removeTile(old, nullptr, nullptr); // Frees its data (added with DT_TILE_FREE_DATA)
+            mTilePolygons.erase(coord);
+            ++changed;
+        }
+        BuiltTile& tile = entry.mTile;
+        if (tile.mData == nullptr) continue;
+        // On success the navmesh owns the data; on failure (out of tiles) it stays ours and is freed
+        if (dtStatusSucceed(
+                mNavMesh->addTile(tile.mData.get(), tile.mDataSize, DT_TILE_FREE_DATA, 0, nullptr)))
+        {
+            (void)tile.mData.release();
+            mTilePolygons[coord] = tile.mNumPolygons;
+            ++changed;
+        }
+    }
+    return changed;
+}
+
+Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter,
+                                          const Vec3& inSearchExtent) const
+{
+    if (!IsValidWorldPosition(inStart) || !IsValidWorldPosition(inEnd) || !IsFinite(inSearchExtent) ||
+        (inSearchExtent.array() <= 0.0f).any())
+        return MakeError(ErrorCode::InvalidArgument, "path: start, end and search extent must be finite");
+    dtQueryFilter filter;
+    filter.setIncludeFlags(cPolyFlagWalk);
+    filter.setExcludeFlags(0);
+    for (int area = 0; area <= cMaxAreaId; ++area)
+    {
+        const bool excluded = (inFilter.mExcludedAreas >> area) & 1u;
+        const float cost = inFilter.mAreaCost[size_t(area)];
+        if (!std::isfinite(cost) || cost < 0.0f)
+            return MakeError(ErrorCode::InvalidArgument, "path: area costs must be finite and >= 0");
+        // Detour's filter excludes by polygon flags, not areas: an excluded area gets a prohibitive cost, so
+        // the search avoids it when any other way exists, and a path that must cross it is cut short below
+        filter.setAreaCost(ToDetourArea(area), excluded ? 1.0e30f : cost);
+    }
+
+    std::shared_lock lock(mNavMeshMutex);
+    dtNavMeshQuery* query = QueryFor(mSerial, mNavMesh);
+    if (query == nullptr)
+        return MakeError(ErrorCode::OutOfCapacity, "path: Detour could not make a query object");
+    dtPolyRef startRef = 0, endRef = 0;
+    float startPoint[3], endPoint[3];
+    query->findNearestPoly(inStart.data(), inSearchExtent.data(), &filter, &startRef, startPoint);
+    query->findNearestPoly(inEnd.data(), inSearchExtent.data(), &filter, &endRef, endPoint);
+    if (startRef == 0) return MakeError(ErrorCode::InvalidArgument, "path: the start is not on the navmesh");
+    if (endRef == 0) return MakeError(ErrorCode::InvalidArgument, "path: the end is not on the navmesh");
+
+    dtPolyRef corridor[cMaxPathPolygons];
+    int numPolygons = 0;
+    if (dtStatusFailed(query->findPath(startRef, endRef, startPoint, endPoint, &filter, corridor,
+                                       &numPolygons, cMaxPathPolygons)) ||
+        numPolygons == 0)
+        return MakeError(ErrorCode::InvalidArgument, "path: no path");
+    // Cut the corridor before the first polygon of an excluded area
+    for (int i = 0; i < numPolygons; ++i)
+    {
+        const dtMeshTile* tile = nullptr;
+        const dtPoly* poly = nullptr;
+        mNavMesh->getTileAndPolyByRefUnsafe(corridor[i], &tile, &poly);
+        const int area = poly->getArea() == 63 ? cDefaultArea : poly->getArea();
+        if (area <= cMaxAreaId && ((inFilter.mExcludedAreas >> area) & 1u) != 0)
+        {
+            if (i == 0)
+                return MakeError(ErrorCode::InvalidArgument, "path: the start is in an excluded area");
+            numPolygons = i;
+            break;
+        }
+    }
+    PathResult result;
+    result.mNumPolygons = numPolygons;
+    result.mReachedEnd = corridor[numPolygons - 1] == endRef;
+    // A partial path ends at the point of its last polygon nearest the end
+    float target[3] = {endPoint[0], endPoint[1], endPoint[2]};
+    if (!result.mReachedEnd) query->closestPointOnPoly(corridor[numPolygons - 1], endPoint, target, nullptr);
+    float points[cMaxStraightPoints * 3];
+    int numPoints = 0;
+    query->findStraightPath(startPoint, target, corridor, numPolygons, points, nullptr, nullptr, &numPoints,
+                            cMaxStraightPoints);
+    for (int i = 0; i < numPoints; ++i)
+        result.mStraightPath.emplace_back(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+    return result;
+}
+
+int NavMeshWorld::GetNumTiles() const
+{
+    std::shared_lock lock(mNavMeshMutex);
+    return int(mTilePolygons.size());
+}
+
+bool NavMeshWorld::HasTile(const TileCoord& inTile) const
+{
+    std::shared_lock lock(mNavMeshMutex);
+    return mTilePolygons.contains(inTile);
+}
+
+int NavMeshWorld::GetTilePolygonCount(const TileCoord& inTile) const
+{
+    std::shared_lock lock(mNavMeshMutex);
+    auto it = mTilePolygons.find(inTile);
+    return it == mTilePolygons.end() ? 0 : it->second;
+}
+
+std::map<TileCoord, std::vector<unsigned char>> NavMeshWorld::SnapshotTiles() const
+{
+    std::shared_lock lock(mNavMeshMutex);
+    std::map<TileCoord, std::vector<unsigned char>> tiles;
+    const dtNavMesh& navMesh = *mNavMesh;
+    for (int i = 0; i < navMesh.getMaxTiles(); ++i)
+    {
+        const dtMeshTile* tile = navMesh.getTile(i);
+        if (tile == nullptr || tile->header == nullptr) continue;
+        // The data as built; the navmesh links tiles in place (links, neighbours), so only the part Detour's
+        // builder wrote before linking is compared: header, vertices, polygons without their links
+        const dtMeshHeader& h = *tile->header;
+        std::vector<unsigned char>& out = tiles[{h.x, h.y}];
+        const auto* verts = reinterpret_cast<const unsigned char*>(tile->verts);
+        out.assign(verts, verts + sizeof(float) * 3 * size_t(h.vertCount));
+        for (int p = 0; p < h.polyCount; ++p)
+        {
+            const dtPoly& poly = tile->polys[p];
+            const unsigned char* bytes = reinterpret_cast<const unsigned char*>(poly.verts);
+            out.insert(out.end(), bytes, bytes + sizeof(poly.verts));
+            out.push_back(poly.vertCount);
+            out.push_back(poly.areaAndtype);
+        }
+    }
+    return tiles;
+}
+
+} // namespace cairn::navmesh
