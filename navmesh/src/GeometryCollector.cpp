@@ -45,7 +45,8 @@ void GeometryCollector::FindBodies(const AABB& inBox, const NavMeshInclusion& in
 
 void GeometryCollector::CollectTriangles(const AABB& inBox, const NavMeshInclusion& inInclusion,
                                          std::span<const BodyID> inBodies, TileGeometry& ioGeometry,
-                                         std::vector<BodyID>& outBusy, CollectStats& ioStats) const
+                                         std::vector<BodyID>& outBusy, CollectStats& ioStats,
+                                         BodyKinds inKinds) const
 {
     const Clock::time_point start = Clock::now();
     thread_local std::vector<Vec3> triangles;
@@ -57,12 +58,13 @@ void GeometryCollector::CollectTriangles(const AABB& inBox, const NavMeshInclusi
             const Clock::time_point lockStart = Clock::now();
             StaticBodyLockRead staticLock(mBodies, id);
             ioStats.mLongestLockWaitMs = std::max(ioStats.mLongestLockWaitMs, MillisecondsSince(lockStart));
-            if (const Body* body = staticLock.GetBody(); body != nullptr && body->IsInWorld())
+            if (const Body* body = staticLock.GetBody();
+                body != nullptr && body->IsInWorld() && inKinds != BodyKinds::NonStatic)
             {
                 copy = {body->GetShape(), body->GetTransform(), body->GetNavMeshArea()};
                 taken = true;
             }
-            else if (staticLock.WasNotStatic())
+            else if (staticLock.WasNotStatic() && inKinds != BodyKinds::Static)
             {
                 staticLock.Release();
                 const Clock::time_point tryStart = Clock::now();

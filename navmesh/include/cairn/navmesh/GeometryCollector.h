@@ -28,6 +28,16 @@ struct NavMeshInclusion
     bool mKinematic = false;      ///< Kinematic bodies (moving platforms, doors) are obstacles
 };
 
+/// Which of the bodies a collection pass reads. A tile job reads static bodies first (never busy), then the
+/// others in one pass that it repeats whole while any is busy, so the triangles always come in the same
+/// order.
+enum class BodyKinds : uint8_t
+{
+    All,
+    Static,
+    NonStatic,
+};
+
 struct CollectStats
 {
     uint32_t mBodies = 0; ///< Bodies whose triangles were collected
@@ -54,7 +64,8 @@ public:
     /// lock the step holds are appended to outBusy. Adds its figures to ioStats.
     void CollectTriangles(const AABB& inBox, const NavMeshInclusion& inInclusion,
                           std::span<const BodyID> inBodies, TileGeometry& ioGeometry,
-                          std::vector<BodyID>& outBusy, CollectStats& ioStats) const;
+                          std::vector<BodyID>& outBusy, CollectStats& ioStats,
+                          BodyKinds inKinds = BodyKinds::All) const;
 
 private:
     const BodyManager& mBodies;

@@ -48,6 +48,9 @@ public:
     const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
     const BroadPhase& GetBroadPhase() const { return *mBroadPhase; }
     const BodyManager& GetBodyManager() const { return *mBodies; }
+    /// Who is told about bodies added, removed, moved by hand, falling asleep and waking (null: nobody). See
+    /// BodyChangeListener.h; set and clear it while no other thread changes bodies.
+    void SetBodyChangeListener(BodyChangeListener* inListener) { mBodies->SetChangeListener(inListener); }
     const LayerSetup& GetLayers() const { return mLayers; }
     const PhysicsSettings& GetSettings() const { return mSettings; }
     /// Figures of the last Update. Read it from the thread that calls Update.

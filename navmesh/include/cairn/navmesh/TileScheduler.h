@@ -1,0 +1,138 @@
+#pragma once
+
+// TileScheduler: decides which navmesh tiles exist and keeps them up to date with the physics world.
+//  - Needed tiles: those within the radius of an invoker (an AI agent asking for navmesh around itself) and
+//    those of kept areas (a streamed-in region, a level being baked). Nearest to an invoker first.
+//  - Dirty tiles: a body that matters to the navmesh (see NavMeshInclusion) added, removed, moved by hand,
+//    falling asleep or waking makes the tiles its old and new bounds touch dirty (it listens to the physics
+//    world's BodyChangeListener). A tile that turns dirty while its job runs is built again afterwards.
+//  - Jobs: one per tile on the jobs' BackgroundQueue, at most Settings::mMaxConcurrentJobs at once, over
+//    several chunks: (1) broad-phase query and the static bodies' triangles, (2) the other bodies' triangles,
+//    retried in a later chunk while the physics step holds them, (3) Recast and Detour. No chunk waits for a
+//    lock held by the step.
+//  - Update, once a frame at the game's sync point: starts jobs, takes finished tiles, publishes them into
+//  the
+//    NavMeshWorld (NavMeshWorld::Publish), and drops tiles no invoker needed for mDropDelayFrames frames;
+//    tiles of a removed area go at once.
+//
+// Threads: Update on one thread (the game's), never inside the physics step; invokers, areas and MarkDirty
+// from any thread; OnBodyChanged on whatever thread changes a body (the physics listener contract).
+// mMutex guards every member below it; it is a leaf lock (held while a body lock is held, never the other
+// way round), held only for bookkeeping, never while waiting for a job or for the navmesh.
+// The scheduler registers itself as the body manager's change listener: create and destroy it while no other
+// thread is changing bodies.
+
+#include "cairn/jobs/BackgroundQueue.h"
+#include "cairn/navmesh/GeometryCollector.h"
+#include "cairn/navmesh/NavMeshWorld.h"
+#include "cairn/physics/PhysicsSystem.h"
+
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+namespace cairn::navmesh
+{
+
+class TileJob;
+
+class TileScheduler final : public BodyChangeListener
+{
+public:
+    struct Settings
+    {
+        NavMeshInclusion mInclusion;
+        uint32_t mMaxConcurrentJobs = 2; ///< Tile jobs running at once (the job budget)
+        uint32_t mDropDelayFrames = 120; ///< A tile no invoker needs is dropped after this many frames
+        int mJobPriority = 0;            ///< On the background queue (higher runs first)
+    };
+
+    struct Stats
+    {
+        uint64_t mJobsStarted = 0;
+        uint64_t mJobsFailed = 0;
+        uint64_t mTilesPublished = 0; ///< Tiles swapped into the navmesh (built or emptied)
+        uint64_t mTilesDropped = 0;
+        uint64_t mRebuilds = 0;        ///< Builds of a tile that was already built (dirty again)
+        uint64_t mBusyRetries = 0;     ///< Chunks that found a body held by the step and tried again later
+        double mLongestLockWaitMs = 0; ///< Longest single lock acquisition of any job
+        double mCollectMs = 0;         ///< Summed over jobs: query and triangle copies
+        double mBuildMs = 0;           ///< Summed over jobs: Recast and Detour
+        /// Frames from a tile being needed to its first publication, one entry per tile
+        std::vector<uint32_t> mFirstPublishFrames;
+        std::string mLastError;
+    };
+
+    using InvokerID = uint32_t;
+    using AreaID = uint32_t;
+
+    TileScheduler(PhysicsSystem& ioPhysics, NavMeshWorld& ioWorld, jobs::BackgroundQueue& ioQueue,
+                  const Settings& inSettings);
+    /// Cancels running jobs and waits for them; unregisters the listener.
+    ~TileScheduler() override;
+    TileScheduler(const TileScheduler&) = delete;
+    TileScheduler& operator=(const TileScheduler&) = delete;
+
+    /// Invokers: the tiles within inRadius (x-z distance from inPosition) are kept built. Any thread.
+    InvokerID AddInvoker(const Vec3& inPosition, float inRadius);
+    void MoveInvoker(InvokerID inInvoker, const Vec3& inPosition);
+    void RemoveInvoker(InvokerID inInvoker);
+    /// Areas: every tile overlapping inBounds is kept built until RemoveArea, which drops them at once
+    /// (unless an invoker or another area still needs them). Any thread.
+    AreaID AddArea(const AABB& inBounds);
+    void RemoveArea(AreaID inArea);
+
+    /// Marks the tiles inBounds touches dirty (for changes the physics world does not report). Any thread.
+    void MarkDirty(const AABB& inBounds);
+    /// BodyChangeListener: marks the tiles of a body that matters dirty.
+    void OnBodyChanged(const BodyChange& inChange) override;
+
+    /// Once a frame, outside the physics step: see above. Returns the number of tiles published.
+    int Update();
+    /// True when every needed tile is built, clean and published, and no job runs.
+    bool IsIdle() const;
+    Stats GetStats() const;
+    const Settings& GetSettings() const { return mSettings; }
+
+private:
+    struct TileState
+    {
+        bool mDirty = true; ///< Needs a build (set again while a job runs: built once more)
+        bool mEverPublished = false;
+        uint64_t mNeededSinceFrame = 0; ///< For the first-publication latency
+        uint64_t mLastNeededFrame = 0;
+        std::shared_ptr<TileJob> mJob; ///< Running job, or null
+        std::shared_ptr<jobs::BackgroundTask> mTask;
+    };
+    struct Invoker
+    {
+        Vec3 mPosition;
+        float mRadius;
+    };
+
+    /// Tiles the invokers and areas need now, with the x-z distance to the nearest invoker (areas: 0).
+    void CollectNeeded(std::unordered_map<TileCoord, float>& outNeeded) const;
+    void MarkDirtyLocked(const AABB& inBounds);
+    void StartJob(const TileCoord& inTile, TileState& ioState);
+    /// Takes a finished job's tile into the navmesh's queue; false while the job still runs.
+    bool CollectFinished(const TileCoord& inTile, TileState& ioState);
+
+    PhysicsSystem& mPhysics;
+    NavMeshWorld& mWorld;
+    jobs::BackgroundQueue& mQueue;
+    const Settings mSettings;
+    const GeometryCollector mCollector;
+    const float mBorder; ///< m of geometry around a tile that its build reads
+
+    mutable std::mutex mMutex;
+    uint64_t mFrame = 0;
+    std::unordered_map<TileCoord, TileState> mTiles;
+    std::unordered_map<InvokerID, Invoker> mInvokers;
+    std::unordered_map<AreaID, AABB> mAreas;
+    uint32_t mNextID = 1;
+    std::vector<TileCoord> mDropNow; ///< Tiles of removed areas, checked at the next Update
+    Stats mStats;
+};
+
+} // namespace cairn::navmesh

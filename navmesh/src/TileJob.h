@@ -1,0 +1,65 @@
+#pragma once
+
+// TileJob: one tile's build, run chunk by chunk on a BackgroundQueue thread (see TileScheduler.h):
+//   chunk 1: broad-phase query of the bordered tile box, then the static bodies' triangles;
+//   chunk 2+: the other bodies' triangles, all again in a later chunk while the step holds any of them;
+//   last:    Recast and Detour.
+// Its fields are written only by the queue thread running it; the scheduler reads the result after seeing
+// mFinished (acquire, paired with the release that sets it).
+
+#include "cairn/jobs/BackgroundQueue.h"
+#include "cairn/navmesh/GeometryCollector.h"
+#include "cairn/navmesh/TileBuilder.h"
+
+#include <atomic>
+#include <optional>
+
+namespace cairn::navmesh
+{
+
+class TileJob
+{
+public:
+    TileJob(const GeometryCollector& inCollector, const AgentProfile& inProfile, const TileGrid& inGrid,
+            const NavMeshInclusion& inInclusion, const TileCoord& inTile, float inBorder)
+        : mCollector(inCollector), mProfile(inProfile), mGrid(inGrid), mInclusion(inInclusion), mTile(inTile),
+          mBox(inGrid.GetTileBoundsWithBorder(inTile, inBorder))
+    {
+    }
+
+    /// The BackgroundQueue step function.
+    jobs::BackgroundStep Step(jobs::BackgroundTaskContext& ioContext);
+
+    bool IsFinished() const { return mFinished.load(std::memory_order_acquire); } // Pairs with Finish
+    /// After IsFinished: the tile, or why it failed (empty optional: cancelled).
+    std::optional<Result<BuiltTile>>& GetResult() { return mResult; }
+    const CollectStats& GetCollectStats() const { return mStats; }
+    uint32_t GetBusyRetries() const { return mBusyRetries; }
+
+private:
+    enum class Stage : uint8_t
+    {
+        Static,
+        Others,
+        Build,
+    };
+    jobs::BackgroundStep Finish(std::optional<Result<BuiltTile>> inResult, jobs::BackgroundStep inStep);
+
+    const GeometryCollector& mCollector;
+    const AgentProfile& mProfile;
+    const TileGrid& mGrid;
+    const NavMeshInclusion mInclusion;
+    const TileCoord mTile;
+    const AABB mBox;
+    Stage mStage = Stage::Static;
+    std::vector<BodyID> mBodies;
+    std::vector<BodyID> mBusy;
+    TileGeometry mGeometry;
+    int mStaticTriangles = 0; ///< Where the other bodies' triangles start (cut back on a retry)
+    CollectStats mStats;
+    uint32_t mBusyRetries = 0;
+    std::optional<Result<BuiltTile>> mResult;
+    std::atomic<bool> mFinished{false};
+};
+
+} // namespace cairn::navmesh

@@ -1,0 +1,289 @@
+#include "cairn/navmesh/TileScheduler.h"
+
+#include "TileJob.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn::navmesh
+{
+
+TileScheduler::TileScheduler(PhysicsSystem& ioPhysics, NavMeshWorld& ioWorld, jobs::BackgroundQueue& ioQueue,
+                             const Settings& inSettings)
+    : mPhysics(ioPhysics), mWorld(ioWorld), mQueue(ioQueue), mSettings(inSettings),
+      mCollector(ioPhysics.GetBodyManager(), ioPhysics.GetBroadPhase()),
+      mBorder(float(ioWorld.GetProfile().GetBorderCells()) * ioWorld.GetProfile().mCellSize)
+{
+    mPhysics.SetBodyChangeListener(this);
+}
+
+TileScheduler::~TileScheduler()
+{
+    mPhysics.SetBodyChangeListener(nullptr);
+    std::vector<std::shared_ptr<jobs::BackgroundTask>> tasks;
+    {
+        std::lock_guard lock(mMutex);
+        for (auto& [tile, state] : mTiles)
+            if (state.mTask != nullptr) tasks.push_back(state.mTask);
+    }
+    // The jobs read the physics world and this scheduler's collector: they must be over before either goes
+    for (const std::shared_ptr<jobs::BackgroundTask>& task : tasks)
+        task->Cancel();
+    for (const std::shared_ptr<jobs::BackgroundTask>& task : tasks)
+        while (!task->Wait(std::chrono::milliseconds(100)))
+        {
+        }
+}
+
+TileScheduler::InvokerID TileScheduler::AddInvoker(const Vec3& inPosition, float inRadius)
+{
+    std::lock_guard lock(mMutex);
+    const InvokerID id = mNextID++;
+    mInvokers[id] = {inPosition, std::isfinite(inRadius) ? std::max(inRadius, 0.0f) : 0.0f};
+    return id;
+}
+
+void TileScheduler::MoveInvoker(InvokerID inInvoker, const Vec3& inPosition)
+{
+    std::lock_guard lock(mMutex);
+    if (auto it = mInvokers.find(inInvoker); it != mInvokers.end() && IsValidWorldPosition(inPosition))
+        it->second.mPosition = inPosition;
+}
+
+void TileScheduler::RemoveInvoker(InvokerID inInvoker)
+{
+    std::lock_guard lock(mMutex);
+    mInvokers.erase(inInvoker);
+}
+
+TileScheduler::AreaID TileScheduler::AddArea(const AABB& inBounds)
+{
+    std::lock_guard lock(mMutex);
+    const AreaID id = mNextID++;
+    mAreas[id] = inBounds;
+    return id;
+}
+
+void TileScheduler::RemoveArea(AreaID inArea)
+{
+    std::lock_guard lock(mMutex);
+    auto it = mAreas.find(inArea);
+    if (it == mAreas.end()) return;
+    mWorld.GetGrid().TilesOverlapping(it->second, 0.0f, mDropNow);
+    mAreas.erase(it);
+}
+
+void TileScheduler::MarkDirty(const AABB& inBounds)
+{
+    std::lock_guard lock(mMutex);
+    MarkDirtyLocked(inBounds);
+}
+
+void TileScheduler::MarkDirtyLocked(const AABB& inBounds)
+{
+    if (inBounds.IsEmpty()) return;
+    thread_local std::vector<TileCoord> touched;
+    touched.clear();
+    // A body changes every tile whose build reads its geometry: those whose bordered box it overlaps
+    if (!mWorld.GetGrid().TilesOverlapping(inBounds, mBorder, touched))
+    {
+        // Bounds too large to list (a huge body): every known tile is dirty
+        for (auto& [tile, state] : mTiles)
+            state.mDirty = true;
+        return;
+    }
+    for (const TileCoord& tile : touched)
+        if (auto it = mTiles.find(tile); it != mTiles.end()) it->second.mDirty = true;
+}
+
+void TileScheduler::OnBodyChanged(const BodyChange& inChange)
+{
+    const NavMeshInclusion& inclusion = mSettings.mInclusion;
+    if ((inclusion.mObjectLayers & ObjectLayerMask(1) << inChange.mObjectLayer) == 0) return;
+    // Awake dynamic bodies are never in the navmesh, but falling asleep, waking, or being placed or removed
+    // while asleep changes it
+    const bool matters = inChange.mMotionType == MotionType::Static ||
+                         (inChange.mMotionType == MotionType::Dynamic && inclusion.mSleepingDynamic) ||
+                         (inChange.mMotionType == MotionType::Kinematic && inclusion.mKinematic);
+    if (!matters) return;
+    std::lock_guard lock(mMutex);
+    MarkDirtyLocked(inChange.mOldBounds);
+    MarkDirtyLocked(inChange.mNewBounds);
+}
+
+void TileScheduler::CollectNeeded(std::unordered_map<TileCoord, float>& outNeeded) const
+{
+    const TileGrid& grid = mWorld.GetGrid();
+    std::vector<TileCoord> tiles;
+    for (const auto& [id, invoker] : mInvokers)
+    {
+        tiles.clear();
+        const Vec3 extent(invoker.mRadius, 0.0f, invoker.mRadius);
+        grid.TilesOverlapping(AABB(invoker.mPosition - extent, invoker.mPosition + extent), 0.0f, tiles,
+                              4096);
+        for (const TileCoord& tile : tiles)
+        {
+            // x-z distance from the invoker to the tile's area: within the radius, the tile is needed
+            const AABB box = grid.GetTileBounds(tile);
+            const float dx =
+                std::max({box.mMin.x() - invoker.mPosition.x(), 0.0f, invoker.mPosition.x() - box.mMax.x()});
+            const float dz =
+                std::max({box.mMin.z() - invoker.mPosition.z(), 0.0f, invoker.mPosition.z() - box.mMax.z()});
+            const float distance = std::sqrt(dx * dx + dz * dz);
+            if (distance > invoker.mRadius) continue;
+            auto [it, inserted] = outNeeded.try_emplace(tile, distance);
+            if (!inserted) it->second = std::min(it->second, distance);
+        }
+    }
+    for (const auto& [id, bounds] : mAreas)
+    {
+        tiles.clear();
+        grid.TilesOverlapping(bounds, 0.0f, tiles);
+        for (const TileCoord& tile : tiles)
+            outNeeded[tile] = 0.0f;
+    }
+}
+
+void TileScheduler::StartJob(const TileCoord& inTile, TileState& ioState)
+{
+    auto job = std::make_shared<TileJob>(mCollector, mWorld.GetProfile(), mWorld.GetGrid(),
+                                         mSettings.mInclusion, inTile, mBorder);
+    ioState.mJob = job;
+    ioState.mDirty = false; // Dirt from now on means this job's result is already stale: build again after
+    ioState.mTask = mQueue.Submit(
+        "navmesh tile " + std::to_string(inTile.mX) + "," + std::to_string(inTile.mZ), mSettings.mJobPriority,
+        [job](jobs::BackgroundTaskContext& ioContext) { return job->Step(ioContext); });
+    if (ioState.mEverPublished) ++mStats.mRebuilds;
+    ++mStats.mJobsStarted;
+}
+
+bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
+{
+    TileJob& job = *ioState.mJob;
+    if (!job.IsFinished())
+    {
+        // Cancelled before it ever ran: no result, build again if still needed
+        if (!ioState.mTask->IsFinished()) return false;
+        ioState.mDirty = true;
+        ioState.mJob.reset();
+        ioState.mTask.reset();
+        return true;
+    }
+    const CollectStats& stats = job.GetCollectStats();
+    mStats.mLongestLockWaitMs = std::max(mStats.mLongestLockWaitMs, stats.mLongestLockWaitMs);
+    mStats.mCollectMs += stats.mCollectMs;
+    mStats.mBusyRetries += job.GetBusyRetries();
+    std::optional<Result<BuiltTile>>& result = job.GetResult();
+    if (!result.has_value())
+        ioState.mDirty = true;
+    else if (!result->IsOk())
+    {
+        ++mStats.mJobsFailed;
+        mStats.mLastError = "tile " + std::to_string(inTile.mX) + "," + std::to_string(inTile.mZ) + ": " +
+                            result->GetError().mMessage;
+    }
+    else
+    {
+        mStats.mBuildMs += result->Value().mBuildMs;
+        mWorld.SubmitTile(std::move(result->Value()));
+        if (!ioState.mEverPublished)
+            mStats.mFirstPublishFrames.push_back(uint32_t(mFrame - ioState.mNeededSinceFrame));
+        ioState.mEverPublished = true;
+        ++mStats.mTilesPublished;
+    }
+    ioState.mJob.reset();
+    ioState.mTask.reset();
+    return true;
+}
+
+int TileScheduler::Update()
+{
+    std::unordered_map<TileCoord, float> needed;
+    {
+        std::lock_guard lock(mMutex);
+        ++mFrame;
+        CollectNeeded(needed);
+
+        // Finished jobs first: their tiles go into the navmesh's queue
+        for (auto& [tile, state] : mTiles)
+            if (state.mJob != nullptr) CollectFinished(tile, state);
+
+        // Newly needed tiles; needed ones are kept
+        for (const auto& [tile, distance] : needed)
+        {
+            auto [it, inserted] = mTiles.try_emplace(tile);
+            if (inserted) it->second.mNeededSinceFrame = mFrame;
+            it->second.mLastNeededFrame = mFrame;
+        }
+        // Drop tiles no longer needed: those of removed areas at once, the others after the delay
+        for (const TileCoord& tile : mDropNow)
+            if (auto it = mTiles.find(tile); it != mTiles.end() && !needed.contains(tile))
+                it->second.mLastNeededFrame = 0;
+        mDropNow.clear();
+        for (auto it = mTiles.begin(); it != mTiles.end();)
+        {
+            TileState& state = it->second;
+            const bool expired =
+                !needed.contains(it->first) &&
+                (state.mLastNeededFrame == 0 || mFrame - state.mLastNeededFrame > mSettings.mDropDelayFrames);
+            if (!expired)
+            {
+                ++it;
+                continue;
+            }
+            if (state.mTask != nullptr)
+            {
+                state.mTask->Cancel(); // Collected (and dropped) when it has stopped
+                state.mLastNeededFrame = 0;
+                ++it;
+                continue;
+            }
+            if (state.mEverPublished) mWorld.SubmitRemoval(it->first);
+            ++mStats.mTilesDropped;
+            it = mTiles.erase(it);
+        }
+
+        // Start jobs for dirty needed tiles, nearest to an invoker first, within the budget
+        uint32_t running = 0;
+        std::vector<std::pair<float, TileCoord>> candidates;
+        for (const auto& [tile, state] : mTiles)
+        {
+            if (state.mJob != nullptr)
+                ++running;
+            else if (state.mDirty && needed.contains(tile))
+                candidates.push_back({needed[tile], tile});
+        }
+        std::sort(candidates.begin(), candidates.end());
+        for (const auto& [distance, tile] : candidates)
+        {
+            if (running >= mSettings.mMaxConcurrentJobs) break;
+            StartJob(tile, mTiles[tile]);
+            ++running;
+        }
+    }
+    // The sync point: outside mMutex, since it waits for path queries in progress
+    return mWorld.Publish();
+}
+
+bool TileScheduler::IsIdle() const
+{
+    std::lock_guard lock(mMutex);
+    std::unordered_map<TileCoord, float> needed;
+    CollectNeeded(needed);
+    for (const auto& [tile, distance] : needed)
+    {
+        auto it = mTiles.find(tile);
+        if (it == mTiles.end() || it->second.mDirty || it->second.mJob != nullptr) return false;
+    }
+    for (const auto& [tile, state] : mTiles)
+        if (state.mJob != nullptr) return false;
+    return true;
+}
+
+TileScheduler::Stats TileScheduler::GetStats() const
+{
+    std::lock_guard lock(mMutex);
+    return mStats;
+}
+
+} // namespace cairn::navmesh

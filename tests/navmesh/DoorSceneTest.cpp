@@ -1,0 +1,101 @@
+// A wall with a door: the path goes through the door; a box dropped into the doorway (dynamic, then asleep,
+// an obstacle) makes its tiles dirty, they are rebuilt in the background, and then no path gets through;
+// removing the box brings the path back.
+
+#include "NavMeshSceneFixture.h"
+
+namespace cairn::navmesh::test
+{
+namespace
+{
+
+class DoorSceneTest : public NavMeshSceneFixture
+{
+protected:
+    void BuildRoom()
+    {
+        AddStaticBox(Vec3(0, -0.5f, 0), Vec3(10, 0.5f, 10)); // Floor, top at y = 0
+        // A wall along x at z = 0, 3 m high, with a 2 m door in the middle (x in [-1, 1])
+        AddStaticBox(Vec3(-5.5f, 1.5f, 0), Vec3(4.5f, 1.5f, 0.2f));
+        AddStaticBox(Vec3(5.5f, 1.5f, 0), Vec3(4.5f, 1.5f, 0.2f));
+        MakeNavMesh();
+    }
+
+    Result<PathResult> PathAcross() const { return mWorld->FindPath(Vec3(0.5f, 0, -6), Vec3(-0.5f, 0, 6)); }
+
+    /// Every point of the path is within the doorway where it crosses the wall.
+    static bool GoesThroughDoor(const PathResult& inPath)
+    {
+        for (size_t i = 0; i + 1 < inPath.mStraightPath.size(); ++i)
+        {
+            const Vec3& a = inPath.mStraightPath[i];
+            const Vec3& b = inPath.mStraightPath[i + 1];
+            if ((a.z() < 0) == (b.z() < 0)) continue;
+            const float t = a.z() / (a.z() - b.z());
+            const float x = a.x() + t * (b.x() - a.x());
+            if (std::abs(x) > 1.0f) return false;
+        }
+        return true;
+    }
+};
+
+TEST_F(DoorSceneTest, BoxInTheDoorwayBlocksThePathUntilRemoved)
+{
+    BuildRoom();
+    ASSERT_TRUE(RunUntilIdle());
+    EXPECT_EQ(mWorld->GetNumTiles(), 4); // The room spans the four tiles around the origin
+
+    Result<PathResult> open = PathAcross();
+    ASSERT_TRUE(open) << open.GetError().mMessage;
+    EXPECT_TRUE(open.Value().mReachedEnd);
+    EXPECT_TRUE(GoesThroughDoor(open.Value()));
+    EXPECT_GE(open.Value().mStraightPath.size(), 2u);
+
+    // Dropped into the doorway: 1.2 m wide, 1.5 m high (too high to climb), falls 0.5 m and goes to sleep
+    const BodyID box = AddDynamicBox(Vec3(0, 1.25f, 0), Vec3(0.6f, 0.75f, 0.18f));
+    int frames = 0;
+    while (mPhysics->GetBodyInterface().IsActive(box).Value() && frames < 600)
+    {
+        Frame();
+        ++frames;
+    }
+    ASSERT_FALSE(mPhysics->GetBodyInterface().IsActive(box).Value()) << "the box did not fall asleep";
+    const uint64_t rebuildsBefore = mScheduler->GetStats().mRebuilds;
+    ASSERT_TRUE(RunUntilIdle());
+    EXPECT_GT(mScheduler->GetStats().mRebuilds, rebuildsBefore); // Its tiles were dirty and built again
+
+    Result<PathResult> blocked = PathAcross();
+    ASSERT_TRUE(blocked) << blocked.GetError().mMessage;
+    EXPECT_FALSE(blocked.Value().mReachedEnd);
+
+    ASSERT_TRUE(mPhysics->GetBodyInterface().RemoveBody(box).IsOk());
+    ASSERT_TRUE(RunUntilIdle());
+    Result<PathResult> reopened = PathAcross();
+    ASSERT_TRUE(reopened) << reopened.GetError().mMessage;
+    EXPECT_TRUE(reopened.Value().mReachedEnd);
+    EXPECT_TRUE(GoesThroughDoor(reopened.Value()));
+}
+
+TEST_F(DoorSceneTest, AnAwakeBoxIsNotAnObstacle)
+{
+    BuildRoom();
+    ASSERT_TRUE(RunUntilIdle());
+    // A box in the doorway that never sleeps: it may move at any time, so it is not in the navmesh, even
+    // when its tiles are rebuilt
+    BodyCreationSettings settings;
+    settings.mShape = BoxShape::Create(Vec3(0.6f, 0.75f, 0.18f)).Value();
+    settings.mPosition = Vec3(0, 0.75f, 0);
+    settings.mMotionType = MotionType::Dynamic;
+    settings.mObjectLayer = Layers::cMoving;
+    settings.mAllowSleeping = false;
+    const BodyID box = mPhysics->GetBodyInterface().CreateAndAddBody(settings, Activation::Activate).Value();
+    mScheduler->MarkDirty(AABB(Vec3(-1, 0, -1), Vec3(1, 3, 1)));
+    ASSERT_TRUE(RunUntilIdle());
+    ASSERT_TRUE(mPhysics->GetBodyInterface().IsActive(box).Value());
+    Result<PathResult> path = PathAcross();
+    ASSERT_TRUE(path);
+    EXPECT_TRUE(path.Value().mReachedEnd);
+}
+
+} // namespace
+} // namespace cairn::navmesh::test
