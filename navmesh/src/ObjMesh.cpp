@@ -1,6 +1,10 @@
 #include "cairn/navmesh/ObjMesh.h"
 
+#include <charconv>
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <tiny_obj_loader.h>
 
 namespace cairn::navmesh
@@ -27,11 +31,43 @@ TileGeometry IndexedMesh::ToTileGeometry(uint8_t inArea) const
     return geometry;
 }
 
+namespace
+{
+/// tinyobjloader reads a coordinate it cannot parse ("nan", "1.2.3", "x") as 0 without a word: a malformed
+/// level would load as a different level. So the vertex lines are checked first, each coordinate in full.
+Status CheckVertexLines(const std::string& inPath)
+{
+    std::ifstream file(inPath);
+    std::string line;
+    for (int number = 1; std::getline(file, line); ++number)
+    {
+        if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+        std::istringstream tokens(line.substr(2));
+        std::string token;
+        int coordinates = 0;
+        while (tokens >> token)
+        {
+            float value = 0.0f;
+            const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+            if (error != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+                return MakeError(ErrorCode::ParseError, inPath + ":" + std::to_string(number) + ": '" +
+                                                            token + "' is not a finite number");
+            ++coordinates;
+        }
+        if (coordinates < 3)
+            return MakeError(ErrorCode::ParseError,
+                             inPath + ":" + std::to_string(number) + ": a vertex needs x, y and z");
+    }
+    return Status::Ok();
+}
+} // namespace
+
 Result<IndexedMesh> LoadObjMesh(const std::string& inPath)
 {
     std::error_code error;
     if (!std::filesystem::is_regular_file(inPath, error))
         return MakeError(ErrorCode::IOError, inPath + ": not a readable file");
+    if (Status checked = CheckVertexLines(inPath); !checked) return checked.GetError();
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;

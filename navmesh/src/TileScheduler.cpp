@@ -280,6 +280,23 @@ bool TileScheduler::IsIdle() const
     return true;
 }
 
+uint32_t TileScheduler::GetNumRunningJobs() const
+{
+    std::lock_guard lock(mMutex);
+    uint32_t running = 0;
+    for (const auto& [tile, state] : mTiles)
+        running += state.mJob != nullptr ? 1 : 0;
+    return running;
+}
+
+bool TileScheduler::HasFinishedJobs() const
+{
+    std::lock_guard lock(mMutex);
+    for (const auto& [tile, state] : mTiles)
+        if (state.mJob != nullptr && state.mJob->IsFinished()) return true;
+    return false;
+}
+
 TileScheduler::Stats TileScheduler::GetStats() const
 {
     std::lock_guard lock(mMutex);

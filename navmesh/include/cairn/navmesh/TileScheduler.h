@@ -93,6 +93,10 @@ public:
     /// True when every needed tile is built, clean and published, and no job runs.
     bool IsIdle() const;
     Stats GetStats() const;
+    /// Jobs started and not yet taken in by Update.
+    uint32_t GetNumRunningJobs() const;
+    /// True when a job has finished and waits for the next Update to publish its tile.
+    bool HasFinishedJobs() const;
     const Settings& GetSettings() const { return mSettings; }
 
 private:

@@ -1,0 +1,96 @@
+// Path queries: area types from the bodies' navmesh area, priced and excluded by the path filter; errors for
+// points off the navmesh and for bad numbers.
+
+#include "NavMeshSceneFixture.h"
+
+namespace cairn::navmesh::test
+{
+namespace
+{
+
+constexpr uint8_t cWater = 5;
+
+class PathQueryTest : public NavMeshSceneFixture
+{
+protected:
+    /// Ground from z = -10 to 10, crossed at z in [-1, 1] by a band of water, except for a dry bridge at
+    /// x in [8, 10]. Start and end are on either side of the water at x = -8.
+    void BuildRiver()
+    {
+        AddStaticBox(Vec3(0, -0.5f, -5.5f), Vec3(10, 0.5f, 4.5f));  // South bank
+        AddStaticBox(Vec3(0, -0.5f, 5.5f), Vec3(10, 0.5f, 4.5f));   // North bank
+        AddStaticBox(Vec3(-1, -0.5f, 0), Vec3(9, 0.5f, 1), cWater); // Water, x in [-10, 8]
+        AddStaticBox(Vec3(9, -0.5f, 0), Vec3(1, 0.5f, 1));          // Bridge, x in [8, 10]
+        MakeNavMesh();
+        ASSERT_TRUE(RunUntilIdle());
+    }
+
+    static float Length(const PathResult& inPath)
+    {
+        float length = 0.0f;
+        for (size_t i = 0; i + 1 < inPath.mStraightPath.size(); ++i)
+            length += (inPath.mStraightPath[i + 1] - inPath.mStraightPath[i]).norm();
+        return length;
+    }
+
+    const Vec3 mStart = Vec3(-8, 0, -6);
+    const Vec3 mEnd = Vec3(-8, 0, 6);
+};
+
+TEST_F(PathQueryTest, AreaCostsAndExclusionsChooseTheWay)
+{
+    BuildRiver();
+    Result<PathResult> swim = mWorld->FindPath(mStart, mEnd);
+    ASSERT_TRUE(swim) << swim.GetError().mMessage;
+    EXPECT_TRUE(swim.Value().mReachedEnd);
+    EXPECT_LT(Length(swim.Value()), 14.0f); // Straight across the water
+
+    PathFilter dear;
+    dear.mAreaCost[cWater] = 50.0f;
+    Result<PathResult> around = mWorld->FindPath(mStart, mEnd, dear);
+    ASSERT_TRUE(around);
+    EXPECT_TRUE(around.Value().mReachedEnd);
+    EXPECT_GT(Length(around.Value()), 30.0f); // Over the bridge, 16 m away
+
+    PathFilter noSwimming;
+    noSwimming.mExcludedAreas = uint64_t(1) << cWater;
+    Result<PathResult> dry = mWorld->FindPath(mStart, mEnd, noSwimming);
+    ASSERT_TRUE(dry);
+    EXPECT_TRUE(dry.Value().mReachedEnd);
+    EXPECT_GT(Length(dry.Value()), 30.0f);
+}
+
+TEST_F(PathQueryTest, AnExcludedAreaThatIsTheOnlyWayCutsThePathShort)
+{
+    AddStaticBox(Vec3(0, -0.5f, -5.5f), Vec3(10, 0.5f, 4.5f));
+    AddStaticBox(Vec3(0, -0.5f, 5.5f), Vec3(10, 0.5f, 4.5f));
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(10, 0.5f, 1), cWater); // No bridge
+    MakeNavMesh();
+    ASSERT_TRUE(RunUntilIdle());
+    PathFilter noSwimming;
+    noSwimming.mExcludedAreas = uint64_t(1) << cWater;
+    Result<PathResult> path = mWorld->FindPath(mStart, mEnd, noSwimming);
+    ASSERT_TRUE(path);
+    EXPECT_FALSE(path.Value().mReachedEnd);
+    ASSERT_FALSE(path.Value().mStraightPath.empty());
+    EXPECT_LT(path.Value().mStraightPath.back().z(), -0.5f); // Stops on the south bank
+}
+
+TEST_F(PathQueryTest, BadQueriesGetClearErrors)
+{
+    BuildRiver();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(mWorld->FindPath(Vec3(nan, 0, 0), mEnd).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(mWorld->FindPath(mStart, Vec3(0, 0, 1.0e9f)).GetError().mCode, ErrorCode::InvalidArgument);
+    // Far above the navmesh: not on it
+    Result<PathResult> off = mWorld->FindPath(Vec3(0, 50, -6), mEnd);
+    ASSERT_FALSE(off);
+    EXPECT_NE(off.GetError().mMessage.find("not on the navmesh"), std::string::npos);
+    PathFilter bad;
+    bad.mAreaCost[0] = -1.0f;
+    EXPECT_EQ(mWorld->FindPath(mStart, mEnd, bad).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(mWorld->FindPath(mStart, mEnd, {}, Vec3(0, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+}
+
+} // namespace
+} // namespace cairn::navmesh::test

@@ -1,0 +1,101 @@
+// TileScheduler: which tiles exist (invokers, areas), in which order they are built, the job budget, and
+// when tiles are dropped.
+
+#include "NavMeshSceneFixture.h"
+
+#include <algorithm>
+
+namespace cairn::navmesh::test
+{
+namespace
+{
+
+class TileSchedulerTest : public NavMeshSceneFixture
+{
+protected:
+    /// A floor of 4 x 4 tiles (51.2 m) and no kept area: invokers decide.
+    void MakeFloorWorld(TileScheduler::Settings inSettings)
+    {
+        AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25.6f, 0.5f, 25.6f));
+        MakeNavMesh(2, inSettings);
+        mScheduler->RemoveArea(mArea);
+    }
+    TileCoord TileAt(float inX, float inZ) const { return mWorld->GetGrid().TileAt(inX, inZ); }
+};
+
+TEST_F(TileSchedulerTest, AnInvokerGetsTheTilesWithinItsRadiusNearestFirstWithinTheBudget)
+{
+    TileScheduler::Settings settings;
+    settings.mMaxConcurrentJobs = 1;
+    MakeFloorWorld(settings);
+    // 2 m from the tile corner at the origin: a 5 m radius reaches the four tiles around the origin
+    mScheduler->AddInvoker(Vec3(2, 0, 2), 5.0f);
+    std::vector<TileCoord> publishOrder;
+    for (int frame = 0; frame < 2000 && !mScheduler->IsIdle(); ++frame)
+    {
+        Frame();
+        EXPECT_LE(mScheduler->GetNumRunningJobs(), 1u);
+        for (int x = 0; x < 4; ++x)
+            for (int z = 0; z < 4; ++z)
+                if (mWorld->HasTile({x, z}) && std::find(publishOrder.begin(), publishOrder.end(),
+                                                         TileCoord{x, z}) == publishOrder.end())
+                    publishOrder.push_back({x, z});
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    mScheduler->Update();
+    ASSERT_EQ(publishOrder.size(), 4u);
+    EXPECT_EQ(publishOrder.front(), TileAt(2, 2)); // The invoker's own tile first
+    EXPECT_EQ(mWorld->GetNumTiles(), 4);
+    EXPECT_TRUE(mWorld->HasTile(TileAt(-2, -2)));
+    EXPECT_FALSE(mWorld->HasTile(TileAt(-20, -20))); // Beyond the radius
+    EXPECT_EQ(mScheduler->GetStats().mFirstPublishFrames.size(), 4u);
+}
+
+TEST_F(TileSchedulerTest, TilesNoInvokerNeedsAreDroppedAfterTheDelay)
+{
+    TileScheduler::Settings settings;
+    settings.mDropDelayFrames = 10;
+    MakeFloorWorld(settings);
+    const TileScheduler::InvokerID invoker = mScheduler->AddInvoker(Vec3(6.4f, 0, 6.4f), 1.0f);
+    ASSERT_TRUE(RunUntilIdle());
+    const TileCoord before = TileAt(6.4f, 6.4f), after = TileAt(-19.2f, -19.2f);
+    ASSERT_TRUE(mWorld->HasTile(before));
+    mScheduler->MoveInvoker(invoker, Vec3(-19.2f, 0, -19.2f)); // The centre of another tile
+    for (int frame = 0; frame < 5; ++frame)
+        Frame();
+    EXPECT_TRUE(mWorld->HasTile(before)); // Kept for a while: the agent may come back
+    ASSERT_TRUE(RunUntilIdle());
+    for (int frame = 0; frame < 12; ++frame)
+        Frame();
+    EXPECT_FALSE(mWorld->HasTile(before));
+    EXPECT_TRUE(mWorld->HasTile(after));
+    EXPECT_GE(mScheduler->GetStats().mTilesDropped, 1u);
+}
+
+TEST_F(TileSchedulerTest, ARemovedAreasTilesGoAtOnce)
+{
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(12.8f, 0.5f, 12.8f));
+    MakeNavMesh(1);
+    ASSERT_TRUE(RunUntilIdle());
+    ASSERT_EQ(mWorld->GetNumTiles(), 4);
+    mScheduler->RemoveArea(mArea); // Streamed out
+    Frame();
+    EXPECT_EQ(mWorld->GetNumTiles(), 0);
+}
+
+TEST_F(TileSchedulerTest, ATileIsPublishedOnlyAtTheSyncPoint)
+{
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(12.8f, 0.5f, 12.8f));
+    MakeNavMesh(1);
+    // Jobs run and finish between Updates, but the navmesh changes only inside Update
+    Frame();
+    for (int wait = 0; wait < 5000 && !mScheduler->HasFinishedJobs(); ++wait)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_TRUE(mScheduler->HasFinishedJobs());
+    EXPECT_EQ(mWorld->GetNumTiles(), 0);
+    mScheduler->Update();
+    EXPECT_GT(mWorld->GetNumTiles(), 0);
+}
+
+} // namespace
+} // namespace cairn::navmesh::test
