@@ -55,9 +55,9 @@ void GeometryCollector::CollectTriangles(const AABB& inBox, const NavMeshInclusi
         BodyCopy copy;
         bool taken = false;
         {
-            const Clock::time_point lockStart = Clock::now();
-            StaticBodyLockRead staticLock(mBodies, id);
-            ioStats.mLongestLockWaitMs = std::max(ioStats.mLongestLockWaitMs, MillisecondsSince(lockStart));
+            double waitMs = 0.0;
+            StaticBodyLockRead staticLock(mBodies, id, &waitMs);
+            ioStats.mLongestLockWaitMs = std::max(ioStats.mLongestLockWaitMs, waitMs);
             if (const Body* body = staticLock.GetBody();
                 body != nullptr && body->IsInWorld() && inKinds != BodyKinds::NonStatic)
             {
@@ -66,11 +66,15 @@ void GeometryCollector::CollectTriangles(const AABB& inBox, const NavMeshInclusi
             }
             else if (staticLock.WasNotStatic() && inKinds != BodyKinds::Static)
             {
+                // An awake dynamic body is no obstacle: skipped without its body lock, which the step may
+                // hold (if it falls asleep after this, the change marks the tile dirty again)
+                const MotionType motion = staticLock.GetNotStaticMotionType();
+                const bool wanted = motion == MotionType::Kinematic
+                                        ? inInclusion.mKinematic
+                                        : inInclusion.mSleepingDynamic && !staticLock.WasActive();
                 staticLock.Release();
-                const Clock::time_point tryStart = Clock::now();
+                if (!wanted) continue;
                 BodyLockRead lock(mBodies, id, TryLock{});
-                ioStats.mLongestLockWaitMs =
-                    std::max(ioStats.mLongestLockWaitMs, MillisecondsSince(tryStart));
                 if (lock.WasBusy())
                 {
                     outBusy.push_back(id);

@@ -51,7 +51,7 @@ unsigned char ToRecastArea(uint8_t inArea)
 } // namespace
 
 Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGrid, const TileCoord& inTile,
-                            const TileGeometry& inGeometry)
+                            const TileGeometry& inGeometry, std::span<const OffMeshLink> inLinks)
 {
     if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
     const int numVertices = inGeometry.GetNumVertices(), numTriangles = inGeometry.GetNumTriangles();
@@ -67,6 +67,25 @@ Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGri
     for (uint8_t area : inGeometry.mAreas)
         if (area > cMaxAreaId)
             return MakeError(ErrorCode::InvalidArgument, "tile geometry: an area id is above cMaxAreaId");
+    // The links that start in this tile, in Detour's layout
+    std::vector<float> linkVerts, linkRadii;
+    std::vector<unsigned char> linkDirections, linkAreas;
+    std::vector<unsigned short> linkFlags;
+    std::vector<unsigned int> linkIDs;
+    for (const OffMeshLink& link : inLinks)
+    {
+        if (!IsValidWorldPosition(link.mStart) || !IsValidWorldPosition(link.mEnd) ||
+            !std::isfinite(link.mRadius) || link.mRadius <= 0.0f || link.mArea > cMaxAreaId)
+            return MakeError(ErrorCode::InvalidArgument, "off-mesh link: bad end points, radius or area");
+        if (inGrid.TileAt(link.mStart.x(), link.mStart.z()) != inTile) continue;
+        linkVerts.insert(linkVerts.end(), {link.mStart.x(), link.mStart.y(), link.mStart.z(), link.mEnd.x(),
+                                           link.mEnd.y(), link.mEnd.z()});
+        linkRadii.push_back(link.mRadius);
+        linkDirections.push_back(link.mBidirectional ? DT_OFFMESH_CON_BIDIR : 0);
+        linkAreas.push_back(ToRecastArea(link.mArea));
+        linkFlags.push_back(cPolyFlagWalk);
+        linkIDs.push_back(link.mUserID);
+    }
 
     const auto start = std::chrono::steady_clock::now();
     BuiltTile result;
@@ -181,6 +200,13 @@ Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGri
     params.detailVertsCount = scratch.mDetail->nverts;
     params.detailTris = scratch.mDetail->tris;
     params.detailTriCount = scratch.mDetail->ntris;
+    params.offMeshConVerts = linkVerts.data();
+    params.offMeshConRad = linkRadii.data();
+    params.offMeshConDir = linkDirections.data();
+    params.offMeshConAreas = linkAreas.data();
+    params.offMeshConFlags = linkFlags.data();
+    params.offMeshConUserID = linkIDs.data();
+    params.offMeshConCount = int(linkRadii.size());
     params.walkableHeight = inProfile.mHeight;
     params.walkableRadius = inProfile.mRadius;
     params.walkableClimb = inProfile.mMaxClimb;

@@ -46,7 +46,7 @@ jobs::BackgroundStep TileJob::Step(jobs::BackgroundTaskContext& ioContext)
 
     case Stage::Build:
     {
-        Result<BuiltTile> built = BuildTile(mProfile, mGrid, mTile, mGeometry);
+        Result<BuiltTile> built = BuildTile(mProfile, mGrid, mTile, mGeometry, mLinks);
         if (!built) ioContext.SetError(built.GetError().mMessage);
         const jobs::BackgroundStep step = built ? jobs::BackgroundStep::Done : jobs::BackgroundStep::Failed;
         return Finish(std::move(built), step);

@@ -20,10 +20,12 @@ namespace cairn::navmesh
 class TileJob
 {
 public:
+    /// inLinks: the off-mesh links that start in the tile (copied: the job owns what it reads).
     TileJob(const GeometryCollector& inCollector, const AgentProfile& inProfile, const TileGrid& inGrid,
-            const NavMeshInclusion& inInclusion, const TileCoord& inTile, float inBorder)
+            const NavMeshInclusion& inInclusion, const TileCoord& inTile, float inBorder,
+            std::vector<OffMeshLink> inLinks)
         : mCollector(inCollector), mProfile(inProfile), mGrid(inGrid), mInclusion(inInclusion), mTile(inTile),
-          mBox(inGrid.GetTileBoundsWithBorder(inTile, inBorder))
+          mBox(inGrid.GetTileBoundsWithBorder(inTile, inBorder)), mLinks(std::move(inLinks))
     {
     }
 
@@ -51,6 +53,7 @@ private:
     const NavMeshInclusion mInclusion;
     const TileCoord mTile;
     const AABB mBox;
+    const std::vector<OffMeshLink> mLinks;
     Stage mStage = Stage::Static;
     std::vector<BodyID> mBodies;
     std::vector<BodyID> mBusy;

@@ -73,6 +73,28 @@ void TileScheduler::RemoveArea(AreaID inArea)
     mAreas.erase(it);
 }
 
+TileScheduler::LinkID TileScheduler::AddOffMeshLink(const OffMeshLink& inLink)
+{
+    std::lock_guard lock(mMutex);
+    const LinkID id = mNextID++;
+    mLinks[id] = inLink;
+    if (auto it = mTiles.find(mWorld.GetGrid().TileAt(inLink.mStart.x(), inLink.mStart.z()));
+        it != mTiles.end())
+        it->second.mDirty = true;
+    return id;
+}
+
+void TileScheduler::RemoveOffMeshLink(LinkID inLink)
+{
+    std::lock_guard lock(mMutex);
+    auto link = mLinks.find(inLink);
+    if (link == mLinks.end()) return;
+    if (auto it = mTiles.find(mWorld.GetGrid().TileAt(link->second.mStart.x(), link->second.mStart.z()));
+        it != mTiles.end())
+        it->second.mDirty = true;
+    mLinks.erase(link);
+}
+
 void TileScheduler::MarkDirty(const AABB& inBounds)
 {
     std::lock_guard lock(mMutex);
@@ -146,8 +168,17 @@ void TileScheduler::CollectNeeded(std::unordered_map<TileCoord, float>& outNeede
 
 void TileScheduler::StartJob(const TileCoord& inTile, TileState& ioState)
 {
+    // The links starting in the tile, by id: the same links in the same order whatever the map's order
+    std::vector<std::pair<LinkID, OffMeshLink>> byID;
+    for (const auto& [id, link] : mLinks)
+        if (mWorld.GetGrid().TileAt(link.mStart.x(), link.mStart.z()) == inTile) byID.push_back({id, link});
+    std::sort(byID.begin(), byID.end(),
+              [](const auto& inL, const auto& inR) { return inL.first < inR.first; });
+    std::vector<OffMeshLink> links;
+    for (const auto& [id, link] : byID)
+        links.push_back(link);
     auto job = std::make_shared<TileJob>(mCollector, mWorld.GetProfile(), mWorld.GetGrid(),
-                                         mSettings.mInclusion, inTile, mBorder);
+                                         mSettings.mInclusion, inTile, mBorder, std::move(links));
     ioState.mJob = job;
     ioState.mDirty = false; // Dirt from now on means this job's result is already stale: build again after
     ioState.mTask = mQueue.Submit(

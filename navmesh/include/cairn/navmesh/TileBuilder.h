@@ -10,6 +10,7 @@
 #include "cairn/navmesh/TileGrid.h"
 
 #include <memory>
+#include <span>
 
 namespace cairn::navmesh
 {
@@ -24,6 +25,18 @@ using TileDataPtr = std::unique_ptr<unsigned char, DetourFree>;
 /// Polygon flags set on every navmesh polygon; path filters include or exclude them.
 inline constexpr uint16_t cPolyFlagWalk = 1;
 
+/// A link the navmesh cannot see in the geometry: a jump, a ladder, a drop. It belongs to the tile that holds
+/// its start; Detour connects its end when the tile there is loaded.
+struct OffMeshLink
+{
+    Vec3 mStart = Vec3::Zero();
+    Vec3 mEnd = Vec3::Zero();
+    float mRadius = 0.5f;       ///< m: how near the navmesh an end must be to connect
+    bool mBidirectional = true; ///< False: from start to end only (a drop)
+    uint8_t mArea = cDefaultArea;
+    uint32_t mUserID = 0; ///< The game's id, kept with the link
+};
+
 struct BuiltTile
 {
     TileCoord mTile;
@@ -34,9 +47,10 @@ struct BuiltTile
     double mBuildMs = 0.0; ///< Time spent in Recast and Detour
 };
 
-/// Builds tile inTile of inGrid from inGeometry (world space, covering at least the tile's bordered area).
-/// Errors: invalid profile, non-finite vertices, bad indices, or Recast running out of memory.
+/// Builds tile inTile of inGrid from inGeometry (world space, covering at least the tile's bordered area) and
+/// the off-mesh links whose start lies in the tile (others are ignored). Errors: invalid profile, non-finite
+/// vertices or links, bad indices, or Recast running out of memory.
 Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGrid, const TileCoord& inTile,
-                            const TileGeometry& inGeometry);
+                            const TileGeometry& inGeometry, std::span<const OffMeshLink> inLinks = {});
 
 } // namespace cairn::navmesh

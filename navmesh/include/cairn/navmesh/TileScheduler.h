@@ -83,6 +83,12 @@ public:
     AreaID AddArea(const AABB& inBounds);
     void RemoveArea(AreaID inArea);
 
+    /// Off-mesh links (jumps, ladders): built into the tile that holds the start; adding or removing one
+    /// makes that tile dirty. Any thread.
+    using LinkID = uint32_t;
+    LinkID AddOffMeshLink(const OffMeshLink& inLink);
+    void RemoveOffMeshLink(LinkID inLink);
+
     /// Marks the tiles inBounds touches dirty (for changes the physics world does not report). Any thread.
     void MarkDirty(const AABB& inBounds);
     /// BodyChangeListener: marks the tiles of a body that matters dirty.
@@ -134,6 +140,7 @@ private:
     std::unordered_map<TileCoord, TileState> mTiles;
     std::unordered_map<InvokerID, Invoker> mInvokers;
     std::unordered_map<AreaID, AABB> mAreas;
+    std::unordered_map<LinkID, OffMeshLink> mLinks;
     uint32_t mNextID = 1;
     std::vector<TileCoord> mDropNow; ///< Tiles of removed areas, checked at the next Update
     Stats mStats;

@@ -9,6 +9,7 @@
 
 #include "cairn/physics/body/BodyManager.h"
 
+#include <chrono>
 #include <mutex>
 #include <shared_mutex>
 
@@ -111,8 +112,10 @@ using BodyLockWrite = BodyLock<true>;
 class StaticBodyLockRead
 {
 public:
-    StaticBodyLockRead(const BodyManager& inManager, const BodyID& inID)
+    /// ioWaitMs, when given, gets the time spent waiting for the mutex if another thread held it (0 if not).
+    StaticBodyLockRead(const BodyManager& inManager, const BodyID& inID, double* ioWaitMs = nullptr)
     {
+        if (ioWaitMs != nullptr) *ioWaitMs = 0.0;
         if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
         {
             mWrongThread = true;
@@ -120,11 +123,26 @@ public:
         }
         if (inID.IsInvalid() || inID.GetIndex() >= inManager.GetMaxBodies()) return;
         mMutex = &inManager.GetStaticMutexForBody(inID.GetIndex());
-        mMutex->lock_shared();
+        if (!mMutex->try_lock_shared())
+        {
+            // Contended (a writer outside the step): time the real wait, not the thread's scheduling
+            const auto start = std::chrono::steady_clock::now();
+            mMutex->lock_shared();
+            if (ioWaitMs != nullptr)
+                *ioWaitMs =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                        .count();
+        }
         BodyManager::NoteBodyLockHeld(+1);
         const Body* body = inManager.TryGetBody(inID);
         if (body != nullptr && body->IsStatic()) mBody = body;
-        mNotStatic = body != nullptr && !body->IsStatic();
+        if (body != nullptr && !body->IsStatic())
+        {
+            // Written only under both mutexes (motion type) or atomic (active index): safe to read here
+            mNotStatic = true;
+            mMotionType = body->GetMotionType();
+            mActive = body->IsActive();
+        }
     }
     ~StaticBodyLockRead() { Release(); }
     StaticBodyLockRead(const StaticBodyLockRead&) = delete;
@@ -142,14 +160,19 @@ public:
     /// The locked static body, or nullptr.
     const Body* GetBody() const { return mBody; }
     bool WasWrongThread() const { return mWrongThread; }
-    /// The body exists but is not static: nothing was read.
+    /// The body exists but is not static: only its motion type and whether it is active were read.
     bool WasNotStatic() const { return mNotStatic; }
+    MotionType GetNotStaticMotionType() const { return mMotionType; }
+    /// Whether the non-static body was active (awake) when locked; it may change at any moment after.
+    bool WasActive() const { return mActive; }
 
 private:
     std::shared_mutex* mMutex = nullptr;
     const Body* mBody = nullptr;
     bool mWrongThread = false;
     bool mNotStatic = false;
+    MotionType mMotionType = MotionType::Static;
+    bool mActive = false;
 };
 
 } // namespace cairn

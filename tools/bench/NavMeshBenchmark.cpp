@@ -1,0 +1,312 @@
+// cairn-bench-navmesh: the navmesh benchmarks of ../shared/bench/SPEC.md and issue 5's targets.
+//  nav_tiles_world_tile0  every 12.8 m tile over world tile 0 (x, z in [0, 64]: 5 x 5 tiles) of the shared
+//                         static world, built from the physics world: ms per tile for the query/collect part
+//                         and for the Recast part, polygons per tile; checksum: polygons and triangles.
+//  nav_step_pile2k_jobs   step_pile2k's physics step (1 thread, 300 real-time frames at 60 Hz) with 0 and
+//                         with 2 background tile jobs running all the time (their tiles dirtied every
+//                         frame): ms per step and the ratio, the tile jobs' longest lock wait.
+//  nav_invoker_latency    at 60 Hz (real-time frames), an invoker appears at a new place every 20 frames:
+//                         frames from request to publication of its tile, median and p99.
+// Own timers (Google Benchmark's loop does not fit multi-frame jobs); medians over --repetitions.
+
+#include "cairn/jobs/BackgroundQueue.h"
+#include "cairn/jobs/JobSystem.h"
+#include "cairn/navmesh/GeometryCollector.h"
+#include "cairn/navmesh/TileBuilder.h"
+#include "cairn/navmesh/TileScheduler.h"
+#include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/shapes/BoxShape.h"
+#include "common/FrameTimes.h"
+#include "common/SharedBenchData.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace cairn;
+using namespace cairn::navmesh;
+using Clock = std::chrono::steady_clock;
+
+namespace
+{
+
+double MillisecondsSince(Clock::time_point inStart)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
+}
+
+double Median(std::vector<double> inValues)
+{
+    if (inValues.empty()) return 0.0;
+    std::sort(inValues.begin(), inValues.end());
+    return inValues[inValues.size() / 2];
+}
+
+BodyCreationSettings BoxSettings(const BenchBox& inBox, MotionType inMotion)
+{
+    BodyCreationSettings settings;
+    settings.mShape = BoxShape::Create(inBox.mHalfExtent).Value();
+    settings.mPosition = inBox.mCenter;
+    settings.mRotation = Quat(Eigen::AngleAxisf(inBox.mYaw, Vec3::UnitY()));
+    settings.mMotionType = inMotion;
+    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
+    settings.mFriction = 0.5f;
+    settings.mDensity = 1000.0f;
+    return settings;
+}
+
+void AddBatch(PhysicsSystem& ioPhysics, const std::vector<BenchBox>& inBoxes, MotionType inMotion)
+{
+    BodyInterface& bodies = ioPhysics.GetBodyInterface();
+    std::vector<BodyID> ids;
+    for (const BenchBox& box : inBoxes)
+        ids.push_back(bodies.CreateBody(BoxSettings(box, inMotion)).Value());
+    BodyInterface::AddBatch batch = bodies.AddBodiesPrepare(ids).Value();
+    (void)bodies.AddBodiesFinalize(batch, inMotion == MotionType::Static ? Activation::DontActivate
+                                                                         : Activation::Activate);
+}
+
+PhysicsSettings PileSettings()
+{
+    PhysicsSettings settings;
+    settings.mMaxBodies = 32768;
+    return settings;
+}
+
+TileGrid WorldGrid(const AgentProfile& inProfile)
+{
+    return TileGrid(0.0f, 0.0f, inProfile.mTileSize, -2.0f, 40.0f);
+}
+
+void RunTiles(const SharedBenchData& inData, int inRepetitions)
+{
+    PhysicsSystem physics(PileSettings());
+    AddBatch(physics, inData.mStatic, MotionType::Static);
+    (void)physics.Update(1.0f / 60.0f); // The broad phase's first rebuild
+    const AgentProfile profile;
+    const TileGrid grid = WorldGrid(profile);
+    const float border = float(profile.GetBorderCells()) * profile.mCellSize;
+    const GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
+
+    std::vector<double> collectMedians, recastMedians, collectMaxes, recastMaxes;
+    uint64_t polygons = 0, triangles = 0;
+    int minPolygons = 1 << 30, maxPolygons = 0, tiles = 0;
+    for (int rep = 0; rep < inRepetitions; ++rep)
+    {
+        std::vector<double> collectMs, recastMs;
+        polygons = triangles = 0;
+        tiles = 0;
+        for (int z = 0; z < 5; ++z)
+            for (int x = 0; x < 5; ++x)
+            {
+                const TileCoord tile{x, z};
+                const AABB box = grid.GetTileBoundsWithBorder(tile, border);
+                const Clock::time_point start = Clock::now();
+                std::vector<BodyID> found, busy;
+                TileGeometry geometry;
+                CollectStats stats;
+                collector.FindBodies(box, {}, found);
+                collector.CollectTriangles(box, {}, found, geometry, busy, stats);
+                collectMs.push_back(MillisecondsSince(start));
+                Result<BuiltTile> built = BuildTile(profile, grid, tile, geometry);
+                if (!built)
+                {
+                    std::fprintf(stderr, "tile %d,%d: %s\n", x, z, built.GetError().mMessage.c_str());
+                    std::exit(1);
+                }
+                recastMs.push_back(built.Value().mBuildMs);
+                polygons += uint64_t(built.Value().mNumPolygons);
+                triangles += uint64_t(geometry.GetNumTriangles());
+                minPolygons = std::min(minPolygons, built.Value().mNumPolygons);
+                maxPolygons = std::max(maxPolygons, built.Value().mNumPolygons);
+                ++tiles;
+            }
+        const tools::TimingSummary collect = tools::Summarize(collectMs), recast = tools::Summarize(recastMs);
+        std::printf("nav_tiles_world_tile0 rep %d: %d tiles  collect ms/tile median %.3f max %.3f  recast "
+                    "ms/tile median %.3f max %.3f\n",
+                    rep, tiles, collect.mP50, collect.mMax, recast.mP50, recast.mMax);
+        collectMedians.push_back(collect.mP50);
+        recastMedians.push_back(recast.mP50);
+        collectMaxes.push_back(collect.mMax);
+        recastMaxes.push_back(recast.mMax);
+    }
+    std::printf(
+        "nav_tiles_world_tile0 median of %d: collect %.3f ms/tile (max %.3f)  recast %.3f ms/tile (max "
+        "%.3f)  collect/recast %.1f%%  polygons/tile mean %.1f min %d max %d  | checksum polygons %llu "
+        "triangles %llu\n",
+        inRepetitions, Median(collectMedians), Median(collectMaxes), Median(recastMedians),
+        Median(recastMaxes), 100.0 * Median(collectMedians) / Median(recastMedians),
+        double(polygons) / double(tiles), minPolygons, maxPolygons, (unsigned long long)polygons,
+        (unsigned long long)triangles);
+}
+
+struct PileRun
+{
+    tools::TimingSummary mStep;
+    double mLongestLockWaitMs = 0.0;
+    uint64_t mTilesBuilt = 0;
+    uint64_t mBusyRetries = 0;
+};
+
+/// step_pile2k on one physics thread, with inBackgroundJobs tile jobs kept running (0: none).
+PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
+{
+    PhysicsSystem physics(PileSettings());
+    AddBatch(physics, inData.mStatic, MotionType::Static);
+    AddBatch(physics, inData.mDynamic, MotionType::Dynamic);
+    jobs::JobSystem::Settings jobSettings;
+    jobSettings.mNumThreads = 1;
+    jobs::JobSystem frameJobs(jobSettings);
+
+    const AgentProfile profile;
+    std::unique_ptr<NavMeshWorld> world =
+        std::move(NavMeshWorld::Create(WorldGrid(profile), profile).Value());
+    jobs::BackgroundQueue::Settings queueSettings;
+    queueSettings.mNumThreads = std::max(1u, inBackgroundJobs);
+    queueSettings.mFrameJobs = &frameJobs;
+    jobs::BackgroundQueue queue(queueSettings);
+    std::unique_ptr<TileScheduler> scheduler;
+    // The pile lands on world tile 0 and around: the area the jobs rebuild over and over
+    const AABB area(Vec3(0, -2, 0), Vec3(64, 40, 64));
+    if (inBackgroundJobs > 0)
+    {
+        TileScheduler::Settings settings;
+        settings.mMaxConcurrentJobs = inBackgroundJobs;
+        scheduler = std::make_unique<TileScheduler>(physics, *world, queue, settings);
+        scheduler->AddArea(area);
+    }
+    // Real-time frames at 60 Hz, as in a game: the step, the sync point, then the rest of the frame, in which
+    // the background jobs get the CPU the frame leaves
+    std::vector<double> stepMs;
+    const Clock::time_point begin = Clock::now();
+    for (int step = 0; step < 300; ++step)
+    {
+        const Clock::time_point start = Clock::now();
+        (void)physics.Update(1.0f / 60.0f, 1, frameJobs);
+        stepMs.push_back(MillisecondsSince(start));
+        if (scheduler != nullptr)
+        {
+            scheduler->MarkDirty(area); // Keep the jobs busy: every tile is always wanted again
+            scheduler->Update();
+        }
+        std::this_thread::sleep_until(begin + std::chrono::microseconds(16667 * (step + 1)));
+    }
+    PileRun run;
+    run.mStep = tools::Summarize(stepMs);
+    if (scheduler != nullptr)
+    {
+        const TileScheduler::Stats stats = scheduler->GetStats();
+        run.mLongestLockWaitMs = stats.mLongestLockWaitMs;
+        run.mTilesBuilt = stats.mTilesPublished;
+        run.mBusyRetries = stats.mBusyRetries;
+    }
+    return run;
+}
+
+void RunPileWithJobs(const SharedBenchData& inData, int inRepetitions)
+{
+    std::vector<double> without, with, lockWaits;
+    for (int rep = 0; rep < inRepetitions; ++rep)
+    {
+        const PileRun none = RunPile(inData, 0);
+        const PileRun two = RunPile(inData, 2);
+        std::printf(
+            "nav_step_pile2k_jobs rep %d: 0 jobs mean %.3f ms p99 %.3f  | 2 jobs mean %.3f ms p99 %.3f  "
+            "tiles built %llu  busy retries %llu  longest lock wait %.4f ms\n",
+            rep, none.mStep.mMean, none.mStep.mP99, two.mStep.mMean, two.mStep.mP99,
+            (unsigned long long)two.mTilesBuilt, (unsigned long long)two.mBusyRetries,
+            two.mLongestLockWaitMs);
+        without.push_back(none.mStep.mMean);
+        with.push_back(two.mStep.mMean);
+        lockWaits.push_back(two.mLongestLockWaitMs);
+    }
+    std::printf("nav_step_pile2k_jobs median of %d: step %.3f ms with 0 jobs, %.3f ms with 2 jobs (%.2fx)  "
+                "longest lock wait %.4f ms (max over reps %.4f)\n",
+                inRepetitions, Median(without), Median(with), Median(with) / Median(without),
+                Median(lockWaits), *std::max_element(lockWaits.begin(), lockWaits.end()));
+}
+
+void RunInvokerLatency(const SharedBenchData& inData)
+{
+    PhysicsSystem physics(PileSettings());
+    AddBatch(physics, inData.mStatic, MotionType::Static);
+    AddBatch(physics, inData.mDynamic, MotionType::Dynamic);
+    const AgentProfile profile;
+    std::unique_ptr<NavMeshWorld> world =
+        std::move(NavMeshWorld::Create(WorldGrid(profile), profile).Value());
+    jobs::BackgroundQueue::Settings queueSettings;
+    queueSettings.mNumThreads = 2;
+    jobs::BackgroundQueue queue(queueSettings);
+    TileScheduler::Settings settings;
+    settings.mMaxConcurrentJobs = 2;
+    settings.mDropDelayFrames = 10;
+    TileScheduler scheduler(physics, *world, queue, settings);
+    // Invokers one after another across the world, each asking for its own tile only, every 20 frames: the
+    // budget is free each time
+    TileScheduler::InvokerID invoker = 0;
+    const Clock::time_point begin = Clock::now();
+    for (int frame = 0; frame < 600; ++frame)
+    {
+        if (frame % 20 == 0)
+        {
+            if (invoker != 0) scheduler.RemoveInvoker(invoker);
+            const int index = frame / 20;
+            invoker = scheduler.AddInvoker(
+                Vec3(6.4f + 12.8f * float(index % 30), 0.0f, 6.4f + 12.8f * float((index * 7) % 19)), 1.0f);
+        }
+        (void)physics.Update(1.0f / 60.0f);
+        scheduler.Update();
+        // Real-time frames: wait for the next 1/60 s tick
+        std::this_thread::sleep_until(begin + std::chrono::microseconds(16667 * (frame + 1)));
+    }
+    std::vector<double> frames;
+    for (uint32_t f : scheduler.GetStats().mFirstPublishFrames)
+        frames.push_back(double(f));
+    const tools::TimingSummary summary = tools::Summarize(frames);
+    std::printf(
+        "nav_invoker_latency: %zu tiles requested, frames to publication median %.0f p99 %.0f max %.0f\n",
+        frames.size(), summary.mP50, summary.mP99, summary.mMax);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    int repetitions = 3;
+    std::string only;
+    for (int i = 1; i < argc; ++i)
+    {
+        if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc)
+            repetitions = std::max(1, std::atoi(argv[++i]));
+        else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
+        else
+        {
+            std::fprintf(stderr, "usage: cairn-bench-navmesh [--repetitions N] [--only "
+                                 "nav_tiles_world_tile0|nav_step_pile2k_jobs|nav_invoker_latency]\n");
+            return 2;
+        }
+    }
+#ifdef NDEBUG
+    const char* buildType = "Release";
+#else
+    const char* buildType = "Debug";
+#endif
+    Result<SharedBenchData> data = LoadSharedBenchData();
+    if (!data)
+    {
+        std::fprintf(stderr, "cairn-bench-navmesh: %s\n", data.GetError().mMessage.c_str());
+        return 1;
+    }
+    std::printf("cairn-bench-navmesh: build %s, %d repetitions, %u hardware threads\n", buildType,
+                repetitions, std::thread::hardware_concurrency());
+    if (only.empty() || only == "nav_tiles_world_tile0") RunTiles(data.Value(), repetitions);
+    if (only.empty() || only == "nav_step_pile2k_jobs") RunPileWithJobs(data.Value(), repetitions);
+    if (only.empty() || only == "nav_invoker_latency") RunInvokerLatency(data.Value());
+    return 0;
+}
