@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds and runs the demo. Usage: bash tools/run-demo.sh [demo flags, see --help]
+# Installs what is missing, builds and runs the streaming open-world demo (about a minute on 2 cores).
+# Usage: bash tools/run-demo.sh [demo flags, see --help]; the report goes to ./demo-output unless --output says.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bash "$root/tools/setup.sh"

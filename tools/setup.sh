@@ -8,6 +8,7 @@ packages=(
     libeigen3-dev         # all math
     librecast-dev         # Recast/Detour navmesh
     libtinyobjloader-dev  # OBJ level meshes
+    libcli11-dev          # the demo's and tools' command-line flags
     libgtest-dev libgmock-dev
     libbenchmark-dev      # benchmarks
     librapidcheck-dev     # property tests

@@ -311,6 +311,17 @@ bool TileScheduler::IsIdle() const
     return true;
 }
 
+uint32_t TileScheduler::CountNeededNeverPublished() const
+{
+    std::lock_guard lock(mMutex);
+    std::unordered_map<TileCoord, float> needed;
+    CollectNeeded(needed);
+    uint32_t count = 0;
+    for (const auto& [tile, distance] : needed)
+        if (auto it = mTiles.find(tile); it == mTiles.end() || !it->second.mEverPublished) ++count;
+    return count;
+}
+
 uint32_t TileScheduler::GetNumRunningJobs() const
 {
     std::lock_guard lock(mMutex);

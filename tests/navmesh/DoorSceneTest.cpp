@@ -97,5 +97,28 @@ TEST_F(DoorSceneTest, AnAwakeBoxIsNotAnObstacle)
     EXPECT_TRUE(path.Value().mReachedEnd);
 }
 
+TEST_F(DoorSceneTest, TriggersAndDebrisAreIgnored)
+{
+    BuildRoom();
+    // A sensor volume filling the doorway, and sleeping debris in it: neither is something agents walk around
+    BodyCreationSettings trigger;
+    trigger.mShape = BoxShape::Create(Vec3(1.0f, 1.5f, 0.2f)).Value();
+    trigger.mPosition = Vec3(0, 1.5f, 0);
+    trigger.mMotionType = MotionType::Static;
+    trigger.mObjectLayer = Layers::cTrigger;
+    ASSERT_TRUE(mPhysics->GetBodyInterface().CreateAndAddBody(trigger, Activation::DontActivate));
+    BodyCreationSettings debris;
+    debris.mShape = BoxShape::Create(Vec3(0.9f, 0.75f, 0.18f)).Value();
+    debris.mPosition = Vec3(0, 0.75f, 0);
+    debris.mMotionType = MotionType::Dynamic;
+    debris.mObjectLayer = Layers::cDebris;
+    ASSERT_TRUE(mPhysics->GetBodyInterface().CreateAndAddBody(debris, Activation::DontActivate));
+    mScheduler->MarkDirty(AABB(Vec3(-1, 0, -1), Vec3(1, 3, 1)));
+    ASSERT_TRUE(RunUntilIdle());
+    Result<PathResult> path = PathAcross();
+    ASSERT_TRUE(path);
+    EXPECT_TRUE(path.Value().mReachedEnd);
+}
+
 } // namespace
 } // namespace cairn::navmesh::test

@@ -1,137 +1,91 @@
-// cairn-demo: until the streaming open-world demo lands, a small physics scene (stacks knocked over by a rain
-// of spheres and a kinematic sweeper) that steps at 60 Hz and prints its frame times.
+// cairn-demo: the streaming open-world demo, Cairn's whole story in about a minute. A player crosses a
+// generated open world; tiles of terrain and ~700 props stream in and out on a loading thread; physics steps
+// at 60 Hz with about a thousand dynamic bodies; game objects query and move on the job threads; AI agents
+// ask for navmesh around themselves and walk it while background jobs build it. It runs once with the
+// lock-free broad phase and once with one global read-write mutex (the "before"), prints both and writes a
+// report. Flags are parsed with CLI11 (Debian's libcli11-dev): --help lists them.
 
-#include "cairn/physics/PhysicsSystem.h"
-#include "cairn/physics/shapes/BoxShape.h"
-#include "cairn/physics/shapes/CapsuleShape.h"
-#include "cairn/physics/shapes/SphereShape.h"
-#include "common/FrameTimes.h"
+#include "DemoReport.h"
+#include "DemoRunner.h"
 
-#include <chrono>
+#include <CLI/CLI.hpp>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
+#include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 using namespace cairn;
+using namespace cairn::demo;
 
-namespace
+int main(int argc, char** argv)
 {
-struct Options
-{
-    int mFrames = 600;
-    int mCollisionSteps = 1;
-};
-
-void PrintHelp()
-{
-    std::printf(
-        "usage: cairn-demo [--frames N] [--collision-steps N] [--help]\n"
-        "  Steps a small scene (box stacks, falling spheres and capsules, a kinematic sweeper) at 60 Hz\n"
-        "  and prints physics frame times.\n");
-}
-
-/// Parses the flags; exits with a message on bad input.
-Options ParseOptions(int inArgc, char** inArgv)
-{
-    Options options;
-    for (int i = 1; i < inArgc; ++i)
+    DemoSettings settings;
+    std::string mode = "both";
+    std::string output = "demo-output";
+    bool fast = false;
+    CLI::App app{"cairn-demo: the streaming open-world demo (lock-free broad phase against a global mutex)"};
+    app.add_option("--frames", settings.mFrames, "Frames per mode (60 per second)")
+        ->check(CLI::Range(1, 1000000));
+    app.add_option("--seed", settings.mSeed, "World and agent seed");
+    app.add_option("--agents", settings.mAgents, "AI agents (navmesh invokers)")->check(CLI::Range(0, 1000));
+    app.add_option("--threads", settings.mThreads, "Job system threads (0: all cores)")
+        ->check(CLI::Range(0, 64));
+    app.add_option("--collision-steps", settings.mCollisionSteps, "Physics collision steps per frame")
+        ->check(CLI::Range(1, 8));
+    app.add_option("--game-objects", settings.mGameObjects, "Game objects updated by jobs each frame")
+        ->check(CLI::Range(0, 20000));
+    app.add_option("--mode", mode, "lock-free, global-mutex or both")
+        ->check(CLI::IsMember({"lock-free", "global-mutex", "both"}));
+    app.add_option("--output", output, "Folder for report.md, the SVG charts and navmesh.obj ('' for none)");
+    app.add_flag("--fast", fast, "Do not wait for each 1/60 s tick (frames back to back)");
+    try
     {
-        const std::string flag = inArgv[i];
-        auto value = [&](int inMin, int inMax)
-        {
-            if (i + 1 >= inArgc)
-            {
-                std::fprintf(stderr, "cairn-demo: %s needs a value\n", flag.c_str());
-                std::exit(2);
-            }
-            char* end = nullptr;
-            const long parsed = std::strtol(inArgv[++i], &end, 10);
-            if (*end != '\0' || parsed < inMin || parsed > inMax)
-            {
-                std::fprintf(stderr, "cairn-demo: %s must be a whole number in [%d, %d]\n", flag.c_str(),
-                             inMin, inMax);
-                std::exit(2);
-            }
-            return int(parsed);
-        };
-        if (flag == "--help" || flag == "-h")
-        {
-            PrintHelp();
-            std::exit(0);
-        }
-        else if (flag == "--frames")
-            options.mFrames = value(1, 1000000);
-        else if (flag == "--collision-steps")
-            options.mCollisionSteps = value(1, 16);
-        else
-        {
-            std::fprintf(stderr, "cairn-demo: unknown flag '%s' (see --help)\n", flag.c_str());
-            std::exit(2);
-        }
+        app.parse(argc, argv);
     }
-    return options;
-}
-
-BodyID Add(BodyInterface& ioBodies, const ShapeRef& inShape, const Vec3& inPosition, MotionType inMotion)
-{
-    BodyCreationSettings settings;
-    settings.mShape = inShape;
-    settings.mPosition = inPosition;
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    settings.mFriction = 0.5f;
-    return ioBodies.CreateAndAddBody(settings, Activation::Activate).Value();
-}
-} // namespace
-
-int main(int inArgc, char** inArgv)
-{
-    const Options options = ParseOptions(inArgc, inArgv);
-    PhysicsSystem system;
-    BodyInterface& bodies = system.GetBodyInterface();
-
-    Add(bodies, BoxShape::Create(Vec3(60, 1, 60)).Value(), Vec3(0, -1, 0), MotionType::Static);
-    const ShapeRef crate = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
-    for (int stack = 0; stack < 16; ++stack)
-        for (int level = 0; level < 8; ++level)
-            Add(bodies, crate,
-                Vec3(-24.0f + 3.0f * float(stack), 0.5f + float(level), 4.0f * float(stack % 3)),
-                MotionType::Dynamic);
-    BodyCreationSettings sweeper;
-    sweeper.mShape = CapsuleShape::Create(8.0f, 0.6f).Value();
-    sweeper.mPosition = Vec3(-30, 0.6f, 4);
-    sweeper.mRotation = Quat(Eigen::AngleAxisf(0.5f * cPi, Vec3::UnitX()));
-    sweeper.mMotionType = MotionType::Kinematic;
-    sweeper.mLinearVelocity = Vec3(4, 0, 0);
-    (void)bodies.CreateAndAddBody(sweeper, Activation::Activate);
-    const ShapeRef ball = SphereShape::Create(0.3f).Value();
-
-    std::vector<double> frameMs;
-    frameMs.reserve(size_t(options.mFrames));
-    for (int frame = 0; frame < options.mFrames; ++frame)
+    catch (const CLI::ParseError& error)
     {
-        if (frame % 10 == 0 && frame < 400)
-            Add(bodies, ball, Vec3(-20.0f + float(frame % 40), 15.0f, float(frame % 7)), MotionType::Dynamic);
-        const auto start = std::chrono::steady_clock::now();
-        if (Status status = system.Update(1.0f / 60.0f, options.mCollisionSteps); !status)
+        return app.exit(error);
+    }
+    settings.mRealTime = !fast;
+
+    std::string commandLine = "cairn-demo";
+    for (int i = 1; i < argc; ++i)
+        commandLine += std::string(" ") + argv[i];
+    std::printf("cairn-demo: %d frames per mode, seed %llu, %d agents, %u hardware threads\n",
+                settings.mFrames, (unsigned long long)settings.mSeed, settings.mAgents,
+                std::thread::hardware_concurrency());
+
+    std::vector<DemoRunResult> runs;
+    if (mode != "global-mutex") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTree, stdout));
+    if (mode != "lock-free") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTreeGlobalMutex, stdout));
+    for (const DemoRunResult& run : runs)
+        PrintSummary(stdout, run);
+    if (runs.size() == 2) PrintComparison(stdout, runs[0], runs[1]);
+
+    int exitCode = 0;
+    for (const DemoRunResult& run : runs)
+        if (!run.mErrors.empty() || run.mLostOrDuplicatedBodies != 0 || run.mPathsThroughWalls != 0 ||
+            run.mTilesRequestedNeverBuilt != 0)
+            exitCode = 1;
+    if (!output.empty())
+    {
+        std::string error;
+        if (!WriteReport(output, runs, commandLine, error))
         {
-            std::fprintf(stderr, "cairn-demo: step failed: %s\n", status.GetError().mMessage.c_str());
+            std::fprintf(stderr, "cairn-demo: %s\n", error.c_str());
             return 1;
         }
-        frameMs.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-        if ((frame + 1) % 100 == 0)
+        // The first run's navmesh, to look at in any OBJ viewer
+        const std::string objPath = output + "/navmesh.obj";
+        std::ofstream obj(objPath);
+        obj << runs.front().mNavMeshObj;
+        if (!obj)
         {
-            const StepStatistics& stats = system.GetLastStepStatistics();
-            std::printf("frame %5d  %6.3f ms  active %4u  pairs-manifolds %5u  islands %4u\n", frame + 1,
-                        frameMs.back(), stats.mNumActiveBodies, stats.mNumManifolds, stats.mNumIslands);
+            std::fprintf(stderr, "cairn-demo: %s: could not be written\n", objPath.c_str());
+            return 1;
         }
+        std::printf("report: %s/report.md (navmesh: %s)\n", output.c_str(), objPath.c_str());
     }
-    const tools::TimingSummary summary = tools::Summarize(frameMs);
-    std::printf(
-        "\nphysics frame time over %d frames (1/60 s, %d collision step(s)): mean %.3f ms, p50 %.3f ms, "
-        "p99 %.3f ms, max %.3f ms\n",
-        options.mFrames, options.mCollisionSteps, summary.mMean, summary.mP50, summary.mP99, summary.mMax);
-    return 0;
+    return exitCode;
 }

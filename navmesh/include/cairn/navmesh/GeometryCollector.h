@@ -23,7 +23,10 @@ namespace cairn::navmesh
 /// Which bodies make the navmesh.
 struct NavMeshInclusion
 {
-    ObjectLayerMask mObjectLayers = cAllObjectLayers; ///< Others (debris, triggers) are ignored
+    /// Bodies in other layers are ignored; by default every layer but the default setup's debris and triggers
+    /// (small things that get kicked around, and sensors that nobody stands on)
+    ObjectLayerMask mObjectLayers = cAllObjectLayers & ~(ObjectLayerMask(1) << Layers::cDebris) &
+                                    ~(ObjectLayerMask(1) << Layers::cTrigger);
     bool mSleepingDynamic = true; ///< Sleeping dynamic bodies are obstacles (awake ones move: never)
     bool mKinematic = false;      ///< Kinematic bodies (moving platforms, doors) are obstacles
 };

@@ -21,6 +21,7 @@
 #include <mutex>
 #include <shared_mutex>
 #include <span>
+#include <string>
 #include <vector>
 
 class dtNavMesh;
@@ -74,6 +75,8 @@ public:
     bool HasTile(const TileCoord& inTile) const;
     /// Polygons of a published tile (0 when absent).
     int GetTilePolygonCount(const TileCoord& inTile) const;
+    /// The published navmesh's surface (each polygon's detail triangles) as Wavefront OBJ text.
+    std::string ToObj() const;
     /// A copy of every published tile's Detour data, by tile: to compare two navmeshes.
     std::map<TileCoord, std::vector<unsigned char>> SnapshotTiles() const;
 

@@ -98,6 +98,8 @@ public:
     int Update();
     /// True when every needed tile is built, clean and published, and no job runs.
     bool IsIdle() const;
+    /// Needed tiles that have never been published (being built, or waiting for the budget).
+    uint32_t CountNeededNeverPublished() const;
     Stats GetStats() const;
     /// Jobs started and not yet taken in by Update.
     uint32_t GetNumRunningJobs() const;

@@ -1,0 +1,68 @@
+#pragma once
+
+// Agents: the demo's AI. Each agent is a navmesh invoker (the tiles within its radius are built in the
+// background) and walks paths on the navmesh as it appears and changes: it picks a target near the player,
+// asks the NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it
+// arrives, when the path was partial (the navmesh there was not built yet) or every few seconds. Every new
+// path is checked against the physics world: a point of it inside a wall (a static body at chest height)
+// counts as a path through a wall, which must never happen.
+//
+// Threads: the main thread only (path queries may come from any thread; the demo keeps them on one).
+
+#include "TileStreamer.h"
+#include "cairn/navmesh/NavMeshWorld.h"
+#include "cairn/navmesh/TileScheduler.h"
+#include "cairn/physics/PhysicsSystem.h"
+
+#include <random>
+#include <vector>
+
+namespace cairn::demo
+{
+
+class Agents
+{
+public:
+    struct Stats
+    {
+        uint64_t mPathQueries = 0;
+        uint64_t mPathsFound = 0; ///< Reaching the target
+        double mPathMicros = 0.0; ///< Summed
+        double mDistance = 0.0;   ///< Metres walked by all agents
+        uint32_t mPathsThroughWalls = 0;
+        std::vector<std::string> mErrors;
+    };
+
+    Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, const TileStreamer& inStreamer,
+           navmesh::NavMeshWorld& ioNavMesh, navmesh::TileScheduler& ioScheduler, int inCount,
+           uint64_t inSeed);
+    ~Agents();
+
+    void Update(float inDeltaTime, const Vec3& inPlayer);
+    const Stats& GetStats() const { return mStats; }
+
+private:
+    struct Agent
+    {
+        Vec3 mPosition;
+        navmesh::TileScheduler::InvokerID mInvoker = 0;
+        std::vector<Vec3> mPath;
+        size_t mNext = 0;       ///< Next corner of mPath
+        float mRepathIn = 0.0f; ///< Seconds until it asks again
+    };
+
+    void Repath(Agent& ioAgent, const Vec3& inPlayer);
+    /// Points of the path inside a static body other than the terrain, sampled every 0.25 m at chest height.
+    bool GoesThroughWall(const std::vector<Vec3>& inPath) const;
+
+    PhysicsSystem& mPhysics;
+    const WorldGenerator& mGenerator;
+    const TileStreamer& mStreamer;
+    navmesh::NavMeshWorld& mNavMesh;
+    navmesh::TileScheduler& mScheduler;
+    std::vector<Agent> mAgents;
+    std::mt19937_64 mRandom;
+    Stats mStats;
+};
+
+} // namespace cairn::demo

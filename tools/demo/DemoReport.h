@@ -1,0 +1,39 @@
+#pragma once
+
+// Turns the demo's measurements (DemoRunResult) into a console summary, a lock-free vs global-mutex
+// comparison, SVG charts, and a Markdown report folder.
+
+#include "demo/DemoResult.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace cairn::demo
+{
+
+/// Compact human summary of one run (one locking mode) written to inOut.
+void PrintSummary(std::FILE* inOut, const DemoRunResult& inRun);
+
+/// Side-by-side table of the two modes with the global/lock-free ratios (the query-cost target is >= 10x).
+void PrintComparison(std::FILE* inOut, const DemoRunResult& inLockFree, const DemoRunResult& inGlobal);
+
+/// Self-contained 800x300 SVG plotting each (name, samples) series against its sample index. Non-finite
+/// samples are skipped (they break the line), empty series only appear in the legend.
+std::string SvgLineChart(const std::string& inTitle, const std::string& inYLabel,
+                         const std::vector<std::pair<std::string, std::vector<double>>>& inSeries);
+
+/// Self-contained 800x300 SVG histogram of inValues with one bar per integer value 0..max, merged into at
+/// most 40 equal-width buckets when the range is larger.
+std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel,
+                         const std::vector<uint32_t>& inValues);
+
+/// Writes report.md, frame_times.svg and tile_latency.svg to inFolder (created if missing). With two runs the
+/// one whose mode name contains "global" is compared against the other. On failure returns false with the
+/// path and reason in outError, and removes the files it had started; never throws.
+bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& inRuns,
+                 const std::string& inCommandLine, std::string& outError);
+
+} // namespace cairn::demo

@@ -1,0 +1,72 @@
+#pragma once
+
+// What one run of the demo measured: plain data, filled by DemoRunner on the main thread after the run, read
+// by DemoReport to print the summary and write the Markdown report.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace cairn::demo
+{
+
+/// Summary of a series of samples (milliseconds unless said otherwise).
+struct SampleSummary
+{
+    double mMean = 0.0;
+    double mP50 = 0.0;
+    double mP99 = 0.0;
+    double mMax = 0.0;
+    size_t mCount = 0;
+};
+
+SampleSummary Summarize(std::vector<double> inSamples);
+
+struct PhaseTimes
+{
+    double mBroadPhaseUpdateMs = 0.0; ///< Means per frame
+    double mNarrowPhaseMs = 0.0;      ///< Pairs + narrow phase
+    double mIslandsMs = 0.0;
+    double mSolveMs = 0.0;
+    double mFinishMs = 0.0;
+};
+
+struct DemoRunResult
+{
+    std::string mModeName; ///< "lock-free" or "global mutex"
+    int mFrames = 0;
+    uint32_t mThreads = 0;          ///< Job system threads
+    std::vector<double> mPhysicsMs; ///< Per frame: PhysicsSystem::Update wall time
+    std::vector<double>
+        mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
+    PhaseTimes mPhases;
+    /// Game-object query jobs: mean microseconds per query, per job-system thread (index = thread slot)
+    std::vector<double> mQueryMicrosPerThread;
+    uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs
+    double mQueryMicrosMean = 0.0; ///< Over all queries
+    /// Streaming, measured on the loading thread per world tile
+    std::vector<double> mStreamInMs;         ///< Create + prepare + finalize of one tile's bodies
+    std::vector<double> mStreamLinkMs;       ///< The finalize (broad-phase link) alone
+    std::vector<double> mStreamOutMs;        ///< Remove + destroy of one tile's bodies
+    std::vector<double> mMainThreadStreamMs; ///< Per frame: time the main thread spent on streaming
+    uint32_t mTilesStreamedIn = 0;
+    uint32_t mTilesStreamedOut = 0;
+    uint32_t mStaticBodiesPeak = 0;
+    uint32_t mDynamicBodiesPeak = 0;
+    /// Navmesh
+    uint64_t mNavTilesBuilt = 0;
+    std::vector<uint32_t> mNavTileLatencyFrames; ///< Request to publication, per tile
+    uint64_t mPathQueries = 0;
+    uint64_t mPathsFound = 0;
+    double mPathQueryMicrosMean = 0.0;
+    int mAgents = 0;
+    double mAgentDistanceMetres = 0.0; ///< Walked by all agents along their paths
+    /// Invariants (the demo test checks them)
+    uint32_t mLostOrDuplicatedBodies = 0;
+    uint32_t mTilesRequestedNeverBuilt = 0;
+    uint32_t mPathsThroughWalls = 0;
+    std::vector<std::string> mErrors; ///< Anything that went wrong, one line each
+    std::string mNavMeshObj;          ///< The navmesh at the end of the run, as Wavefront OBJ text
+};
+
+} // namespace cairn::demo

@@ -1,0 +1,191 @@
+#include "DemoRunner.h"
+
+#include "Agents.h"
+#include "GameObjects.h"
+#include "TileStreamer.h"
+#include "WorldGenerator.h"
+#include "cairn/jobs/BackgroundQueue.h"
+#include "cairn/jobs/JobSystem.h"
+#include "cairn/navmesh/NavMeshWorld.h"
+#include "cairn/navmesh/TileScheduler.h"
+#include "cairn/physics/PhysicsSystem.h"
+
+#include <chrono>
+#include <thread>
+
+namespace cairn::demo
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point inStart)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
+}
+
+/// Runs frames of physics and the navmesh sync point (no measuring) until inDone or inMaxSeconds.
+template <class Done>
+bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, navmesh::TileScheduler& ioScheduler,
+              const Done& inDone, double inMaxSeconds)
+{
+    const Clock::time_point start = Clock::now();
+    while (!inDone())
+    {
+        if (MillisecondsSince(start) > inMaxSeconds * 1000.0) return false;
+        (void)ioPhysics.Update(1.0f / 60.0f, 1, ioJobs);
+        ioScheduler.Update();
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+}
+} // namespace
+
+DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress)
+{
+    DemoRunResult result;
+    result.mModeName = inMode == BroadPhaseType::QuadTreeGlobalMutex ? "global mutex" : "lock-free";
+    result.mAgents = inSettings.mAgents;
+
+    PhysicsSettings physicsSettings;
+    physicsSettings.mMaxBodies = 65536;
+    physicsSettings.mBroadPhase = inMode;
+    PhysicsSystem physics(physicsSettings);
+    jobs::JobSystem::Settings jobSettings;
+    jobSettings.mNumThreads = inSettings.mThreads;
+    jobs::JobSystem frameJobs(jobSettings);
+    result.mThreads = frameJobs.GetNumThreads();
+    jobs::BackgroundQueue::Settings queueSettings;
+    queueSettings.mNumThreads = 1;
+    queueSettings.mFrameJobs = &frameJobs;
+    jobs::BackgroundQueue background(queueSettings);
+
+    WorldSettings worldSettings;
+    worldSettings.mSeed = inSettings.mSeed;
+    worldSettings.mPropsPerTile = inSettings.mPropsPerTile;
+    worldSettings.mDynamicPerTile = inSettings.mDynamicPerTile;
+    worldSettings.mPlayerSpeed = inSettings.mPlayerSpeed;
+    const WorldGenerator generator(worldSettings);
+
+    const navmesh::AgentProfile profile;
+    const navmesh::TileGrid grid(0.0f, 0.0f, profile.mTileSize, -50.0f, 100.0f);
+    std::unique_ptr<navmesh::NavMeshWorld> navMesh =
+        std::move(navmesh::NavMeshWorld::Create(grid, profile).Value());
+    navmesh::TileScheduler::Settings schedulerSettings;
+    schedulerSettings.mMaxConcurrentJobs = 2;
+    schedulerSettings.mDropDelayFrames = 180;
+    auto scheduler =
+        std::make_unique<navmesh::TileScheduler>(physics, *navMesh, background, schedulerSettings);
+
+    // Game objects before the streamer: the streamer counts the bodies it finds as not its own
+    auto gameObjects =
+        std::make_unique<GameObjects>(physics, generator, inSettings.mGameObjects, inSettings.mSeed);
+    auto streamer = std::make_unique<TileStreamer>(physics, generator, inSettings.mCollisionRadius);
+
+    // The loading screen: the tiles around the start, before the clock runs
+    const float speed = worldSettings.mPlayerSpeed;
+    const float lookAhead = generator.GetSettings().mTileSize / speed; // Seconds to cross one tile
+    streamer->SetFocus(generator.GetPlayerPosition(0.0f), generator.GetPlayerPosition(lookAhead));
+    if (!RunUntil(
+            physics, frameJobs, *scheduler, [&] { return streamer->IsSettled(); }, 60.0))
+        result.mErrors.push_back("the start area did not load within 60 s");
+    auto agents = std::make_unique<Agents>(physics, generator, *streamer, *navMesh, *scheduler,
+                                           inSettings.mAgents, inSettings.mSeed + 1);
+
+    const float dt = 1.0f / 60.0f;
+    const Clock::time_point begin = Clock::now();
+    for (int frame = 0; frame < inSettings.mFrames; ++frame)
+    {
+        const Clock::time_point frameStart = Clock::now();
+        const float seconds = float(frame) * dt;
+        const Vec3 player = generator.GetPlayerPosition(seconds);
+
+        const Clock::time_point streamStart = Clock::now();
+        streamer->SetFocus(player, generator.GetPlayerPosition(seconds + lookAhead));
+        result.mMainThreadStreamMs.push_back(MillisecondsSince(streamStart));
+
+        const Clock::time_point physicsStart = Clock::now();
+        if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
+            result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
+        result.mPhysicsMs.push_back(MillisecondsSince(physicsStart));
+        const StepStatistics& step = physics.GetLastStepStatistics();
+        result.mPhases.mBroadPhaseUpdateMs += step.mBroadPhaseUpdateMs;
+        result.mPhases.mNarrowPhaseMs += step.mNarrowPhaseMs;
+        result.mPhases.mIslandsMs += step.mIslandsMs;
+        result.mPhases.mSolveMs += step.mSolveMs;
+        result.mPhases.mFinishMs += step.mFinishMs;
+
+        gameObjects->Update(frameJobs, inSettings.mGameObjectJobs, player, dt);
+        agents->Update(dt, player);
+        scheduler->Update();
+        result.mFrameMs.push_back(MillisecondsSince(frameStart));
+
+        if (inProgress != nullptr && (frame % 15 == 0 || frame + 1 == inSettings.mFrames))
+        {
+            const TileStreamer::Stats streaming = streamer->GetStats();
+            std::fprintf(inProgress,
+                         "\r  %-12s frame %5d/%d  physics %6.2f ms  world tiles %2zu  bodies %5u static %4u "
+                         "dynamic  navmesh tiles %3d   ",
+                         result.mModeName.c_str(), frame + 1, inSettings.mFrames, result.mPhysicsMs.back(),
+                         streamer->GetLoadedTiles().size(), streaming.mStaticBodies, streaming.mDynamicBodies,
+                         navMesh->GetNumTiles());
+            std::fflush(inProgress);
+        }
+        if (inSettings.mRealTime)
+            std::this_thread::sleep_until(begin + std::chrono::microseconds(int64_t(16667.0 * (frame + 1))));
+    }
+    if (inProgress != nullptr) std::fprintf(inProgress, "\n");
+    result.mFrames = inSettings.mFrames;
+
+    // Invariants: every tile the agents asked for gets built; no body lost or duplicated by streaming
+    if (!RunUntil(
+            physics, frameJobs, *scheduler, [&] { return scheduler->IsIdle() && streamer->IsSettled(); },
+            30.0))
+        result.mErrors.push_back("the navmesh or the streaming did not settle within 30 s after the run");
+    result.mTilesRequestedNeverBuilt = scheduler->CountNeededNeverPublished();
+    result.mLostOrDuplicatedBodies = streamer->CountLostOrDuplicated();
+
+    const navmesh::TileScheduler::Stats navStats = scheduler->GetStats();
+    result.mNavTilesBuilt = navStats.mTilesPublished;
+    result.mNavMeshObj = navMesh->ToObj();
+    result.mNavTileLatencyFrames = navStats.mFirstPublishFrames;
+    if (navStats.mJobsFailed > 0) result.mErrors.push_back("navmesh: " + navStats.mLastError);
+    const Agents::Stats& agentStats = agents->GetStats();
+    result.mPathQueries = agentStats.mPathQueries;
+    result.mPathsFound = agentStats.mPathsFound;
+    result.mPathQueryMicrosMean =
+        agentStats.mPathQueries == 0 ? 0.0 : agentStats.mPathMicros / double(agentStats.mPathQueries);
+    result.mAgentDistanceMetres = agentStats.mDistance;
+    result.mPathsThroughWalls = agentStats.mPathsThroughWalls;
+    result.mQueries = gameObjects->GetNumQueries();
+    result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();
+    result.mQueryMicrosPerThread = gameObjects->GetQueryMicrosPerThread();
+    const TileStreamer::Stats streaming = streamer->GetStats();
+    result.mStreamInMs = streaming.mStreamInMs;
+    result.mStreamLinkMs = streaming.mStreamLinkMs;
+    result.mStreamOutMs = streaming.mStreamOutMs;
+    result.mTilesStreamedIn = streaming.mTilesIn;
+    result.mTilesStreamedOut = streaming.mTilesOut;
+    result.mStaticBodiesPeak = streaming.mStaticPeak;
+    result.mDynamicBodiesPeak = streaming.mDynamicPeak;
+    for (const std::string& error : streaming.mErrors)
+        result.mErrors.push_back("streaming: " + error);
+    const double frames = std::max(1, inSettings.mFrames);
+    result.mPhases.mBroadPhaseUpdateMs /= frames;
+    result.mPhases.mNarrowPhaseMs /= frames;
+    result.mPhases.mIslandsMs /= frames;
+    result.mPhases.mSolveMs /= frames;
+    result.mPhases.mFinishMs /= frames;
+
+    // Tear down in dependency order: agents (invokers), the scheduler (its jobs read the world), then the
+    // streamer, whose unload checks every body it made once more
+    agents.reset();
+    scheduler.reset();
+    result.mLostOrDuplicatedBodies += streamer->UnloadAllAndCheck();
+    streamer.reset();
+    gameObjects.reset();
+    return result;
+}
+
+} // namespace cairn::demo

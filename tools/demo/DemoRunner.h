@@ -1,0 +1,37 @@
+#pragma once
+
+// DemoRunner: one run of the streaming open-world demo in one broad-phase mode. The main thread's frame:
+//   streaming focus -> physics step (job system) -> game-object jobs (queries and moves on the job threads)
+//   -> AI agents (paths) -> navmesh sync point (TileScheduler::Update) -> wait for the next 1/60 s tick.
+// The loading thread streams tiles in and out meanwhile, and background tile jobs build the navmesh.
+// Threads: RunDemo on one thread; it owns everything it makes.
+
+#include "DemoResult.h"
+#include "cairn/physics/PhysicsSettings.h"
+
+#include <cstdio>
+#include <string>
+
+namespace cairn::demo
+{
+
+struct DemoSettings
+{
+    uint64_t mSeed = 1;
+    int mFrames = 1200; ///< Per mode
+    int mAgents = 8;
+    uint32_t mThreads = 0;         ///< Job system threads (0: all cores)
+    int mCollisionSteps = 1;       ///< Per 1/60 s frame
+    uint32_t mGameObjects = 256;   ///< Objects updated by jobs each frame
+    uint32_t mGameObjectJobs = 8;  ///< K jobs per frame
+    bool mRealTime = true;         ///< Wait for each 1/60 s tick (false: as fast as it goes)
+    float mCollisionRadius = 3.0f; ///< World tiles with collision around the player (29 tiles)
+    int mPropsPerTile = 700;
+    int mDynamicPerTile = 110;
+    float mPlayerSpeed = 8.0f; ///< m/s across the world
+};
+
+/// Runs the demo in inMode; inProgress (may be null) gets a live one-line display.
+DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress);
+
+} // namespace cairn::demo

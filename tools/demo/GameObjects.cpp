@@ -1,0 +1,141 @@
+#include "GameObjects.h"
+
+#include "WorldGenerator.h"
+#include "cairn/physics/shapes/BoxShape.h"
+
+#include <chrono>
+#include <cmath>
+
+namespace cairn::demo
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+std::atomic<uint32_t> sNextThreadSlot{0}; // Relaxed: only uniqueness matters
+} // namespace
+
+uint32_t GameObjects::ThreadSlotIndex()
+{
+    thread_local const uint32_t slot = sNextThreadSlot.fetch_add(1, std::memory_order_relaxed);
+    return slot % cMaxThreadSlots;
+}
+
+GameObjects::GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
+                         uint64_t inSeed)
+    : mPhysics(ioPhysics), mGenerator(inGenerator)
+{
+    std::mt19937_64 random(inSeed);
+    std::uniform_real_distribution<float> offset(-40.0f, 40.0f), phase(0.0f, 6.28f);
+    const ShapeRef shape = BoxShape::Create(Vec3(0.3f, 0.9f, 0.3f)).Value();
+    for (uint32_t i = 0; i < inCount; ++i)
+    {
+        Object object;
+        object.mOffset = Vec3(offset(random), 0.0f, offset(random));
+        object.mPhase = phase(random);
+        BodyCreationSettings settings;
+        settings.mShape = shape;
+        settings.mPosition = Vec3(object.mOffset.x(), 50.0f, object.mOffset.z());
+        settings.mMotionType = MotionType::Kinematic;
+        settings.mObjectLayer = Layers::cMoving;
+        Result<BodyID> id = mPhysics.GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate);
+        if (!id) continue;
+        object.mBody = id.Value();
+        mObjects.push_back(object);
+    }
+}
+
+GameObjects::~GameObjects()
+{
+    for (const Object& object : mObjects)
+    {
+        (void)mPhysics.GetBodyInterface().RemoveBody(object.mBody);
+        (void)mPhysics.GetBodyInterface().DestroyBody(object.mBody);
+    }
+}
+
+void GameObjects::UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries)
+{
+    const WorldQuery& query = mPhysics.GetWorldQuery();
+    // A patrol circle around its spot near the player
+    const Vec3 spot = inPlayer + ioObject.mOffset +
+                      3.0f * Vec3(std::cos(mTime + ioObject.mPhase), 0.0f, std::sin(mTime + ioObject.mPhase));
+    QueryFilter filter;
+    filter.mIgnoreBody = ioObject.mBody;
+
+    // Ground probe: straight down from well above the terrain
+    const Clock::time_point start = Clock::now();
+    RayCast down;
+    down.mOrigin = Vec3(spot.x(), mGenerator.GetTerrainHeight(spot.x(), spot.z()) + 30.0f, spot.z());
+    down.mDirection = Vec3(0.0f, -60.0f, 0.0f);
+    const std::optional<RayCastResult> ground = query.CastRayClosest(down, filter);
+    ioObject.mGroundY = ground ? down.mOrigin.y() + ground->mFraction * down.mDirection.y() : spot.y();
+    // Line of sight to the player's head
+    const Vec3 eye(spot.x(), ioObject.mGroundY + 1.6f, spot.z());
+    RayCast sight;
+    sight.mOrigin = eye;
+    sight.mDirection = inPlayer + Vec3(0.0f, 1.6f, 0.0f) - eye;
+    ioObject.mCanSeePlayer = !query.CastRayAny(sight, filter);
+    // What is around it
+    thread_local std::vector<BodyID> around;
+    query.CollideSphere(eye, 2.0f, around, filter);
+    ioNanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
+    ioQueries += 3;
+
+    // Move: a broad-phase write from this thread
+    (void)mPhysics.GetBodyInterface().SetPosition(
+        ioObject.mBody, Vec3(spot.x(), ioObject.mGroundY + 0.9f, spot.z()), Activation::DontActivate);
+}
+
+void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime)
+{
+    mTime += inDeltaTime * 0.5f;
+    const uint32_t count = uint32_t(mObjects.size());
+    if (count == 0) return;
+    const uint32_t grain = std::max(1u, (count + inJobs - 1) / std::max(1u, inJobs));
+    ioJobs.ParallelFor(count, grain,
+                       [&](uint32_t inBegin, uint32_t inEnd)
+                       {
+                           uint64_t nanos = 0, queries = 0;
+                           for (uint32_t i = inBegin; i < inEnd; ++i)
+                               UpdateObject(mObjects[i], inPlayer, nanos, queries);
+                           ThreadSlot& slot = mSlots[ThreadSlotIndex()];
+                           // Relaxed: totals read after the jobs are waited for (the wait orders them)
+                           slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
+                           slot.mQueries.fetch_add(queries, std::memory_order_relaxed);
+                       });
+}
+
+uint64_t GameObjects::GetNumQueries() const
+{
+    uint64_t total = 0;
+    for (const ThreadSlot& slot : mSlots)
+        total += slot.mQueries.load(std::memory_order_relaxed);
+    return total;
+}
+
+std::vector<double> GameObjects::GetQueryMicrosPerThread() const
+{
+    std::vector<double> perThread;
+    for (const ThreadSlot& slot : mSlots)
+    {
+        const uint64_t queries = slot.mQueries.load(std::memory_order_relaxed);
+        if (queries > 0)
+            perThread.push_back(double(slot.mNanos.load(std::memory_order_relaxed)) / 1000.0 /
+                                double(queries));
+    }
+    return perThread;
+}
+
+double GameObjects::GetQueryMicrosMean() const
+{
+    uint64_t nanos = 0, queries = 0;
+    for (const ThreadSlot& slot : mSlots)
+    {
+        nanos += slot.mNanos.load(std::memory_order_relaxed);
+        queries += slot.mQueries.load(std::memory_order_relaxed);
+    }
+    return queries == 0 ? 0.0 : double(nanos) / 1000.0 / double(queries);
+}
+
+} // namespace cairn::demo

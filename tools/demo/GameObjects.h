@@ -1,0 +1,69 @@
+#pragma once
+
+// GameObjects: the game-object update of the demo. Many independent game objects (patrolling kinematic bodies
+// around the player) are updated each frame by K jobs on the job system's threads, as a game does: each
+// object probes the ground (a ray cast down), checks its line of sight to the player (a ray cast), looks for
+// bodies around it (a sphere query), then moves its body (a broad-phase write). These queries and moves from
+// several threads at once are the load under which the lock-free broad phase and the global-mutex mode are
+// compared.
+//
+// Threads: Update on the main thread, which runs the jobs and waits for them; each object is touched by one
+// job only. The per-thread query figures are atomics added once per job.
+
+#include "cairn/jobs/JobSystem.h"
+#include "cairn/physics/PhysicsSystem.h"
+
+#include <array>
+#include <atomic>
+#include <random>
+#include <vector>
+
+namespace cairn::demo
+{
+
+class WorldGenerator;
+
+class GameObjects
+{
+public:
+    static constexpr uint32_t cMaxThreadSlots = 16;
+
+    GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
+                uint64_t inSeed);
+    ~GameObjects();
+
+    /// One frame: inJobs jobs on ioJobs update every object around inPlayer.
+    void Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime);
+
+    uint64_t GetNumQueries() const;
+    /// Mean microseconds per query on each thread that ran game-object jobs (in the order threads first
+    /// came).
+    std::vector<double> GetQueryMicrosPerThread() const;
+    double GetQueryMicrosMean() const;
+
+private:
+    struct Object
+    {
+        BodyID mBody;
+        Vec3 mOffset; ///< From the player: the objects move with the streaming window
+        float mPhase; ///< Of its patrol circle
+        bool mCanSeePlayer = false;
+        float mGroundY = 0.0f;
+    };
+    struct alignas(64) ThreadSlot
+    {
+        std::atomic<uint64_t> mNanos{0};
+        std::atomic<uint64_t> mQueries{0};
+    };
+
+    void UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);
+    static uint32_t ThreadSlotIndex();
+
+    PhysicsSystem& mPhysics;
+    const WorldGenerator& mGenerator;
+    std::vector<Object> mObjects;
+    float mTime = 0.0f;
+    std::array<ThreadSlot, cMaxThreadSlots> mSlots;
+};
+
+} // namespace cairn::demo
