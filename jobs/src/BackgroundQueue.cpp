@@ -7,6 +7,7 @@
 #include <exception>
 
 #if defined(__linux__)
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -241,9 +242,12 @@ void BackgroundQueue::ThreadMain()
 {
 #if defined(__linux__)
     // Linux applies nice per thread: the frame's threads win the cores while a chunk runs
-    if (mSettings.mLowerThreadPriority &&
-        setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10) == 0)
+    sched_param idle{};
+    if (mSettings.mIdleScheduling && sched_setscheduler(0, SCHED_IDLE, &idle) == 0)
         mThreadPriorityLowered.store(true, std::memory_order_relaxed); // Statistic only
+    else if (mSettings.mLowerThreadPriority &&
+             setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10) == 0)
+        mThreadPriorityLowered.store(true, std::memory_order_relaxed);
 #endif
     for (;;)
     {

@@ -439,7 +439,8 @@ std::string TableMarkdown(const Table& inTable)
 {
     auto line = [](const std::vector<std::string>& inCells)
     {
-        // Appended piece by piece: g++ 12 warns (wrongly, -Wrestrict) about " " + std::string temporaries here
+        // Appended piece by piece: g++ 12 warns (wrongly, -Wrestrict) about " " + std::string temporaries
+        // here
         std::string text = "|";
         for (const std::string& cell : inCells)
         {

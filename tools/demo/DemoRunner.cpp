@@ -2,6 +2,7 @@
 
 #include "Agents.h"
 #include "GameObjects.h"
+#include "Projectiles.h"
 #include "TileStreamer.h"
 #include "WorldGenerator.h"
 #include "cairn/jobs/BackgroundQueue.h"
@@ -59,6 +60,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     jobs::BackgroundQueue::Settings queueSettings;
     queueSettings.mNumThreads = 1;
     queueSettings.mFrameJobs = &frameJobs;
+    queueSettings.mIdleScheduling = inSettings.mRealTime; // Frames leave idle time only when paced
     jobs::BackgroundQueue background(queueSettings);
 
     WorldSettings worldSettings;
@@ -93,6 +95,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     auto agents = std::make_unique<Agents>(physics, generator, *streamer, *navMesh, *scheduler,
                                            inSettings.mAgents, inSettings.mSeed + 1);
 
+    Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
     const float dt = 1.0f / 60.0f;
     const Clock::time_point begin = Clock::now();
     for (int frame = 0; frame < inSettings.mFrames; ++frame)
@@ -104,6 +107,8 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         const Clock::time_point streamStart = Clock::now();
         streamer->SetFocus(player, generator.GetPlayerPosition(seconds + lookAhead));
         result.mMainThreadStreamMs.push_back(MillisecondsSince(streamStart));
+
+        if (inSettings.mThrowBalls) projectiles.Update(frame, player);
 
         const Clock::time_point physicsStart = Clock::now();
         if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
@@ -137,6 +142,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     }
     if (inProgress != nullptr) std::fprintf(inProgress, "\n");
     result.mFrames = inSettings.mFrames;
+    projectiles.RemoveAll(); // Before the streamer counts the world's bodies
 
     // Invariants: every tile the agents asked for gets built; no body lost or duplicated by streaming
     if (!RunUntil(

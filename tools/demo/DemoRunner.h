@@ -1,7 +1,8 @@
 #pragma once
 
 // DemoRunner: one run of the streaming open-world demo in one broad-phase mode. The main thread's frame:
-//   streaming focus -> physics step (job system) -> game-object jobs (queries and moves on the job threads)
+//   streaming focus -> balls thrown by the player -> physics step (job system) -> game-object jobs (queries
+//   and moves on the job threads)
 //   -> AI agents (paths) -> navmesh sync point (TileScheduler::Update) -> wait for the next 1/60 s tick.
 // The loading thread streams tiles in and out meanwhile, and background tile jobs build the navmesh.
 // Threads: RunDemo on one thread; it owns everything it makes.
@@ -29,6 +30,7 @@ struct DemoSettings
     int mPropsPerTile = 700;
     int mDynamicPerTile = 110;
     float mPlayerSpeed = 8.0f; ///< m/s across the world
+    bool mThrowBalls = true;   ///< The player throws balls that knock crates and stacks over
 };
 
 /// Runs the demo in inMode; inProgress (may be null) gets a live one-line display.

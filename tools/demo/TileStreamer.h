@@ -1,11 +1,12 @@
 #pragma once
 
 // TileStreamer: streams the open world's tiles in and out of the physics world on a loading thread of its
-// own, as a game's streaming system does. The main thread only says where the player is (SetFocus: a mutex
-// held for a few instructions); the loading thread generates a tile's bodies, creates them, prepares their
-// broad-phase add off the main thread and finalizes it (an O(1) link into the broad phase), and removes tiles
-// that left the collision radius. Tiles within one tile of the player are high-LOD and also get dynamic
-// bodies (crates, stacks, debris), removed again when the tile drops back to medium LOD.
+// own, as a game's streaming system does. The main thread only says where the player is (SetFocus: a
+// try-lock, it never waits); the loading thread (at a lower OS priority) generates a tile's bodies, creates
+// them, prepares their broad-phase add off the main thread and finalizes it (an O(1) link into the broad
+// phase), and removes tiles that left the collision radius. Tiles within one tile of the player are high-LOD
+// and also get dynamic bodies (crates, stacks, debris; created asleep), removed again when the tile drops
+// back to medium LOD.
 //
 // Threads: SetFocus, GetStats, IsSettled from any thread (mMutex); everything else happens on the loading
 // thread, which owns mTiles. The physics world is used through BodyInterface, which may be called while the
@@ -49,7 +50,8 @@ public:
     TileStreamer(const TileStreamer&) = delete;
     TileStreamer& operator=(const TileStreamer&) = delete;
 
-    /// Where the player is and where it will be soon: tiles around both are wanted. Never blocks for long.
+    /// Where the player is and where it will be soon: tiles around both are wanted. Never waits: when the
+    /// loading thread holds the lock, this focus is skipped (call it every frame).
     void SetFocus(const Vec3& inPlayer, const Vec3& inAhead);
     /// True when every wanted tile is loaded at the right LOD and nothing else is.
     bool IsSettled() const;

@@ -127,6 +127,10 @@ public:
         std::chrono::microseconds mMaxYield{4000};
         /// Lower the threads' OS priority (nice 10)
         bool mLowerThreadPriority = true;
+        /// Linux: run the threads only when no other thread wants a core (SCHED_IDLE) instead of nice 10.
+        /// Best when the frame leaves idle time (a 60 Hz game): a background thread then never preempts a
+        /// frame thread. Frames that keep every core busy would starve background work
+        bool mIdleScheduling = false;
     };
 
     struct Stats

@@ -1,0 +1,66 @@
+#include "Projectiles.h"
+
+#include "WorldGenerator.h"
+#include "cairn/physics/shapes/SphereShape.h"
+
+#include <cmath>
+
+namespace cairn::demo
+{
+
+namespace
+{
+constexpr int cFramesBetweenThrows = 12; ///< Five a second
+constexpr int cLifetimeFrames = 300;     ///< Five seconds
+constexpr float cSpeed = 14.0f;          ///< m/s
+} // namespace
+
+Projectiles::Projectiles(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint64_t inSeed)
+    : mPhysics(ioPhysics), mGenerator(inGenerator), mRandom(inSeed),
+      mShape(SphereShape::Create(0.35f).Value())
+{
+}
+
+void Projectiles::Update(int inFrame, const Vec3& inPlayer)
+{
+    BodyInterface& bodies = mPhysics.GetBodyInterface();
+    while (!mBalls.empty() && inFrame - mBalls.front().mBornFrame > cLifetimeFrames)
+    {
+        (void)bodies.RemoveBody(mBalls.front().mBody);
+        (void)bodies.DestroyBody(mBalls.front().mBody);
+        mBalls.pop_front();
+    }
+    if (inFrame % cFramesBetweenThrows != 0) return;
+    // At a spot 5-25 m away in any direction, in a flat arc
+    std::uniform_real_distribution<float> angle(0.0f, 6.2831853f), distance(5.0f, 25.0f);
+    const float a = angle(mRandom), d = distance(mRandom);
+    const float x = inPlayer.x() + d * std::cos(a), z = inPlayer.z() + d * std::sin(a);
+    const Vec3 from = inPlayer + Vec3(0.0f, 2.0f, 0.0f);
+    const Vec3 to(x, mGenerator.GetTerrainHeight(x, z) + 0.5f, z);
+    const float flight = (to - from).norm() / cSpeed;
+    BodyCreationSettings settings;
+    settings.mShape = mShape;
+    settings.mPosition = from;
+    // Aimed to arrive after the flight time despite gravity
+    settings.mLinearVelocity = (to - from) / flight - 0.5f * flight * mPhysics.GetSettings().mGravity;
+    settings.mDensity = 3000.0f;
+    settings.mObjectLayer = Layers::cMoving;
+    settings.mFriction = 0.5f;
+    Result<BodyID> id = bodies.CreateAndAddBody(settings, Activation::Activate);
+    if (!id) return;
+    mBalls.push_back({id.Value(), inFrame});
+    ++mThrown;
+}
+
+void Projectiles::RemoveAll()
+{
+    BodyInterface& bodies = mPhysics.GetBodyInterface();
+    for (const Ball& ball : mBalls)
+    {
+        (void)bodies.RemoveBody(ball.mBody);
+        (void)bodies.DestroyBody(ball.mBody);
+    }
+    mBalls.clear();
+}
+
+} // namespace cairn::demo

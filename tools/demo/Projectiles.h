@@ -1,0 +1,43 @@
+#pragma once
+
+// Projectiles: the player throws heavy balls at the world around it, a few a second, so that crates and
+// stacks that were streamed in asleep get knocked over and the physics step has steady work, as in a game.
+// Balls are removed after a few seconds. Threads: the main thread only, between physics steps.
+
+#include "cairn/physics/PhysicsSystem.h"
+
+#include <deque>
+#include <random>
+
+namespace cairn::demo
+{
+
+class WorldGenerator;
+
+class Projectiles
+{
+public:
+    Projectiles(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint64_t inSeed);
+    ~Projectiles() { RemoveAll(); }
+
+    /// Frame inFrame: maybe throws a ball from inPlayer, and removes balls older than their lifetime.
+    void Update(int inFrame, const Vec3& inPlayer);
+    void RemoveAll();
+    uint32_t GetNumThrown() const { return mThrown; }
+
+private:
+    struct Ball
+    {
+        BodyID mBody;
+        int mBornFrame;
+    };
+
+    PhysicsSystem& mPhysics;
+    const WorldGenerator& mGenerator;
+    std::mt19937_64 mRandom;
+    ShapeRef mShape;
+    std::deque<Ball> mBalls;
+    uint32_t mThrown = 0;
+};
+
+} // namespace cairn::demo
