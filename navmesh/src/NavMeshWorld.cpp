@@ -1,5 +1,7 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 
+#include "cairn/navmesh/NavMeshFile.h"
+
 #include <DetourNavMesh.h>
 #include <DetourNavMeshQuery.h>
 #include <atomic>
@@ -56,27 +58,11 @@ Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGri
                                                            const AgentProfile& inProfile, int inMaxTiles)
 {
     if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
-    if (inMaxTiles < 1 || inMaxTiles > (1 << 20))
-        return MakeError(ErrorCode::InvalidArgument, "navmesh: max tiles must be 1 to 2^20");
+    Result<dtNavMeshParams> params = MakeNavMeshParams(inGrid, inMaxTiles);
+    if (!params) return params.GetError();
     std::unique_ptr<NavMeshWorld> world(new NavMeshWorld(inGrid, inProfile));
-    // A 32-bit polygon reference holds salt, tile and polygon bits: tiles take what they need, polygons get
-    // the rest up to 22 (10 bits of salt, as Detour's samples leave)
-    int tileBits = 0;
-    while ((1 << tileBits) < inMaxTiles)
-        ++tileBits;
-    const int polyBits = std::min(22 - tileBits, 14);
-    if (polyBits < 8)
-        return MakeError(ErrorCode::InvalidArgument, "navmesh: too many tiles for 32-bit polygon references");
-    dtNavMeshParams params{};
-    params.orig[0] = inGrid.GetOriginX();
-    params.orig[1] = 0.0f;
-    params.orig[2] = inGrid.GetOriginZ();
-    params.tileWidth = inGrid.GetTileSize();
-    params.tileHeight = inGrid.GetTileSize();
-    params.maxTiles = 1 << tileBits;
-    params.maxPolys = 1 << polyBits;
     world->mNavMesh = dtAllocNavMesh();
-    if (world->mNavMesh == nullptr || dtStatusFailed(world->mNavMesh->init(&params)))
+    if (world->mNavMesh == nullptr || dtStatusFailed(world->mNavMesh->init(&params.Value())))
         return MakeError(ErrorCode::OutOfCapacity, "navmesh: Detour could not allocate the navmesh");
     return world;
 }

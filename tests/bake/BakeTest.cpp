@@ -1,0 +1,191 @@
+// The offline baker on Recast's demo meshes: the same polygons per tile as a direct Recast build; the file
+// loads back into a dtNavMesh that answers path queries; 1 and 2 threads give the same bytes, and two merged
+// shards equal the full bake; malformed inputs get clear errors and leave no output behind.
+
+#include "Baker.h"
+#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/TileBuilder.h"
+#include "common/SharedBenchData.h"
+
+#include <DetourNavMeshQuery.h>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <iterator>
+#include <map>
+#include <random>
+
+namespace cairn::bake
+{
+namespace
+{
+
+std::string MeshPath(const char* inName)
+{
+    return GetSharedDataDir() + "/recast-meshes/" + inName;
+}
+
+std::vector<unsigned char> ReadBytes(const std::string& inPath)
+{
+    std::ifstream in(inPath, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string TempPath(const std::string& inName)
+{
+    return (std::filesystem::temp_directory_path() / ("cairn-bake-test-" + inName)).string();
+}
+
+class BakeMeshTest : public ::testing::TestWithParam<const char*>
+{
+};
+
+TEST_P(BakeMeshTest, SamePolygonsAsDirectRecastAndLoadsBackForPaths)
+{
+    const std::string path = MeshPath(GetParam());
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path << " (../shared/data not present)";
+    BakeSettings settings;
+    settings.mInputs = {path};
+    settings.mThreads = 1;
+    Result<BakeResult> baked = Bake(settings);
+    ASSERT_TRUE(baked) << baked.GetError().mMessage;
+
+    // The direct build: the OBJ's raw triangles into Recast, tile by tile, on the same grid
+    const navmesh::IndexedMesh mesh = navmesh::LoadObjMesh(path).Value();
+    const AABB bounds = mesh.GetBounds();
+    const navmesh::TileGrid grid(0.0f, 0.0f, settings.mProfile.mTileSize, bounds.mMin.y() - 1.0f,
+                                 bounds.mMax.y() + 1.0f);
+    std::vector<navmesh::TileCoord> tiles;
+    ASSERT_TRUE(grid.TilesOverlapping(bounds, 0.0f, tiles));
+    const navmesh::TileGeometry raw = mesh.ToTileGeometry();
+    std::map<navmesh::TileCoord, int> directPolygons;
+    for (const navmesh::TileCoord& tile : tiles)
+    {
+        Result<navmesh::BuiltTile> direct = navmesh::BuildTile(settings.mProfile, grid, tile, raw);
+        ASSERT_TRUE(direct) << direct.GetError().mMessage;
+        if (direct.Value().mData != nullptr) directPolygons[tile] = direct.Value().mNumPolygons;
+    }
+    ASSERT_EQ(baked.Value().mNavMesh.mTiles.size(), directPolygons.size());
+    for (const navmesh::NavMeshFileTile& tile : baked.Value().mNavMesh.mTiles)
+    {
+        dtMeshHeader header;
+        std::memcpy(&header, tile.mData.data(), sizeof(header));
+        ASSERT_TRUE(directPolygons.contains(tile.mTile));
+        EXPECT_EQ(header.polyCount, directPolygons[tile.mTile])
+            << "tile " << tile.mTile.mX << "," << tile.mTile.mZ;
+    }
+
+    // Saved, loaded back as a runtime would, and queried
+    const std::string file = TempPath(std::string(GetParam()) + ".navmesh");
+    ASSERT_TRUE(navmesh::SaveNavMeshFile(file, baked.Value().mNavMesh).IsOk());
+    Result<navmesh::NavMeshFileContents> loaded = navmesh::LoadNavMeshFile(file);
+    ASSERT_TRUE(loaded) << loaded.GetError().mMessage;
+    Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(loaded.Value());
+    ASSERT_TRUE(navMesh) << navMesh.GetError().mMessage;
+    dtNavMeshQuery query;
+    ASSERT_TRUE(dtStatusSucceed(query.init(navMesh.Value().get(), 2048)));
+    dtQueryFilter filter;
+    auto frand = []() -> float
+    {
+        static std::mt19937 generator(9);
+        return std::uniform_real_distribution<float>(0.0f, 1.0f)(generator);
+    };
+    int paths = 0;
+    for (int i = 0; i < 20; ++i)
+    {
+        dtPolyRef start = 0, end = 0;
+        float startPoint[3], endPoint[3];
+        ASSERT_TRUE(dtStatusSucceed(query.findRandomPoint(&filter, frand, &start, startPoint)));
+        // A point reachable from the start, by construction
+        if (dtStatusFailed(query.findRandomPointAroundCircle(start, startPoint, 10.0f, &filter, frand, &end,
+                                                             endPoint)) ||
+            end == 0)
+            continue;
+        dtPolyRef corridor[256];
+        int count = 0;
+        ASSERT_TRUE(dtStatusSucceed(
+            query.findPath(start, end, startPoint, endPoint, &filter, corridor, &count, 256)));
+        ASSERT_GT(count, 0);
+        EXPECT_EQ(corridor[count - 1], end);
+        ++paths;
+    }
+    EXPECT_GT(paths, 10);
+    std::filesystem::remove(file);
+}
+
+INSTANTIATE_TEST_SUITE_P(RecastDemoMeshes, BakeMeshTest,
+                         ::testing::Values("dungeon.obj", "nav_test.obj", "undulating.obj"),
+                         [](const ::testing::TestParamInfo<const char*>& inInfo)
+                         {
+                             std::string name = inInfo.param;
+                             return name.substr(0, name.find('.'));
+                         });
+
+TEST(BakeTest, ThreadCountAndShardsDoNotChangeTheBytes)
+{
+    const std::string path = MeshPath("nav_test.obj");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+    BakeSettings settings;
+    settings.mInputs = {path};
+    auto bakeTo = [&](uint32_t inThreads, uint32_t inShard, uint32_t inShards, const std::string& inFile)
+    {
+        settings.mThreads = inThreads;
+        settings.mShard = inShard;
+        settings.mShardCount = inShards;
+        Result<BakeResult> result = Bake(settings);
+        EXPECT_TRUE(result);
+        EXPECT_TRUE(navmesh::SaveNavMeshFile(inFile, result.Value().mNavMesh).IsOk());
+        return result.Value().mNavMesh;
+    };
+    const std::string one = TempPath("one.navmesh"), two = TempPath("two.navmesh"),
+                      merged = TempPath("merged.navmesh");
+    bakeTo(1, 0, 1, one);
+    bakeTo(2, 0, 1, two);
+    EXPECT_EQ(ReadBytes(one), ReadBytes(two));
+    const navmesh::NavMeshFileContents shard0 = bakeTo(2, 0, 2, TempPath("s0.navmesh"));
+    const navmesh::NavMeshFileContents shard1 = bakeTo(1, 1, 2, TempPath("s1.navmesh"));
+    EXPECT_FALSE(shard0.mTiles.empty());
+    EXPECT_FALSE(shard1.mTiles.empty());
+    Result<navmesh::NavMeshFileContents> combined = MergeShards({shard0, shard1});
+    ASSERT_TRUE(combined);
+    ASSERT_TRUE(navmesh::SaveNavMeshFile(merged, combined.Value()).IsOk());
+    EXPECT_EQ(ReadBytes(one), ReadBytes(merged));
+    // A shard merged twice is refused
+    EXPECT_FALSE(MergeShards({shard0, shard0}));
+    for (const char* name : {"one.navmesh", "two.navmesh", "merged.navmesh", "s0.navmesh", "s1.navmesh"})
+        std::filesystem::remove(TempPath(name));
+}
+
+TEST(BakeTest, BadInputGetsClearErrorsAndNoOutput)
+{
+    const std::string obj = TempPath("broken.obj");
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv oops 0 1\nf 1 2 3\n";
+    BakeSettings settings;
+    settings.mInputs = {obj};
+    Result<BakeResult> broken = Bake(settings);
+    ASSERT_FALSE(broken);
+    EXPECT_NE(broken.GetError().mMessage.find(obj + ":3"), std::string::npos) << broken.GetError().mMessage;
+    settings.mInputs = {TempPath("missing.obj")};
+    EXPECT_EQ(Bake(settings).GetError().mCode, ErrorCode::IOError);
+    settings.mInputs = {MeshPath("nav_test.obj")};
+    settings.mShard = 2;
+    settings.mShardCount = 2;
+    EXPECT_EQ(Bake(settings).GetError().mCode, ErrorCode::InvalidArgument);
+
+    // Navmesh files: wrong magic, truncated, missing
+    const std::string bad = TempPath("bad.navmesh");
+    std::ofstream(bad, std::ios::binary) << "not a navmesh at all, long enough for a header ................";
+    EXPECT_EQ(navmesh::LoadNavMeshFile(bad).GetError().mCode, ErrorCode::ParseError);
+    EXPECT_EQ(navmesh::LoadNavMeshFile(TempPath("missing.navmesh")).GetError().mCode, ErrorCode::IOError);
+    // A save into a folder that does not exist fails and leaves nothing
+    const std::string nowhere = TempPath("no-such-folder/out.navmesh");
+    navmesh::NavMeshFileContents empty;
+    empty.mParams = navmesh::MakeNavMeshParams(navmesh::TileGrid(0, 0, 12.8f, 0, 10), 16).Value();
+    EXPECT_EQ(navmesh::SaveNavMeshFile(nowhere, empty).GetError().mCode, ErrorCode::IOError);
+    EXPECT_FALSE(std::filesystem::exists(nowhere + ".tmp"));
+    std::filesystem::remove(obj);
+    std::filesystem::remove(bad);
+}
+
+} // namespace
+} // namespace cairn::bake

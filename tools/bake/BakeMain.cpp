@@ -1,0 +1,128 @@
+// cairn-bake: bakes whole levels (OBJ) into a tiled Detour navmesh file in Recast's demo layout, with the
+// runtime's pipeline on all cores; `merge` combines the outputs of shards (--shard K/N) into one file.
+// Flags with CLI11 (Debian's libcli11-dev). Errors: one line naming the file and what is wrong, exit code 1,
+// no partial output (files are written to a temporary name and renamed).
+
+#include "Baker.h"
+#include "cairn/navmesh/NavMeshFile.h"
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <unistd.h>
+
+using namespace cairn;
+
+namespace
+{
+/// "K/N" to (K, N); false when malformed.
+bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount)
+{
+    unsigned shard = 0, count = 0;
+    char extra = 0;
+    if (std::sscanf(inText.c_str(), "%u/%u%c", &shard, &count, &extra) != 2 || count == 0 || shard >= count)
+        return false;
+    outShard = shard;
+    outCount = count;
+    return true;
+}
+
+int Fail(const std::string& inMessage)
+{
+    std::fprintf(stderr, "cairn-bake: %s\n", inMessage.c_str());
+    return 1;
+}
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"cairn-bake: bake level meshes into a tiled Detour navmesh (Recast's saved-navmesh layout)"};
+    app.require_subcommand(1);
+
+    bake::BakeSettings settings;
+    std::string output, shard = "0/1";
+    CLI::App* bakeCommand = app.add_subcommand("bake", "Bake OBJ level files");
+    bakeCommand->add_option("inputs", settings.mInputs, "OBJ files (each object a static mesh)")->required();
+    bakeCommand->add_option("-o,--output", output, "The navmesh file to write")->required();
+    bakeCommand->add_option("--threads", settings.mThreads, "Threads (0: all cores)")
+        ->check(CLI::Range(0, 256));
+    bakeCommand->add_option("--shard", shard, "Bake shard K of N (K/N, K from 0)");
+    bakeCommand->add_option("--tile-size", settings.mProfile.mTileSize, "Tile side, m");
+    bakeCommand->add_option("--cell-size", settings.mProfile.mCellSize, "Voxel size, m");
+    bakeCommand->add_option("--cell-height", settings.mProfile.mCellHeight, "Voxel height, m");
+    bakeCommand->add_option("--agent-height", settings.mProfile.mHeight, "m");
+    bakeCommand->add_option("--agent-radius", settings.mProfile.mRadius, "m");
+    bakeCommand->add_option("--agent-max-climb", settings.mProfile.mMaxClimb, "m");
+    bakeCommand->add_option("--agent-max-slope", settings.mProfile.mMaxSlopeDegrees, "degrees");
+
+    std::vector<std::string> shards;
+    std::string mergedOutput;
+    CLI::App* mergeCommand = app.add_subcommand("merge", "Combine shard outputs into one navmesh file");
+    mergeCommand->add_option("shards", shards, "Navmesh files of the shards")->required();
+    mergeCommand->add_option("-o,--output", mergedOutput, "The navmesh file to write")->required();
+
+    try
+    {
+        app.parse(argc, argv);
+    }
+    catch (const CLI::ParseError& error)
+    {
+        return app.exit(error);
+    }
+
+    if (*mergeCommand)
+    {
+        std::vector<navmesh::NavMeshFileContents> loaded;
+        for (const std::string& path : shards)
+        {
+            Result<navmesh::NavMeshFileContents> contents = navmesh::LoadNavMeshFile(path);
+            if (!contents) return Fail(contents.GetError().mMessage);
+            loaded.push_back(std::move(contents.Value()));
+        }
+        Result<navmesh::NavMeshFileContents> merged = bake::MergeShards(loaded);
+        if (!merged) return Fail(merged.GetError().mMessage);
+        if (Status saved = navmesh::SaveNavMeshFile(mergedOutput, merged.Value()); !saved)
+            return Fail(saved.GetError().mMessage);
+        std::printf("merged %zu shards: %zu tiles -> %s\n", shards.size(), merged.Value().mTiles.size(),
+                    mergedOutput.c_str());
+        return 0;
+    }
+
+    if (!ParseShard(shard, settings.mShard, settings.mShardCount))
+        return Fail("--shard " + shard + ": expected K/N with 0 <= K < N");
+    // A bar on a terminal, a line every tenth otherwise (logs)
+    const bool terminal = isatty(fileno(stdout)) != 0;
+    const auto start = std::chrono::steady_clock::now();
+    uint32_t lastTenth = 0;
+    settings.mProgress = [&](uint32_t inDone, uint32_t inTotal)
+    {
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double rate = seconds > 0.0 ? inDone / seconds : 0.0;
+        const double eta = rate > 0.0 ? (inTotal - inDone) / rate : 0.0;
+        if (terminal)
+        {
+            std::printf("\r  tiles %u/%u  %.1f tiles/s  ETA %.0f s   ", inDone, inTotal, rate, eta);
+            std::fflush(stdout);
+        }
+        else if (const uint32_t tenth = inDone * 10 / std::max(inTotal, 1u);
+                 tenth > lastTenth || inDone == inTotal)
+        {
+            lastTenth = tenth;
+            std::printf("tiles %u/%u (%.1f tiles/s, ETA %.0f s)\n", inDone, inTotal, rate, eta);
+        }
+    };
+    Result<bake::BakeResult> result = bake::Bake(settings);
+    if (terminal) std::printf("\n");
+    if (!result) return Fail(result.GetError().mMessage);
+    if (Status saved = navmesh::SaveNavMeshFile(output, result.Value().mNavMesh); !saved)
+        return Fail(saved.GetError().mMessage);
+    std::printf(
+        "baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu polygons, in %.1f ms (load %.1f ms) "
+        "-> %s\n",
+        result.Value().mTilesBaked, result.Value().mTilesInWorld, settings.mShard, settings.mShardCount,
+        result.Value().mNavMesh.mTiles.size(), (unsigned long long)result.Value().mPolygons,
+        result.Value().mBakeMs, result.Value().mLoadMs, output.c_str());
+    return 0;
+}

@@ -1,0 +1,48 @@
+#pragma once
+
+// Baker: the offline tile baker. Loads level meshes into a physics world (each object a static mesh body),
+// then builds every tile that touches the geometry with the runtime's pipeline (GeometryCollector and
+// TileBuilder), spread over a job system's threads, and returns the tiles in the navmesh file layout. Each
+// tile is built alone from the same inputs, so the result is the same whatever the thread count; a shard
+// (K of N) takes every N-th tile of the sorted list from the K-th on, and merged shards equal the full bake.
+// Threads: Bake on one thread; it runs its own job system.
+
+#include "cairn/navmesh/AgentProfile.h"
+#include "cairn/navmesh/NavMeshFile.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cairn::bake
+{
+
+struct BakeSettings
+{
+    std::vector<std::string> mInputs; ///< OBJ files
+    navmesh::AgentProfile mProfile;
+    uint32_t mThreads = 0;    ///< 0: all cores
+    uint32_t mShard = 0;      ///< This shard (0-based) ...
+    uint32_t mShardCount = 1; ///< ... of this many
+    /// Called after each tile with (tiles done, tiles in all); may be empty
+    std::function<void(uint32_t, uint32_t)> mProgress;
+};
+
+struct BakeResult
+{
+    navmesh::NavMeshFileContents mNavMesh; ///< Tiles with walkable polygons
+    uint32_t mTilesBaked = 0;              ///< This shard's tiles, empty ones included
+    uint32_t mTilesInWorld = 0;            ///< Of every shard
+    uint64_t mPolygons = 0;
+    double mBakeMs = 0.0; ///< Tiles only (loading excluded)
+    double mLoadMs = 0.0;
+};
+
+/// Errors: unreadable or malformed inputs (naming the file and line), a world too large for the navmesh's
+/// reference bits (before baking), a bad shard.
+Result<BakeResult> Bake(const BakeSettings& inSettings);
+
+/// Combines shard outputs into one navmesh: the same parameters, no tile twice.
+Result<navmesh::NavMeshFileContents> MergeShards(const std::vector<navmesh::NavMeshFileContents>& inShards);
+
+} // namespace cairn::bake
