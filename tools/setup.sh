@@ -9,6 +9,7 @@ packages=(
     librecast-dev         # Recast/Detour navmesh
     libtinyobjloader-dev  # OBJ level meshes
     libcli11-dev          # the demo's and tools' command-line flags
+    nlohmann-json3-dev    # the baker's JSON summary
     libgtest-dev libgmock-dev
     libbenchmark-dev      # benchmarks
     librapidcheck-dev     # property tests

@@ -189,3 +189,78 @@ TEST(BakeTest, BadInputGetsClearErrorsAndNoOutput)
 
 } // namespace
 } // namespace cairn::bake
+
+namespace cairn::bake
+{
+namespace
+{
+
+/// A 6 m square platform at (inX, inZ), 1 m thick, as an OBJ file.
+void WritePlatform(const std::string& inPath, float inX, float inZ)
+{
+    std::ofstream out(inPath);
+    const float h = 3.0f;
+    for (float y : {0.0f, -1.0f})
+        for (auto [dx, dz] : {std::pair{-h, -h}, std::pair{h, -h}, std::pair{h, h}, std::pair{-h, h}})
+            out << "v " << inX + dx << " " << y << " " << inZ + dz << "\n";
+    // Top (counter-clockwise from above), bottom and sides
+    out << "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 "
+           "5\nf 4 5 8\n";
+}
+
+TEST(BakeTest, AnIncrementalBakeRebuildsOnlyTheTilesAMovedObjectTouches)
+{
+    // A ground slab over 5 x 5 tiles and a platform on it
+    const std::string ground = TempPath("ground.obj"), platform = TempPath("platform.obj");
+    {
+        std::ofstream out(ground);
+        out << "v 0 -3 0\nv 64 -3 0\nv 64 -3 64\nv 0 -3 64\nf 1 4 3\nf 1 3 2\n";
+    }
+    WritePlatform(platform, 10.0f, 10.0f);
+    BakeSettings settings;
+    settings.mInputs = {ground, platform};
+    Result<BakeResult> first = Bake(settings);
+    ASSERT_TRUE(first) << first.GetError().mMessage;
+    EXPECT_EQ(first.Value().mSummary.mTilesRebuilt, first.Value().mTilesBaked);
+    const std::string summaryFile = TempPath("summary.json");
+    ASSERT_TRUE(SaveBakeSummary(summaryFile, first.Value().mSummary).IsOk());
+    Result<BakeSummary> summary = LoadBakeSummary(summaryFile);
+    ASSERT_TRUE(summary) << summary.GetError().mMessage;
+
+    // Unchanged: nothing rebuilt, the same tiles
+    settings.mPrevious = &summary.Value();
+    settings.mPreviousNavMesh = &first.Value().mNavMesh;
+    Result<BakeResult> same = Bake(settings);
+    ASSERT_TRUE(same);
+    EXPECT_EQ(same.Value().mSummary.mTilesRebuilt, 0u);
+
+    // The platform moved from one corner to the far one: only the tiles around its old and new place
+    WritePlatform(platform, 50.0f, 50.0f);
+    Result<BakeResult> incremental = Bake(settings);
+    ASSERT_TRUE(incremental);
+    const uint32_t rebuilt = incremental.Value().mSummary.mTilesRebuilt;
+    EXPECT_GT(rebuilt, 0u);
+    EXPECT_LE(rebuilt, 8u); // Each place touches at most 4 tiles (with the border)
+    EXPECT_LT(rebuilt, incremental.Value().mTilesBaked);
+    settings.mPrevious = nullptr;
+    settings.mPreviousNavMesh = nullptr;
+    Result<BakeResult> full = Bake(settings);
+    ASSERT_TRUE(full);
+    const std::string a = TempPath("incremental.navmesh"), b = TempPath("full.navmesh");
+    ASSERT_TRUE(navmesh::SaveNavMeshFile(a, incremental.Value().mNavMesh).IsOk());
+    ASSERT_TRUE(navmesh::SaveNavMeshFile(b, full.Value().mNavMesh).IsOk());
+    EXPECT_EQ(ReadBytes(a), ReadBytes(b));
+
+    // A malformed summary names what is wrong
+    std::ofstream(summaryFile) << R"({"format": "cairn-bake-summary", "version": 1, "tiles": [{"x": 1}]})";
+    Result<BakeSummary> broken = LoadBakeSummary(summaryFile);
+    ASSERT_FALSE(broken);
+    EXPECT_NE(broken.GetError().mMessage.find("tiles[0]"), std::string::npos);
+    std::ofstream(summaryFile) << "{ not json";
+    EXPECT_EQ(LoadBakeSummary(summaryFile).GetError().mCode, ErrorCode::ParseError);
+    for (const std::string& file : {ground, platform, summaryFile, a, b})
+        std::filesystem::remove(file);
+}
+
+} // namespace
+} // namespace cairn::bake

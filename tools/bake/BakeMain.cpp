@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <unistd.h>
 
@@ -48,6 +49,13 @@ int main(int argc, char** argv)
     bakeCommand->add_option("--threads", settings.mThreads, "Threads (0: all cores)")
         ->check(CLI::Range(0, 256));
     bakeCommand->add_option("--shard", shard, "Bake shard K of N (K/N, K from 0)");
+    std::string summaryPath, previousSummaryPath, previousNavMeshPath;
+    bakeCommand->add_option("--summary", summaryPath,
+                            "Write a JSON summary (tiles, polygons, per-tile hashes)");
+    bakeCommand->add_option("--previous", previousSummaryPath,
+                            "Incremental: the previous bake's summary (with --previous-navmesh)");
+    bakeCommand->add_option("--previous-navmesh", previousNavMeshPath,
+                            "Incremental: the previous bake's navmesh");
     bakeCommand->add_option("--tile-size", settings.mProfile.mTileSize, "Tile side, m");
     bakeCommand->add_option("--cell-size", settings.mProfile.mCellSize, "Voxel size, m");
     bakeCommand->add_option("--cell-height", settings.mProfile.mCellHeight, "Voxel height, m");
@@ -113,6 +121,21 @@ int main(int argc, char** argv)
             std::printf("tiles %u/%u (%.1f tiles/s, ETA %.0f s)\n", inDone, inTotal, rate, eta);
         }
     };
+    std::optional<bake::BakeSummary> previous;
+    std::optional<navmesh::NavMeshFileContents> previousNavMesh;
+    if (previousSummaryPath.empty() != previousNavMeshPath.empty())
+        return Fail("--previous and --previous-navmesh go together");
+    if (!previousSummaryPath.empty())
+    {
+        Result<bake::BakeSummary> loadedSummary = bake::LoadBakeSummary(previousSummaryPath);
+        if (!loadedSummary) return Fail(loadedSummary.GetError().mMessage);
+        Result<navmesh::NavMeshFileContents> loadedNavMesh = navmesh::LoadNavMeshFile(previousNavMeshPath);
+        if (!loadedNavMesh) return Fail(loadedNavMesh.GetError().mMessage);
+        previous = std::move(loadedSummary.Value());
+        previousNavMesh = std::move(loadedNavMesh.Value());
+        settings.mPrevious = &*previous;
+        settings.mPreviousNavMesh = &*previousNavMesh;
+    }
     Result<bake::BakeResult> result = bake::Bake(settings);
     if (terminal) std::printf("\n");
     if (!result) return Fail(result.GetError().mMessage);

@@ -35,6 +35,9 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
                                                          std::to_string(inSettings.mShardCount) +
                                                          ": K must be below N");
     if (inSettings.mInputs.empty()) return MakeError(ErrorCode::InvalidArgument, "no input files");
+    if ((inSettings.mPrevious == nullptr) != (inSettings.mPreviousNavMesh == nullptr))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "an incremental bake needs the previous summary and navmesh");
 
     // Every object a static mesh body; the level's bounds decide the tiles
     BakeResult result;
@@ -75,6 +78,7 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
                          "the level is too large for one navmesh: " + params.GetError().mMessage);
     result.mNavMesh.mParams = params.Value();
     result.mTilesInWorld = uint32_t(tiles.size());
+    std::sort(tiles.begin(), tiles.end()); // The sorted list the shards split and the file keeps
     std::vector<navmesh::TileCoord> mine;
     for (size_t i = 0; i < tiles.size(); ++i)
         if (i % inSettings.mShardCount == inSettings.mShard) mine.push_back(tiles[i]);
@@ -83,6 +87,36 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
     const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
     std::vector<std::optional<Result<navmesh::BuiltTile>>> built(mine.size());
+    std::vector<TileRecord> records(mine.size());
+    std::vector<const navmesh::NavMeshFileTile*> reused(mine.size(), nullptr);
+    // Everything besides the triangles that decides a tile: the settings
+    const navmesh::AgentProfile& p = profile;
+    const float settingsValues[] = {p.mHeight,
+                                    p.mRadius,
+                                    p.mMaxClimb,
+                                    p.mMaxSlopeDegrees,
+                                    p.mCellSize,
+                                    p.mCellHeight,
+                                    p.mTileSize,
+                                    p.mRegionMinSize,
+                                    p.mRegionMergeSize,
+                                    p.mEdgeMaxLength,
+                                    p.mEdgeMaxError,
+                                    float(p.mMaxVertsPerPoly),
+                                    p.mDetailSampleDistance,
+                                    p.mDetailSampleMaxError,
+                                    float(int(p.mPartition)),
+                                    grid.GetTileBounds({0, 0}).mMin.y(),
+                                    grid.GetTileBounds({0, 0}).mMax.y()};
+    const uint64_t settingsHash = Hash64Of(std::span<const float>(settingsValues), Hash64({}));
+    auto previousTile = [&](const navmesh::TileCoord& inTile) -> const navmesh::NavMeshFileTile*
+    {
+        const std::vector<navmesh::NavMeshFileTile>& tiles = inSettings.mPreviousNavMesh->mTiles;
+        auto it = std::lower_bound(tiles.begin(), tiles.end(), inTile,
+                                   [](const navmesh::NavMeshFileTile& inT, const navmesh::TileCoord& inC)
+                                   { return inT.mTile < inC; });
+        return it != tiles.end() && it->mTile == inTile ? &*it : nullptr;
+    };
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
     jobs::JobSystem jobSystem(jobSettings);
@@ -100,7 +134,28 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
                                   navmesh::CollectStats stats;
                                   collector.FindBodies(box, {}, bodies);
                                   collector.CollectTriangles(box, {}, bodies, geometry, busy, stats);
-                                  built[i] = navmesh::BuildTile(profile, grid, mine[i], geometry);
+                                  uint64_t hash =
+                                      Hash64Of(std::span<const int32_t>(&mine[i].mX, 1), settingsHash);
+                                  hash = Hash64Of(std::span<const int32_t>(&mine[i].mZ, 1), hash);
+                                  hash = Hash64Of(std::span<const float>(geometry.mVertices), hash);
+                                  hash = Hash64Of(std::span<const int>(geometry.mTriangles), hash);
+                                  hash = Hash64Of(std::span<const uint8_t>(geometry.mAreas), hash);
+                                  records[i].mTile = mine[i];
+                                  records[i].mInputHash = hash;
+                                  // Unchanged input: the previous output, built or empty, is this tile's
+                                  const TileRecord* before = inSettings.mPrevious != nullptr
+                                                                 ? inSettings.mPrevious->Find(mine[i])
+                                                                 : nullptr;
+                                  const navmesh::NavMeshFileTile* beforeTile =
+                                      before != nullptr ? previousTile(mine[i]) : nullptr;
+                                  if (before != nullptr && before->mInputHash == hash &&
+                                      (beforeTile != nullptr) == (before->mBytes > 0))
+                                  {
+                                      reused[i] = beforeTile;
+                                      records[i] = *before;
+                                  }
+                                  else
+                                      built[i] = navmesh::BuildTile(profile, grid, mine[i], geometry);
                                   if (inSettings.mProgress)
                                   {
                                       // One call at a time: the callback need not be thread-safe
@@ -111,20 +166,43 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
                           });
     result.mBakeMs = MillisecondsSince(bakeStart);
 
+    result.mSummary.mInputs = inSettings.mInputs;
+    result.mSummary.mShard = inSettings.mShard;
+    result.mSummary.mShardCount = inSettings.mShardCount;
+    result.mSummary.mTilesInWorld = result.mTilesInWorld;
+    result.mSummary.mBakeMs = result.mBakeMs;
     for (size_t i = 0; i < mine.size(); ++i)
     {
+        if (!built[i].has_value())
+        {
+            // Taken over from the previous bake
+            ++result.mTilesBaked;
+            result.mPolygons += uint64_t(records[i].mPolygons);
+            result.mSummary.mTiles.push_back(records[i]);
+            if (reused[i] != nullptr) result.mNavMesh.mTiles.push_back(*reused[i]);
+            continue;
+        }
         Result<navmesh::BuiltTile>& tile = *built[i];
         if (!tile)
             return MakeError(tile.GetError().mCode, "tile (" + std::to_string(mine[i].mX) + ", " +
                                                         std::to_string(mine[i].mZ) +
                                                         "): " + tile.GetError().mMessage);
         ++result.mTilesBaked;
+        ++result.mSummary.mTilesRebuilt;
         result.mPolygons += uint64_t(tile.Value().mNumPolygons);
-        if (tile.Value().mData == nullptr) continue;
-        const unsigned char* data = tile.Value().mData.get();
-        result.mNavMesh.mTiles.push_back(
-            {mine[i], std::vector<unsigned char>(data, data + tile.Value().mDataSize)});
+        TileRecord& record = records[i];
+        record.mPolygons = tile.Value().mNumPolygons;
+        if (tile.Value().mData != nullptr)
+        {
+            const unsigned char* data = tile.Value().mData.get();
+            result.mNavMesh.mTiles.push_back(
+                {mine[i], std::vector<unsigned char>(data, data + tile.Value().mDataSize)});
+            record.mBytes = uint32_t(tile.Value().mDataSize);
+            record.mOutputHash = Hash64(result.mNavMesh.mTiles.back().mData);
+        }
+        result.mSummary.mTiles.push_back(record);
     }
+    result.mSummary.mPolygons = result.mPolygons;
     return result;
 }
 

@@ -7,6 +7,7 @@
 // (K of N) takes every N-th tile of the sorted list from the K-th on, and merged shards equal the full bake.
 // Threads: Bake on one thread; it runs its own job system.
 
+#include "BakeSummary.h"
 #include "cairn/navmesh/AgentProfile.h"
 #include "cairn/navmesh/NavMeshFile.h"
 
@@ -24,8 +25,12 @@ struct BakeSettings
     uint32_t mThreads = 0;    ///< 0: all cores
     uint32_t mShard = 0;      ///< This shard (0-based) ...
     uint32_t mShardCount = 1; ///< ... of this many
-    /// Called after each tile with (tiles done, tiles in all); may be empty
+    /// Called after each tile with (tiles done, tiles in all), one call at a time; may be empty
     std::function<void(uint32_t, uint32_t)> mProgress;
+    /// Incremental: the previous bake's summary and navmesh (both or neither). A tile whose input hash is
+    /// unchanged takes its previous output instead of being built again
+    const BakeSummary* mPrevious = nullptr;
+    const navmesh::NavMeshFileContents* mPreviousNavMesh = nullptr;
 };
 
 struct BakeResult
@@ -36,6 +41,7 @@ struct BakeResult
     uint64_t mPolygons = 0;
     double mBakeMs = 0.0; ///< Tiles only (loading excluded)
     double mLoadMs = 0.0;
+    BakeSummary mSummary; ///< Per tile hashes, for the next incremental bake
 };
 
 /// Errors: unreadable or malformed inputs (naming the file and line), a world too large for the navmesh's
