@@ -141,11 +141,15 @@ int main(int argc, char** argv)
     if (!result) return Fail(result.GetError().mMessage);
     if (Status saved = navmesh::SaveNavMeshFile(output, result.Value().mNavMesh); !saved)
         return Fail(saved.GetError().mMessage);
-    std::printf(
-        "baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu polygons, in %.1f ms (load %.1f ms) "
-        "-> %s\n",
-        result.Value().mTilesBaked, result.Value().mTilesInWorld, settings.mShard, settings.mShardCount,
-        result.Value().mNavMesh.mTiles.size(), (unsigned long long)result.Value().mPolygons,
-        result.Value().mBakeMs, result.Value().mLoadMs, output.c_str());
+    if (!summaryPath.empty())
+        if (Status saved = bake::SaveBakeSummary(summaryPath, result.Value().mSummary); !saved)
+            return Fail(saved.GetError().mMessage);
+    std::printf("rebuilt %u, baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu polygons, in %.1f "
+                "ms (load %.1f ms) "
+                "-> %s\n",
+                result.Value().mSummary.mTilesRebuilt, result.Value().mTilesBaked,
+                result.Value().mTilesInWorld, settings.mShard, settings.mShardCount,
+                result.Value().mNavMesh.mTiles.size(), (unsigned long long)result.Value().mPolygons,
+                result.Value().mBakeMs, result.Value().mLoadMs, output.c_str());
     return 0;
 }
