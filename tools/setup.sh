@@ -8,6 +8,7 @@ packages=(
     libeigen3-dev         # all math
     librecast-dev         # Recast/Detour navmesh
     libtinyobjloader-dev  # OBJ level meshes
+    libtinygltf-dev       # glTF level meshes
     libcli11-dev          # the demo's and tools' command-line flags
     nlohmann-json3-dev    # the baker's JSON summary
     libgtest-dev libgmock-dev

@@ -43,8 +43,11 @@ int main(int argc, char** argv)
 
     bake::BakeSettings settings;
     std::string output, shard = "0/1";
-    CLI::App* bakeCommand = app.add_subcommand("bake", "Bake OBJ level files");
-    bakeCommand->add_option("inputs", settings.mInputs, "OBJ files (each object a static mesh)")->required();
+    CLI::App* bakeCommand = app.add_subcommand("bake", "Bake OBJ and glTF level files");
+    bakeCommand
+        ->add_option("inputs", settings.mInputs,
+                     "OBJ and glTF files (.obj, .gltf, .glb; each file a static mesh)")
+        ->required();
     bakeCommand->add_option("-o,--output", output, "The navmesh file to write")->required();
     bakeCommand->add_option("--threads", settings.mThreads, "Threads (0: all cores)")
         ->check(CLI::Range(0, 256));

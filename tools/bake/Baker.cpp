@@ -48,7 +48,7 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
     AABB bounds;
     for (const std::string& input : inSettings.mInputs)
     {
-        Result<navmesh::IndexedMesh> mesh = navmesh::LoadObjMesh(input);
+        Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(input);
         if (!mesh) return mesh.GetError();
         auto shape = TriangleMeshShape::Create(mesh.Value().mVertices, mesh.Value().mTriangles);
         if (!shape) return MakeError(shape.GetError().mCode, input + ": " + shape.GetError().mMessage);

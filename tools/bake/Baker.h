@@ -20,7 +20,7 @@ namespace cairn::bake
 
 struct BakeSettings
 {
-    std::vector<std::string> mInputs; ///< OBJ files
+    std::vector<std::string> mInputs; ///< OBJ and glTF (.gltf, .glb) files
     navmesh::AgentProfile mProfile;
     uint32_t mThreads = 0;    ///< 0: all cores
     uint32_t mShard = 0;      ///< This shard (0-based) ...

@@ -1,7 +1,8 @@
 #pragma once
 
-// Wavefront OBJ level meshes (Recast's demo meshes, a baker's input), read with tinyobjloader: vertices and
-// triangles only (polygons are split into fans, materials ignored). Plain functions, any thread.
+// Level meshes for the navmesh: Wavefront OBJ (Recast's demo meshes) read with tinyobjloader, and glTF 2.0
+// read with tinygltf; vertices and triangles only (polygons split into fans, materials ignored). Plain
+// functions, any thread.
 
 #include "cairn/navmesh/TileGeometry.h"
 #include "cairn/physics/math/AABB.h"
@@ -27,5 +28,13 @@ struct IndexedMesh
 /// Errors: IOError when the file cannot be read; ParseError for a malformed file (bad numbers or indices),
 /// non-finite or out-of-range coordinates, or a mesh without triangles.
 Result<IndexedMesh> LoadObjMesh(const std::string& inPath);
+
+/// glTF 2.0 (.gltf with its buffers, or .glb), read with tinygltf (Debian's libtinygltf-dev): the triangles
+/// of every mesh of the default scene (or of every node when there is none), placed by their nodes'
+/// transforms. Errors name the file and the element (meshes[i].primitives[j], accessors[k]) that is wrong.
+Result<IndexedMesh> LoadGltfMesh(const std::string& inPath);
+
+/// OBJ or glTF by the file's extension (.obj, .gltf, .glb).
+Result<IndexedMesh> LoadLevelMesh(const std::string& inPath);
 
 } // namespace cairn::navmesh

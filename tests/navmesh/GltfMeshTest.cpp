@@ -1,0 +1,137 @@
+// glTF level meshes: nodes' transforms applied, the same walkable tiles as the same geometry from OBJ, and
+// malformed files named by file and element.
+
+#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/TileBuilder.h"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
+#include <tiny_gltf.h>
+
+namespace cairn::navmesh::test
+{
+namespace
+{
+
+std::string TempPath(const std::string& inName)
+{
+    return (std::filesystem::temp_directory_path() / ("cairn-gltf-test-" + inName)).string();
+}
+
+/// A 20 m square floor (two triangles, unsigned short indices) in a node moved by inTranslation.
+tinygltf::Model FloorModel(const std::array<double, 3>& inTranslation)
+{
+    const float positions[] = {0, 0, 0, 0, 0, 20, 20, 0, 20, 20, 0, 0};
+    const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+    tinygltf::Model model;
+    tinygltf::Buffer buffer;
+    buffer.data.resize(sizeof(positions) + sizeof(indices));
+    std::memcpy(buffer.data.data(), positions, sizeof(positions));
+    std::memcpy(buffer.data.data() + sizeof(positions), indices, sizeof(indices));
+    model.buffers.push_back(buffer);
+    tinygltf::BufferView positionView, indexView;
+    positionView.buffer = 0;
+    positionView.byteLength = sizeof(positions);
+    indexView.buffer = 0;
+    indexView.byteOffset = sizeof(positions);
+    indexView.byteLength = sizeof(indices);
+    model.bufferViews = {positionView, indexView};
+    tinygltf::Accessor positionAccessor, indexAccessor;
+    positionAccessor.bufferView = 0;
+    positionAccessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    positionAccessor.type = TINYGLTF_TYPE_VEC3;
+    positionAccessor.count = 4;
+    positionAccessor.minValues = {0, 0, 0};
+    positionAccessor.maxValues = {20, 0, 20};
+    indexAccessor.bufferView = 1;
+    indexAccessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    indexAccessor.type = TINYGLTF_TYPE_SCALAR;
+    indexAccessor.count = 6;
+    model.accessors = {positionAccessor, indexAccessor};
+    tinygltf::Primitive primitive;
+    primitive.attributes["POSITION"] = 0;
+    primitive.indices = 1;
+    primitive.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Mesh mesh;
+    mesh.primitives.push_back(primitive);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.mesh = 0;
+    node.translation = {inTranslation[0], inTranslation[1], inTranslation[2]};
+    model.nodes.push_back(node);
+    tinygltf::Scene scene;
+    scene.nodes = {0};
+    model.scenes.push_back(scene);
+    model.defaultScene = 0;
+    model.asset.version = "2.0";
+    return model;
+}
+
+void Write(const tinygltf::Model& inModel, const std::string& inPath, bool inBinary)
+{
+    tinygltf::TinyGLTF writer;
+    ASSERT_TRUE(writer.WriteGltfSceneToFile(&inModel, inPath, true, true, true, inBinary));
+}
+
+TEST(GltfMeshTest, NodesArePlacedAndTheFloorIsWalkable)
+{
+    for (bool binary : {false, true})
+    {
+        const std::string path = TempPath(binary ? "floor.glb" : "floor.gltf");
+        Write(FloorModel({2, 1, 3}), path, binary);
+        Result<IndexedMesh> mesh = LoadLevelMesh(path);
+        ASSERT_TRUE(mesh) << mesh.GetError().mMessage;
+        ASSERT_EQ(mesh.Value().mVertices.size(), 4u);
+        ASSERT_EQ(mesh.Value().mTriangles.size(), 2u);
+        EXPECT_EQ(mesh.Value().mVertices[2], Vec3(22, 1, 23)); // Moved by the node
+        // As walkable as the same floor from an OBJ file
+        const std::string obj = TempPath("floor.obj");
+        std::ofstream(obj) << "v 2 1 3\nv 2 1 23\nv 22 1 23\nv 22 1 3\nf 1 2 3\nf 1 3 4\n";
+        const AgentProfile profile;
+        const TileGrid grid(0, 0, profile.mTileSize, 0, 5);
+        Result<BuiltTile> fromGltf = BuildTile(profile, grid, {0, 0}, mesh.Value().ToTileGeometry());
+        Result<BuiltTile> fromObj =
+            BuildTile(profile, grid, {0, 0}, LoadLevelMesh(obj).Value().ToTileGeometry());
+        ASSERT_TRUE(fromGltf && fromObj);
+        EXPECT_GT(fromGltf.Value().mNumPolygons, 0);
+        EXPECT_EQ(fromGltf.Value().mNumPolygons, fromObj.Value().mNumPolygons);
+        EXPECT_EQ(fromGltf.Value().mDataSize, fromObj.Value().mDataSize);
+        std::filesystem::remove(path);
+        std::filesystem::remove(obj);
+    }
+}
+
+TEST(GltfMeshTest, MalformedFilesNameTheFileAndElement)
+{
+    const std::string path = TempPath("bad.gltf");
+    std::ofstream(path) << "{ this is not json";
+    Result<IndexedMesh> notJson = LoadGltfMesh(path);
+    ASSERT_FALSE(notJson);
+    EXPECT_EQ(notJson.GetError().mCode, ErrorCode::ParseError);
+    EXPECT_NE(notJson.GetError().mMessage.find(path), std::string::npos);
+
+    tinygltf::Model badIndex = FloorModel({0, 0, 0});
+    reinterpret_cast<uint16_t*>(badIndex.buffers[0].data.data() + 48)[2] = 9; // Beyond the 4 vertices
+    Write(badIndex, path, false);
+    Result<IndexedMesh> index = LoadGltfMesh(path);
+    ASSERT_FALSE(index);
+    EXPECT_NE(index.GetError().mMessage.find("meshes[0].primitives[0]"), std::string::npos)
+        << index.GetError().mMessage;
+
+    tinygltf::Model badAccessor = FloorModel({0, 0, 0});
+    badAccessor.accessors[0].count = 400; // Reads beyond its buffer
+    Write(badAccessor, path, false);
+    Result<IndexedMesh> accessor = LoadGltfMesh(path);
+    ASSERT_FALSE(accessor);
+    EXPECT_NE(accessor.GetError().mMessage.find("accessors[0]"), std::string::npos)
+        << accessor.GetError().mMessage;
+
+    EXPECT_EQ(LoadLevelMesh(TempPath("level.fbx")).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(LoadGltfMesh(TempPath("missing.glb")).GetError().mCode, ErrorCode::IOError);
+    std::filesystem::remove(path);
+}
+
+} // namespace
+} // namespace cairn::navmesh::test
