@@ -1,4 +1,4 @@
-// The streaming open-world demo, run for a few hundred frames in both broad-phase modes with a fast player
+// The streaming open-world demo, run for 240 frames (4 s) in both broad-phase modes with a fast player
 // (so tiles stream in and out several times): no body lost or duplicated by streaming, every navmesh tile the
 // agents asked for built, no agent path through a wall, nothing reported wrong.
 
@@ -14,15 +14,17 @@ namespace
 DemoSettings SmallDemo()
 {
     DemoSettings settings;
-    settings.mFrames = 300;
+    settings.mFrames = 240;
     settings.mAgents = 4;
     settings.mGameObjects = 64;
     settings.mGameObjectJobs = 4;
-    settings.mRealTime = false;
+    // Paced at 60 Hz, as the demo runs: back to back frames under a loaded CI left the navmesh's background
+    // thread no time to build tiles before the run ended
+    settings.mRealTime = true;
     settings.mCollisionRadius = 2.0f; // 13 world tiles
     settings.mPropsPerTile = 200;
     settings.mDynamicPerTile = 30;
-    settings.mPlayerSpeed = 40.0f; // 200 m in 300 frames: three tiles
+    settings.mPlayerSpeed = 40.0f; // 160 m in 240 frames: two and a half tiles
     return settings;
 }
 
@@ -36,7 +38,7 @@ void ExpectInvariants(const DemoRunResult& inRun)
     // The run did what a demo does: streamed in and out, stepped, queried, built navmesh, walked
     EXPECT_GT(inRun.mTilesStreamedIn, 13u) << inRun.mModeName;
     EXPECT_GT(inRun.mTilesStreamedOut, 0u) << inRun.mModeName;
-    EXPECT_EQ(inRun.mPhysicsMs.size(), 300u);
+    EXPECT_EQ(inRun.mPhysicsMs.size(), 240u);
     EXPECT_GT(inRun.mQueries, 0u);
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
     EXPECT_GT(inRun.mPathsFound, 0u);
