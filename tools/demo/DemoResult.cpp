@@ -1,10 +1,12 @@
-// Summarize for the demo's results: mean and nearest-rank percentiles of a series of samples.
+// Summarize for the demo's results: the tools' frame-time summary (mean and nearest-rank percentiles), over
+// the finite samples only.
 
 #include "demo/DemoResult.h"
 
+#include "common/FrameTimes.h"
+
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 namespace cairn::demo
 {
@@ -16,20 +18,9 @@ SampleSummary Summarize(std::vector<double> inSamples)
     inSamples.erase(std::remove_if(inSamples.begin(), inSamples.end(),
                                    [](double inValue) { return !std::isfinite(inValue); }),
                     inSamples.end());
-    SampleSummary summary;
-    if (inSamples.empty()) return summary;
-    std::sort(inSamples.begin(), inSamples.end());
-    auto rank = [&](double inFraction)
-    {
-        const size_t index = size_t(inFraction * double(inSamples.size() - 1) + 0.5);
-        return inSamples[std::min(index, inSamples.size() - 1)];
-    };
-    summary.mMean = std::accumulate(inSamples.begin(), inSamples.end(), 0.0) / double(inSamples.size());
-    summary.mP50 = rank(0.50);
-    summary.mP99 = rank(0.99);
-    summary.mMax = inSamples.back();
-    summary.mCount = inSamples.size();
-    return summary;
+    const size_t count = inSamples.size();
+    const tools::TimingSummary timing = tools::Summarize(std::move(inSamples));
+    return {timing.mMean, timing.mP50, timing.mP99, timing.mMax, count};
 }
 
 } // namespace cairn::demo
