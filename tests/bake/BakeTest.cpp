@@ -264,3 +264,45 @@ TEST(BakeTest, AnIncrementalBakeRebuildsOnlyTheTilesAMovedObjectTouches)
 
 } // namespace
 } // namespace cairn::bake
+
+#include "BakeConfig.h"
+
+namespace cairn::bake
+{
+namespace
+{
+
+TEST(BakeConfigTest, AJsonFileSetsTheProfileAndNamesWhatIsWrong)
+{
+    const std::string path = TempPath("profile.json");
+    std::ofstream(path)
+        << R"({"agent_radius": 0.4, "cell_size": 0.25, "tile_size": 16, "region_partition": "monotone",
+                               "max_verts_per_poly": 5})";
+    navmesh::AgentProfile profile;
+    ASSERT_TRUE(LoadBakeConfig(path, profile).IsOk());
+    EXPECT_EQ(profile.mRadius, 0.4f);
+    EXPECT_EQ(profile.mCellSize, 0.25f);
+    EXPECT_EQ(profile.mTileSize, 16.0f);
+    EXPECT_EQ(profile.mPartition, navmesh::RegionPartition::Monotone);
+    EXPECT_EQ(profile.mMaxVertsPerPoly, 5);
+    EXPECT_EQ(profile.mHeight, navmesh::AgentProfile{}.mHeight); // Not named: the default stays
+
+    auto errorFor = [&](const char* inJson)
+    {
+        std::ofstream(path) << inJson;
+        navmesh::AgentProfile any;
+        const Status status = LoadBakeConfig(path, any);
+        return status ? std::string() : status.GetError().mMessage;
+    };
+    EXPECT_NE(errorFor(R"({"agent_radus": 0.4})").find("unknown key 'agent_radus'"), std::string::npos);
+    EXPECT_NE(errorFor(R"({"cell_size": "small"})").find("'cell_size' must be a number"), std::string::npos);
+    EXPECT_NE(errorFor(R"({"region_partition": "voronoi"})").find("region_partition"), std::string::npos);
+    EXPECT_NE(errorFor(R"({"tile_size": 12.7})").find("whole number"), std::string::npos); // Validate's
+    EXPECT_NE(errorFor("[1, 2]").find("not a JSON object"), std::string::npos);
+    navmesh::AgentProfile any;
+    EXPECT_EQ(LoadBakeConfig(TempPath("missing.json"), any).GetError().mCode, ErrorCode::IOError);
+    std::filesystem::remove(path);
+}
+
+} // namespace
+} // namespace cairn::bake

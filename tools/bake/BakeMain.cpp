@@ -3,6 +3,7 @@
 // Flags with CLI11 (Debian's libcli11-dev). Errors: one line naming the file and what is wrong, exit code 1,
 // no partial output (files are written to a temporary name and renamed).
 
+#include "BakeConfig.h"
 #include "Baker.h"
 #include "cairn/navmesh/NavMeshFile.h"
 
@@ -59,13 +60,25 @@ int main(int argc, char** argv)
                             "Incremental: the previous bake's summary (with --previous-navmesh)");
     bakeCommand->add_option("--previous-navmesh", previousNavMeshPath,
                             "Incremental: the previous bake's navmesh");
-    bakeCommand->add_option("--tile-size", settings.mProfile.mTileSize, "Tile side, m");
-    bakeCommand->add_option("--cell-size", settings.mProfile.mCellSize, "Voxel size, m");
-    bakeCommand->add_option("--cell-height", settings.mProfile.mCellHeight, "Voxel height, m");
-    bakeCommand->add_option("--agent-height", settings.mProfile.mHeight, "m");
-    bakeCommand->add_option("--agent-radius", settings.mProfile.mRadius, "m");
-    bakeCommand->add_option("--agent-max-climb", settings.mProfile.mMaxClimb, "m");
-    bakeCommand->add_option("--agent-max-slope", settings.mProfile.mMaxSlopeDegrees, "degrees");
+    // Flags override the JSON config: they go to a profile of their own, copied over the config's when given
+    navmesh::AgentProfile flagProfile;
+    std::string configPath;
+    bakeCommand->add_option("--config", configPath, "Agent profile and tile size from a JSON file");
+    CLI::Option* flags[] = {
+        bakeCommand->add_option("--tile-size", flagProfile.mTileSize, "Tile side, m"),
+        bakeCommand->add_option("--cell-size", flagProfile.mCellSize, "Voxel size, m"),
+        bakeCommand->add_option("--cell-height", flagProfile.mCellHeight, "Voxel height, m"),
+        bakeCommand->add_option("--agent-height", flagProfile.mHeight, "m"),
+        bakeCommand->add_option("--agent-radius", flagProfile.mRadius, "m"),
+        bakeCommand->add_option("--agent-max-climb", flagProfile.mMaxClimb, "m"),
+        bakeCommand->add_option("--agent-max-slope", flagProfile.mMaxSlopeDegrees, "degrees"),
+    };
+    float navmesh::AgentProfile::*fields[] = {
+        &navmesh::AgentProfile::mTileSize,        &navmesh::AgentProfile::mCellSize,
+        &navmesh::AgentProfile::mCellHeight,      &navmesh::AgentProfile::mHeight,
+        &navmesh::AgentProfile::mRadius,          &navmesh::AgentProfile::mMaxClimb,
+        &navmesh::AgentProfile::mMaxSlopeDegrees,
+    };
 
     std::vector<std::string> shards;
     std::string mergedOutput;
@@ -100,6 +113,11 @@ int main(int argc, char** argv)
         return 0;
     }
 
+    if (!configPath.empty())
+        if (Status loaded = bake::LoadBakeConfig(configPath, settings.mProfile); !loaded)
+            return Fail(loaded.GetError().mMessage);
+    for (size_t i = 0; i < std::size(flags); ++i)
+        if (flags[i]->count() > 0) settings.mProfile.*fields[i] = flagProfile.*fields[i];
     if (!ParseShard(shard, settings.mShard, settings.mShardCount))
         return Fail("--shard " + shard + ": expected K/N with 0 <= K < N");
     // A bar on a terminal, a line every tenth otherwise (logs)

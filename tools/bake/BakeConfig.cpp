@@ -1,0 +1,69 @@
+#include "BakeConfig.h"
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+
+namespace cairn::bake
+{
+
+Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfile)
+{
+    std::ifstream in(inPath);
+    if (!in) return MakeError(ErrorCode::IOError, inPath + ": cannot be read");
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+    if (json.is_discarded() || !json.is_object())
+        return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
+    navmesh::AgentProfile& p = ioProfile;
+    const std::map<std::string, float*> numbers = {
+        {"agent_height", &p.mHeight},
+        {"agent_radius", &p.mRadius},
+        {"agent_max_climb", &p.mMaxClimb},
+        {"agent_max_slope", &p.mMaxSlopeDegrees},
+        {"cell_size", &p.mCellSize},
+        {"cell_height", &p.mCellHeight},
+        {"tile_size", &p.mTileSize},
+        {"region_min_size", &p.mRegionMinSize},
+        {"region_merge_size", &p.mRegionMergeSize},
+        {"edge_max_length", &p.mEdgeMaxLength},
+        {"edge_max_error", &p.mEdgeMaxError},
+        {"detail_sample_distance", &p.mDetailSampleDistance},
+        {"detail_sample_max_error", &p.mDetailSampleMaxError},
+    };
+    for (const auto& [key, value] : json.items())
+    {
+        if (auto number = numbers.find(key); number != numbers.end())
+        {
+            if (!value.is_number())
+                return MakeError(ErrorCode::ParseError, inPath + ": '" + key + "' must be a number");
+            *number->second = value.get<float>();
+        }
+        else if (key == "max_verts_per_poly")
+        {
+            if (!value.is_number_integer())
+                return MakeError(ErrorCode::ParseError, inPath + ": '" + key + "' must be a whole number");
+            p.mMaxVertsPerPoly = value.get<int>();
+        }
+        else if (key == "region_partition")
+        {
+            const std::string name = value.is_string() ? value.get<std::string>() : "";
+            if (name == "watershed")
+                p.mPartition = navmesh::RegionPartition::Watershed;
+            else if (name == "monotone")
+                p.mPartition = navmesh::RegionPartition::Monotone;
+            else if (name == "layers")
+                p.mPartition = navmesh::RegionPartition::Layers;
+            else
+                return MakeError(
+                    ErrorCode::ParseError,
+                    inPath + ": 'region_partition' must be \"watershed\", \"monotone\" or \"layers\"");
+        }
+        else
+            return MakeError(ErrorCode::ParseError, inPath + ": unknown key '" + key + "'");
+    }
+    if (Status valid = p.Validate(); !valid)
+        return MakeError(valid.GetError().mCode, inPath + ": " + valid.GetError().mMessage);
+    return Status::Ok();
+}
+
+} // namespace cairn::bake
