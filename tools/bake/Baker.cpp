@@ -6,6 +6,7 @@
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/FrameTimes.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,11 +21,8 @@ namespace cairn::bake
 namespace
 {
 using Clock = std::chrono::steady_clock;
+using tools::MillisecondsSince;
 
-double MillisecondsSince(Clock::time_point inStart)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
-}
 } // namespace
 
 Result<BakeResult> Bake(const BakeSettings& inSettings)

@@ -14,6 +14,7 @@
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/FrameTimes.h"
 #include "common/SharedBenchData.h"
 
 #include <atomic>
@@ -31,6 +32,7 @@ namespace
 {
 
 using Clock = std::chrono::steady_clock;
+using tools::MillisecondsSince;
 
 enum Kind : int64_t
 {
@@ -101,11 +103,6 @@ std::unique_ptr<BroadPhase> MakeLoadedWorld(int64_t inKind)
     for (int update = 0; update < 3; ++update)
         broadPhase->Update();
     return broadPhase;
-}
-
-double MillisecondsSince(Clock::time_point inStart)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
 }
 
 uint64_t QueryAllBoxes(const BroadPhase& inBroadPhase)

@@ -31,14 +31,10 @@
 using namespace cairn;
 using namespace cairn::navmesh;
 using Clock = std::chrono::steady_clock;
+using tools::MillisecondsSince;
 
 namespace
 {
-
-double MillisecondsSince(Clock::time_point inStart)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
-}
 
 double Median(std::vector<double> inValues)
 {

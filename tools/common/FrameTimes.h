@@ -1,14 +1,21 @@
 #pragma once
 
-// Collects per-frame timings and summarises them (mean, percentiles, max) for the tools' reports.
+// Times and summarises per-frame timings (mean, percentiles, max) for the tools' reports.
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <numeric>
 #include <vector>
 
 namespace cairn::tools
 {
+
+/// Wall time since inStart, in milliseconds.
+inline double MillisecondsSince(std::chrono::steady_clock::time_point inStart)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - inStart).count();
+}
 
 struct TimingSummary
 {

@@ -10,6 +10,7 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "common/FrameTimes.h"
 
 #include <chrono>
 #include <thread>
@@ -20,11 +21,7 @@ namespace cairn::demo
 namespace
 {
 using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point inStart)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
-}
+using tools::MillisecondsSince;
 
 /// Runs frames of physics and the navmesh sync point (no measuring) until inDone or inMaxSeconds.
 template <class Done>

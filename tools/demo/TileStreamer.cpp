@@ -1,5 +1,7 @@
 #include "TileStreamer.h"
 
+#include "common/FrameTimes.h"
+
 #include <chrono>
 #include <cmath>
 
@@ -13,11 +15,8 @@ namespace cairn::demo
 namespace
 {
 using Clock = std::chrono::steady_clock;
+using tools::MillisecondsSince;
 
-double MillisecondsSince(Clock::time_point inStart)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
-}
 } // namespace
 
 TileStreamer::TileStreamer(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator,
