@@ -1,5 +1,7 @@
 #include "cairn/navmesh/NavMeshFile.h"
 
+#include "cairn/navmesh/ReplaceFile.h"
+
 #include <DetourAlloc.h>
 #include <algorithm>
 #include <cerrno>
@@ -88,36 +90,23 @@ Status SaveNavMeshFile(const std::string& inPath, NavMeshFileContents inContents
                                                        " tiles, more than the parameters allow (" +
                                                        std::to_string(inContents.mParams.maxTiles) + ")");
 
-    const std::string temporary = inPath + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out)
-            return MakeError(ErrorCode::IOError, temporary + ": cannot be written: " + std::strerror(errno));
-        SetHeader header{cSetMagic, cSetVersion, int32_t(inContents.mTiles.size()), inContents.mParams};
-        out.write(reinterpret_cast<const char*>(&header), sizeof(header));
-        for (size_t i = 0; i < inContents.mTiles.size(); ++i)
+    return ReplaceFile(
+        inPath,
+        [&](std::ostream& ioOut)
         {
-            const NavMeshFileTile& tile = inContents.mTiles[i];
-            const TileHeader tileHeader{layout->encodePolyId(1, unsigned(i), 0), int32_t(tile.mData.size())};
-            out.write(reinterpret_cast<const char*>(&tileHeader), sizeof(tileHeader));
-            out.write(reinterpret_cast<const char*>(tile.mData.data()), std::streamsize(tile.mData.size()));
-        }
-        out.flush();
-        if (!out)
-        {
-            std::error_code ignored;
-            std::filesystem::remove(temporary, ignored);
-            return MakeError(ErrorCode::IOError, temporary + ": write failed");
-        }
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, inPath, error);
-    if (error)
-    {
-        std::filesystem::remove(temporary, error);
-        return MakeError(ErrorCode::IOError, inPath + ": cannot be replaced: " + error.message());
-    }
-    return Status::Ok();
+            SetHeader header{cSetMagic, cSetVersion, int32_t(inContents.mTiles.size()), inContents.mParams};
+            ioOut.write(reinterpret_cast<const char*>(&header), sizeof(header));
+            for (size_t i = 0; i < inContents.mTiles.size(); ++i)
+            {
+                const NavMeshFileTile& tile = inContents.mTiles[i];
+                const TileHeader tileHeader{layout->encodePolyId(1, unsigned(i), 0),
+                                            int32_t(tile.mData.size())};
+                ioOut.write(reinterpret_cast<const char*>(&tileHeader), sizeof(tileHeader));
+                ioOut.write(reinterpret_cast<const char*>(tile.mData.data()),
+                            std::streamsize(tile.mData.size()));
+            }
+            return Status::Ok();
+        });
 }
 
 Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath)

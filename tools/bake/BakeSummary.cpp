@@ -1,5 +1,7 @@
 #include "BakeSummary.h"
 
+#include "cairn/navmesh/ReplaceFile.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -71,25 +73,7 @@ Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary)
                          {"polygons", tile.mPolygons},
                          {"bytes", tile.mBytes}});
     json["tiles"] = tiles;
-    const std::string temporary = inPath + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::trunc);
-        out << json.dump(1) << "\n";
-        if (!out)
-        {
-            std::error_code ignored;
-            std::filesystem::remove(temporary, ignored);
-            return MakeError(ErrorCode::IOError, temporary + ": cannot be written");
-        }
-    }
-    std::error_code error;
-    std::filesystem::rename(temporary, inPath, error);
-    if (error)
-    {
-        std::filesystem::remove(temporary, error);
-        return MakeError(ErrorCode::IOError, inPath + ": cannot be replaced");
-    }
-    return Status::Ok();
+    return navmesh::ReplaceFileWithText(inPath, json.dump(1) + "\n");
 }
 
 Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
