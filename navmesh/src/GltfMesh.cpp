@@ -41,7 +41,13 @@ Mat4 LocalTransform(const tinygltf::Node& inNode)
 class GltfReader
 {
 public:
-    GltfReader(const std::string& inPath, const tinygltf::Model& inModel) : mPath(inPath), mModel(inModel) {}
+    GltfReader(const std::string& inPath, const tinygltf::Model& inModel) : mPath(inPath), mModel(inModel)
+    {
+        for (size_t i = 0; i < inModel.materials.size(); ++i)
+            mMesh.mMaterials.push_back(!inModel.materials[i].name.empty()
+                                           ? inModel.materials[i].name
+                                           : "materials[" + std::to_string(i) + "]");
+    }
 
     Status AddNode(int inNode, const Mat4& inParent, int inDepth)
     {
@@ -50,7 +56,14 @@ public:
         const tinygltf::Node& node = mModel.nodes[size_t(inNode)];
         const Mat4 world = inParent * LocalTransform(node);
         if (node.mesh >= 0)
+        {
+            // Each node with a mesh is an object of its own (instances of one mesh included)
+            MeshObject object{!node.name.empty() ? node.name : "nodes[" + std::to_string(inNode) + "]",
+                              uint32_t(mMesh.mTriangles.size()), 0};
             if (Status added = AddMesh(node.mesh, world); !added) return added;
+            object.mNumTriangles = uint32_t(mMesh.mTriangles.size()) - object.mFirstTriangle;
+            if (object.mNumTriangles > 0) mMesh.mObjects.push_back(std::move(object));
+        }
         for (int child : node.children)
             if (Status added = AddNode(child, world, inDepth + 1); !added) return added;
         return Status::Ok();
@@ -167,6 +180,11 @@ private:
                     indices.push_back(i);
             // A mirroring transform turns the winding: keep triangles counter-clockwise seen from their front
             const bool mirrored = inWorld.block<3, 3>(0, 0).determinant() < 0.0;
+            if (primitive.material >= int(mModel.materials.size()))
+                return Fail(where, "names material " + std::to_string(primitive.material) + " of " +
+                                       std::to_string(mModel.materials.size()));
+            const uint32_t material =
+                primitive.material >= 0 ? uint32_t(primitive.material) : IndexedMesh::cNoMaterial;
             for (size_t i = 0; i + 2 < indices.size(); i += 3)
             {
                 std::array<uint32_t, 3> triangle;
@@ -178,6 +196,7 @@ private:
                 }
                 if (mirrored) std::swap(triangle[1], triangle[2]);
                 mMesh.mTriangles.push_back(triangle);
+                mMesh.mTriangleMaterials.push_back(material);
             }
         }
         return Status::Ok();

@@ -1,6 +1,7 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 
 #include "cairn/navmesh/NavMeshFile.h"
+#include "cairn/navmesh/NavMeshPreview.h"
 
 #include <DetourNavMesh.h>
 #include <DetourNavMeshQuery.h>
@@ -207,40 +208,7 @@ int NavMeshWorld::GetTilePolygonCount(const TileCoord& inTile) const
 std::string NavMeshWorld::ToObj() const
 {
     std::shared_lock lock(mNavMeshMutex);
-    std::string obj = "# Cairn navmesh: detail triangles of every polygon\n";
-    char line[96];
-    int firstVertex = 1;
-    const dtNavMesh& navMesh = *mNavMesh;
-    for (int i = 0; i < navMesh.getMaxTiles(); ++i)
-    {
-        const dtMeshTile* tile = navMesh.getTile(i);
-        if (tile == nullptr || tile->header == nullptr) continue;
-        for (int p = 0; p < tile->header->polyCount; ++p)
-        {
-            const dtPoly& poly = tile->polys[p];
-            if (poly.getType() == DT_POLYTYPE_OFFMESH_CONNECTION) continue;
-            const dtPolyDetail& detail = tile->detailMeshes[p];
-            for (int t = 0; t < detail.triCount; ++t)
-            {
-                const unsigned char* triangle = &tile->detailTris[(detail.triBase + unsigned(t)) * 4];
-                for (int k = 0; k < 3; ++k)
-                {
-                    // The first vertCount indices are the polygon's own vertices, the rest detail vertices
-                    const float* v =
-                        triangle[k] < poly.vertCount
-                            ? &tile->verts[poly.verts[triangle[k]] * 3]
-                            : &tile->detailVerts[(detail.vertBase + (triangle[k] - poly.vertCount)) * 3];
-                    std::snprintf(line, sizeof(line), "v %.3f %.3f %.3f\n", v[0], v[1], v[2]);
-                    obj += line;
-                }
-                std::snprintf(line, sizeof(line), "f %d %d %d\n", firstVertex, firstVertex + 1,
-                              firstVertex + 2);
-                obj += line;
-                firstVertex += 3;
-            }
-        }
-    }
-    return obj;
+    return NavMeshToObj(*mNavMesh);
 }
 
 std::map<TileCoord, std::vector<unsigned char>> NavMeshWorld::SnapshotTiles() const

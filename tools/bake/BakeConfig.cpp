@@ -66,4 +66,47 @@ Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfil
     return Status::Ok();
 }
 
+Result<navmesh::AreaMapping> LoadAreaMapping(const std::string& inPath)
+{
+    std::ifstream in(inPath);
+    if (!in) return MakeError(ErrorCode::IOError, inPath + ": cannot be read");
+    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
+    if (json.is_discarded() || !json.is_object())
+        return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
+    auto areaId = [&](const nlohmann::json& inValue, const std::string& inWhat) -> Result<uint8_t>
+    {
+        if (!inValue.is_number_integer() || inValue.get<int64_t>() < 0 ||
+            inValue.get<int64_t>() > navmesh::cMaxAreaId)
+            return MakeError(ErrorCode::ParseError, inPath + ": " + inWhat +
+                                                        " must be a whole number from 0 to " +
+                                                        std::to_string(navmesh::cMaxAreaId));
+        return uint8_t(inValue.get<int64_t>());
+    };
+    navmesh::AreaMapping mapping;
+    for (const auto& [key, value] : json.items())
+    {
+        if (key == "default")
+        {
+            Result<uint8_t> area = areaId(value, "'default'");
+            if (!area) return area.GetError();
+            mapping.mDefaultArea = area.Value();
+        }
+        else if (key == "materials")
+        {
+            if (!value.is_object())
+                return MakeError(ErrorCode::ParseError,
+                                 inPath + ": 'materials' must map material names to area ids");
+            for (const auto& [material, id] : value.items())
+            {
+                Result<uint8_t> area = areaId(id, "material '" + material + "'");
+                if (!area) return area.GetError();
+                mapping.mMaterialAreas[material] = area.Value();
+            }
+        }
+        else
+            return MakeError(ErrorCode::ParseError, inPath + ": unknown key '" + key + "'");
+    }
+    return mapping;
+}
+
 } // namespace cairn::bake

@@ -9,6 +9,7 @@
 // Every key is optional (the profile's defaults stay); an unknown key is an error, so a typo is not ignored.
 
 #include "cairn/navmesh/AgentProfile.h"
+#include "cairn/navmesh/ObjMesh.h"
 
 #include <string>
 
@@ -18,5 +19,11 @@ namespace cairn::bake
 /// Reads inPath into ioProfile (keys it does not name keep their values) and validates the result. Errors
 /// name the file and the key.
 Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfile);
+
+/// Reads an area mapping (material names to navmesh area ids, see navmesh::AreaMapping) from a JSON file:
+///   { "default": 0, "materials": { "road": 1, "grass": 2, "shallow_water": 3 } }
+/// Both keys are optional; ids are whole numbers from 0 to navmesh::cMaxAreaId. Errors name the file and the
+/// key or material.
+Result<navmesh::AreaMapping> LoadAreaMapping(const std::string& inPath);
 
 } // namespace cairn::bake

@@ -6,6 +6,8 @@
 #include "BakeConfig.h"
 #include "Baker.h"
 #include "cairn/navmesh/NavMeshFile.h"
+#include "cairn/navmesh/NavMeshPreview.h"
+#include "cairn/navmesh/ReplaceFile.h"
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -47,7 +49,7 @@ int main(int argc, char** argv)
     CLI::App* bakeCommand = app.add_subcommand("bake", "Bake OBJ and glTF level files");
     bakeCommand
         ->add_option("inputs", settings.mInputs,
-                     "OBJ and glTF files (.obj, .gltf, .glb; each file a static mesh)")
+                     "OBJ and glTF files (.obj, .gltf, .glb; each object a static mesh)")
         ->required();
     bakeCommand->add_option("-o,--output", output, "The navmesh file to write")->required();
     bakeCommand->add_option("--threads", settings.mThreads, "Threads (0: all cores)")
@@ -64,6 +66,14 @@ int main(int argc, char** argv)
     navmesh::AgentProfile flagProfile;
     std::string configPath;
     bakeCommand->add_option("--config", configPath, "Agent profile and tile size from a JSON file");
+    std::string areasPath, previewObjPath, previewSvgPath;
+    bakeCommand->add_option("--preview-obj", previewObjPath,
+                            "Also write the navmesh's walkable surface as Wavefront OBJ");
+    bakeCommand->add_option("--preview-svg", previewSvgPath,
+                            "Also write a top-down SVG map of the navmesh (areas, tiles, links)");
+    bakeCommand->add_option("--areas", areasPath,
+                            "Navmesh area ids of material names, from a JSON file "
+                            "({\"default\": 0, \"materials\": {\"road\": 1}})");
     CLI::Option* flags[] = {
         bakeCommand->add_option("--tile-size", flagProfile.mTileSize, "Tile side, m"),
         bakeCommand->add_option("--cell-size", flagProfile.mCellSize, "Voxel size, m"),
@@ -116,6 +126,12 @@ int main(int argc, char** argv)
     if (!configPath.empty())
         if (Status loaded = bake::LoadBakeConfig(configPath, settings.mProfile); !loaded)
             return Fail(loaded.GetError().mMessage);
+    if (!areasPath.empty())
+    {
+        Result<navmesh::AreaMapping> areas = bake::LoadAreaMapping(areasPath);
+        if (!areas) return Fail(areas.GetError().mMessage);
+        settings.mAreas = std::move(areas.Value());
+    }
     for (size_t i = 0; i < std::size(flags); ++i)
         if (flags[i]->count() > 0) settings.mProfile.*fields[i] = flagProfile.*fields[i];
     if (!ParseShard(shard, settings.mShard, settings.mShardCount))
@@ -165,10 +181,25 @@ int main(int argc, char** argv)
     if (!summaryPath.empty())
         if (Status saved = bake::SaveBakeSummary(summaryPath, result.Value().mSummary); !saved)
             return Fail(saved.GetError().mMessage);
-    std::printf("rebuilt %u, baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu polygons, in %.1f "
-                "ms (load %.1f ms) "
-                "-> %s\n",
-                result.Value().mSummary.mTilesRebuilt, result.Value().mTilesBaked,
+    if (!previewObjPath.empty() || !previewSvgPath.empty())
+    {
+        // The previews show the file as a runtime loads it
+        Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(result.Value().mNavMesh);
+        if (!navMesh) return Fail(navMesh.GetError().mMessage);
+        if (!previewObjPath.empty())
+            if (Status saved =
+                    navmesh::ReplaceFileWithText(previewObjPath, navmesh::NavMeshToObj(*navMesh.Value()));
+                !saved)
+                return Fail(saved.GetError().mMessage);
+        if (!previewSvgPath.empty())
+            if (Status saved =
+                    navmesh::ReplaceFileWithText(previewSvgPath, navmesh::NavMeshToSvg(*navMesh.Value()));
+                !saved)
+                return Fail(saved.GetError().mMessage);
+    }
+    std::printf("%u bodies; rebuilt %u, baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu "
+                "polygons, in %.1f ms (load %.1f ms) -> %s\n",
+                result.Value().mBodies, result.Value().mSummary.mTilesRebuilt, result.Value().mTilesBaked,
                 result.Value().mTilesInWorld, settings.mShard, settings.mShardCount,
                 result.Value().mNavMesh.mTiles.size(), (unsigned long long)result.Value().mPolygons,
                 result.Value().mBakeMs, result.Value().mLoadMs, output.c_str());

@@ -23,6 +23,9 @@ namespace
 using Clock = std::chrono::steady_clock;
 using tools::MillisecondsSince;
 
+/// Bodies a bake may make (objects times their areas): far beyond any level, well inside the body ids
+constexpr size_t cMaxObjects = size_t(1) << 24;
+
 } // namespace
 
 Result<BakeResult> Bake(const BakeSettings& inSettings)
@@ -40,25 +43,49 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
     // Every object a static mesh body; the level's bounds decide the tiles
     BakeResult result;
     const Clock::time_point loadStart = Clock::now();
-    PhysicsSettings physicsSettings;
-    physicsSettings.mMaxBodies = 1 << 20;
-    PhysicsSystem physics(physicsSettings);
+    if (Status valid = inSettings.mAreas.Validate(); !valid) return valid.GetError();
+    // A body per object and area: an edited object changes only the tiles it touches, and each body carries
+    // the area its materials map to. All parts first, so that the world is made for their number
+    struct NamedPart
+    {
+        std::string mWhere; ///< File and object, for errors
+        navmesh::LevelPart mPart;
+    };
+    std::vector<NamedPart> parts;
     AABB bounds;
     for (const std::string& input : inSettings.mInputs)
     {
         Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(input);
         if (!mesh) return mesh.GetError();
-        auto shape = TriangleMeshShape::Create(mesh.Value().mVertices, mesh.Value().mTriangles);
-        if (!shape) return MakeError(shape.GetError().mCode, input + ": " + shape.GetError().mMessage);
+        bounds.Encapsulate(mesh.Value().GetBounds());
+        for (navmesh::LevelPart& part : navmesh::SplitIntoParts(mesh.Value(), inSettings.mAreas))
+        {
+            std::string where = input + (part.mName.empty() ? "" : ": object '" + part.mName + "'");
+            parts.push_back({std::move(where), std::move(part)});
+        }
+    }
+    PhysicsSettings physicsSettings;
+    physicsSettings.mMaxBodies = uint32_t(std::max<size_t>(parts.size(), 1));
+    if (parts.size() > cMaxObjects)
+        return MakeError(ErrorCode::OutOfCapacity, "the level has " + std::to_string(parts.size()) +
+                                                       " objects, more than a physics world holds");
+    PhysicsSystem physics(physicsSettings);
+    for (NamedPart& named : parts)
+    {
+        const navmesh::LevelPart& part = named.mPart;
+        auto shape = TriangleMeshShape::Create(part.mMesh.mVertices, part.mMesh.mTriangles);
+        if (!shape) return MakeError(shape.GetError().mCode, named.mWhere + ": " + shape.GetError().mMessage);
         BodyCreationSettings settings;
         settings.mShape = shape.Value();
         settings.mMotionType = MotionType::Static;
         settings.mObjectLayer = Layers::cStatic;
+        settings.mNavMeshArea = part.mArea;
         if (Result<BodyID> id =
                 physics.GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate);
             !id)
-            return MakeError(id.GetError().mCode, input + ": " + id.GetError().mMessage);
-        bounds.Encapsulate(mesh.Value().GetBounds());
+            return MakeError(id.GetError().mCode, named.mWhere + ": " + id.GetError().mMessage);
+        ++result.mBodies;
+        named.mPart.mMesh = {}; // The shape holds its own copy
     }
     result.mLoadMs = MillisecondsSince(loadStart);
 

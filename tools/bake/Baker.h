@@ -1,6 +1,7 @@
 #pragma once
 
-// Baker: the offline tile baker. Loads level meshes into a physics world (each object a static mesh body),
+// Baker: the offline tile baker. Loads level meshes into a physics world (each object a static mesh body, one
+// per area when its materials map to several),
 // then builds every tile that touches the geometry with the runtime's pipeline (GeometryCollector and
 // TileBuilder), spread over a job system's threads, and returns the tiles in the navmesh file layout. Each
 // tile is built alone from the same inputs, so the result is the same whatever the thread count; a shard
@@ -10,6 +11,7 @@
 #include "BakeSummary.h"
 #include "cairn/navmesh/AgentProfile.h"
 #include "cairn/navmesh/NavMeshFile.h"
+#include "cairn/navmesh/ObjMesh.h"
 
 #include <functional>
 #include <string>
@@ -22,9 +24,10 @@ struct BakeSettings
 {
     std::vector<std::string> mInputs; ///< OBJ and glTF (.gltf, .glb) files
     navmesh::AgentProfile mProfile;
-    uint32_t mThreads = 0;    ///< 0: all cores
-    uint32_t mShard = 0;      ///< This shard (0-based) ...
-    uint32_t mShardCount = 1; ///< ... of this many
+    navmesh::AreaMapping mAreas; ///< Area ids of material names
+    uint32_t mThreads = 0;       ///< 0: all cores
+    uint32_t mShard = 0;         ///< This shard (0-based) ...
+    uint32_t mShardCount = 1;    ///< ... of this many
     /// Called after each tile with (tiles done, tiles in all), one call at a time; may be empty
     std::function<void(uint32_t, uint32_t)> mProgress;
     /// Incremental: the previous bake's summary and navmesh (both or neither). A tile whose input hash is
@@ -39,6 +42,7 @@ struct BakeResult
     uint32_t mTilesBaked = 0;              ///< This shard's tiles, empty ones included
     uint32_t mTilesInWorld = 0;            ///< Of every shard
     uint64_t mPolygons = 0;
+    uint32_t mBodies = 0; ///< Static bodies made from the inputs' objects
     double mBakeMs = 0.0; ///< Tiles only (loading excluded)
     double mLoadMs = 0.0;
     BakeSummary mSummary; ///< Per tile hashes, for the next incremental bake

@@ -1,29 +1,73 @@
 #pragma once
 
 // Level meshes for the navmesh: Wavefront OBJ (Recast's demo meshes) read with tinyobjloader, and glTF 2.0
-// read with tinygltf; vertices and triangles only (polygons split into fans, materials ignored). Plain
-// functions, any thread.
+// read with tinygltf: vertices, triangles, the objects they belong to and their materials' names (a level's
+// area types come from those, see AreaMapping). Plain functions, any thread.
 
 #include "cairn/navmesh/TileGeometry.h"
 #include "cairn/physics/math/AABB.h"
 #include "cairn/physics/math/Result.h"
 
 #include <array>
+#include <map>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace cairn::navmesh
 {
 
+/// A named part of a level file: an OBJ object or group (`o`, `g`), a glTF node with a mesh.
+struct MeshObject
+{
+    std::string mName;
+    uint32_t mFirstTriangle = 0; ///< Its triangles are [first, first + count) of IndexedMesh::mTriangles
+    uint32_t mNumTriangles = 0;
+};
+
 struct IndexedMesh
 {
+    static constexpr uint32_t cNoMaterial = 0xffffffffu;
+
     std::vector<Vec3> mVertices;
     std::vector<std::array<uint32_t, 3>> mTriangles;
+    std::vector<MeshObject> mObjects;         ///< In triangle order, covering every triangle once
+    std::vector<std::string> mMaterials;      ///< Names as the file gives them (OBJ `usemtl`, glTF materials)
+    std::vector<uint32_t> mTriangleMaterials; ///< Per triangle: index into mMaterials, or cNoMaterial
 
     AABB GetBounds() const;
     /// Every triangle, as a tile build takes them, with area inArea.
     TileGeometry ToTileGeometry(uint8_t inArea = cDefaultArea) const;
+    /// The triangles inTriangles (indices into mTriangles) as a mesh of their own, holding only the vertices
+    /// they use, in first-use order; no objects or materials.
+    IndexedMesh ExtractTriangles(std::span<const uint32_t> inTriangles) const;
+    /// The name of triangle inTriangle's material, or an empty string when it has none.
+    const std::string& GetMaterialName(uint32_t inTriangle) const;
 };
+
+/// Navmesh area ids of materials, by name: how a level's floors become roads, grass or water for the path
+/// query's costs. Materials it does not name (and triangles without one) get mDefaultArea.
+struct AreaMapping
+{
+    uint8_t mDefaultArea = cDefaultArea;
+    std::map<std::string, uint8_t> mMaterialAreas; ///< Area ids up to cMaxAreaId
+
+    uint8_t GetArea(const std::string& inMaterial) const;
+    /// Errors: an area id above cMaxAreaId.
+    Status Validate() const;
+};
+
+/// One static body's worth of a level file: an object's triangles of one area.
+struct LevelPart
+{
+    std::string mName; ///< The object's name
+    uint8_t mArea = cDefaultArea;
+    IndexedMesh mMesh; ///< Only the vertices its triangles use
+};
+
+/// Splits a level mesh into parts: each object, and within it each area that inAreas gives its materials,
+/// in the order of the objects and then of each area's first triangle. A mesh without objects is one.
+std::vector<LevelPart> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas);
 
 /// Errors: IOError when the file cannot be read; ParseError for a malformed file (bad numbers or indices),
 /// non-finite or out-of-range coordinates, or a mesh without triangles.
