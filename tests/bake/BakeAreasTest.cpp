@@ -4,11 +4,10 @@
 #include "BakeConfig.h"
 #include "Baker.h"
 #include "cairn/navmesh/NavMeshFile.h"
+#include "common/TempFiles.h"
 
 #include <DetourNavMesh.h>
 #include <Recast.h>
-#include <filesystem>
-#include <fstream>
 #include <gtest/gtest.h>
 #include <map>
 
@@ -22,18 +21,9 @@ class BakeAreasTest : public ::testing::Test
 protected:
     std::string Write(const std::string& inName, const std::string& inText)
     {
-        const std::string path =
-            (std::filesystem::temp_directory_path() / ("cairn-bake-areas-" + inName)).string();
-        std::ofstream(path, std::ios::binary) << inText;
-        mFiles.push_back(path);
-        return path;
+        return mFiles.Write(inName, inText);
     }
-    void TearDown() override
-    {
-        for (const std::string& path : mFiles)
-            std::filesystem::remove(path);
-    }
-    std::vector<std::string> mFiles;
+    cairn::test::TempFiles mFiles;
 };
 
 /// A 24 m x 24 m floor: x < 12 is "road", the rest "grass", as two objects of one file.

@@ -2,10 +2,9 @@
 // material library), glTF nodes and materials, and the split into one part per object and area.
 
 #include "cairn/navmesh/ObjMesh.h"
+#include "common/TempFiles.h"
 
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <gtest/gtest.h>
 #include <set>
 #include <tiny_gltf.h>
@@ -20,18 +19,9 @@ class LevelPartsTest : public ::testing::Test
 protected:
     std::string Write(const std::string& inName, const std::string& inText)
     {
-        const std::string path =
-            (std::filesystem::temp_directory_path() / ("cairn-level-parts-" + inName)).string();
-        std::ofstream(path, std::ios::binary) << inText;
-        mFiles.push_back(path);
-        return path;
+        return mFiles.Write(inName, inText);
     }
-    void TearDown() override
-    {
-        for (const std::string& path : mFiles)
-            std::filesystem::remove(path);
-    }
-    std::vector<std::string> mFiles;
+    cairn::test::TempFiles mFiles;
 };
 
 // Two objects; the first has two materials. Vertices are shared by the whole file, as OBJ has them

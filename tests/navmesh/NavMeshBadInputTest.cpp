@@ -4,9 +4,8 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
+#include "common/TempFiles.h"
 
-#include <filesystem>
-#include <fstream>
 #include <gtest/gtest.h>
 #include <limits>
 
@@ -69,21 +68,10 @@ class ObjFileTest : public ::testing::Test
 protected:
     std::string Write(const std::string& inText)
     {
-        const std::string path =
-            (std::filesystem::temp_directory_path() /
-             ("cairn-objtest-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
-              std::to_string(mFiles.size()) + ".obj"))
-                .string();
-        std::ofstream(path) << inText;
-        mFiles.push_back(path);
-        return path;
+        return mFiles.Write("level-" + std::to_string(mCount++) + ".obj", inText);
     }
-    void TearDown() override
-    {
-        for (const std::string& path : mFiles)
-            std::filesystem::remove(path);
-    }
-    std::vector<std::string> mFiles;
+    cairn::test::TempFiles mFiles;
+    int mCount = 0;
 };
 
 TEST_F(ObjFileTest, AGoodFileLoads)
