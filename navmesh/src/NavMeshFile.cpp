@@ -78,35 +78,68 @@ Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles
     return params;
 }
 
+NavMeshFileWriter::NavMeshFileWriter(std::string inPath, const dtNavMeshParams& inParams)
+    : mPath(std::move(inPath)), mParams(inParams), mFile(mPath)
+{
+}
+
+NavMeshFileWriter::~NavMeshFileWriter() = default;
+
+Result<std::unique_ptr<NavMeshFileWriter>> NavMeshFileWriter::Create(const std::string& inPath,
+                                                                     const dtNavMeshParams& inParams)
+{
+    std::unique_ptr<NavMeshFileWriter> writer(new NavMeshFileWriter(inPath, inParams));
+    // The references a fresh navmesh gives tiles added in file order: tile slot i, salt 1
+    writer->mLayout.reset(dtAllocNavMesh());
+    if (writer->mLayout == nullptr || dtStatusFailed(writer->mLayout->init(&inParams)))
+        return MakeError(ErrorCode::InvalidArgument, inPath + ": the navmesh parameters are invalid");
+    if (Status opened = writer->mFile.GetOpenStatus(); !opened) return opened.GetError();
+    // The tile count is written again by Finish, when it is known
+    const SetHeader header{cSetMagic, cSetVersion, 0, inParams};
+    writer->mFile.Stream().write(reinterpret_cast<const char*>(&header), sizeof(header));
+    return writer;
+}
+
+Status NavMeshFileWriter::Add(const TileCoord& inTile, std::span<const unsigned char> inData)
+{
+    if (mNumTiles > 0 && !(mLastTile < inTile))
+        return MakeError(ErrorCode::InvalidArgument,
+                         mPath + ": tile (" + std::to_string(inTile.mX) + ", " + std::to_string(inTile.mZ) +
+                             ") comes after a later one: tiles go in sorted order");
+    if (mNumTiles >= mParams.maxTiles)
+        return MakeError(ErrorCode::OutOfCapacity, mPath + ": more tiles than the parameters allow (" +
+                                                       std::to_string(mParams.maxTiles) + ")");
+    TileCoord fromData;
+    const std::vector<unsigned char> header(inData.begin(),
+                                            inData.begin() + std::min(inData.size(), sizeof(dtMeshHeader)));
+    if (!ReadTileCoord(header, fromData) || !(fromData == inTile))
+        return MakeError(ErrorCode::InvalidArgument,
+                         mPath + ": the data of tile (" + std::to_string(inTile.mX) + ", " +
+                             std::to_string(inTile.mZ) + ") is not a Detour tile at that place");
+    const TileHeader tileHeader{mLayout->encodePolyId(1, unsigned(mNumTiles), 0), int32_t(inData.size())};
+    mFile.Stream().write(reinterpret_cast<const char*>(&tileHeader), sizeof(tileHeader));
+    mFile.Stream().write(reinterpret_cast<const char*>(inData.data()), std::streamsize(inData.size()));
+    ++mNumTiles;
+    mLastTile = inTile;
+    return Status::Ok();
+}
+
+Status NavMeshFileWriter::Finish()
+{
+    const SetHeader header{cSetMagic, cSetVersion, mNumTiles, mParams};
+    mFile.Stream().seekp(0);
+    mFile.Stream().write(reinterpret_cast<const char*>(&header), sizeof(header));
+    return mFile.Commit();
+}
+
 Status SaveNavMeshFile(const std::string& inPath, NavMeshFileContents inContents)
 {
     SortTiles(inContents);
-    // The references a fresh navmesh gives the tiles added in this order: tile slot i, salt 1
-    DetourNavMeshPtr layout(dtAllocNavMesh());
-    if (layout == nullptr || dtStatusFailed(layout->init(&inContents.mParams)))
-        return MakeError(ErrorCode::InvalidArgument, inPath + ": the navmesh parameters are invalid");
-    if (int64_t(inContents.mTiles.size()) > inContents.mParams.maxTiles)
-        return MakeError(ErrorCode::OutOfCapacity, inPath + ": " + std::to_string(inContents.mTiles.size()) +
-                                                       " tiles, more than the parameters allow (" +
-                                                       std::to_string(inContents.mParams.maxTiles) + ")");
-
-    return ReplaceFile(
-        inPath,
-        [&](std::ostream& ioOut)
-        {
-            SetHeader header{cSetMagic, cSetVersion, int32_t(inContents.mTiles.size()), inContents.mParams};
-            ioOut.write(reinterpret_cast<const char*>(&header), sizeof(header));
-            for (size_t i = 0; i < inContents.mTiles.size(); ++i)
-            {
-                const NavMeshFileTile& tile = inContents.mTiles[i];
-                const TileHeader tileHeader{layout->encodePolyId(1, unsigned(i), 0),
-                                            int32_t(tile.mData.size())};
-                ioOut.write(reinterpret_cast<const char*>(&tileHeader), sizeof(tileHeader));
-                ioOut.write(reinterpret_cast<const char*>(tile.mData.data()),
-                            std::streamsize(tile.mData.size()));
-            }
-            return Status::Ok();
-        });
+    Result<std::unique_ptr<NavMeshFileWriter>> writer = NavMeshFileWriter::Create(inPath, inContents.mParams);
+    if (!writer) return writer.GetError();
+    for (const NavMeshFileTile& tile : inContents.mTiles)
+        if (Status added = writer.Value()->Add(tile.mTile, tile.mData); !added) return added;
+    return writer.Value()->Finish();
 }
 
 Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath)

@@ -8,11 +8,13 @@
 // Tiles are written sorted by tile coordinate with the references a fresh dtNavMesh gives them in that order,
 // so the same tiles always give the same bytes. Plain functions over plain data: any thread.
 
+#include "cairn/navmesh/ReplaceFile.h"
 #include "cairn/navmesh/TileGrid.h"
 #include "cairn/physics/math/Result.h"
 
 #include <DetourNavMesh.h>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,16 +37,46 @@ struct NavMeshFileContents
 /// polygon reference (10 bits of salt). Error when inMaxTiles leaves too few bits for polygons.
 Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles);
 
-/// Writes inContents to inPath (through a temporary file renamed into place: no partial file on failure).
-Status SaveNavMeshFile(const std::string& inPath, NavMeshFileContents inContents);
-/// Reads a file written by SaveNavMeshFile or Recast's demo. Errors name the file and what is wrong.
-Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath);
-
 struct DetourNavMeshDeleter
 {
     void operator()(dtNavMesh* inNavMesh) const { dtFreeNavMesh(inNavMesh); }
 };
 using DetourNavMeshPtr = std::unique_ptr<dtNavMesh, DetourNavMeshDeleter>;
+
+/// Writes a navmesh file tile by tile, holding none of them (a bake larger than memory streams its tiles
+/// through it); the same bytes as SaveNavMeshFile when given the same tiles. Tiles must come in sorted order.
+/// To a temporary file that Finish renames into place; destroyed unfinished, it leaves nothing behind. One
+/// thread.
+class NavMeshFileWriter
+{
+public:
+    /// Errors: invalid parameters, the temporary file cannot be created.
+    static Result<std::unique_ptr<NavMeshFileWriter>> Create(const std::string& inPath,
+                                                             const dtNavMeshParams& inParams);
+    ~NavMeshFileWriter();
+
+    /// Errors: a tile out of order, more than the parameters' maxTiles, data that is not a Detour tile at
+    /// inTile.
+    Status Add(const TileCoord& inTile, std::span<const unsigned char> inData);
+    /// Writes the tile count and renames the file into place.
+    Status Finish();
+
+private:
+    NavMeshFileWriter(std::string inPath, const dtNavMeshParams& inParams);
+
+    std::string mPath;
+    dtNavMeshParams mParams;
+    DetourNavMeshPtr mLayout; ///< Only encodes the tiles' references
+    PendingFile mFile;
+    int32_t mNumTiles = 0;
+    TileCoord mLastTile;
+};
+
+/// Writes inContents to inPath (through a temporary file renamed into place: no partial file on failure).
+Status SaveNavMeshFile(const std::string& inPath, NavMeshFileContents inContents);
+/// Reads a file written by SaveNavMeshFile or Recast's demo. Errors name the file and what is wrong.
+Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath);
+
 /// A dtNavMesh holding copies of the tiles, as a runtime would load it.
 Result<DetourNavMeshPtr> CreateDetourNavMesh(const NavMeshFileContents& inContents);
 
