@@ -173,18 +173,19 @@ int main(int argc, char** argv)
         settings.mPrevious = &*previous;
         settings.mPreviousNavMesh = &*previousNavMesh;
     }
+    settings.mOutputPath = output; // Tiles go to the file as they are done
     Result<bake::BakeResult> result = bake::Bake(settings);
     if (terminal) std::printf("\n");
     if (!result) return Fail(result.GetError().mMessage);
-    if (Status saved = navmesh::SaveNavMeshFile(output, result.Value().mNavMesh); !saved)
-        return Fail(saved.GetError().mMessage);
     if (!summaryPath.empty())
         if (Status saved = bake::SaveBakeSummary(summaryPath, result.Value().mSummary); !saved)
             return Fail(saved.GetError().mMessage);
     if (!previewObjPath.empty() || !previewSvgPath.empty())
     {
         // The previews show the file as a runtime loads it
-        Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(result.Value().mNavMesh);
+        Result<navmesh::NavMeshFileContents> written = navmesh::LoadNavMeshFile(output);
+        if (!written) return Fail(written.GetError().mMessage);
+        Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(written.Value());
         if (!navMesh) return Fail(navMesh.GetError().mMessage);
         if (!previewObjPath.empty())
             if (Status saved =
@@ -197,11 +198,12 @@ int main(int argc, char** argv)
                 !saved)
                 return Fail(saved.GetError().mMessage);
     }
-    std::printf("%u bodies; rebuilt %u, baked %u of %u tiles (shard %u/%u), %zu with polygons, %llu "
-                "polygons, in %.1f ms (load %.1f ms) -> %s\n",
-                result.Value().mBodies, result.Value().mSummary.mTilesRebuilt, result.Value().mTilesBaked,
-                result.Value().mTilesInWorld, settings.mShard, settings.mShardCount,
-                result.Value().mNavMesh.mTiles.size(), (unsigned long long)result.Value().mPolygons,
-                result.Value().mBakeMs, result.Value().mLoadMs, output.c_str());
+    const bake::BakeResult& baked = result.Value();
+    std::printf("%llu bodies (at most %u at once); rebuilt %u, baked %u of %u tiles (shard %u/%u), %u with "
+                "polygons, %llu polygons, in %.1f ms (load %.1f ms) -> %s\n",
+                (unsigned long long)baked.mBodies, baked.mPeakBodies, baked.mSummary.mTilesRebuilt,
+                baked.mTilesBaked, baked.mTilesInWorld, settings.mShard, settings.mShardCount,
+                baked.mTilesWithPolygons, (unsigned long long)baked.mPolygons, baked.mBakeMs, baked.mLoadMs,
+                output.c_str());
     return 0;
 }

@@ -1,5 +1,6 @@
 #include "Baker.h"
 
+#include "LiveObjects.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/navmesh/GeometryCollector.h"
 #include "cairn/navmesh/ObjMesh.h"
@@ -12,7 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <mutex>
+#include <deque>
 #include <optional>
 
 namespace cairn::bake
@@ -23,73 +24,118 @@ namespace
 using Clock = std::chrono::steady_clock;
 using tools::MillisecondsSince;
 
-/// Bodies a bake may make (objects times their areas): far beyond any level, well inside the body ids
-constexpr size_t cMaxObjects = size_t(1) << 24;
+/// Everything besides the triangles that decides a tile's output: the settings and the grid's height range.
+uint64_t SettingsHash(const navmesh::AgentProfile& inProfile, const navmesh::TileGrid& inGrid)
+{
+    const navmesh::AgentProfile& p = inProfile;
+    const float values[] = {p.mHeight,
+                            p.mRadius,
+                            p.mMaxClimb,
+                            p.mMaxSlopeDegrees,
+                            p.mCellSize,
+                            p.mCellHeight,
+                            p.mTileSize,
+                            p.mRegionMinSize,
+                            p.mRegionMergeSize,
+                            p.mEdgeMaxLength,
+                            p.mEdgeMaxError,
+                            float(p.mMaxVertsPerPoly),
+                            p.mDetailSampleDistance,
+                            p.mDetailSampleMaxError,
+                            float(int(p.mPartition)),
+                            inGrid.GetTileBounds({0, 0}).mMin.y(),
+                            inGrid.GetTileBounds({0, 0}).mMax.y()};
+    return Hash64Of(std::span<const float>(values), Hash64({}));
+}
+
+/// A tile in flight: entered (its objects' bodies held) by the main thread, built by a job, then written out
+/// and left, in the order of the sorted tile list.
+struct TileInFlight
+{
+    navmesh::TileCoord mTile;
+    std::vector<TileObject> mObjects; ///< In key order: the order its triangles are read in
+    jobs::JobHandle mJob;
+    // Written by the job, read by the main thread after Wait
+    TileRecord mRecord;
+    std::optional<Result<navmesh::BuiltTile>> mBuilt; ///< Empty when taken over from the previous bake
+    const navmesh::NavMeshFileTile* mReused = nullptr;
+};
+
+/// What the tile jobs share (read only while they run).
+struct TileJobContext
+{
+    const BakeSettings* mSettings;
+    const navmesh::TileGrid* mGrid;
+    const navmesh::GeometryCollector* mCollector;
+    float mBorder;
+    uint64_t mSettingsHash;
+};
+
+const navmesh::NavMeshFileTile* FindPreviousTile(const navmesh::NavMeshFileContents& inPrevious,
+                                                 const navmesh::TileCoord& inTile)
+{
+    auto it = std::lower_bound(inPrevious.mTiles.begin(), inPrevious.mTiles.end(), inTile,
+                               [](const navmesh::NavMeshFileTile& inT, const navmesh::TileCoord& inC)
+                               { return inT.mTile < inC; });
+    return it != inPrevious.mTiles.end() && it->mTile == inTile ? &*it : nullptr;
+}
+
+/// A tile job: the broad-phase query around the tile, its objects' triangles in key order, and Recast, or the
+/// previous bake's output when the input hash is unchanged.
+void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
+{
+    const BakeSettings& settings = *inContext.mSettings;
+    const AABB box = inContext.mGrid->GetTileBoundsWithBorder(ioTile.mTile, inContext.mBorder);
+    std::vector<BodyID> found, ordered, busy;
+    inContext.mCollector->FindBodies(box, {}, found);
+    // The bodies the query found, in the order of their objects' keys: body ids depend on which tiles were in
+    // flight, keys do not, so the triangles (and the input hash) are the same however the bake ran. A body of
+    // another tile's object that the query finds was not there when this tile entered, or is gone before it
+    // leaves: it is not this tile's
+    std::sort(found.begin(), found.end());
+    for (const TileObject& object : ioTile.mObjects)
+        if (std::binary_search(found.begin(), found.end(), object.mBody)) ordered.push_back(object.mBody);
+    navmesh::TileGeometry geometry;
+    navmesh::CollectStats stats;
+    inContext.mCollector->CollectTriangles(box, {}, ordered, geometry, busy, stats);
+    uint64_t hash = Hash64Of(std::span<const int32_t>(&ioTile.mTile.mX, 1), inContext.mSettingsHash);
+    hash = Hash64Of(std::span<const int32_t>(&ioTile.mTile.mZ, 1), hash);
+    hash = Hash64Of(std::span<const float>(geometry.mVertices), hash);
+    hash = Hash64Of(std::span<const int>(geometry.mTriangles), hash);
+    hash = Hash64Of(std::span<const uint8_t>(geometry.mAreas), hash);
+    ioTile.mRecord.mTile = ioTile.mTile;
+    ioTile.mRecord.mInputHash = hash;
+    // Unchanged input: the previous output, built or empty, is this tile's
+    const TileRecord* before =
+        settings.mPrevious != nullptr ? settings.mPrevious->Find(ioTile.mTile) : nullptr;
+    const navmesh::NavMeshFileTile* beforeTile =
+        before != nullptr ? FindPreviousTile(*settings.mPreviousNavMesh, ioTile.mTile) : nullptr;
+    if (before != nullptr && before->mInputHash == hash && (beforeTile != nullptr) == (before->mBytes > 0))
+    {
+        ioTile.mReused = beforeTile;
+        ioTile.mRecord = *before;
+        return;
+    }
+    ioTile.mBuilt = navmesh::BuildTile(settings.mProfile, *inContext.mGrid, ioTile.mTile, geometry);
+}
 
 } // namespace
 
-Result<BakeResult> Bake(const BakeSettings& inSettings)
+Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& inSettings)
 {
     if (Status valid = inSettings.mProfile.Validate(); !valid) return valid.GetError();
     if (inSettings.mShardCount == 0 || inSettings.mShard >= inSettings.mShardCount)
         return MakeError(ErrorCode::InvalidArgument, "shard " + std::to_string(inSettings.mShard) + "/" +
                                                          std::to_string(inSettings.mShardCount) +
                                                          ": K must be below N");
-    if (inSettings.mInputs.empty()) return MakeError(ErrorCode::InvalidArgument, "no input files");
     if ((inSettings.mPrevious == nullptr) != (inSettings.mPreviousNavMesh == nullptr))
         return MakeError(ErrorCode::InvalidArgument,
                          "an incremental bake needs the previous summary and navmesh");
-
-    // Every object a static mesh body; the level's bounds decide the tiles
-    BakeResult result;
-    const Clock::time_point loadStart = Clock::now();
-    if (Status valid = inSettings.mAreas.Validate(); !valid) return valid.GetError();
-    // A body per object and area: an edited object changes only the tiles it touches, and each body carries
-    // the area its materials map to. All parts first, so that the world is made for their number
-    struct NamedPart
-    {
-        std::string mWhere; ///< File and object, for errors
-        navmesh::LevelPart mPart;
-    };
-    std::vector<NamedPart> parts;
-    AABB bounds;
-    for (const std::string& input : inSettings.mInputs)
-    {
-        Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(input);
-        if (!mesh) return mesh.GetError();
-        bounds.Encapsulate(mesh.Value().GetBounds());
-        for (navmesh::LevelPart& part : navmesh::SplitIntoParts(mesh.Value(), inSettings.mAreas))
-        {
-            std::string where = input + (part.mName.empty() ? "" : ": object '" + part.mName + "'");
-            parts.push_back({std::move(where), std::move(part)});
-        }
-    }
-    PhysicsSettings physicsSettings;
-    physicsSettings.mMaxBodies = uint32_t(std::max<size_t>(parts.size(), 1));
-    if (parts.size() > cMaxObjects)
-        return MakeError(ErrorCode::OutOfCapacity, "the level has " + std::to_string(parts.size()) +
-                                                       " objects, more than a physics world holds");
-    PhysicsSystem physics(physicsSettings);
-    for (NamedPart& named : parts)
-    {
-        const navmesh::LevelPart& part = named.mPart;
-        auto shape = TriangleMeshShape::Create(part.mMesh.mVertices, part.mMesh.mTriangles);
-        if (!shape) return MakeError(shape.GetError().mCode, named.mWhere + ": " + shape.GetError().mMessage);
-        BodyCreationSettings settings;
-        settings.mShape = shape.Value();
-        settings.mMotionType = MotionType::Static;
-        settings.mObjectLayer = Layers::cStatic;
-        settings.mNavMeshArea = part.mArea;
-        if (Result<BodyID> id =
-                physics.GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate);
-            !id)
-            return MakeError(id.GetError().mCode, named.mWhere + ": " + id.GetError().mMessage);
-        ++result.mBodies;
-        named.mPart.mMesh = {}; // The shape holds its own copy
-    }
-    result.mLoadMs = MillisecondsSince(loadStart);
+    const AABB bounds = inSource.GetBounds();
+    if (bounds.IsEmpty()) return MakeError(ErrorCode::InvalidArgument, "the level has no geometry");
 
     // Tiles on a grid anchored at the world origin, so that every shard and every bake agree on them
+    BakeResult result;
     const navmesh::AgentProfile& profile = inSettings.mProfile;
     const navmesh::TileGrid grid(0.0f, 0.0f, profile.mTileSize, bounds.mMin.y() - 1.0f,
                                  bounds.mMax.y() + 1.0f);
@@ -107,127 +153,131 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
     std::vector<navmesh::TileCoord> mine;
     for (size_t i = 0; i < tiles.size(); ++i)
         if (i % inSettings.mShardCount == inSettings.mShard) mine.push_back(tiles[i]);
-
-    // Each tile alone, on any thread: its own query, triangles and Recast run
-    const float border = float(profile.GetBorderCells()) * profile.mCellSize;
-    const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
-    std::vector<std::optional<Result<navmesh::BuiltTile>>> built(mine.size());
-    std::vector<TileRecord> records(mine.size());
-    std::vector<const navmesh::NavMeshFileTile*> reused(mine.size(), nullptr);
-    // Everything besides the triangles that decides a tile: the settings
-    const navmesh::AgentProfile& p = profile;
-    const float settingsValues[] = {p.mHeight,
-                                    p.mRadius,
-                                    p.mMaxClimb,
-                                    p.mMaxSlopeDegrees,
-                                    p.mCellSize,
-                                    p.mCellHeight,
-                                    p.mTileSize,
-                                    p.mRegionMinSize,
-                                    p.mRegionMergeSize,
-                                    p.mEdgeMaxLength,
-                                    p.mEdgeMaxError,
-                                    float(p.mMaxVertsPerPoly),
-                                    p.mDetailSampleDistance,
-                                    p.mDetailSampleMaxError,
-                                    float(int(p.mPartition)),
-                                    grid.GetTileBounds({0, 0}).mMin.y(),
-                                    grid.GetTileBounds({0, 0}).mMax.y()};
-    const uint64_t settingsHash = Hash64Of(std::span<const float>(settingsValues), Hash64({}));
-    auto previousTile = [&](const navmesh::TileCoord& inTile) -> const navmesh::NavMeshFileTile*
+    tiles = {};
+    std::unique_ptr<navmesh::NavMeshFileWriter> output;
+    if (!inSettings.mOutputPath.empty())
     {
-        const std::vector<navmesh::NavMeshFileTile>& tiles = inSettings.mPreviousNavMesh->mTiles;
-        auto it = std::lower_bound(tiles.begin(), tiles.end(), inTile,
-                                   [](const navmesh::NavMeshFileTile& inT, const navmesh::TileCoord& inC)
-                                   { return inT.mTile < inC; });
-        return it != tiles.end() && it->mTile == inTile ? &*it : nullptr;
-    };
+        Result<std::unique_ptr<navmesh::NavMeshFileWriter>> writer =
+            navmesh::NavMeshFileWriter::Create(inSettings.mOutputPath, params.Value());
+        if (!writer) return writer.GetError();
+        output = std::move(writer.Value());
+    }
+
+    // A world for the objects near the tiles in flight only
+    PhysicsSettings physicsSettings;
+    physicsSettings.mMaxBodies = std::clamp<uint32_t>(inSource.GetMaxObjectsNear() * 2, 64, 1u << 16);
+    PhysicsSystem physics(physicsSettings);
+    LiveObjects objects(physics, inSource);
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
     jobs::JobSystem jobSystem(jobSettings);
-    std::mutex progressMutex;
-    uint32_t done = 0; ///< Guarded by progressMutex
-    const Clock::time_point bakeStart = Clock::now();
-    jobSystem.ParallelFor(uint32_t(mine.size()), 1,
-                          [&](uint32_t inBegin, uint32_t inEnd)
-                          {
-                              for (uint32_t i = inBegin; i < inEnd; ++i)
-                              {
-                                  const AABB box = grid.GetTileBoundsWithBorder(mine[i], border);
-                                  std::vector<BodyID> bodies, busy;
-                                  navmesh::TileGeometry geometry;
-                                  navmesh::CollectStats stats;
-                                  collector.FindBodies(box, {}, bodies);
-                                  collector.CollectTriangles(box, {}, bodies, geometry, busy, stats);
-                                  uint64_t hash =
-                                      Hash64Of(std::span<const int32_t>(&mine[i].mX, 1), settingsHash);
-                                  hash = Hash64Of(std::span<const int32_t>(&mine[i].mZ, 1), hash);
-                                  hash = Hash64Of(std::span<const float>(geometry.mVertices), hash);
-                                  hash = Hash64Of(std::span<const int>(geometry.mTriangles), hash);
-                                  hash = Hash64Of(std::span<const uint8_t>(geometry.mAreas), hash);
-                                  records[i].mTile = mine[i];
-                                  records[i].mInputHash = hash;
-                                  // Unchanged input: the previous output, built or empty, is this tile's
-                                  const TileRecord* before = inSettings.mPrevious != nullptr
-                                                                 ? inSettings.mPrevious->Find(mine[i])
-                                                                 : nullptr;
-                                  const navmesh::NavMeshFileTile* beforeTile =
-                                      before != nullptr ? previousTile(mine[i]) : nullptr;
-                                  if (before != nullptr && before->mInputHash == hash &&
-                                      (beforeTile != nullptr) == (before->mBytes > 0))
-                                  {
-                                      reused[i] = beforeTile;
-                                      records[i] = *before;
-                                  }
-                                  else
-                                      built[i] = navmesh::BuildTile(profile, grid, mine[i], geometry);
-                                  if (inSettings.mProgress)
-                                  {
-                                      // One call at a time: the callback need not be thread-safe
-                                      std::lock_guard lock(progressMutex);
-                                      inSettings.mProgress(++done, uint32_t(mine.size()));
-                                  }
-                              }
-                          });
-    result.mBakeMs = MillisecondsSince(bakeStart);
+    const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
+    const float border = float(profile.GetBorderCells()) * profile.mCellSize;
+    const TileJobContext context{&inSettings, &grid, &collector, border, SettingsHash(profile, grid)};
+    // Enough tiles in flight to keep every thread busy while the front one is written out
+    const size_t maxInFlight = std::max<size_t>(4, size_t(jobSystem.GetNumThreads()) * 4);
+    std::deque<TileInFlight> inFlight; // References stay valid when the ends change
+    std::vector<SourceObject> near;
+    // On an error, the jobs still running read the tiles: wait for them before anything goes
+    struct WaitForJobs
+    {
+        jobs::JobSystem& mJobs;
+        ~WaitForJobs() { mJobs.WaitIdle(); }
+    } waitForJobs{jobSystem};
 
-    result.mSummary.mInputs = inSettings.mInputs;
+    result.mSummary.mInputs = inSource.GetInputNames();
     result.mSummary.mShard = inSettings.mShard;
     result.mSummary.mShardCount = inSettings.mShardCount;
     result.mSummary.mTilesInWorld = result.mTilesInWorld;
-    result.mSummary.mBakeMs = result.mBakeMs;
-    for (size_t i = 0; i < mine.size(); ++i)
+    const Clock::time_point bakeStart = Clock::now();
+    size_t next = 0;
+    uint32_t leftSinceUpdate = 0;
+    while (next < mine.size() || !inFlight.empty())
     {
-        if (!built[i].has_value())
+        while (next < mine.size() && inFlight.size() < maxInFlight)
         {
-            // Taken over from the previous bake
-            ++result.mTilesBaked;
-            result.mPolygons += uint64_t(records[i].mPolygons);
-            result.mSummary.mTiles.push_back(records[i]);
-            if (reused[i] != nullptr) result.mNavMesh.mTiles.push_back(*reused[i]);
-            continue;
+            TileInFlight& tile = inFlight.emplace_back();
+            tile.mTile = mine[next++];
+            near.clear();
+            inSource.FindObjects(grid.GetTileBoundsWithBorder(tile.mTile, border), near);
+            Result<std::vector<TileObject>> held = objects.Acquire(near);
+            if (!held) return held.GetError();
+            tile.mObjects = std::move(held.Value());
+            TileInFlight* job = &tile;
+            tile.mJob =
+                jobSystem.Schedule("bake tile", [&context, job] { BuildTileInFlight(context, *job); });
         }
-        Result<navmesh::BuiltTile>& tile = *built[i];
-        if (!tile)
-            return MakeError(tile.GetError().mCode, "tile (" + std::to_string(mine[i].mX) + ", " +
-                                                        std::to_string(mine[i].mZ) +
-                                                        "): " + tile.GetError().mMessage);
+
+        // The front tile, written out in order
+        TileInFlight& tile = inFlight.front();
+        jobSystem.Wait(tile.mJob);
         ++result.mTilesBaked;
-        ++result.mSummary.mTilesRebuilt;
-        result.mPolygons += uint64_t(tile.Value().mNumPolygons);
-        TileRecord& record = records[i];
-        record.mPolygons = tile.Value().mNumPolygons;
-        if (tile.Value().mData != nullptr)
+        TileRecord& record = tile.mRecord;
+        std::span<const unsigned char> data;
+        if (!tile.mBuilt.has_value())
         {
-            const unsigned char* data = tile.Value().mData.get();
-            result.mNavMesh.mTiles.push_back(
-                {mine[i], std::vector<unsigned char>(data, data + tile.Value().mDataSize)});
-            record.mBytes = uint32_t(tile.Value().mDataSize);
-            record.mOutputHash = Hash64(result.mNavMesh.mTiles.back().mData);
+            if (tile.mReused != nullptr) data = tile.mReused->mData; // Taken over from the previous bake
+        }
+        else
+        {
+            Result<navmesh::BuiltTile>& built = *tile.mBuilt;
+            if (!built)
+                return MakeError(built.GetError().mCode, "tile (" + std::to_string(tile.mTile.mX) + ", " +
+                                                             std::to_string(tile.mTile.mZ) +
+                                                             "): " + built.GetError().mMessage);
+            ++result.mSummary.mTilesRebuilt;
+            record.mPolygons = built.Value().mNumPolygons;
+            if (built.Value().mData != nullptr)
+            {
+                data = {built.Value().mData.get(), size_t(built.Value().mDataSize)};
+                record.mBytes = uint32_t(data.size());
+                record.mOutputHash = Hash64(data);
+            }
+        }
+        result.mPolygons += uint64_t(record.mPolygons);
+        if (!data.empty())
+        {
+            ++result.mTilesWithPolygons;
+            if (output != nullptr)
+            {
+                if (Status added = output->Add(tile.mTile, data); !added) return added.GetError();
+            }
+            else
+                result.mNavMesh.mTiles.push_back(
+                    {tile.mTile, std::vector<unsigned char>(data.begin(), data.end())});
         }
         result.mSummary.mTiles.push_back(record);
+        objects.Release(tile.mObjects);
+        inFlight.pop_front();
+        if (inSettings.mProgress) inSettings.mProgress(result.mTilesBaked, uint32_t(mine.size()));
+        // The broad phase rebuilds what the adds and removes changed and frees the old nodes (a step of a
+        // world without moving bodies is only that)
+        if (++leftSinceUpdate >= 8)
+        {
+            leftSinceUpdate = 0;
+            if (Status updated = physics.Update(1.0f / 60.0f); !updated) return updated.GetError();
+        }
     }
+    result.mBakeMs = MillisecondsSince(bakeStart);
+    result.mPeakBodies = objects.GetPeakLive();
+    result.mBodies = objects.GetNumMade();
+    if (output != nullptr)
+        if (Status finished = output->Finish(); !finished) return finished.GetError();
+    result.mSummary.mBakeMs = result.mBakeMs;
     result.mSummary.mPolygons = result.mPolygons;
+    return result;
+}
+
+Result<BakeResult> Bake(const BakeSettings& inSettings)
+{
+    if (inSettings.mInputs.empty()) return MakeError(ErrorCode::InvalidArgument, "no input files");
+    const Clock::time_point loadStart = Clock::now();
+    Result<std::unique_ptr<FileLevelSource>> source =
+        FileLevelSource::Load(inSettings.mInputs, inSettings.mAreas, inSettings.mProfile.mTileSize);
+    if (!source) return source.GetError();
+    const double loadMs = MillisecondsSince(loadStart);
+    Result<BakeResult> result = BakeSource(*source.Value(), inSettings);
+    if (result) result.Value().mLoadMs = loadMs;
     return result;
 }
 

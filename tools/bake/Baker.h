@@ -1,14 +1,16 @@
 #pragma once
 
-// Baker: the offline tile baker. Loads level meshes into a physics world (each object a static mesh body, one
-// per area when its materials map to several),
-// then builds every tile that touches the geometry with the runtime's pipeline (GeometryCollector and
-// TileBuilder), spread over a job system's threads, and returns the tiles in the navmesh file layout. Each
-// tile is built alone from the same inputs, so the result is the same whatever the thread count; a shard
-// (K of N) takes every N-th tile of the sorted list from the K-th on, and merged shards equal the full bake.
-// Threads: Bake on one thread; it runs its own job system.
+// Baker: the offline tile baker. Builds every tile that touches a level's geometry with the runtime's
+// pipeline (a broad-phase query, GeometryCollector and TileBuilder) on a job system's threads, in the order
+// of the sorted tile list with a few tiles per thread in flight. The level's objects (each a static mesh
+// body, one per area when its materials map to several) are in the physics world only while a tile in flight
+// is near them (LiveObjects), and a tile's triangles come in the order of their objects' keys, so each tile
+// is built from the same inputs whatever the thread count or the shard: 1 and N threads give the same bytes,
+// a shard (K of N) takes every N-th tile of the sorted list from the K-th on, and merged shards equal the
+// full bake. Threads: Bake and BakeSource on one thread; each runs its own job system.
 
 #include "BakeSummary.h"
+#include "LevelSource.h"
 #include "cairn/navmesh/AgentProfile.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/ObjMesh.h"
@@ -22,7 +24,10 @@ namespace cairn::bake
 
 struct BakeSettings
 {
-    std::vector<std::string> mInputs; ///< OBJ and glTF (.gltf, .glb) files
+    std::vector<std::string> mInputs; ///< OBJ and glTF (.gltf, .glb) files (Bake; BakeSource has its source)
+    /// When set, tiles are written to this navmesh file as they are done (BakeResult::mNavMesh stays empty):
+    /// the bake then holds only the tiles in flight
+    std::string mOutputPath;
     navmesh::AgentProfile mProfile;
     navmesh::AreaMapping mAreas; ///< Area ids of material names
     uint32_t mThreads = 0;       ///< 0: all cores
@@ -38,19 +43,26 @@ struct BakeSettings
 
 struct BakeResult
 {
-    navmesh::NavMeshFileContents mNavMesh; ///< Tiles with walkable polygons
-    uint32_t mTilesBaked = 0;              ///< This shard's tiles, empty ones included
-    uint32_t mTilesInWorld = 0;            ///< Of every shard
+    navmesh::NavMeshFileContents mNavMesh; ///< Tiles with walkable polygons (none kept with mOutputPath)
+    uint32_t mTilesWithPolygons = 0;
+    uint32_t mTilesBaked = 0;   ///< This shard's tiles, empty ones included
+    uint32_t mTilesInWorld = 0; ///< Of every shard
     uint64_t mPolygons = 0;
-    uint32_t mBodies = 0; ///< Static bodies made from the inputs' objects
-    double mBakeMs = 0.0; ///< Tiles only (loading excluded)
+    uint64_t mBodies = 0; ///< Static bodies made (an object near tiles far apart in the list, several times)
+    uint32_t mPeakBodies = 0; ///< Most bodies in the world at once (the objects near the tiles in flight)
+    double mBakeMs = 0.0;     ///< Tiles only (loading excluded)
     double mLoadMs = 0.0;
     BakeSummary mSummary; ///< Per tile hashes, for the next incremental bake
 };
 
-/// Errors: unreadable or malformed inputs (naming the file and line), a world too large for the navmesh's
-/// reference bits (before baking), a bad shard.
+/// Bakes the files of inSettings.mInputs. Errors: unreadable or malformed inputs (naming the file and line),
+/// a world too large for the navmesh's reference bits (before baking), a bad shard.
 Result<BakeResult> Bake(const BakeSettings& inSettings);
+
+/// Bakes the level inSource gives (inSettings.mInputs is not used). Tiles go through in sorted order with a
+/// few per thread in flight; the physics world holds only the objects near those, and with mOutputPath no
+/// finished tile is held either: peak memory follows the tiles in flight, not the size of the level.
+Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& inSettings);
 
 /// Combines shard outputs into one navmesh: the same parameters, no tile twice.
 Result<navmesh::NavMeshFileContents> MergeShards(const std::vector<navmesh::NavMeshFileContents>& inShards);

@@ -5,8 +5,14 @@
 //                  against cairn-bake's tile work (query, triangle copies and builds) on 1 and 2 threads.
 // Prints ms (medians of --repetitions), the ratio bake/direct (target <= 1.2 on 1 thread) and the 2-thread
 // speed-up (target >= 1.7), and the polygon total as a checksum (equal for all three).
+//  bake_large_world  a generated level (GeneratedLevel, made on demand) of 1x, 10x and 100x the area, baked
+//                  on all cores with tiles streamed to a file, each in a child process of its own so that its
+//                  peak resident memory (wait4's ru_maxrss) is its alone: time should grow with the area,
+//                  peak memory should not (target: about the same at 100x).
+// --only direct|large runs one of the two.
 
 #include "Baker.h"
+#include "GeneratedLevel.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/SharedBenchData.h"
@@ -18,6 +24,9 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 using namespace cairn;
@@ -62,20 +71,111 @@ std::pair<double, uint64_t> DirectBuild(const navmesh::IndexedMesh& inMesh,
     }
     return {ms, polygons};
 }
+
+/// What a child process reports of its bake.
+struct LargeWorldRun
+{
+    double mBakeMs = 0.0;
+    uint32_t mTiles = 0;
+    uint32_t mPeakBodies = 0;
+    uint64_t mBodiesMade = 0;
+    uint64_t mPolygons = 0;
+    uint64_t mObjects = 0;
+    bool mOk = false;
+};
+
+/// Bakes a generated level of inCells x inCells cells in a child process; returns its figures and its peak
+/// resident memory in KiB.
+std::pair<LargeWorldRun, long> BakeLargeWorldInChild(uint32_t inCells)
+{
+    int channel[2];
+    if (pipe(channel) != 0) return {};
+    const pid_t child = fork();
+    if (child == 0)
+    {
+        close(channel[0]);
+        LargeWorldRun run;
+        bake::GeneratedLevelSettings level;
+        level.mCellsX = level.mCellsZ = inCells;
+        Result<std::unique_ptr<bake::GeneratedLevel>> source = bake::GeneratedLevel::Create(level);
+        if (source)
+        {
+            bake::BakeSettings settings;
+            settings.mOutputPath = (std::filesystem::temp_directory_path() /
+                                    ("cairn-bench-large-world-" + std::to_string(getpid()) + ".navmesh"))
+                                       .string();
+            Result<bake::BakeResult> result = bake::BakeSource(*source.Value(), settings);
+            std::filesystem::remove(settings.mOutputPath);
+            if (result)
+            {
+                run = {result.Value().mBakeMs,
+                       result.Value().mTilesBaked,
+                       result.Value().mPeakBodies,
+                       result.Value().mBodies,
+                       result.Value().mPolygons,
+                       uint64_t(inCells) * inCells * (1 + level.mPropsPerCell),
+                       true};
+            }
+            else
+                std::fprintf(stderr, "bake_large_world: %s\n", result.GetError().mMessage.c_str());
+        }
+        const ssize_t written = write(channel[1], &run, sizeof(run));
+        _exit(written == ssize_t(sizeof(run)) ? 0 : 1);
+    }
+    close(channel[1]);
+    LargeWorldRun run;
+    if (child < 0 || read(channel[0], &run, sizeof(run)) != ssize_t(sizeof(run))) run.mOk = false;
+    close(channel[0]);
+    int status = 0;
+    rusage usage{};
+    if (child > 0) wait4(child, &status, 0, &usage);
+    return {run, usage.ru_maxrss};
+}
+
+void BenchLargeWorld()
+{
+    double firstMs = 0.0;
+    long firstKiB = 0;
+    for (uint32_t cells : {2u, 6u, 20u}) // 1x, 9x, 100x the area
+    {
+        const auto [run, peakKiB] = BakeLargeWorldInChild(cells);
+        if (!run.mOk)
+        {
+            std::printf("bake_large_world %ux%u cells: failed\n", cells, cells);
+            continue;
+        }
+        if (firstMs == 0.0)
+        {
+            firstMs = run.mBakeMs;
+            firstKiB = peakKiB;
+        }
+        std::printf("bake_large_world %2ux%-2u cells (%5.0f m square, %6llu objects): %5u tiles in %8.1f ms "
+                    "(%.1fx the first), peak memory %6.1f MiB (%.2fx), at most %u bodies at once (%llu made) "
+                    "| checksum polygons %llu\n",
+                    cells, cells, cells * 32.0, (unsigned long long)run.mObjects, run.mTiles, run.mBakeMs,
+                    run.mBakeMs / firstMs, peakKiB / 1024.0, double(peakKiB) / double(firstKiB),
+                    run.mPeakBodies, (unsigned long long)run.mBodiesMade, (unsigned long long)run.mPolygons);
+    }
+}
 } // namespace
 
 int main(int argc, char** argv)
 {
     int repetitions = 3;
+    std::string only;
     for (int i = 1; i < argc; ++i)
         if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc)
             repetitions = std::max(1, std::atoi(argv[++i]));
+        else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
         else
         {
-            std::fprintf(stderr, "usage: cairn-bench-bake [--repetitions N]\n");
+            std::fprintf(stderr, "usage: cairn-bench-bake [--repetitions N] [--only direct|large]\n");
             return 2;
         }
     std::printf("cairn-bench-bake: %d repetitions\n", repetitions);
+    if (only.empty() || only == "large") BenchLargeWorld();
+    if (!only.empty() && only != "direct") return 0;
     for (const char* name : {"dungeon.obj", "nav_test.obj", "undulating.obj"})
     {
         const std::string path = GetSharedDataDir() + "/recast-meshes/" + name;
