@@ -175,7 +175,7 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
     const TileJobContext context{&inSettings, &grid, &collector, border, SettingsHash(profile, grid)};
     // Enough tiles in flight to keep every thread busy while the front one is written out
-    const size_t maxInFlight = std::max<size_t>(4, size_t(jobSystem.GetNumThreads()) * 4);
+    const size_t maxInFlight = std::max<size_t>(8, size_t(jobSystem.GetNumThreads()) * 8);
     std::deque<TileInFlight> inFlight; // References stay valid when the ends change
     std::vector<SourceObject> near;
     // On an error, the jobs still running read the tiles: wait for them before anything goes
