@@ -42,6 +42,12 @@ grep -q "area 4: " preview.svg || fail "the map has no road (area 4)"
 grep -q "ground: " preview.svg || fail "the map has no default ground"
 grep -q "^f " preview.obj || fail "the OBJ preview has no triangles"
 
+# Part of the level: a box or a list of tiles
+"$bake" bake level.obj -o part.navmesh --box 1,1,10,10 >part.log 2>&1 || fail "the box bake failed: $(cat part.log)"
+grep -q "baked 1 of 4 tiles" part.log || fail "--box 1,1,10,10 should bake tile (0, 0) alone: $(cat part.log)"
+"$bake" bake level.obj -o part.navmesh --tile 1,1 --tile 0,1 >part.log 2>&1 || fail "the tile bake failed"
+grep -q "baked 2 of 4 tiles" part.log || fail "two --tile flags should bake two tiles: $(cat part.log)"
+
 # Bad inputs: exit code 1, the file named, nothing written
 expect_error() { # <what the message names> <output file> <arguments...>
     local named="$1" output="$2"
@@ -50,7 +56,7 @@ expect_error() { # <what the message names> <output file> <arguments...>
     message=$("$bake" "$@" 2>&1)
     local code=$?
     [ "$code" -eq 1 ] || fail "$* exited with $code, expected 1"
-    echo "$message" | grep -qF "$named" || fail "$* did not name $named: $message"
+    echo "$message" | grep -qF -- "$named" || fail "$* did not name $named: $message"
     [ ! -e "$output" ] || fail "$* left $output behind"
 }
 echo '{"materials": {"road": 99}}' >bad-areas.json
@@ -61,6 +67,10 @@ expect_error "broken.obj" out3.navmesh bake broken.obj -o out3.navmesh
 expect_error "line 5" out3.navmesh bake broken.obj -o out3.navmesh
 printf 'v 0 0 0\nv 1 0 nan\nv 1 0 1\nf 1 2 3\n' >nan.obj
 expect_error "nan.obj:2" out4.navmesh bake nan.obj -o out4.navmesh
+expect_error "(7, 0)" out5.navmesh bake level.obj -o out5.navmesh --tile 7,0
+expect_error "--tile" out5.navmesh bake level.obj -o out5.navmesh --tile a,b
+expect_error "--box" out5.navmesh bake level.obj -o out5.navmesh --box 1,2,3
+expect_error "not a box" out5.navmesh bake level.obj -o out5.navmesh --box 5,5,1,1
 echo "not a navmesh" >junk.navmesh
 expect_error "junk.navmesh" merged.navmesh merge junk.navmesh -o merged.navmesh
 if ls ./*.tmp >/dev/null 2>&1; then fail "temporary files left: $(ls ./*.tmp)"; fi

@@ -55,6 +55,12 @@ int main(int argc, char** argv)
     bakeCommand->add_option("--threads", settings.mThreads, "Threads (0: all cores)")
         ->check(CLI::Range(0, 256));
     bakeCommand->add_option("--shard", shard, "Bake shard K of N (K/N, K from 0)");
+    std::vector<float> box;
+    bakeCommand->add_option("--box", box, "Only the tiles overlapping this box: MINX,MINZ,MAXX,MAXZ (m)")
+        ->expected(4)
+        ->delimiter(',');
+    std::vector<std::string> tileTexts;
+    bakeCommand->add_option("--tile", tileTexts, "Only this tile, X,Z (repeat for more)");
     std::string summaryPath, previousSummaryPath, previousNavMeshPath;
     bakeCommand->add_option("--summary", summaryPath,
                             "Write a JSON summary (tiles, polygons, per-tile hashes)");
@@ -102,7 +108,8 @@ int main(int argc, char** argv)
     }
     catch (const CLI::ParseError& error)
     {
-        return app.exit(error);
+        // CLI11 prints the help or the message; a usage error exits with 1, as every other error
+        return app.exit(error) == 0 ? 0 : 1;
     }
 
     if (*mergeCommand)
@@ -134,6 +141,20 @@ int main(int argc, char** argv)
     }
     for (size_t i = 0; i < std::size(flags); ++i)
         if (flags[i]->count() > 0) settings.mProfile.*fields[i] = flagProfile.*fields[i];
+    if (!box.empty())
+    {
+        if (box.size() != 4) return Fail("--box: expected MINX,MINZ,MAXX,MAXZ");
+        settings.mRegion =
+            AABB(Vec3(box[0], -cMaxWorldCoordinate, box[1]), Vec3(box[2], cMaxWorldCoordinate, box[3]));
+    }
+    for (const std::string& text : tileTexts)
+    {
+        int x = 0, z = 0;
+        char extra = 0;
+        if (std::sscanf(text.c_str(), "%d,%d%c", &x, &z, &extra) != 2)
+            return Fail("--tile " + text + ": expected X,Z (whole numbers)");
+        settings.mTiles.push_back({x, z});
+    }
     if (!ParseShard(shard, settings.mShard, settings.mShardCount))
         return Fail("--shard " + shard + ": expected K/N with 0 <= K < N");
     // A bar on a terminal, a line every tenth otherwise (logs)

@@ -119,6 +119,44 @@ void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
     ioTile.mBuilt = navmesh::BuildTile(settings.mProfile, *inContext.mGrid, ioTile.mTile, geometry);
 }
 
+/// The tiles of the sorted list inTiles that inSettings' region and tile list choose, sorted. Errors: a
+/// listed tile that is not the level's, a region that is not a box.
+Result<std::vector<navmesh::TileCoord>> SelectTiles(const std::vector<navmesh::TileCoord>& inTiles,
+                                                    const navmesh::TileGrid& inGrid,
+                                                    const BakeSettings& inSettings)
+{
+    std::vector<navmesh::TileCoord> selected;
+    if (inSettings.mTiles.empty())
+        selected = inTiles;
+    else
+    {
+        for (const navmesh::TileCoord& tile : inSettings.mTiles)
+            if (!std::binary_search(inTiles.begin(), inTiles.end(), tile))
+                return MakeError(ErrorCode::InvalidArgument, "tile (" + std::to_string(tile.mX) + ", " +
+                                                                 std::to_string(tile.mZ) +
+                                                                 ") is not one of the level's " +
+                                                                 std::to_string(inTiles.size()) + " tiles");
+        selected = inSettings.mTiles;
+        std::sort(selected.begin(), selected.end());
+        selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
+    }
+    if (inSettings.mRegion.has_value())
+    {
+        const AABB& region = *inSettings.mRegion;
+        if (!region.mMin.allFinite() || !region.mMax.allFinite() || region.mMin.x() > region.mMax.x() ||
+            region.mMin.z() > region.mMax.z())
+            return MakeError(ErrorCode::InvalidArgument, "the region to bake is not a box (min above max)");
+        std::erase_if(selected,
+                      [&](const navmesh::TileCoord& inTile)
+                      {
+                          const AABB bounds = inGrid.GetTileBounds(inTile);
+                          return bounds.mMax.x() < region.mMin.x() || bounds.mMin.x() > region.mMax.x() ||
+                                 bounds.mMax.z() < region.mMin.z() || bounds.mMin.z() > region.mMax.z();
+                      });
+    }
+    return selected;
+}
+
 } // namespace
 
 Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& inSettings)
@@ -150,10 +188,13 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     result.mNavMesh.mParams = params.Value();
     result.mTilesInWorld = uint32_t(tiles.size());
     std::sort(tiles.begin(), tiles.end()); // The sorted list the shards split and the file keeps
+    Result<std::vector<navmesh::TileCoord>> selected = SelectTiles(tiles, grid, inSettings);
+    if (!selected) return selected.GetError();
     std::vector<navmesh::TileCoord> mine;
-    for (size_t i = 0; i < tiles.size(); ++i)
-        if (i % inSettings.mShardCount == inSettings.mShard) mine.push_back(tiles[i]);
+    for (size_t i = 0; i < selected.Value().size(); ++i)
+        if (i % inSettings.mShardCount == inSettings.mShard) mine.push_back(selected.Value()[i]);
     tiles = {};
+    selected = std::vector<navmesh::TileCoord>();
     std::unique_ptr<navmesh::NavMeshFileWriter> output;
     if (!inSettings.mOutputPath.empty())
     {

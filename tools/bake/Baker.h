@@ -16,6 +16,7 @@
 #include "cairn/navmesh/ObjMesh.h"
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,11 @@ struct BakeSettings
     /// unchanged takes its previous output instead of being built again
     const BakeSummary* mPrevious = nullptr;
     const navmesh::NavMeshFileContents* mPreviousNavMesh = nullptr;
+    /// Only the level's tiles that overlap this box (x and z; y is ignored), when set
+    std::optional<AABB> mRegion;
+    /// Only these of the level's tiles, when not empty (with mRegion: those of them in the box). The navmesh
+    /// parameters stay the whole level's, so partial bakes merge with others
+    std::vector<navmesh::TileCoord> mTiles;
 };
 
 struct BakeResult
