@@ -1,6 +1,7 @@
 #include "GeneratedLevel.h"
 
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/Mix64.h"
 
 #include <algorithm>
 #include <array>
@@ -33,15 +34,7 @@ constexpr float cEmbedDepth = 0.3f;
 /// which is what lets FindObjects look at the cells a box touches only
 constexpr float cCellMargin = 0.05f;
 
-/// splitmix64's finalizer: every input bit changes about half the output bits.
-uint64_t Mix64(uint64_t inZ)
-{
-    inZ ^= inZ >> 30;
-    inZ *= 0xbf58476d1ce4e5b9ull;
-    inZ ^= inZ >> 27;
-    inZ *= 0x94d049bb133111ebull;
-    return inZ ^ (inZ >> 31);
-}
+using tools::Mix64;
 
 /// A splitmix64 sequence as floats of 24 random bits (exact in a float, so the same everywhere).
 class Dice

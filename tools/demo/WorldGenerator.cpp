@@ -8,6 +8,7 @@
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/Mix64.h"
 
 #include <algorithm>
 #include <array>
@@ -67,20 +68,11 @@ constexpr int cArchSegments = 10;
 constexpr int cNumRocks = 6;
 constexpr float cCrateHalf = 0.25f;
 
-/// splitmix64's finaliser: a bijection that spreads every input bit over the output
-uint64_t Mix(uint64_t inValue)
-{
-    inValue ^= inValue >> 30;
-    inValue *= 0xbf58476d1ce4e5b9ull;
-    inValue ^= inValue >> 27;
-    inValue *= 0x94d049bb133111ebull;
-    inValue ^= inValue >> 31;
-    return inValue;
-}
+using tools::Mix64;
 
 uint64_t Hash(uint64_t inA, uint64_t inB)
 {
-    return Mix(Mix(inA) ^ (inB + 0x9e3779b97f4a7c15ull));
+    return Mix64(Mix64(inA) ^ (inB + 0x9e3779b97f4a7c15ull));
 }
 
 /// PCG32 (O'Neill): tiny, fast and fully specified, unlike <random>'s distributions
@@ -392,7 +384,7 @@ WorldGenerator::WorldGenerator(const WorldSettings& inSettings) : mSettings(inSe
     mSettings.mDynamicPerTile = std::clamp(mSettings.mDynamicPerTile, 0, 100000);
     if (!std::isfinite(mSettings.mPlayerSpeed)) mSettings.mPlayerSpeed = 8.0f;
     mSettings.mPlayerSpeed = std::clamp(mSettings.mPlayerSpeed, -1000.0f, 1000.0f);
-    mSeedHash = Mix(mSettings.mSeed ^ 0x636169726e776f72ull);
+    mSeedHash = Mix64(mSettings.mSeed ^ 0x636169726e776f72ull);
 
     // Boxes: every size combination (17^3, about 0.3 MB), so that no tile allocates a box shape
     mBoxes.resize(size_t(cNumBoxSizes) * cNumBoxSizes * cNumBoxSizes);
@@ -521,7 +513,7 @@ float WorldGenerator::SampleHeight(int64_t inX, int64_t inZ) const
     uint64_t octaveSeed = mSeedHash;
     for (const Octave& octave : cOctaves)
     {
-        octaveSeed = Mix(octaveSeed + 1);
+        octaveSeed = Mix64(octaveSeed + 1);
         const int64_t period = octave.mPeriod;
         const int64_t cx = FloorDiv(inX, period), cz = FloorDiv(inZ, period);
         // Exact integer remainders over the period, so every tile computes a shared sample identically
@@ -530,7 +522,7 @@ float WorldGenerator::SampleHeight(int64_t inX, int64_t inZ) const
         auto lattice = [&](int64_t inCx, int64_t inCz)
         {
             // 24 bits to [-1, 1), exact in a float
-            const uint64_t h = Mix(Mix(octaveSeed ^ uint64_t(inCx)) ^ uint64_t(inCz));
+            const uint64_t h = Mix64(Mix64(octaveSeed ^ uint64_t(inCx)) ^ uint64_t(inCz));
             return float(h >> 40) * (2.0f / 16777216.0f) - 1.0f;
         };
         const float v00 = lattice(cx, cz), v10 = lattice(cx + 1, cz);
