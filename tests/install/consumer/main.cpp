@@ -1,6 +1,10 @@
-// A program outside Cairn's tree that finds the installed package and links cairn::physics: a dropped sphere
-// falls under gravity. Prints the height after one second so the test can check the library really ran.
+// A program outside Cairn's tree that finds the installed package and links cairn::physics and cairn::navmesh:
+// a dropped sphere falls under gravity, and a navmesh tile is built from a floor body in the physics world.
+// Prints the height after one second and the tile's polygons so the test can check the libraries really ran.
+#include <cairn/navmesh/GeometryCollector.h>
+#include <cairn/navmesh/TileBuilder.h>
 #include <cairn/physics/PhysicsSystem.h>
+#include <cairn/physics/shapes/BoxShape.h>
 #include <cairn/physics/shapes/SphereShape.h>
 #include <cstdio>
 
@@ -15,5 +19,26 @@ int main()
     for (int i = 0; i < 60; ++i)
         (void)system.Update(1.0f / 60.0f);
     std::printf("height after 1 s: %.2f\n", system.GetBodyInterface().GetPosition(id).Value().y());
+
+    // A static floor far from the sphere, and the navmesh tile over it
+    cairn::BodyCreationSettings floor;
+    floor.mShape = cairn::BoxShape::Create(cairn::Vec3(20, 0.5f, 20)).Value();
+    floor.mPosition = cairn::Vec3(100, -0.5f, 100);
+    floor.mMotionType = cairn::MotionType::Static;
+    floor.mObjectLayer = cairn::Layers::cStatic;
+    (void)system.GetBodyInterface().CreateAndAddBody(floor, cairn::Activation::DontActivate);
+    const cairn::navmesh::AgentProfile profile;
+    const cairn::navmesh::TileGrid grid(0, 0, profile.mTileSize, -5, 5);
+    const cairn::navmesh::TileCoord tile{8, 8}; // x and z in [102.4, 115.2]: on the floor
+    const cairn::AABB box =
+        grid.GetTileBoundsWithBorder(tile, float(profile.GetBorderCells()) * profile.mCellSize);
+    const cairn::navmesh::GeometryCollector collector(system.GetBodyManager(), system.GetBroadPhase());
+    std::vector<cairn::BodyID> bodies, busy;
+    cairn::navmesh::TileGeometry geometry;
+    cairn::navmesh::CollectStats stats;
+    collector.FindBodies(box, {}, bodies);
+    collector.CollectTriangles(box, {}, bodies, geometry, busy, stats);
+    const auto built = cairn::navmesh::BuildTile(profile, grid, tile, geometry);
+    std::printf("navmesh tile polygons: %d\n", built ? built.Value().mNumPolygons : -1);
     return 0;
 }
