@@ -63,6 +63,8 @@ Result<ObjScan> ScanLines(const std::string& inPath)
     for (int number = 1; std::getline(file, line); ++number)
     {
         if (!line.empty() && line.back() == '\r') line.pop_back();
+        // tinyobjloader skips leading blanks: so must we, or an indented line would escape the checks
+        line.erase(0, line.find_first_not_of(" \t"));
         if (StartsWithKeyword(line, "mtllib")) library = true;
         if (StartsWithKeyword(line, "usemtl"))
         {

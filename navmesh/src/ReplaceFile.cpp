@@ -1,14 +1,29 @@
 #include "cairn/navmesh/ReplaceFile.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <unistd.h>
 
 namespace cairn::navmesh
 {
 
+namespace
+{
+/// "<path>.tmp-<process>-<n>": two writers of one path (two processes, or two threads) never share a
+/// temporary; the last rename wins and every file renamed into place is whole.
+std::string TemporaryName(const std::string& inPath)
+{
+    static std::atomic<uint64_t> sCount{0};
+    // Relaxed: only distinct numbers are needed
+    const uint64_t count = sCount.fetch_add(1, std::memory_order_relaxed);
+    return inPath + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(count);
+}
+} // namespace
+
 PendingFile::PendingFile(std::string inPath)
-    : mPath(std::move(inPath)), mTemporary(mPath + ".tmp"),
+    : mPath(std::move(inPath)), mTemporary(TemporaryName(mPath)),
       mStream(mTemporary, std::ios::binary | std::ios::trunc)
 {
     if (!mStream)

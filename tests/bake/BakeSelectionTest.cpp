@@ -61,7 +61,9 @@ TEST(BakeSelectionTest, ABoxOrAListGivesThoseTilesOfTheFullBake)
     for (const auto& [tile, data] : TilesOf(two.Value()))
         EXPECT_EQ(data, fullTiles.at(tile));
     listed.mRegion = AABB(Vec3(1, 0, 1), Vec3(5, 0, 5)); // Both: the listed tiles in the box
-    EXPECT_EQ(Bake(listed).Value().mTilesBaked, 1u);
+    Result<BakeResult> inBox = Bake(listed);
+    ASSERT_TRUE(inBox) << inBox.GetError().mMessage;
+    EXPECT_EQ(inBox.Value().mTilesBaked, 1u);
 
     listed.mRegion.reset();
     listed.mTiles = {{0, 0}, {500, 3}};
@@ -96,6 +98,43 @@ TEST(BakeSelectionTest, ALevelTooLargeForTheReferenceBitsIsRefusedBeforeBaking)
     Result<BakeResult> fits = Bake(settings);
     ASSERT_TRUE(fits) << fits.GetError().mMessage;
     EXPECT_GT(fits.Value().mPolygons, 0u);
+}
+
+} // namespace
+} // namespace cairn::bake
+
+namespace cairn::bake
+{
+namespace
+{
+
+TEST(FileLevelSourceTest, LargePartsAndDegeneratePartsAndTinyCells)
+{
+    test::TempFiles files;
+    // A 2 km road (over far more cells than the index keeps per part), a small box, and a collapsed helper
+    // object whose triangles have no area
+    const std::string level =
+        files.Write("level.obj", "o Road\nv 0 0 0\nv 0 0 4\nv 2000 0 4\nv 2000 0 0\nf 1 2 3 4\n"
+                                 "o Box\nv 10 0 10\nv 10 0 12\nv 12 0 12\nf 5 6 7\n"
+                                 "o Helper\nv 5 0 5\nv 6 0 5\nv 7 0 5\nf 8 9 10\n");
+    Result<std::unique_ptr<FileLevelSource>> source = FileLevelSource::Load({level}, {}, 12.8f);
+    ASSERT_TRUE(source) << source.GetError().mMessage;
+    EXPECT_EQ(source.Value()->GetNumObjects(), 2u); // The helper is left out
+    std::vector<SourceObject> near;
+    source.Value()->FindObjects(AABB(Vec3(1500, -1, 0), Vec3(1510, 1, 10)), near);
+    ASSERT_EQ(near.size(), 1u); // The road, far from its first cells
+    near.clear();
+    source.Value()->FindObjects(AABB(Vec3(9, -1, 0), Vec3(13, 1, 13)), near);
+    EXPECT_EQ(near.size(), 2u); // The road and the box
+    near.clear();
+    source.Value()->FindObjects(AABB(Vec3(-1e6f, -1, -1e6f), Vec3(1e6f, 1, 1e6f)), near); // Every cell
+    EXPECT_EQ(near.size(), 2u);
+
+    // A tile size far too small is refused before the level is indexed by it
+    BakeSettings settings;
+    settings.mInputs = {level};
+    settings.mProfile.mTileSize = 0.01f;
+    EXPECT_EQ(Bake(settings).GetError().mCode, ErrorCode::InvalidArgument);
 }
 
 } // namespace

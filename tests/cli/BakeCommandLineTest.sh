@@ -73,5 +73,5 @@ expect_error "--box" out5.navmesh bake level.obj -o out5.navmesh --box 1,2,3
 expect_error "not a box" out5.navmesh bake level.obj -o out5.navmesh --box 5,5,1,1
 echo "not a navmesh" >junk.navmesh
 expect_error "junk.navmesh" merged.navmesh merge junk.navmesh -o merged.navmesh
-if ls ./*.tmp >/dev/null 2>&1; then fail "temporary files left: $(ls ./*.tmp)"; fi
+if ls ./*.tmp* >/dev/null 2>&1; then fail "temporary files left: $(ls ./*.tmp*)"; fi
 echo "cairn-bake command line: all checks passed"

@@ -3,6 +3,7 @@
 
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
+#include "common/TempFiles.h"
 
 #include <cstring>
 #include <filesystem>
@@ -17,7 +18,8 @@ namespace
 
 std::string TempPath(const std::string& inName)
 {
-    return (std::filesystem::temp_directory_path() / ("cairn-gltf-test-" + inName)).string();
+    static const cairn::test::TempFiles files; // A folder of this process's own, removed at exit
+    return files.Path(inName);
 }
 
 /// A 20 m square floor (two triangles, unsigned short indices) in a node moved by inTranslation.

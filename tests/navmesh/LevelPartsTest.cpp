@@ -52,6 +52,19 @@ TEST_F(LevelPartsTest, ObjObjectsAndMaterialsWithoutALibrary)
     }
 }
 
+TEST_F(LevelPartsTest, IndentedLinesAreCheckedAndNamedToo)
+{
+    // tinyobjloader reads indented lines: the loader's own checks must see them as well
+    Result<IndexedMesh> loaded =
+        LoadObjMesh(Write("indented.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\n  usemtl road\n\tf 1 2 3\n"));
+    ASSERT_TRUE(loaded) << loaded.GetError().mMessage;
+    EXPECT_EQ(loaded.Value().GetMaterialName(0), "road");
+    Result<IndexedMesh> bad =
+        LoadObjMesh(Write("indented-bad.obj", "v 0 0 0\n  v 1.2.3 0 0\nv 1 0 1\nf 1 2 3\n"));
+    ASSERT_FALSE(bad);
+    EXPECT_NE(bad.GetError().mMessage.find(":2:"), std::string::npos) << bad.GetError().mMessage;
+}
+
 TEST_F(LevelPartsTest, TrianglesWithoutAMaterialHaveNone)
 {
     Result<IndexedMesh> loaded = LoadObjMesh(Write("plain.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 3\n"));

@@ -205,18 +205,27 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     }
 
     // A world for the objects near the tiles in flight only
-    PhysicsSettings physicsSettings;
-    physicsSettings.mMaxBodies = std::clamp<uint32_t>(inSource.GetMaxObjectsNear() * 2, 64, 1u << 16);
-    PhysicsSystem physics(physicsSettings);
-    LiveObjects objects(physics, inSource);
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
     jobs::JobSystem jobSystem(jobSettings);
+    // Enough tiles in flight to keep every thread busy while the front one is written out
+    const size_t maxInFlight = std::max<size_t>(8, size_t(jobSystem.GetNumThreads()) * 8);
+    // Room for the objects near a few tiles: a tile that would not fit waits until tiles ahead of it leave
+    // (tiles far apart in a shard share no objects, and a world sized for every tile in flight at worst would
+    // cost memory in proportion to the thread count)
+    PhysicsSettings physicsSettings;
+    physicsSettings.mMaxBodies =
+        inSettings.mMaxBodiesInWorld != 0
+            ? inSettings.mMaxBodiesInWorld
+            : uint32_t(std::clamp<uint64_t>(
+                  std::min(uint64_t(inSource.GetMaxObjectsNear()) * 2, inSource.GetNumObjects()), 64,
+                  1u << 20));
+    const size_t maxLive = physicsSettings.mMaxBodies;
+    PhysicsSystem physics(physicsSettings);
+    LiveObjects objects(physics, inSource);
     const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
     const TileJobContext context{&inSettings, &grid, &collector, border, SettingsHash(profile, grid)};
-    // Enough tiles in flight to keep every thread busy while the front one is written out
-    const size_t maxInFlight = std::max<size_t>(8, size_t(jobSystem.GetNumThreads()) * 8);
     std::deque<TileInFlight> inFlight; // References stay valid when the ends change
     std::vector<SourceObject> near;
     // On an error, the jobs still running read the tiles: wait for them before anything goes
@@ -233,14 +242,22 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     const Clock::time_point bakeStart = Clock::now();
     size_t next = 0;
     uint32_t leftSinceUpdate = 0;
+    bool nearIsNext = false; // near holds the objects of mine[next], which waits for room in the world
     while (next < mine.size() || !inFlight.empty())
     {
         while (next < mine.size() && inFlight.size() < maxInFlight)
         {
+            if (!nearIsNext)
+            {
+                near.clear();
+                inSource.FindObjects(grid.GetTileBoundsWithBorder(mine[next], border), near);
+                nearIsNext = true;
+            }
+            // Counts its objects as new even if some are held already: room is never overestimated
+            if (!inFlight.empty() && objects.GetNumLive() + near.size() > maxLive) break;
             TileInFlight& tile = inFlight.emplace_back();
             tile.mTile = mine[next++];
-            near.clear();
-            inSource.FindObjects(grid.GetTileBoundsWithBorder(tile.mTile, border), near);
+            nearIsNext = false;
             Result<std::vector<TileObject>> held = objects.Acquire(near);
             if (!held) return held.GetError();
             tile.mObjects = std::move(held.Value());
@@ -312,6 +329,8 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
 Result<BakeResult> Bake(const BakeSettings& inSettings)
 {
     if (inSettings.mInputs.empty()) return MakeError(ErrorCode::InvalidArgument, "no input files");
+    // Before loading: the source's index of cells is made for the tile size
+    if (Status valid = inSettings.mProfile.Validate(); !valid) return valid.GetError();
     const Clock::time_point loadStart = Clock::now();
     Result<std::unique_ptr<FileLevelSource>> source =
         FileLevelSource::Load(inSettings.mInputs, inSettings.mAreas, inSettings.mProfile.mTileSize);

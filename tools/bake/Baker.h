@@ -29,6 +29,9 @@ struct BakeSettings
     /// When set, tiles are written to this navmesh file as they are done (BakeResult::mNavMesh stays empty):
     /// the bake then holds only the tiles in flight
     std::string mOutputPath;
+    /// Bodies the bake's world holds at most (0: twice the objects one tile can have near it). Tiles wait to
+    /// enter while their objects would not fit; a single tile with more objects near it is an error
+    uint32_t mMaxBodiesInWorld = 0;
     navmesh::AgentProfile mProfile;
     navmesh::AreaMapping mAreas; ///< Area ids of material names
     uint32_t mThreads = 0;       ///< 0: all cores

@@ -52,6 +52,10 @@ public:
 
     AABB GetBounds() const override { return mBounds; }
     uint32_t GetMaxObjectsNear() const override { return mMaxObjectsNear; }
+    uint64_t GetNumObjects() const override
+    {
+        return uint64_t(mSettings.mCellsX) * mSettings.mCellsZ * (1 + uint64_t(mSettings.mPropsPerCell));
+    }
     /// Costs O(cells the box's x/z range touches + their objects), whatever the world's size.
     void FindObjects(const AABB& inBox, std::vector<SourceObject>& ioObjects) const override;
     /// A TriangleMeshShape of MakeObject's part. Errors: MakeObject's, the shape's (with Describe's words).

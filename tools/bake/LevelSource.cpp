@@ -27,25 +27,43 @@ Result<std::unique_ptr<FileLevelSource>> FileLevelSource::Load(const std::vector
         {
             std::string where = path + (part.mName.empty() ? "" : ": object '" + part.mName + "'");
             auto shape = TriangleMeshShape::Create(part.mMesh.mVertices, part.mMesh.mTriangles);
+            // A part of zero-area triangles only (a collapsed helper object) has no surface to walk on or
+            // bump into: left out, as degenerate triangles among good ones are
+            if (!shape && shape.GetError().mCode == ErrorCode::DegenerateShape) continue;
             if (!shape) return MakeError(shape.GetError().mCode, where + ": " + shape.GetError().mMessage);
             const AABB bounds = part.mMesh.GetBounds();
             source->mParts.push_back({std::move(where), {shape.Value(), part.mArea}, bounds});
         }
     }
-    // Each part in every cell its bounds touch (x and z only: levels are wide, not tall)
+    // Each part in every cell its bounds touch (x and z only: levels are wide, not tall); a part over more
+    // cells than that (a terrain, a long road) goes in a list every query looks at instead, so the index
+    // stays in proportion to the parts
     for (uint32_t p = 0; p < source->mParts.size(); ++p)
     {
-        const AABB& bounds = source->mParts[p].mBounds;
-        const int32_t x0 = int32_t(std::floor(bounds.mMin.x() / inCellSize)),
-                      x1 = int32_t(std::floor(bounds.mMax.x() / inCellSize)),
-                      z0 = int32_t(std::floor(bounds.mMin.z() / inCellSize)),
-                      z1 = int32_t(std::floor(bounds.mMax.z() / inCellSize));
-        for (int32_t x = x0; x <= x1; ++x)
-            for (int32_t z = z0; z <= z1; ++z)
+        const CellRange cells = source->CellsOf(source->mParts[p].mBounds);
+        if ((cells.mX1 - cells.mX0 + 1) * (cells.mZ1 - cells.mZ0 + 1) > cMaxCellsPerPart)
+        {
+            source->mLargeParts.push_back(p);
+            continue;
+        }
+        for (int64_t x = cells.mX0; x <= cells.mX1; ++x)
+            for (int64_t z = cells.mZ0; z <= cells.mZ1; ++z)
                 source->mCells[source->CellKey(x, z)].push_back(p);
     }
     source->mSeen.assign(source->mParts.size(), 0);
     return source;
+}
+
+FileLevelSource::CellRange FileLevelSource::CellsOf(const AABB& inBox) const
+{
+    // In doubles and clamped: coordinates are within the world's range, but divided by a small cell they
+    // would overflow 32 bits
+    auto cell = [&](float inCoordinate)
+    {
+        return int64_t(
+            std::clamp(std::floor(double(inCoordinate) / mCellSize), -double(1 << 30), double(1 << 30)));
+    };
+    return {cell(inBox.mMin.x()), cell(inBox.mMax.x()), cell(inBox.mMin.z()), cell(inBox.mMax.z())};
 }
 
 void FileLevelSource::FindObjects(const AABB& inBox, std::vector<SourceObject>& ioObjects) const
@@ -56,21 +74,30 @@ void FileLevelSource::FindObjects(const AABB& inBox, std::vector<SourceObject>& 
         std::fill(mSeen.begin(), mSeen.end(), 0);
         mStamp = 1;
     }
-    const int32_t x0 = int32_t(std::floor(inBox.mMin.x() / mCellSize)),
-                  x1 = int32_t(std::floor(inBox.mMax.x() / mCellSize)),
-                  z0 = int32_t(std::floor(inBox.mMin.z() / mCellSize)),
-                  z1 = int32_t(std::floor(inBox.mMax.z() / mCellSize));
-    for (int32_t x = x0; x <= x1; ++x)
-        for (int32_t z = z0; z <= z1; ++z)
+    auto consider = [&](uint32_t inPart)
+    {
+        if (mSeen[inPart] == mStamp) return;
+        mSeen[inPart] = mStamp;
+        if (mParts[inPart].mBounds.Overlaps(inBox)) ioObjects.push_back({inPart, mParts[inPart].mBounds});
+    };
+    for (uint32_t part : mLargeParts)
+        consider(part);
+    const CellRange cells = CellsOf(inBox);
+    if ((cells.mX1 - cells.mX0 + 1) * (cells.mZ1 - cells.mZ0 + 1) > int64_t(mCells.size()))
+    {
+        // A box over more cells than are filled: look at the filled ones
+        for (const auto& [key, parts] : mCells)
+            for (uint32_t part : parts)
+                consider(part);
+        return;
+    }
+    for (int64_t x = cells.mX0; x <= cells.mX1; ++x)
+        for (int64_t z = cells.mZ0; z <= cells.mZ1; ++z)
         {
             auto cell = mCells.find(CellKey(x, z));
             if (cell == mCells.end()) continue;
-            for (uint32_t p : cell->second)
-            {
-                if (mSeen[p] == mStamp) continue;
-                mSeen[p] = mStamp;
-                if (mParts[p].mBounds.Overlaps(inBox)) ioObjects.push_back({p, mParts[p].mBounds});
-            }
+            for (uint32_t part : cell->second)
+                consider(part);
         }
 }
 

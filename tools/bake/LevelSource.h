@@ -42,6 +42,8 @@ public:
     virtual AABB GetBounds() const = 0;
     /// At least as many as the objects whose bounds one tile's bordered box can overlap (sizes the world).
     virtual uint32_t GetMaxObjectsNear() const = 0;
+    /// Objects in the level (the world never needs room for more).
+    virtual uint64_t GetNumObjects() const = 0;
     /// Appends the objects whose bounds overlap inBox, each once, in any order.
     virtual void FindObjects(const AABB& inBox, std::vector<SourceObject>& ioObjects) const = 0;
     /// The shape and area of the object with key inKey (one static body). Errors name the object.
@@ -64,6 +66,7 @@ public:
 
     AABB GetBounds() const override { return mBounds; }
     uint32_t GetMaxObjectsNear() const override { return uint32_t(mParts.size()); }
+    uint64_t GetNumObjects() const override { return mParts.size(); }
     void FindObjects(const AABB& inBox, std::vector<SourceObject>& ioObjects) const override;
     Result<SourceBody> MakeBody(uint64_t inKey) const override;
     std::string Describe(uint64_t inKey) const override;
@@ -76,14 +79,25 @@ private:
         SourceBody mBody;
         AABB mBounds;
     };
-    uint64_t CellKey(int32_t inX, int32_t inZ) const { return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ); }
+    /// Cells spanned on x and z (inclusive), clamped to +-2^30.
+    struct CellRange
+    {
+        int64_t mX0, mX1, mZ0, mZ1;
+    };
+    CellRange CellsOf(const AABB& inBox) const;
+    static uint64_t CellKey(int64_t inX, int64_t inZ)
+    {
+        return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ);
+    }
+    static constexpr int64_t cMaxCellsPerPart = 64; ///< Parts over more cells are in mLargeParts
 
     std::vector<std::string> mPaths;
     std::vector<Part> mParts;
     AABB mBounds;
     float mCellSize = 1.0f;
     std::unordered_map<uint64_t, std::vector<uint32_t>> mCells; ///< Cell -> parts whose bounds touch it
-    mutable std::vector<uint32_t> mSeen;                        ///< FindObjects' dedup stamps, per part
+    std::vector<uint32_t> mLargeParts;   ///< Parts over more than cMaxCellsPerPart cells
+    mutable std::vector<uint32_t> mSeen; ///< FindObjects' dedup stamps, per part
     mutable uint32_t mStamp = 0;
 };
 

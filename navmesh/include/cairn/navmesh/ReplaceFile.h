@@ -15,8 +15,8 @@
 namespace cairn::navmesh
 {
 
-/// A file being written: Stream() goes to "<path>.tmp"; Commit renames it to the path. Destroyed uncommitted
-/// (an error, an exception, a cancelled bake), it removes the temporary.
+/// A file being written: Stream() goes to "<path>.tmp-<process>-<n>"; Commit renames it to the path.
+/// Destroyed uncommitted (an error, an exception, a cancelled bake), it removes the temporary.
 class PendingFile
 {
 public:
