@@ -30,7 +30,7 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inM
 } // namespace
 
 PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
-    : mSettings(inSettings), mLayers(inLayers), mBodies(std::make_unique<BodyManager>(inSettings.mMaxBodies)),
+    : mSettings(inSettings), mLayers(inLayers), mBodies(std::make_unique<BodyManager>(inSettings.mMaxBodies, inSettings.mNumBodyMutexes)),
       mBroadPhase(CreateBroadPhase(inSettings.mBroadPhase, inSettings.mMaxBodies, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
       mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase)),

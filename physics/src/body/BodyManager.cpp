@@ -1,5 +1,7 @@
 #include "cairn/physics/body/BodyManager.h"
 
+#include <algorithm>
+#include <bit>
 #include <cassert>
 #include <string>
 
@@ -49,8 +51,9 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
 }
 } // namespace
 
-BodyManager::BodyManager(uint32_t inMaxBodies)
-    : mMaxBodies(inMaxBodies), mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]())
+BodyManager::BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes)
+    : mMaxBodies(inMaxBodies), mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
+      mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]())
 {
     // Hand out low indices first: they pack the hot part of the array
     mFreeList.reserve(inMaxBodies);
@@ -182,16 +185,16 @@ void BodyManager::NotifyChange(BodyChangeKind inKind, const Body& inBody, const 
 void BodyManager::LockAllBodies() const
 {
     assert(!tInsideStep);
-    for (PaddedMutex& m : mBodyMutexes)
-        m.mMutex.lock();
+    for (uint32_t m = 0; m <= mMutexMask; ++m) // In index order: see the lock order above
+        mBodyMutexes[m].mMutex.lock();
     tInsideStep = true;
 }
 
 void BodyManager::UnlockAllBodies() const
 {
     tInsideStep = false;
-    for (PaddedMutex& m : mBodyMutexes)
-        m.mMutex.unlock();
+    for (uint32_t m = 0; m <= mMutexMask; ++m)
+        mBodyMutexes[m].mMutex.unlock();
 }
 
 bool BodyManager::IsInsideStep()

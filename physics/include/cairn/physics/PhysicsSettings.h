@@ -28,6 +28,9 @@ struct PhysicsSettings
     float mTimeBeforeSleep = 0.5f; ///< s an island must stay slow before it sleeps
     float mSleepVelocity = 0.05f;  ///< m/s: the fastest point of a body must stay below this
     BroadPhaseType mBroadPhase = BroadPhaseType::QuadTree;
+    /// Read-write mutexes guarding the bodies (body i by mutex i % this): a power of two from 1 to 32. 32 as
+    /// in the reference engine's "after"; 1 is its "before" (one lock for every body), for measuring
+    uint32_t mNumBodyMutexes = 32;
     /// A body pair whose relative pose moved less than this (m, and radians) since its manifolds were made
     /// takes them over instead of colliding its shapes again; 0 turns the reuse off. Jolt's defaults: small
     /// enough that a contact point moves by at most a few millimetres on a metre-sized body

@@ -1,10 +1,12 @@
 #pragma once
 
 // BodyManager: owns every Body in a fixed array (so a Body never moves in memory), hands out BodyIDs, and
-// owns the 32 sharded read-write mutexes that guard them (body index i is guarded by mutex i % 32).
+// owns the sharded read-write mutexes that guard them (body index i is guarded by mutex i % shards; 32 shards
+// by default, 1 for the "before" mode that measures a single global body lock,
+// PhysicsSettings::mNumBodyMutexes).
 //
 // Threads and locks:
-//  - A body's fields: its shard mutex (shared to read, exclusive to write). The physics step holds all 32
+//  - A body's fields: its shard mutex (shared to read, exclusive to write). The physics step holds them all
 //    exclusively while it runs (LockAllBodies), so code inside the step reads and writes bodies without
 //    locks.
 //  - Free list and body count: mFreeListMutex. Lock order: body mutex < mFreeListMutex < mActiveListMutex.
@@ -34,9 +36,10 @@ namespace cairn
 class BodyManager
 {
 public:
-    static constexpr uint32_t cNumBodyMutexes = 32;
+    static constexpr uint32_t cNumBodyMutexes = 32; ///< Shards at most (and by default)
 
-    explicit BodyManager(uint32_t inMaxBodies);
+    /// inNumMutexes: shards, a power of two from 1 to cNumBodyMutexes (others are rounded down into range).
+    explicit BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes = cNumBodyMutexes);
     ~BodyManager();
 
     uint32_t GetMaxBodies() const { return mMaxBodies; }
@@ -51,13 +54,13 @@ public:
     /// The mutex guarding body index inIndex.
     std::shared_mutex& GetMutexForBody(uint32_t inIndex) const
     {
-        return mBodyMutexes[inIndex % cNumBodyMutexes].mMutex;
+        return mBodyMutexes[inIndex & mMutexMask].mMutex;
     }
 
     /// The shard's static mutex (see above).
     std::shared_mutex& GetStaticMutexForBody(uint32_t inIndex) const
     {
-        return mStaticMutexes[inIndex % cNumBodyMutexes].mMutex;
+        return mStaticMutexes[inIndex & mMutexMask].mMutex;
     }
 
     /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the
@@ -108,6 +111,7 @@ private:
     std::vector<uint32_t>& GetActiveBodiesForStep() { return mActiveBodies; }
 
     uint32_t mMaxBodies;
+    uint32_t mMutexMask;                ///< Shards - 1 (a power of two minus one); set at construction
     std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
