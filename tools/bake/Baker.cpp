@@ -3,15 +3,12 @@
 #include "LiveObjects.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/navmesh/GeometryCollector.h"
-#include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/PhysicsSystem.h"
-#include "cairn/physics/shapes/TriangleMeshShape.h"
 #include "common/FrameTimes.h"
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstring>
 #include <deque>
 #include <optional>
