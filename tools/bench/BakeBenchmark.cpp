@@ -15,6 +15,7 @@
 #include "GeneratedLevel.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
+#include "common/BenchOptions.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -161,18 +162,12 @@ void BenchLargeWorld()
 
 int main(int argc, char** argv)
 {
-    int repetitions = 3;
-    std::string only;
-    for (int i = 1; i < argc; ++i)
-        if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc)
-            repetitions = std::max(1, std::atoi(argv[++i]));
-        else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc)
-            only = argv[++i];
-        else
-        {
-            std::fprintf(stderr, "usage: cairn-bench-bake [--repetitions N] [--only direct|large]\n");
-            return 2;
-        }
+    tools::BenchOptions options;
+    if (auto stop = tools::ParseBenchOptions(argc, argv, "cairn-bench-bake: the offline baker's figures",
+                                             {"direct", "large"}, options))
+        return *stop;
+    const int repetitions = options.mRepetitions;
+    const std::string& only = options.mOnly;
     std::printf("cairn-bench-bake: %d repetitions\n", repetitions);
     if (only.empty() || only == "large") BenchLargeWorld();
     if (!only.empty() && only != "direct") return 0;

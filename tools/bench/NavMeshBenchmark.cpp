@@ -16,6 +16,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/BenchOptions.h"
 #include "common/FrameTimes.h"
 #include "common/SharedBenchData.h"
 
@@ -273,21 +274,13 @@ void RunInvokerLatency(const SharedBenchData& inData)
 
 int main(int argc, char** argv)
 {
-    int repetitions = 3;
-    std::string only;
-    for (int i = 1; i < argc; ++i)
-    {
-        if (std::strcmp(argv[i], "--repetitions") == 0 && i + 1 < argc)
-            repetitions = std::max(1, std::atoi(argv[++i]));
-        else if (std::strcmp(argv[i], "--only") == 0 && i + 1 < argc)
-            only = argv[++i];
-        else
-        {
-            std::fprintf(stderr, "usage: cairn-bench-navmesh [--repetitions N] [--only "
-                                 "nav_tiles_world_tile0|nav_step_pile2k_jobs|nav_invoker_latency]\n");
-            return 2;
-        }
-    }
+    tools::BenchOptions options;
+    if (auto stop = tools::ParseBenchOptions(
+            argc, argv, "cairn-bench-navmesh: navmesh tile and tile-job figures",
+            {"nav_tiles_world_tile0", "nav_step_pile2k_jobs", "nav_invoker_latency"}, options))
+        return *stop;
+    const int repetitions = options.mRepetitions;
+    const std::string& only = options.mOnly;
 #ifdef NDEBUG
     const char* buildType = "Release";
 #else

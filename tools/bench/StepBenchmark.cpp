@@ -9,6 +9,7 @@
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/BenchOptions.h"
 #include "common/FrameTimes.h"
 #include "common/SharedBenchData.h"
 
@@ -170,38 +171,13 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
 
 int main(int inArgc, char** inArgv)
 {
-    int repetitions = 3;
-    std::string only;
-    std::vector<uint32_t> threadCounts = {1, 2};
-    for (int i = 1; i < inArgc; ++i)
-    {
-        if (std::strcmp(inArgv[i], "--repetitions") == 0 && i + 1 < inArgc)
-            repetitions = std::max(1, std::atoi(inArgv[++i]));
-        else if (std::strcmp(inArgv[i], "--only") == 0 && i + 1 < inArgc)
-            only = inArgv[++i];
-        else if (std::strcmp(inArgv[i], "--threads") == 0 && i + 1 < inArgc)
-        {
-            threadCounts.clear();
-            for (const char* p = inArgv[++i]; *p != 0;)
-            {
-                char* end = nullptr;
-                const long count = std::strtol(p, &end, 10);
-                if (end == p || count < 1 || count > 64)
-                {
-                    std::fprintf(stderr, "--threads: a comma-separated list of counts in 1..64\n");
-                    return 2;
-                }
-                threadCounts.push_back(uint32_t(count));
-                p = *end == ',' ? end + 1 : end;
-            }
-        }
-        else
-        {
-            std::fprintf(stderr, "usage: cairn-bench-step [--repetitions N] [--only "
-                                 "step_pile2k|step_pyramid] [--threads 1,2]\n");
-            return 2;
-        }
-    }
+    tools::BenchOptions options;
+    if (auto stop = tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-step: physics step figures",
+                                             {"step_pile2k", "step_pyramid"}, options, true))
+        return *stop;
+    const int repetitions = options.mRepetitions;
+    const std::string& only = options.mOnly;
+    const std::vector<uint32_t>& threadCounts = options.mThreads;
 #ifdef NDEBUG
     const char* buildType = "Release";
 #else
