@@ -1,6 +1,7 @@
 // glTF level meshes: nodes' transforms applied, the same walkable tiles as the same geometry from OBJ, and
 // malformed files named by file and element.
 
+#include "GltfTestModel.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/TempFiles.h"
@@ -25,33 +26,7 @@ std::string TempPath(const std::string& inName)
 /// A 20 m square floor (two triangles, unsigned short indices) in a node moved by inTranslation.
 tinygltf::Model FloorModel(const std::array<double, 3>& inTranslation)
 {
-    const float positions[] = {0, 0, 0, 0, 0, 20, 20, 0, 20, 20, 0, 0};
-    const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
-    tinygltf::Model model;
-    tinygltf::Buffer buffer;
-    buffer.data.resize(sizeof(positions) + sizeof(indices));
-    std::memcpy(buffer.data.data(), positions, sizeof(positions));
-    std::memcpy(buffer.data.data() + sizeof(positions), indices, sizeof(indices));
-    model.buffers.push_back(buffer);
-    tinygltf::BufferView positionView, indexView;
-    positionView.buffer = 0;
-    positionView.byteLength = sizeof(positions);
-    indexView.buffer = 0;
-    indexView.byteOffset = sizeof(positions);
-    indexView.byteLength = sizeof(indices);
-    model.bufferViews = {positionView, indexView};
-    tinygltf::Accessor positionAccessor, indexAccessor;
-    positionAccessor.bufferView = 0;
-    positionAccessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-    positionAccessor.type = TINYGLTF_TYPE_VEC3;
-    positionAccessor.count = 4;
-    positionAccessor.minValues = {0, 0, 0};
-    positionAccessor.maxValues = {20, 0, 20};
-    indexAccessor.bufferView = 1;
-    indexAccessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
-    indexAccessor.type = TINYGLTF_TYPE_SCALAR;
-    indexAccessor.count = 6;
-    model.accessors = {positionAccessor, indexAccessor};
+    tinygltf::Model model = SquareModel(20.0f);
     tinygltf::Primitive primitive;
     primitive.attributes["POSITION"] = 0;
     primitive.indices = 1;
@@ -67,7 +42,6 @@ tinygltf::Model FloorModel(const std::array<double, 3>& inTranslation)
     scene.nodes = {0};
     model.scenes.push_back(scene);
     model.defaultScene = 0;
-    model.asset.version = "2.0";
     return model;
 }
 

@@ -1,6 +1,7 @@
 // Level files as objects with materials: OBJ objects and groups and their `usemtl` names (with or without a
 // material library), glTF nodes and materials, and the split into one part per object and area.
 
+#include "GltfTestModel.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "common/TempFiles.h"
 
@@ -136,40 +137,14 @@ TEST_F(LevelPartsTest, AreaMappingRejectsIdsAboveTheLimit)
 /// Two nodes instancing one two-triangle mesh whose primitives use materials "road" and an unnamed one.
 tinygltf::Model TwoNodeModel()
 {
-    const float positions[] = {0, 0, 0, 0, 0, 4, 4, 0, 4, 4, 0, 0};
-    const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
-    tinygltf::Model model;
-    tinygltf::Buffer buffer;
-    buffer.data.resize(sizeof(positions) + sizeof(indices));
-    std::memcpy(buffer.data.data(), positions, sizeof(positions));
-    std::memcpy(buffer.data.data() + sizeof(positions), indices, sizeof(indices));
-    model.buffers.push_back(buffer);
-    tinygltf::BufferView positionView, firstTriangle, secondTriangle;
-    positionView.buffer = 0;
-    positionView.byteLength = sizeof(positions);
-    firstTriangle.buffer = 0;
-    firstTriangle.byteOffset = sizeof(positions);
-    firstTriangle.byteLength = 6;
-    secondTriangle.buffer = 0;
-    secondTriangle.byteOffset = sizeof(positions) + 6;
-    secondTriangle.byteLength = 6;
-    model.bufferViews = {positionView, firstTriangle, secondTriangle};
-    tinygltf::Accessor positionAccessor;
-    positionAccessor.bufferView = 0;
-    positionAccessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-    positionAccessor.type = TINYGLTF_TYPE_VEC3;
-    positionAccessor.count = 4;
-    positionAccessor.minValues = {0, 0, 0};
-    positionAccessor.maxValues = {4, 0, 4};
-    model.accessors.push_back(positionAccessor);
-    for (int view : {1, 2})
+    tinygltf::Model model = SquareModel(4.0f);
+    // Accessors 2 and 3: the first and the second triangle of the square's indices
+    for (size_t firstIndex : {0, 3})
     {
-        tinygltf::Accessor indexAccessor;
-        indexAccessor.bufferView = view;
-        indexAccessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
-        indexAccessor.type = TINYGLTF_TYPE_SCALAR;
-        indexAccessor.count = 3;
-        model.accessors.push_back(indexAccessor);
+        tinygltf::Accessor triangle = model.accessors[1];
+        triangle.byteOffset = firstIndex * sizeof(uint16_t);
+        triangle.count = 3;
+        model.accessors.push_back(triangle);
     }
     tinygltf::Material road, unnamed;
     road.name = "road";
@@ -179,7 +154,7 @@ tinygltf::Model TwoNodeModel()
     {
         tinygltf::Primitive primitive;
         primitive.attributes["POSITION"] = 0;
-        primitive.indices = 1 + p;
+        primitive.indices = 2 + p;
         primitive.material = p;
         primitive.mode = TINYGLTF_MODE_TRIANGLES;
         mesh.primitives.push_back(primitive);
@@ -195,7 +170,6 @@ tinygltf::Model TwoNodeModel()
     scene.nodes = {0, 1};
     model.scenes.push_back(scene);
     model.defaultScene = 0;
-    model.asset.version = "2.0";
     return model;
 }
 
