@@ -261,6 +261,8 @@ private:
     EpochReclaimer mReclaimer;                     ///< Read sections of queries
     std::vector<RetiredBatch> mRetired;            ///< Update thread only: nodes waiting to be freed
     std::atomic<uint32_t> mNumRetired{0};          ///< Statistic: nodes in mRetired
+    std::vector<uint64_t>
+        mFreeMarks; ///< Update thread only: a bit per node being freed (all zero between calls)
     /// Bodies linked: queries skip an empty tree without entering its read section (relaxed: a body whose
     /// link finished before a query started is counted in the same thread before its link, so the query sees
     /// it)
