@@ -178,12 +178,15 @@ void PhysicsStep::WakeIslandsOfWokenBodies()
         if (!body.mWakeIsland) continue;
         body.mWakeIsland = false;
         // Walk the ring of the island it slept in. Every hop wakes a sleeping body, and the walk stops at an
-        // active one (the start, or a body that woke since and whose ring link is stale), so it terminates
-        for (uint32_t next = body.mSleepRingNext;;)
+        // active one (the start, or a body that woke since and whose ring link is stale) and at a link to a
+        // body that is gone (the id's sequence no longer matches) or cannot wake (not in the world, static),
+        // so it terminates
+        for (BodyID next = body.mSleepRingNext;;)
         {
-            Body* member = mBodies.TryGetBodyAtIndex(next);
+            Body* member = mBodies.TryGetBody(next);
             if (member == nullptr || !member->IsInWorld() || member->IsActive()) break;
             mBodies.ActivateBody(*member);
+            if (!member->IsActive()) break; // Could not wake: following its own link would never end
             next = member->mSleepRingNext;
         }
     }
@@ -791,7 +794,8 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
         for (size_t i = 0; i < members.size(); ++i)
         {
             Body& body = *mBodies.TryGetBodyAtIndex(active[members[i]]);
-            body.mSleepRingNext = active[members[(i + 1) % members.size()]];
+            body.mSleepRingNext =
+                mBodies.TryGetBodyAtIndex(active[members[(i + 1) % members.size()]])->GetID();
             mSleepingIslands.push_back(active[members[i]]);
         }
     }

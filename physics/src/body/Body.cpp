@@ -29,7 +29,7 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     mInWorld = false;
     mAddPending = false;
     mWakeIsland = false;
-    mSleepRingNext = inID.GetIndex();
+    mSleepRingNext = inID;
 
     mInvMass = 0.0f;
     mInvInertiaDiagonal.setZero();

@@ -44,6 +44,28 @@ TEST_F(SleepAndWakeTest, RemovingTheSupportWakesTheBodyOnIt)
     EXPECT_LT(Position(box).y(), 0.5f) << "the box should be falling";
 }
 
+TEST_F(SleepAndWakeTest, AWokenIslandWhoseOtherMemberWasDestroyedAndItsSlotReusedStillSteps)
+{
+    AddFloor();
+    const BodyID bottom = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+    const BodyID top = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.5f, 0)));
+    Step(120);
+    ASSERT_FALSE(IsActive(bottom));
+    ASSERT_FALSE(IsActive(top));
+    // Removing the top box wakes the bottom one, whose island ring still names the top box's slot
+    ASSERT_TRUE(Bodies().RemoveBody(top).IsOk());
+    ASSERT_TRUE(Bodies().DestroyBody(top).IsOk());
+    ASSERT_TRUE(IsActive(bottom));
+    // The next body made takes the freed slot: a static one, which never wakes
+    const BodyID reused = AddStatic(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(10, 0.5f, 0));
+    ASSERT_EQ(reused.GetIndex(), top.GetIndex()) << "the test needs the slot to be reused";
+    // The step walks the woken island's ring: it looped forever on the static body (holding every body lock)
+    Step(1);
+    EXPECT_TRUE(IsActive(bottom));
+    EXPECT_FALSE(IsActive(reused));
+    EXPECT_NEAR(Position(reused).x(), 10.0f, 1e-6f);
+}
+
 TEST_F(SleepAndWakeTest, ContactWithAnActiveBodyWakesASleepingOne)
 {
     AddFloor();

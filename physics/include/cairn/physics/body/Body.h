@@ -100,7 +100,9 @@ private:
         cInactive; ///< Index in the active list, or cInactive; see GetActiveIndex
     BodyID mID;
     uint64_t mUserData;
-    uint32_t mSleepRingNext; ///< Next body (index) of the island this body fell asleep with: a ring
+    /// Next body of the island this body fell asleep with: a ring. An id, not an index: a member removed and
+    /// destroyed since leaves a stale link, and its slot may hold another body by now
+    BodyID mSleepRingNext;
     MotionType mMotionType;
     ObjectLayer mObjectLayer;
     uint8_t mNavMeshArea;
