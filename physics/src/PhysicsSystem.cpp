@@ -27,11 +27,27 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inM
     }
     return nullptr;
 }
+
+Status ValidateSetup(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
+{
+    if (Status settings = ValidateSettings(inSettings); !settings) return settings;
+    return inLayers.GetStatus();
+}
 } // namespace
 
+Result<std::unique_ptr<PhysicsSystem>> PhysicsSystem::Create(const PhysicsSettings& inSettings,
+                                                             const LayerSetup& inLayers)
+{
+    if (Status setup = ValidateSetup(inSettings, inLayers); !setup) return setup.GetError();
+    return std::make_unique<PhysicsSystem>(inSettings, inLayers);
+}
+
 PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
-    : mSettings(inSettings), mLayers(inLayers), mBodies(std::make_unique<BodyManager>(inSettings.mMaxBodies, inSettings.mNumBodyMutexes)),
-      mBroadPhase(CreateBroadPhase(inSettings.mBroadPhase, inSettings.mMaxBodies, mLayers)),
+    : mSetupStatus(ValidateSetup(inSettings, inLayers)),
+      mSettings(mSetupStatus.IsOk() ? inSettings : PhysicsSettings{}),
+      mLayers(mSetupStatus.IsOk() ? inLayers : LayerSetup::CreateDefault()),
+      mBodies(std::make_unique<BodyManager>(mSettings.mMaxBodies, mSettings.mNumBodyMutexes)),
+      mBroadPhase(CreateBroadPhase(mSettings.mBroadPhase, mSettings.mMaxBodies, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
       mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase)),
       mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase))
@@ -52,6 +68,7 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobS
 
 Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobSystem* ioJobs)
 {
+    if (!mSetupStatus) return mSetupStatus;
     if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)
         return MakeError(ErrorCode::InvalidArgument, "time step must be in (0, 1] s");
     if (inCollisionSteps < 1 || inCollisionSteps > 16)

@@ -1,15 +1,31 @@
 #include "cairn/physics/body/Layers.h"
 
-#include <cassert>
+#include <algorithm>
 
 namespace cairn
 {
 
 LayerSetup::LayerSetup(uint32_t inNumObjectLayers, uint32_t inNumBroadPhaseLayers)
-    : mNumObjectLayers(inNumObjectLayers), mNumBroadPhaseLayers(inNumBroadPhaseLayers)
+    : mNumObjectLayers(std::clamp(inNumObjectLayers, 1u, cMaxObjectLayers)),
+      mNumBroadPhaseLayers(std::clamp(inNumBroadPhaseLayers, 1u, cMaxBroadPhaseLayers))
 {
-    assert(inNumObjectLayers > 0 && inNumObjectLayers <= cMaxObjectLayers);
-    assert(inNumBroadPhaseLayers > 0 && inNumBroadPhaseLayers <= cMaxBroadPhaseLayers);
+    if (mNumObjectLayers != inNumObjectLayers)
+        RecordError("the number of object layers must be in 1.." + std::to_string(cMaxObjectLayers) +
+                    ", not " + std::to_string(inNumObjectLayers));
+    if (mNumBroadPhaseLayers != inNumBroadPhaseLayers)
+        RecordError("the number of broad-phase layers must be in 1.." + std::to_string(cMaxBroadPhaseLayers) +
+                    ", not " + std::to_string(inNumBroadPhaseLayers));
+}
+
+void LayerSetup::RecordError(std::string inMessage)
+{
+    if (mError.empty()) mError = "layer setup: " + std::move(inMessage);
+}
+
+Status LayerSetup::GetStatus() const
+{
+    if (mError.empty()) return Status::Ok();
+    return MakeError(ErrorCode::InvalidArgument, mError);
 }
 
 LayerSetup LayerSetup::CreateDefault()
@@ -27,13 +43,25 @@ LayerSetup LayerSetup::CreateDefault()
 
 void LayerSetup::SetBroadPhaseLayer(ObjectLayer inLayer, BroadPhaseLayer inBroadPhaseLayer)
 {
-    assert(inLayer < mNumObjectLayers && inBroadPhaseLayer < mNumBroadPhaseLayers);
+    if (inLayer >= mNumObjectLayers || inBroadPhaseLayer >= mNumBroadPhaseLayers)
+    {
+        RecordError("SetBroadPhaseLayer(" + std::to_string(inLayer) + ", " +
+                    std::to_string(inBroadPhaseLayer) + ") is out of range (" +
+                    std::to_string(mNumObjectLayers) + " object layers, " +
+                    std::to_string(mNumBroadPhaseLayers) + " broad-phase layers)");
+        return;
+    }
     mBroadPhaseLayer[inLayer] = inBroadPhaseLayer;
 }
 
 void LayerSetup::SetCollides(ObjectLayer inA, ObjectLayer inB, bool inCollides)
 {
-    assert(inA < mNumObjectLayers && inB < mNumObjectLayers);
+    if (inA >= mNumObjectLayers || inB >= mNumObjectLayers)
+    {
+        RecordError("SetCollides(" + std::to_string(inA) + ", " + std::to_string(inB) +
+                    ") is out of range (" + std::to_string(mNumObjectLayers) + " object layers)");
+        return;
+    }
     const ObjectLayerMask bitA = ObjectLayerMask(1) << inA;
     const ObjectLayerMask bitB = ObjectLayerMask(1) << inB;
     if (inCollides)

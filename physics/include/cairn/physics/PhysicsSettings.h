@@ -3,6 +3,7 @@
 // World-wide settings, fixed when the PhysicsSystem is created. Plain value type.
 
 #include "cairn/physics/math/Math.h"
+#include "cairn/physics/math/Result.h"
 #include "cairn/physics/solver/SolverSettings.h"
 
 #include <cstdint>
@@ -20,6 +21,9 @@ enum class BroadPhaseType : uint8_t
 
 struct PhysicsSettings
 {
+    static constexpr uint32_t cMaxBodiesLimit =
+        1u << 22; ///< Largest mMaxBodies (the array is allocated at once)
+
     uint32_t mMaxBodies = 65536;              ///< Fixed capacity of the body array
     Vec3 mGravity = Vec3(0.0f, -9.81f, 0.0f); ///< m/s^2
     SolverSettings mSolver;                   ///< Iterations, slop, restitution threshold
@@ -37,6 +41,10 @@ struct PhysicsSettings
     float mPairCacheMaxDeltaPosition = 0.001f;
     float mPairCacheMaxDeltaAngle = 2.0f * cPi / 180.0f;
 };
+
+/// Ok, or an InvalidArgument error naming the first field out of its documented range (NaN, infinity, a
+/// negative distance, an iteration count over 1000, a body mutex count that is not a power of two up to 32).
+Status ValidateSettings(const PhysicsSettings& inSettings);
 
 /// What the last Update did and how long each phase took (summed over its collision steps).
 struct StepStatistics

@@ -31,6 +31,13 @@ class PhysicsStep;
 class PhysicsSystem
 {
 public:
+    /// A world, or the error of settings or layers that are out of range (ValidateSettings,
+    /// LayerSetup::GetStatus).
+    static Result<std::unique_ptr<PhysicsSystem>>
+    Create(const PhysicsSettings& inSettings = {}, const LayerSetup& inLayers = LayerSetup::CreateDefault());
+    /// The same without the check up front: a world made from settings or layers that are not valid is built
+    /// on the defaults instead, never steps (every Update returns the error) and reports it in
+    /// GetSetupStatus.
     explicit PhysicsSystem(const PhysicsSettings& inSettings = {},
                            const LayerSetup& inLayers = LayerSetup::CreateDefault());
     ~PhysicsSystem();
@@ -53,10 +60,13 @@ public:
     void SetBodyChangeListener(BodyChangeListener* inListener) { mBodies->SetChangeListener(inListener); }
     const LayerSetup& GetLayers() const { return mLayers; }
     const PhysicsSettings& GetSettings() const { return mSettings; }
+    /// Ok, or why the settings or layers given at construction were refused.
+    const Status& GetSetupStatus() const { return mSetupStatus; }
     /// Figures of the last Update. Read it from the thread that calls Update.
     const StepStatistics& GetLastStepStatistics() const { return mLastStatistics; }
 
 private:
+    Status mSetupStatus; ///< Set at construction, constant afterwards
     PhysicsSettings mSettings;
     LayerSetup mLayers;
     std::unique_ptr<BodyManager> mBodies;

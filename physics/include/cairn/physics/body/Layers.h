@@ -4,9 +4,14 @@
 // trigger...), a table says which object layers collide with which, and each object layer maps to one
 // broad-phase layer (one broad-phase tree per broad-phase layer, e.g. static vs moving).
 // LayerSetup is configured once before the world is created and read-only afterwards: any thread may read it.
+// Misuse (a count or a layer id out of range) never writes out of bounds: the count is clamped or the call is
+// ignored, and GetStatus reports the first such error (PhysicsSystem refuses a setup whose status is not Ok).
+
+#include "cairn/physics/math/Result.h"
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 namespace cairn
 {
@@ -46,6 +51,9 @@ public:
     /// Static, Moving, Debris and Trigger object layers over Static and Moving broad-phase layers.
     static LayerSetup CreateDefault();
 
+    /// Ok, or the first misuse since construction (see the top of this file).
+    Status GetStatus() const;
+
     uint32_t GetNumObjectLayers() const { return mNumObjectLayers; }
     uint32_t GetNumBroadPhaseLayers() const { return mNumBroadPhaseLayers; }
 
@@ -66,6 +74,9 @@ private:
     uint32_t mNumBroadPhaseLayers;
     std::array<BroadPhaseLayer, cMaxObjectLayers> mBroadPhaseLayer{};
     std::array<ObjectLayerMask, cMaxObjectLayers> mCollidesWith{};
+    std::string mError; ///< The first misuse, empty when none
+
+    void RecordError(std::string inMessage);
 };
 
 } // namespace cairn
