@@ -36,7 +36,12 @@ uint64_t MixBits(uint64_t inKey)
 Vec3 ClampLength(const Vec3& inV, float inMax)
 {
     const float lengthSq = inV.squaredNorm();
-    return lengthSq > inMax * inMax ? inV * (inMax / std::sqrt(lengthSq)) : inV;
+    if (!(lengthSq > inMax * inMax)) return inV;
+    if (std::isfinite(lengthSq)) return inV * (inMax / std::sqrt(lengthSq));
+    // Finite but too long to square (a huge force on a light body): scale it down first, the direction is
+    // all that is kept
+    const Vec3 scaled = inV / inV.cwiseAbs().maxCoeff();
+    return scaled * (inMax / scaled.norm());
 }
 } // namespace
 
@@ -197,7 +202,13 @@ void PhysicsStep::ApplyForces(std::span<const uint32_t> inBodies, float inDeltaT
     for (uint32_t index : inBodies)
     {
         Body& body = *mBodies.TryGetBodyAtIndex(index);
-        if (!body.IsDynamic()) continue;
+        if (!body.IsDynamic())
+        {
+            // Kinematic bodies move as set, within the same limits (a limit is what keeps every speed finite)
+            body.mLinearVelocity = ClampLength(body.mLinearVelocity, body.mMaxLinearVelocity);
+            body.mAngularVelocity = ClampLength(body.mAngularVelocity, body.mMaxAngularVelocity);
+            continue;
+        }
         // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new
         // velocity
         body.mLinearVelocity +=

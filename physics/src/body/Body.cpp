@@ -48,7 +48,12 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
         mInertiaRotation = Quat(axes).normalized();
         const Vec3 moments = solver.eigenvalues();
         for (int i = 0; i < 3; ++i)
-            mInvInertiaDiagonal[i] = moments[i] > 0.0f ? 1.0f / moments[i] : 0.0f;
+        {
+            // A moment too small to invert (a tiny body) turns as if infinitely stiff about that axis rather
+            // than with an infinite inverse, which the step would make NaN
+            const float inverse = moments[i] > 0.0f ? 1.0f / moments[i] : 0.0f;
+            mInvInertiaDiagonal[i] = std::isfinite(inverse) ? inverse : 0.0f;
+        }
     }
     else if (mMotionType == MotionType::Kinematic)
     {

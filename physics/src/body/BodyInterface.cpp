@@ -168,6 +168,13 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
         assert(body != nullptr && body->mAddPending);
         body->mAddPending = false;
         body->mInWorld = true;
+        // Moved since the prepare (a loader placing bodies while the batch waited): the broad phase linked
+        // the bounds of the prepare, so it gets the current ones now
+        if (body->mBounds.mMin != entry.mBounds.mMin || body->mBounds.mMax != entry.mBounds.mMax)
+        {
+            const BroadPhaseBody moved = ToBroadPhase(*body);
+            mBroadPhase.NotifyBodiesAABBChanged({&moved, 1});
+        }
         mBodies.NotifyChange(BodyChangeKind::Added, *body, AABB::Empty());
         if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     }
@@ -264,7 +271,7 @@ Status BodyInterface::SetPositionAndRotation(const BodyID& inID, const Vec3& inP
 
 Status BodyInterface::SetLinearVelocity(const BodyID& inID, const Vec3& inVelocity)
 {
-    if (!IsFinite(inVelocity)) return InvalidVector("linear velocity");
+    if (!IsFiniteLength(inVelocity)) return InvalidVector("linear velocity");
     return ModifyBody(inID, true,
                       [&](Body& ioBody)
                       {
@@ -276,7 +283,7 @@ Status BodyInterface::SetLinearVelocity(const BodyID& inID, const Vec3& inVeloci
 
 Status BodyInterface::SetAngularVelocity(const BodyID& inID, const Vec3& inVelocity)
 {
-    if (!IsFinite(inVelocity)) return InvalidVector("angular velocity");
+    if (!IsFiniteLength(inVelocity)) return InvalidVector("angular velocity");
     return ModifyBody(inID, true,
                       [&](Body& ioBody)
                       {
@@ -289,14 +296,31 @@ Status BodyInterface::SetAngularVelocity(const BodyID& inID, const Vec3& inVeloc
 template <class F>
 Status BodyInterface::PushBody(const BodyID& inID, const Vec3& inAmount, const char* inWhat, F&& inApply)
 {
-    if (!IsFinite(inAmount)) return InvalidVector(inWhat);
+    if (!IsFiniteLength(inAmount)) return InvalidVector(inWhat);
     return ModifyBody(inID, true,
                       [&](Body& ioBody)
                       {
                           if (!ioBody.IsDynamic())
                               return Status(MakeError(ErrorCode::InvalidArgument,
                                                       std::string(inWhat) + " acts on dynamic bodies only"));
+                          // Finite amounts can still add up to infinity (two forces of 2e38 N, or a huge
+                          // impulse on a light body), which the step would turn into NaN: such a change is
+                          // refused whole
+                          const Vec3 force = ioBody.mForce, torque = ioBody.mTorque;
+                          const Vec3 linear = ioBody.mLinearVelocity, angular = ioBody.mAngularVelocity;
                           inApply(ioBody);
+                          if (!IsFiniteLength(ioBody.mForce) || !IsFiniteLength(ioBody.mTorque) ||
+                              !IsFiniteLength(ioBody.mLinearVelocity) ||
+                              !IsFiniteLength(ioBody.mAngularVelocity))
+                          {
+                              ioBody.mForce = force;
+                              ioBody.mTorque = torque;
+                              ioBody.mLinearVelocity = linear;
+                              ioBody.mAngularVelocity = angular;
+                              return Status(MakeError(ErrorCode::InvalidArgument,
+                                                      std::string(inWhat) + " is too large: the body's " +
+                                                          "accumulated force or velocity would overflow"));
+                          }
                           mBodies.ActivateBody(ioBody);
                           return Status::Ok();
                       });

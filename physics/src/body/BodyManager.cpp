@@ -24,8 +24,8 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
         return invalid("body position is NaN, infinite or beyond 1e6 m");
     if (!IsValidRotation(inSettings.mRotation))
         return invalid("body rotation is not a finite unit quaternion");
-    if (!IsFinite(inSettings.mLinearVelocity) || !IsFinite(inSettings.mAngularVelocity))
-        return invalid("body velocity is NaN or infinite");
+    if (!IsFiniteLength(inSettings.mLinearVelocity) || !IsFiniteLength(inSettings.mAngularVelocity))
+        return invalid("body velocity is NaN, infinite or too large to square");
     if (!std::isfinite(inSettings.mFriction) || inSettings.mFriction < 0.0f)
         return invalid("friction must be finite and >= 0");
     if (!(inSettings.mRestitution >= 0.0f && inSettings.mRestitution <= 1.0f))
@@ -33,9 +33,12 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (!(inSettings.mLinearDamping >= 0.0f) || !(inSettings.mAngularDamping >= 0.0f) ||
         !std::isfinite(inSettings.mLinearDamping) || !std::isfinite(inSettings.mAngularDamping))
         return invalid("damping must be finite and >= 0");
-    if (!std::isfinite(inSettings.mGravityFactor)) return invalid("gravity factor must be finite");
-    if (!(inSettings.mMaxLinearVelocity > 0.0f) || !(inSettings.mMaxAngularVelocity > 0.0f))
-        return invalid("velocity limits must be > 0");
+    if (!(std::abs(inSettings.mGravityFactor) <= 1e3f))
+        return invalid("gravity factor must be in [-1e3, 1e3]");
+    // Finite limits keep every body's speed finite, kinematic ones included (a step at most moves it by them)
+    if (!(inSettings.mMaxLinearVelocity > 0.0f && inSettings.mMaxLinearVelocity <= 1e5f) ||
+        !(inSettings.mMaxAngularVelocity > 0.0f && inSettings.mMaxAngularVelocity <= 1e5f))
+        return invalid("velocity limits must be in (0, 1e5] m/s and rad/s");
     if (!inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation}).IsFinite())
         return invalid("body bounds are not finite");
     if (inSettings.mMotionType == MotionType::Dynamic)
@@ -46,6 +49,9 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
         if (!(mass.mMass > 0.0f) || !std::isfinite(mass.mMass) || !mass.mInertia.allFinite())
             return invalid(std::string("a dynamic body needs a shape with volume; a ") +
                            ToString(inSettings.mShape->GetType()) + " has none");
+        // A mass in the denormals (a density of 1e-40) has an infinite inverse: the first step would make NaN
+        if (!std::isfinite(1.0f / mass.mMass))
+            return invalid("the body's mass (density times volume) is too small to invert");
     }
     return Status::Ok();
 }

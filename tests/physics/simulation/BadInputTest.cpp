@@ -137,6 +137,73 @@ TEST_F(BadInputTest, BodyInAPreparedBatchCannotBeDestroyed)
     ExpectWorldUnchanged();
 }
 
+TEST_F(BadInputTest, ABodyMovedBetweenPrepareAndFinalizeIsFoundWhereItIs)
+{
+    BodyCreationSettings settings = DynamicSettings(Box(Vec3(1, 1, 1)), Vec3(20, 1, 0));
+    settings.mMotionType = MotionType::Static;
+    settings.mObjectLayer = Layers::cStatic;
+    const BodyID pending = Bodies().CreateBody(settings).Value();
+    Result<BodyInterface::AddBatch> batch = Bodies().AddBodiesPrepare({&pending, 1});
+    ASSERT_TRUE(batch.IsOk());
+    ASSERT_TRUE(Bodies().SetPosition(pending, Vec3(-20, 1, 0), Activation::DontActivate).IsOk());
+    ASSERT_TRUE(Bodies().AddBodiesFinalize(batch.Value(), Activation::DontActivate).IsOk());
+    bool found = false;
+    System().GetBroadPhase().CollidePoint(Vec3(-20, 1, 0), {},
+                                          [&](BodyID inID) { found |= inID == pending; });
+    EXPECT_TRUE(found) << "the broad phase kept the bounds of the prepare";
+}
+
+static_assert(!std::is_copy_constructible_v<BodyInterface::AddBatch>,
+              "a copy of a prepared batch could be finalized and aborted: its state freed twice");
+
+TEST_F(BadInputTest, ChangesThatWouldOverflowABodysStateAreRefused)
+{
+    BodyCreationSettings light = DynamicSettings(Sphere(0.1f), Vec3(5, 1, 5));
+    light.mDensity = 1.0f; // About 4 g
+    const BodyID body = AddDynamic(light);
+    EXPECT_EQ(Bodies().AddForce(body, Vec3(2e38f, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument)
+        << "finite, but its length cannot be squared";
+    ASSERT_TRUE(Bodies().AddForce(body, Vec3(1e19f, 0, 0)).IsOk());
+    EXPECT_EQ(Bodies().AddForce(body, Vec3(1e19f, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument)
+        << "two forces of 1e19 N square to more than a float holds";
+    // A finite impulse that makes the velocity too large to square
+    EXPECT_EQ(Bodies().AddImpulse(body, Vec3(0, 1e18f, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(Bodies().SetLinearVelocity(body, Vec3(1e20f, 0, 0)).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    // The first force stays: a = 1e19 N / 4 g; the step clamps the speed to the body's limit without NaN
+    Step(1);
+    EXPECT_TRUE(IsFinite(Position(body)));
+    EXPECT_NEAR(Velocity(body).norm(), light.mMaxLinearVelocity, 1.0f);
+}
+
+TEST_F(BadInputTest, BodySettingsThatWouldOverflowAreRejected)
+{
+    BodyCreationSettings settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+    settings.mGravityFactor = 1e38f;
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+    settings.mMaxLinearVelocity = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+    settings.mDensity = 1e-40f; // A denormal mass: its inverse is infinite
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+    settings.mLinearVelocity = Vec3(1e20f, 0, 0);
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    ExpectWorldUnchanged();
+}
+
+TEST_F(BadInputTest, KinematicBodiesKeepToTheirVelocityLimit)
+{
+    BodyCreationSettings settings = DynamicSettings(Box(Vec3(1, 1, 1)), Vec3(0, 20, 0));
+    settings.mMotionType = MotionType::Kinematic;
+    const BodyID kinematic = AddDynamic(settings);
+    ASSERT_TRUE(Bodies().SetLinearVelocity(kinematic, Vec3(1e9f, 0, 0)).IsOk());
+    Step(1);
+    EXPECT_NEAR(Velocity(kinematic).norm(), settings.mMaxLinearVelocity, 1e-3f);
+    EXPECT_NEAR(Position(kinematic).x(), settings.mMaxLinearVelocity * cDeltaTime, 1e-2f);
+}
+
 TEST_F(BadInputTest, CallsThatWouldDeadlockWhileHoldingABodyLockAreRefused)
 {
     {

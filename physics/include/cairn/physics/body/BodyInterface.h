@@ -13,6 +13,7 @@
 #include "cairn/physics/broadphase/BroadPhase.h"
 
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace cairn
@@ -36,11 +37,23 @@ public:
 
     /// A batch of bodies being added: the slow part (broad-phase preparation) runs on the caller's thread
     /// without touching the live world; AddBodiesFinalize then links it quickly.
+    /// Move-only: it owns the broad phase's prepared state, which must be finalized or aborted exactly once
+    /// (a copy finalized and then the original aborted would free it twice).
     struct AddBatch
     {
         std::vector<BroadPhaseBody> mBodies;
         BroadPhase::AddState mState = nullptr;
         bool IsEmpty() const { return mBodies.empty(); }
+
+        AddBatch() = default;
+        AddBatch(AddBatch&& ioOther) noexcept
+            : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr))
+        {
+            ioOther.mBodies.clear();
+        }
+        AddBatch(const AddBatch&) = delete;
+        AddBatch& operator=(const AddBatch&) = delete;
+        AddBatch& operator=(AddBatch&&) = delete; ///< Overwriting a prepared batch would leak it
     };
     /// Fails (and marks nothing) if any id is stale, already in the world, or already in another batch.
     Result<AddBatch> AddBodiesPrepare(std::span<const BodyID> inIDs);

@@ -31,6 +31,13 @@ inline bool IsFinite(const Vec3& inV)
     return std::isfinite(inV.x()) && std::isfinite(inV.y()) && std::isfinite(inV.z());
 }
 
+/// Finite, and so is its squared length (components up to about 1e19): lengths and normalisations of it stay
+/// finite.
+inline bool IsFiniteLength(const Vec3& inV)
+{
+    return std::isfinite(inV.squaredNorm());
+}
+
 /// True when every component is finite and within the accepted world range.
 inline bool IsValidWorldPosition(const Vec3& inV)
 {
