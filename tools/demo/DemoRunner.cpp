@@ -165,6 +165,8 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mAgentDistanceMetres = agentStats.mDistance;
     result.mPathsThroughWalls = agentStats.mPathsThroughWalls;
     result.mQueries = gameObjects->GetNumQueries();
+    if (const uint64_t queryErrors = gameObjects->GetNumQueryErrors(); queryErrors > 0)
+        result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");
     result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();
     result.mQueryMicrosPerThread = gameObjects->GetQueryMicrosPerThread();
     const TileStreamer::Stats streaming = streamer->GetStats();

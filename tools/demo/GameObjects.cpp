@@ -68,17 +68,22 @@ void GameObjects::UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t&
     RayCast down;
     down.mOrigin = Vec3(spot.x(), mGenerator.GetTerrainHeight(spot.x(), spot.z()) + 30.0f, spot.z());
     down.mDirection = Vec3(0.0f, -60.0f, 0.0f);
-    const std::optional<RayCastResult> ground = query.CastRayClosest(down, filter);
-    ioObject.mGroundY = ground ? down.mOrigin.y() + ground->mFraction * down.mDirection.y() : spot.y();
+    const Result<std::optional<RayCastResult>> ground = query.CastRayClosest(down, filter);
+    const bool groundHit = ground.IsOk() && ground.Value().has_value();
+    ioObject.mGroundY =
+        groundHit ? down.mOrigin.y() + ground.Value()->mFraction * down.mDirection.y() : spot.y();
     // Line of sight to the player's head
     const Vec3 eye(spot.x(), ioObject.mGroundY + 1.6f, spot.z());
     RayCast sight;
     sight.mOrigin = eye;
     sight.mDirection = inPlayer + Vec3(0.0f, 1.6f, 0.0f) - eye;
-    ioObject.mCanSeePlayer = !query.CastRayAny(sight, filter);
+    const Result<bool> blocked = query.CastRayAny(sight, filter);
+    ioObject.mCanSeePlayer = blocked.IsOk() && !blocked.Value();
     // What is around it
     thread_local std::vector<BodyID> around;
-    query.CollideSphere(eye, 2.0f, around, filter);
+    const Status aroundStatus = query.CollideSphere(eye, 2.0f, around, filter);
+    const int errors = int(!ground.IsOk()) + int(!blocked.IsOk()) + int(!aroundStatus.IsOk());
+    if (errors > 0) mQueryErrors.fetch_add(uint64_t(errors), std::memory_order_relaxed); // A count only
     ioNanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
     ioQueries += 3;
 

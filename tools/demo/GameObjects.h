@@ -36,6 +36,8 @@ public:
     void Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime);
 
     uint64_t GetNumQueries() const;
+    /// Queries that returned an error (bad input or a wrong thread: a bug in the demo); 0 in a good run.
+    uint64_t GetNumQueryErrors() const { return mQueryErrors.load(std::memory_order_relaxed); }
     /// Mean microseconds per query on each thread that ran game-object jobs (in the order threads first
     /// came).
     std::vector<double> GetQueryMicrosPerThread() const;
@@ -64,6 +66,7 @@ private:
     std::vector<Object> mObjects;
     float mTime = 0.0f;
     std::array<ThreadSlot, cMaxThreadSlots> mSlots;
+    std::atomic<uint64_t> mQueryErrors{0}; ///< Any job thread; relaxed: a count read after the frame's jobs
 };
 
 } // namespace cairn::demo

@@ -39,8 +39,10 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (!(inSettings.mMaxLinearVelocity > 0.0f && inSettings.mMaxLinearVelocity <= 1e5f) ||
         !(inSettings.mMaxAngularVelocity > 0.0f && inSettings.mMaxAngularVelocity <= 1e5f))
         return invalid("velocity limits must be in (0, 1e5] m/s and rad/s");
-    if (!inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation}).IsFinite())
-        return invalid("body bounds are not finite");
+    const AABB bounds = inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation});
+    if (!bounds.IsFinite()) return invalid("body bounds are not finite");
+    // An empty or inverted box (a shape built around its checked Create) would be dropped by the broad phase
+    if (bounds.IsEmpty()) return invalid("body bounds are empty: the shape has no extent");
     if (inSettings.mMotionType == MotionType::Dynamic)
     {
         if (!std::isfinite(inSettings.mDensity) || inSettings.mDensity <= 0.0f)

@@ -6,6 +6,7 @@
 #include "cairn/physics/shapes/SphereShape.h"
 
 #include <algorithm>
+#include <string>
 
 namespace cairn
 {
@@ -26,6 +27,23 @@ thread_local std::vector<BodyID> tBodies;
 BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter)
 {
     return {inFilter.mObjectLayers};
+}
+
+/// WrongThread when this thread may not read bodies now, else Ok.
+Status CheckThread()
+{
+    if (BodyManager::IsInsideStep())
+        return MakeError(ErrorCode::WrongThread, "world query called from inside the physics step");
+    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        return MakeError(
+            ErrorCode::WrongThread,
+            "world query called while this thread holds a body lock (it could not read the bodies)");
+    return Status::Ok();
+}
+
+Status InvalidQuery(const char* inWhat)
+{
+    return MakeError(ErrorCode::InvalidArgument, std::string("world query: ") + inWhat);
 }
 
 /// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
@@ -50,11 +68,14 @@ bool WorldQuery::ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& out
     return true;
 }
 
-void WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
-                         std::vector<RayCastResult>& outHits, bool inClosestOnly) const
+Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
+                           std::vector<RayCastResult>& outHits, bool inClosestOnly) const
 {
     outHits.clear();
-    if (!IsValidWorldPosition(inRay.mOrigin) || !IsFinite(inRay.mDirection)) return;
+    if (Status thread = CheckThread(); !thread) return thread;
+    if (!IsValidWorldPosition(inRay.mOrigin))
+        return InvalidQuery("ray origin is NaN, infinite or beyond the world");
+    if (!IsFiniteLength(inRay.mDirection)) return InvalidQuery("ray direction is NaN, infinite or too long");
     std::vector<Candidate>& candidates = tCandidates;
     candidates.clear();
     mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter),
@@ -88,45 +109,49 @@ void WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool
         }
         else
             outHits.push_back(result);
-        if (inAny) return;
+        if (inAny) return Status::Ok();
     }
     std::sort(outHits.begin(), outHits.end(),
               [](const RayCastResult& inA, const RayCastResult& inB) {
                   return inA.mFraction < inB.mFraction ||
                          (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
               });
+    return Status::Ok();
 }
 
-std::optional<RayCastResult> WorldQuery::CastRayClosest(const RayCast& inRay,
-                                                        const QueryFilter& inFilter) const
+Result<std::optional<RayCastResult>> WorldQuery::CastRayClosest(const RayCast& inRay,
+                                                                const QueryFilter& inFilter) const
 {
     thread_local std::vector<RayCastResult> hits;
-    CastRay(inRay, inFilter, false, hits, true);
-    if (hits.empty()) return std::nullopt;
-    return hits.front();
+    if (Status status = CastRay(inRay, inFilter, false, hits, true); !status) return status.GetError();
+    if (hits.empty()) return std::optional<RayCastResult>();
+    return std::optional<RayCastResult>(hits.front());
 }
 
-bool WorldQuery::CastRayAny(const RayCast& inRay, const QueryFilter& inFilter) const
+Result<bool> WorldQuery::CastRayAny(const RayCast& inRay, const QueryFilter& inFilter) const
 {
     thread_local std::vector<RayCastResult> hits;
-    CastRay(inRay, inFilter, true, hits, false);
+    if (Status status = CastRay(inRay, inFilter, true, hits, false); !status) return status.GetError();
     return !hits.empty();
 }
 
-void WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
-                            const QueryFilter& inFilter) const
+Status WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
+                              const QueryFilter& inFilter) const
 {
-    CastRay(inRay, inFilter, false, outHits, false);
+    return CastRay(inRay, inFilter, false, outHits, false);
 }
 
-void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform,
-                              std::vector<ShapeQueryHit>& outHits, const QueryFilter& inFilter,
-                              float inMaxSeparation) const
+Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform,
+                                std::vector<ShapeQueryHit>& outHits, const QueryFilter& inFilter,
+                                float inMaxSeparation) const
 {
     outHits.clear();
-    if (!IsValidWorldPosition(inTransform.mPosition) || !IsValidRotation(inTransform.mRotation) ||
-        !std::isfinite(inMaxSeparation))
-        return;
+    if (Status thread = CheckThread(); !thread) return thread;
+    if (!IsValidWorldPosition(inTransform.mPosition))
+        return InvalidQuery("shape position is NaN, infinite or beyond the world");
+    if (!IsValidRotation(inTransform.mRotation))
+        return InvalidQuery("shape rotation is not a finite unit quaternion");
+    if (!std::isfinite(inMaxSeparation)) return InvalidQuery("maximum separation is NaN or infinite");
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
     const AABB bounds = inShape.GetWorldBounds(inTransform).Expanded(std::max(inMaxSeparation, 0.0f));
@@ -158,37 +183,48 @@ void WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform
                       });
         if (deepest >= -settings.mMaxSeparation) outHits.push_back(hit);
     }
+    return Status::Ok();
 }
 
-void WorldQuery::CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies,
-                              const QueryFilter& inFilter) const
+Status WorldQuery::CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies,
+                                const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!inBox.IsFinite() || inBox.IsEmpty()) return;
+    if (!IsValidWorldPosition(inBox.mMin) || !IsValidWorldPosition(inBox.mMax))
+        return InvalidQuery("box corner is NaN, infinite or beyond the world");
+    if (inBox.IsEmpty()) return InvalidQuery("box min is above its max");
     const BoxShape box(QueryHalfExtent(inBox));
     thread_local std::vector<ShapeQueryHit> hits;
-    CollideShape(box, {inBox.Center(), Quat::Identity()}, hits, inFilter);
+    if (Status status = CollideShape(box, {inBox.Center(), Quat::Identity()}, hits, inFilter); !status)
+        return status;
     for (const ShapeQueryHit& hit : hits)
         outBodies.push_back(hit.mBody);
+    return Status::Ok();
 }
 
-void WorldQuery::CollideSphere(const Vec3& inCenter, float inRadius, std::vector<BodyID>& outBodies,
-                               const QueryFilter& inFilter) const
+Status WorldQuery::CollideSphere(const Vec3& inCenter, float inRadius, std::vector<BodyID>& outBodies,
+                                 const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!IsValidWorldPosition(inCenter) || !std::isfinite(inRadius) || inRadius <= 0.0f) return;
+    if (!IsValidWorldPosition(inCenter))
+        return InvalidQuery("sphere centre is NaN, infinite or beyond the world");
+    if (!(inRadius > 0.0f && inRadius <= cMaxWorldCoordinate))
+        return InvalidQuery("sphere radius must be in (0, 1e6] m");
     const SphereShape sphere(inRadius);
     thread_local std::vector<ShapeQueryHit> hits;
-    CollideShape(sphere, {inCenter, Quat::Identity()}, hits, inFilter);
+    if (Status status = CollideShape(sphere, {inCenter, Quat::Identity()}, hits, inFilter); !status)
+        return status;
     for (const ShapeQueryHit& hit : hits)
         outBodies.push_back(hit.mBody);
+    return Status::Ok();
 }
 
-void WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies,
-                              const QueryFilter& inFilter) const
+Status WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies,
+                                const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (!IsValidWorldPosition(inPoint)) return;
+    if (Status thread = CheckThread(); !thread) return thread;
+    if (!IsValidWorldPosition(inPoint)) return InvalidQuery("point is NaN, infinite or beyond the world");
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
     mBroadPhase.CollidePoint(inPoint, {inFilter.mObjectLayers},
@@ -208,6 +244,7 @@ void WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodie
         if (shape->CastRay({transform.InverseTransformPoint(inPoint), Vec3::Zero()}, hit))
             outBodies.push_back(id);
     }
+    return Status::Ok();
 }
 
 } // namespace cairn

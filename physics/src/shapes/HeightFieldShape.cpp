@@ -201,8 +201,10 @@ Result<std::shared_ptr<const HeightFieldShape>> HeightFieldShape::Create(uint32_
                                                          std::to_string(inHeights.size()));
     if (!std::isfinite(inCellSize))
         return MakeError(ErrorCode::InvalidArgument, "HeightFieldShape: cell size must be finite");
-    if (!(inCellSize > 0.0f))
-        return MakeError(ErrorCode::DegenerateShape, "HeightFieldShape: cell size must be > 0");
+    // A millimetre at least: the ray walk divides by it, and coordinates over cells of 1e-25 m overflow its
+    // cell indices
+    if (!(inCellSize >= 1e-3f))
+        return MakeError(ErrorCode::DegenerateShape, "HeightFieldShape: cell size must be at least 1 mm");
     if (double(std::max(inSampleCountX, inSampleCountZ) - 1) * inCellSize > cMaxWorldCoordinate)
         return MakeError(ErrorCode::InvalidArgument, "HeightFieldShape: extent exceeds cMaxWorldCoordinate");
     for (size_t i = 0; i < inHeights.size(); ++i)
@@ -255,7 +257,8 @@ void HeightFieldShape::VisitTriangles(const AABB& inLocalBox, TriangleVisitor in
 
 bool HeightFieldShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
-    if (!IsFinite(inLocalRay.mOrigin) || !IsFinite(inLocalRay.mDirection)) return false;
+    if (!IsFinite(inLocalRay.mOrigin) || !IsFinite(inLocalRay.mDirection) || !(ioHit.mFraction >= 0.0f))
+        return false;
 
     // Clip the segment to the (slightly grown) bounds so that the walk starts and ends over the grid
     const AABB grown = mBounds.Expanded(1.0e-4f * std::max(mCellSize, mBounds.Size().maxCoeff()));

@@ -51,6 +51,8 @@ TEST(HeightFieldShapeTest, RejectsBadInput)
               ErrorCode::InvalidArgument);
     EXPECT_EQ(HeightFieldShape::Create(2, 2, 0.0f, four).GetError().mCode, ErrorCode::DegenerateShape);
     EXPECT_EQ(HeightFieldShape::Create(2, 2, -1.0f, four).GetError().mCode, ErrorCode::DegenerateShape);
+    EXPECT_EQ(HeightFieldShape::Create(2, 2, 1e-30f, four).GetError().mCode, ErrorCode::DegenerateShape)
+        << "cells too small for the ray walk's indices";
     EXPECT_EQ(HeightFieldShape::Create(2, 2, std::numeric_limits<float>::quiet_NaN(), four).GetError().mCode,
               ErrorCode::InvalidArgument);
     std::vector<float> infinite = four;

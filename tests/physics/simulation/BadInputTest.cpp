@@ -193,6 +193,16 @@ TEST_F(BadInputTest, BodySettingsThatWouldOverflowAreRejected)
     ExpectWorldUnchanged();
 }
 
+TEST_F(BadInputTest, AShapeWithNoExtentIsRejected)
+{
+    // Built around CapsuleShape::Create, which would refuse it: its bounds are inverted
+    BodyCreationSettings settings =
+        DynamicSettings(std::make_shared<CapsuleShape>(-5.0f, 1.0f), Vec3(5, 5, 5));
+    settings.mMotionType = MotionType::Kinematic;
+    EXPECT_EQ(Bodies().CreateBody(settings).GetError().mCode, ErrorCode::InvalidArgument);
+    ExpectWorldUnchanged();
+}
+
 TEST_F(BadInputTest, KinematicBodiesKeepToTheirVelocityLimit)
 {
     BodyCreationSettings settings = DynamicSettings(Box(Vec3(1, 1, 1)), Vec3(0, 20, 0));

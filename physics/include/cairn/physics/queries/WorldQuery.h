@@ -6,9 +6,14 @@
 // shape and transform under that body's read lock, releases it, and runs the exact test on the copy (shapes
 // are immutable, and the ShapeRef keeps the shape alive). So a query never holds two locks at once, and it
 // waits for a body only while the physics step is writing it.
+// Errors: a query refuses bad input (a NaN or out-of-world origin or centre, a direction or radius that is
+// not finite, a rotation that is not a unit quaternion) with InvalidArgument, and a call from inside the step
+// or from a thread that holds a body lock (it could not read the bodies) with WrongThread, instead of
+// returning "nothing there": a caller must be able to tell a clear line of sight from a failed query.
 
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
+#include "cairn/physics/math/Result.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
 #include <optional>
@@ -43,35 +48,37 @@ class WorldQuery
 public:
     WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase);
 
-    /// The closest hit along the segment, if any.
-    std::optional<RayCastResult> CastRayClosest(const RayCast& inRay, const QueryFilter& inFilter = {}) const;
+    /// The closest hit along the segment, or nullopt when there is none.
+    Result<std::optional<RayCastResult>> CastRayClosest(const RayCast& inRay,
+                                                        const QueryFilter& inFilter = {}) const;
     /// True as soon as any body is hit (cheapest: stops at the first).
-    bool CastRayAny(const RayCast& inRay, const QueryFilter& inFilter = {}) const;
+    Result<bool> CastRayAny(const RayCast& inRay, const QueryFilter& inFilter = {}) const;
     /// Every body hit (its closest hit each), sorted by fraction; outHits is cleared first.
-    void CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
-                    const QueryFilter& inFilter = {}) const;
-
-    /// Bodies whose shape overlaps inShape at inTransform (penetration >= -inMaxSeparation); outHits is
-    /// cleared.
-    void CollideShape(const Shape& inShape, const Transform& inTransform, std::vector<ShapeQueryHit>& outHits,
-                      const QueryFilter& inFilter = {}, float inMaxSeparation = 0.0f) const;
-    /// Bodies whose shape overlaps the box (exact test); outBodies is cleared.
-    void CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies,
+    Status CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
                       const QueryFilter& inFilter = {}) const;
-    /// Bodies whose shape overlaps the sphere (exact test); outBodies is cleared.
-    void CollideSphere(const Vec3& inCenter, float inRadius, std::vector<BodyID>& outBodies,
-                       const QueryFilter& inFilter = {}) const;
+
+    /// Bodies whose shape overlaps inShape at inTransform (penetration >= -inMaxSeparation, which must be
+    /// finite; negative counts as 0); outHits is cleared.
+    Status CollideShape(const Shape& inShape, const Transform& inTransform,
+                        std::vector<ShapeQueryHit>& outHits, const QueryFilter& inFilter = {},
+                        float inMaxSeparation = 0.0f) const;
+    /// Bodies whose shape overlaps the box (exact test; a flat box is a very thin one); outBodies is cleared.
+    Status CollideAABox(const AABB& inBox, std::vector<BodyID>& outBodies,
+                        const QueryFilter& inFilter = {}) const;
+    /// Bodies whose shape overlaps the sphere (exact test, radius > 0); outBodies is cleared.
+    Status CollideSphere(const Vec3& inCenter, float inRadius, std::vector<BodyID>& outBodies,
+                         const QueryFilter& inFilter = {}) const;
     /// Bodies whose solid shape contains the point (meshes and height fields have no inside); outBodies is
     /// cleared.
-    void CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies,
-                      const QueryFilter& inFilter = {}) const;
+    Status CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBodies,
+                        const QueryFilter& inFilter = {}) const;
 
 private:
     /// Shape and transform of a body, read under its read lock; false for a stale id or a removed body.
     bool ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& outTransform) const;
     /// Runs the ray against candidate bodies; inAny stops at the first hit.
-    void CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
-                 std::vector<RayCastResult>& outHits, bool inClosestOnly) const;
+    Status CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
+                   std::vector<RayCastResult>& outHits, bool inClosestOnly) const;
 
     const BodyManager& mBodies;
     const BroadPhase& mBroadPhase;
