@@ -29,10 +29,23 @@ Status AgentProfile::Validate() const
     if (mMaxVertsPerPoly < 3 || mMaxVertsPerPoly > 6)
         return MakeError(ErrorCode::InvalidArgument,
                          "agent profile: max vertices per polygon must be 3 to 6");
-    if (!(mRegionMinSize >= 0.0f) || !(mRegionMergeSize >= 0.0f) || !(mEdgeMaxLength >= 0.0f) ||
-        !(mEdgeMaxError >= 0.0f) || !(mDetailSampleDistance >= 0.0f) || !(mDetailSampleMaxError >= 0.0f))
+    // Upper bounds too: Recast takes these as ints of cells (a radius of 1e9 m, or an infinite region size,
+    // overflowed them and silently built every tile empty)
+    auto inRange = [](float inValue, float inMax)
+    { return std::isfinite(inValue) && inValue >= 0.0f && inValue <= inMax; };
+    if (!inRange(mHeight, 1e3f) || !inRange(mRadius, 1e3f) || !inRange(mMaxClimb, 1e3f))
         return MakeError(ErrorCode::InvalidArgument,
-                         "agent profile: region, edge and detail settings must be >= 0");
+                         "agent profile: height, radius and max climb must be at most 1000 m");
+    if (!inRange(mCellSize, 1e3f) || !inRange(mCellHeight, 1e3f) || mHeight / mCellHeight > 1e6f ||
+        mRadius / mCellSize > 1e6f || mMaxClimb / mCellHeight > 1e6f)
+        return MakeError(ErrorCode::InvalidArgument,
+                         "agent profile: cells too small for the agent (over a million cells across it)");
+    if (!inRange(mRegionMinSize, 1e4f) || !inRange(mRegionMergeSize, 1e4f) ||
+        !inRange(mEdgeMaxLength, 1e6f) || !inRange(mEdgeMaxError, 1e6f) ||
+        !inRange(mDetailSampleDistance, 1e6f) || !inRange(mDetailSampleMaxError, 1e6f))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "agent profile: region, edge and detail settings must be finite, >= 0 and not huge "
+                         "(region sizes up to 1e4 cells, the others up to 1e6)");
     return Status::Ok();
 }
 

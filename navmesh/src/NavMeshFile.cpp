@@ -3,6 +3,8 @@
 #include "cairn/navmesh/ReplaceFile.h"
 
 #include <DetourAlloc.h>
+#include <DetourCommon.h>
+#include <DetourNavMesh.h>
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
@@ -43,6 +45,86 @@ bool ReadTileCoord(const std::vector<unsigned char>& inData, TileCoord& outTile)
     if (header.magic != DT_NAVMESH_MAGIC || header.version != DT_NAVMESH_VERSION) return false;
     outTile = {header.x, header.y};
     return true;
+}
+
+/// Reads element inIndex of an array of T at inOffset of inData (unaligned-safe).
+template <class T> T ReadAt(const std::vector<unsigned char>& inData, size_t inOffset, size_t inIndex)
+{
+    T value;
+    std::memcpy(&value, inData.data() + inOffset + inIndex * sizeof(T), sizeof(T));
+    return value;
+}
+
+/// Empty when inData is a Detour tile whose sections fit its size and whose indices stay inside their arrays,
+/// else what is wrong. Detour's addTile trusts the header's counts and the polygons' indices: a flipped bit
+/// in a file made it write and read outside the tile's buffer.
+std::string CheckTileData(const std::vector<unsigned char>& inData)
+{
+    if (inData.size() < sizeof(dtMeshHeader)) return "shorter than a Detour tile header";
+    const dtMeshHeader h = ReadAt<dtMeshHeader>(inData, 0, 0);
+    if (h.magic != DT_NAVMESH_MAGIC || h.version != DT_NAVMESH_VERSION) return "not Detour tile data";
+    constexpr int cMaxCount = 1 << 20;
+    for (const int count : {h.vertCount, h.polyCount, h.maxLinkCount, h.detailMeshCount, h.detailVertCount,
+                            h.detailTriCount, h.bvNodeCount, h.offMeshConCount})
+        if (count < 0 || count > cMaxCount) return "a section count is negative or over 2^20";
+    // The sections in Detour's order, each padded to 4 bytes (dtNavMesh::addTile)
+    size_t offset = size_t(dtAlign4(int(sizeof(dtMeshHeader))));
+    auto section = [&](size_t inElementSize, int inCount)
+    {
+        const size_t start = offset;
+        offset += (inElementSize * size_t(inCount) + 3) & ~size_t(3);
+        return start;
+    };
+    const size_t verts = section(3 * sizeof(float), h.vertCount);
+    const size_t polys = section(sizeof(dtPoly), h.polyCount);
+    section(sizeof(dtLink), h.maxLinkCount);
+    const size_t details = section(sizeof(dtPolyDetail), h.detailMeshCount);
+    section(3 * sizeof(float), h.detailVertCount);
+    const size_t detailTris = section(4, h.detailTriCount);
+    const size_t bvNodes = section(sizeof(dtBVNode), h.bvNodeCount);
+    const size_t offMesh = section(sizeof(dtOffMeshConnection), h.offMeshConCount);
+    (void)verts;
+    if (offset > inData.size())
+        return "its sections need " + std::to_string(offset) + " bytes, it has " +
+               std::to_string(inData.size());
+    for (int i = 0; i < h.polyCount; ++i)
+    {
+        const dtPoly poly = ReadAt<dtPoly>(inData, polys, size_t(i));
+        const bool offMeshPoly = poly.getType() == DT_POLYTYPE_OFFMESH_CONNECTION;
+        if (poly.vertCount > DT_VERTS_PER_POLYGON || poly.vertCount < (offMeshPoly ? 2 : 3))
+            return "polygon " + std::to_string(i) + " has " + std::to_string(poly.vertCount) + " vertices";
+        for (int j = 0; j < poly.vertCount; ++j)
+        {
+            if (poly.verts[j] >= h.vertCount)
+                return "polygon " + std::to_string(i) + " names a missing vertex";
+            const unsigned short neighbour = poly.neis[j];
+            if (neighbour != 0 && (neighbour & DT_EXT_LINK) == 0 && neighbour - 1 >= h.polyCount)
+                return "polygon " + std::to_string(i) + " names a missing neighbour";
+        }
+        if (offMeshPoly) continue;
+        if (i >= h.detailMeshCount) return "polygon " + std::to_string(i) + " has no detail mesh";
+        const dtPolyDetail detail = ReadAt<dtPolyDetail>(inData, details, size_t(i));
+        if (size_t(detail.vertBase) + detail.vertCount > size_t(h.detailVertCount) ||
+            size_t(detail.triBase) + detail.triCount > size_t(h.detailTriCount))
+            return "the detail mesh of polygon " + std::to_string(i) + " is outside the detail arrays";
+        for (int t = 0; t < detail.triCount; ++t)
+            for (int k = 0; k < 3; ++k)
+                if (ReadAt<unsigned char>(inData, detailTris,
+                                          (size_t(detail.triBase) + size_t(t)) * 4 + size_t(k)) >=
+                    poly.vertCount + detail.vertCount)
+                    return "a detail triangle of polygon " + std::to_string(i) + " names a missing vertex";
+    }
+    for (int i = 0; i < h.bvNodeCount; ++i)
+    {
+        const int index = ReadAt<dtBVNode>(inData, bvNodes, size_t(i)).i;
+        if (index >= h.polyCount || (index < 0 && (index == INT32_MIN || -index > h.bvNodeCount - i)))
+            return "bounding-volume node " + std::to_string(i) + " points outside the tree";
+    }
+    if (h.offMeshBase < 0 || h.offMeshBase > h.polyCount) return "the off-mesh base is outside the polygons";
+    for (int i = 0; i < h.offMeshConCount; ++i)
+        if (ReadAt<dtOffMeshConnection>(inData, offMesh, size_t(i)).poly >= h.polyCount)
+            return "off-mesh connection " + std::to_string(i) + " names a missing polygon";
+    return "";
 }
 
 void SortTiles(NavMeshFileContents& ioContents)
@@ -172,9 +254,9 @@ Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath)
         if (!in.read(reinterpret_cast<char*>(tile.mData.data()), tileHeader.mDataSize))
             return MakeError(ErrorCode::ParseError,
                              inPath + ": tile " + std::to_string(i) + ": truncated data");
-        if (!ReadTileCoord(tile.mData, tile.mTile))
-            return MakeError(ErrorCode::ParseError,
-                             inPath + ": tile " + std::to_string(i) + ": not Detour tile data");
+        if (const std::string problem = CheckTileData(tile.mData); !problem.empty())
+            return MakeError(ErrorCode::ParseError, inPath + ": tile " + std::to_string(i) + ": " + problem);
+        (void)ReadTileCoord(tile.mData, tile.mTile); // Checked above
         contents.mTiles.push_back(std::move(tile));
     }
     SortTiles(contents);
@@ -188,6 +270,10 @@ Result<DetourNavMeshPtr> CreateDetourNavMesh(const NavMeshFileContents& inConten
         return MakeError(ErrorCode::InvalidArgument, "navmesh: the parameters are invalid");
     for (const NavMeshFileTile& tile : inContents.mTiles)
     {
+        if (const std::string problem = CheckTileData(tile.mData); !problem.empty())
+            return MakeError(ErrorCode::InvalidArgument, "navmesh: tile (" + std::to_string(tile.mTile.mX) +
+                                                             ", " + std::to_string(tile.mTile.mZ) +
+                                                             "): " + problem);
         auto* data = static_cast<unsigned char*>(dtAlloc(tile.mData.size(), DT_ALLOC_PERM));
         if (data == nullptr) return MakeError(ErrorCode::OutOfCapacity, "navmesh: out of memory");
         std::memcpy(data, tile.mData.data(), tile.mData.size());

@@ -48,6 +48,13 @@ dtNavMeshQuery* QueryFor(uint64_t inSerial, const dtNavMesh* inNavMesh)
     }
     return perThread.mQuery.get();
 }
+
+bool IsFiniteGrid(const TileGrid& inGrid)
+{
+    return std::isfinite(inGrid.GetOriginX()) && std::isfinite(inGrid.GetOriginZ()) &&
+           std::isfinite(inGrid.GetMinY()) && std::isfinite(inGrid.GetMaxY()) &&
+           inGrid.GetMinY() < inGrid.GetMaxY();
+}
 } // namespace
 
 NavMeshWorld::NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile)
@@ -59,6 +66,16 @@ Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGri
                                                            const AgentProfile& inProfile, int inMaxTiles)
 {
     if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
+    // The grid's tiles are the profile's: a different size would misplace every tile built with the profile
+    if (!(inGrid.GetTileSize() == inProfile.mTileSize))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: the tile grid's tile size (" +
+                                                         std::to_string(inGrid.GetTileSize()) +
+                                                         " m) is not the agent profile's (" +
+                                                         std::to_string(inProfile.mTileSize) + " m)");
+    if (!IsFiniteGrid(inGrid))
+        return MakeError(
+            ErrorCode::InvalidArgument,
+            "navmesh: the tile grid's origin and height range must be finite, min y below max y");
     Result<dtNavMeshParams> params = MakeNavMeshParams(inGrid, inMaxTiles);
     if (!params) return params.GetError();
     std::unique_ptr<NavMeshWorld> world(new NavMeshWorld(inGrid, inProfile));
@@ -125,6 +142,13 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
     if (!IsValidWorldPosition(inStart) || !IsValidWorldPosition(inEnd) || !IsFinite(inSearchExtent) ||
         (inSearchExtent.array() <= 0.0f).any())
         return MakeError(ErrorCode::InvalidArgument, "path: start, end and search extent must be finite");
+    // Detour visits every tile cell under the extent while the navmesh is locked: a huge one would stall
+    // Publish (and the frame) for minutes
+    const float maxExtent = cMaxSearchExtentTiles * mGrid.GetTileSize();
+    if (inSearchExtent.x() > maxExtent || inSearchExtent.z() > maxExtent)
+        return MakeError(ErrorCode::InvalidArgument, "path: the search extent may span at most " +
+                                                         std::to_string(int(cMaxSearchExtentTiles)) +
+                                                         " tiles across (x and z)");
     dtQueryFilter filter;
     filter.setIncludeFlags(cPolyFlagWalk);
     filter.setExcludeFlags(0);

@@ -1,11 +1,15 @@
 // Bad input to the navmesh pipeline gets a clear error, never a crash: agent profiles out of range, tile
 // geometry with NaN or bad indices, malformed OBJ files.
 
+#include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/ObjMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/TempFiles.h"
 
+#include <DetourCommon.h>
+#include <DetourNavMesh.h>
+#include <cstring>
 #include <gtest/gtest.h>
 #include <limits>
 
@@ -29,9 +33,53 @@ TEST(NavMeshBadInputTest, AgentProfilesOutOfRangeAreRefused)
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mTileSize = 12.7f; })); // Not a whole number of 0.2 m cells
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mMaxVertsPerPoly = 7; }));
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mCellSize = 0.0f; }));
+    // Values Recast turns into int cell counts: too large ones overflowed and built every tile empty
+    EXPECT_TRUE(refused([](AgentProfile& p) { p.mRadius = 1e9f; }));
+    EXPECT_TRUE(refused([](AgentProfile& p) { p.mRegionMinSize = std::numeric_limits<float>::infinity(); }));
+    EXPECT_TRUE(refused([](AgentProfile& p) { p.mEdgeMaxLength = 1e30f; }));
     AgentProfile bad;
     bad.mCellSize = -0.2f;
     EXPECT_FALSE(NavMeshWorld::Create(TileGrid(0, 0, 12.8f, 0, 10), bad));
+}
+
+TEST(NavMeshBadInputTest, AGridThatDoesNotMatchTheProfileIsRefused)
+{
+    const AgentProfile profile;
+    EXPECT_TRUE(NavMeshWorld::Create(TileGrid(0, 0, profile.mTileSize, 0, 10), profile));
+    EXPECT_FALSE(NavMeshWorld::Create(TileGrid(0, 0, 2 * profile.mTileSize, 0, 10), profile))
+        << "tiles of another size than the profile's";
+    EXPECT_FALSE(NavMeshWorld::Create(TileGrid(0, 0, 0.0f, 0, 10), profile));
+    EXPECT_FALSE(NavMeshWorld::Create(
+        TileGrid(std::numeric_limits<float>::quiet_NaN(), 0, profile.mTileSize, 0, 10), profile));
+    EXPECT_FALSE(NavMeshWorld::Create(TileGrid(0, 0, profile.mTileSize, 10, 0), profile))
+        << "min y above max y";
+}
+
+TEST(NavMeshBadInputTest, HugeBoxesGiveACutOffNotAnOverflow)
+{
+    const TileGrid grid(0, 0, 12.8f, 0, 10);
+    std::vector<TileCoord> tiles;
+    // 5e10 m across: the tile span overflowed int32 and passed the cut-off, then billions of tiles were
+    // listed
+    EXPECT_FALSE(grid.TilesOverlapping(AABB(Vec3(-2.5e10f, 0, 0), Vec3(2.5e10f, 1, 1)), 0.0f, tiles));
+    EXPECT_TRUE(tiles.empty());
+    const TileCoord far = grid.TileAt(1e30f, -1e30f);
+    EXPECT_EQ(far.mX, 1 << 30);
+    EXPECT_EQ(far.mZ, -(1 << 30));
+    EXPECT_TRUE(grid.TilesOverlapping(AABB(Vec3(0, 0, 0), Vec3(30, 1, 1)), 0.0f, tiles));
+    EXPECT_EQ(tiles.size(), 3u);
+}
+
+TEST(NavMeshBadInputTest, AHugePathSearchExtentIsRefused)
+{
+    const AgentProfile profile;
+    auto world = NavMeshWorld::Create(TileGrid(0, 0, profile.mTileSize, 0, 10), profile);
+    ASSERT_TRUE(world);
+    // Detour would visit every tile cell under it while holding the navmesh: minutes for 1e6 m
+    const Result<PathResult> path =
+        world.Value()->FindPath(Vec3(0, 0, 0), Vec3(5, 0, 5), {}, Vec3(1e6f, 1, 1e6f));
+    ASSERT_FALSE(path);
+    EXPECT_NE(path.GetError().mMessage.find("search extent"), std::string::npos);
 }
 
 TEST(NavMeshBadInputTest, BrokenTileGeometryIsRefused)
@@ -93,6 +141,52 @@ TEST_F(ObjFileTest, MalformedFilesGetClearErrors)
               ErrorCode::ParseError);
     Result<IndexedMesh> garbage = LoadObjMesh(Write("\x01\x02 this is not an obj file\n\xff\xfe"));
     EXPECT_FALSE(garbage);
+}
+
+TEST(NavMeshBadInputTest, CorruptTileDataIsRefusedBeforeDetourReadsIt)
+{
+    // One real tile: a flat 10 m square
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    TileGeometry geometry;
+    geometry.AddTriangle(Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 0), cDefaultArea);
+    geometry.AddTriangle(Vec3(10, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 10), cDefaultArea);
+    Result<BuiltTile> built = BuildTile(profile, grid, {0, 0}, geometry);
+    ASSERT_TRUE(built);
+    ASSERT_NE(built.Value().mData, nullptr);
+    NavMeshFileContents contents;
+    contents.mParams = MakeNavMeshParams(grid, 16).Value();
+    const unsigned char* bytes = built.Value().mData.get();
+    contents.mTiles.push_back({{0, 0}, std::vector<unsigned char>(bytes, bytes + built.Value().mDataSize)});
+    ASSERT_TRUE(CreateDetourNavMesh(contents)) << "the good tile loads";
+
+    cairn::test::TempFiles files;
+    auto loadError = [&](const NavMeshFileContents& inCorrupt)
+    {
+        const std::string path = files.Path("corrupt.navmesh");
+        EXPECT_TRUE(SaveNavMeshFile(path, inCorrupt).IsOk());
+        Result<NavMeshFileContents> loaded = LoadNavMeshFile(path);
+        EXPECT_FALSE(loaded.IsOk());
+        EXPECT_EQ(CreateDetourNavMesh(inCorrupt).GetError().mCode, ErrorCode::InvalidArgument);
+        return loaded.IsOk() ? std::string() : loaded.GetError().mMessage;
+    };
+    // A header count larger than the data: Detour would read and link past the buffer
+    NavMeshFileContents moreVertices = contents;
+    dtMeshHeader header;
+    std::memcpy(&header, moreVertices.mTiles[0].mData.data(), sizeof(header));
+    header.vertCount += 1000;
+    std::memcpy(moreVertices.mTiles[0].mData.data(), &header, sizeof(header));
+    EXPECT_NE(loadError(moreVertices).find("bytes"), std::string::npos);
+    // A polygon naming a vertex that is not there
+    NavMeshFileContents badIndex = contents;
+    dtMeshHeader original;
+    std::memcpy(&original, contents.mTiles[0].mData.data(), sizeof(original));
+    const size_t polysOffset = size_t(dtAlign4(sizeof(dtMeshHeader)) + dtAlign4(12 * original.vertCount));
+    dtPoly poly;
+    std::memcpy(&poly, badIndex.mTiles[0].mData.data() + polysOffset, sizeof(poly));
+    poly.verts[0] = 60000;
+    std::memcpy(badIndex.mTiles[0].mData.data() + polysOffset, &poly, sizeof(poly));
+    EXPECT_NE(loadError(badIndex).find("missing vertex"), std::string::npos);
 }
 
 } // namespace

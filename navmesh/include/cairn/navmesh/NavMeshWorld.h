@@ -65,8 +65,12 @@ public:
     /// meant for one place in the frame; it waits for path queries in progress.
     int Publish();
 
-    /// A path for an agent from inStart to inEnd (each snapped to the navmesh within inSearchExtent). Error
-    /// when either point is off the navmesh or not finite. Any thread.
+    /// Largest search extent of FindPath in x and z, in tiles.
+    static constexpr float cMaxSearchExtentTiles = 4.0f;
+
+    /// A path for an agent from inStart to inEnd (each snapped to the navmesh within inSearchExtent, at most
+    /// cMaxSearchExtentTiles tiles in x and z). Error when either point is off the navmesh or not finite. Any
+    /// thread.
     Result<PathResult> FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter = {},
                                 const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
 

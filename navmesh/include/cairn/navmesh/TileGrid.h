@@ -33,12 +33,12 @@ public:
     float GetTileSize() const { return mTileSize; }
     float GetOriginX() const { return mOriginX; }
     float GetOriginZ() const { return mOriginZ; }
+    float GetMinY() const { return mMinY; }
+    float GetMaxY() const { return mMaxY; }
 
-    TileCoord TileAt(float inX, float inZ) const
-    {
-        return {int32_t(std::floor((inX - mOriginX) / mTileSize)),
-                int32_t(std::floor((inZ - mOriginZ) / mTileSize))};
-    }
+    /// The tile under (inX, inZ). Coordinates far outside the world clamp to +-2^30 tiles instead of
+    /// overflowing the integers (NaN gives tile 0).
+    TileCoord TileAt(float inX, float inZ) const { return {ToTile(inX - mOriginX), ToTile(inZ - mOriginZ)}; }
 
     /// The tile's own area over the height range.
     AABB GetTileBounds(const TileCoord& inTile) const
@@ -68,7 +68,9 @@ public:
             return true;
         const TileCoord lo = TileAt(inBox.mMin.x() - inBorder, inBox.mMin.z() - inBorder);
         const TileCoord hi = TileAt(inBox.mMax.x() + inBorder, inBox.mMax.z() + inBorder);
-        if (double(hi.mX - lo.mX + 1) * double(hi.mZ - lo.mZ + 1) > double(inMaxTiles)) return false;
+        // In 64 bits: a box of 5e10 m spans more tiles than an int32 difference holds
+        if (double(int64_t(hi.mX) - lo.mX + 1) * double(int64_t(hi.mZ) - lo.mZ + 1) > double(inMaxTiles))
+            return false;
         for (int32_t z = lo.mZ; z <= hi.mZ; ++z)
             for (int32_t x = lo.mX; x <= hi.mX; ++x)
                 outTiles.push_back({x, z});
@@ -76,6 +78,16 @@ public:
     }
 
 private:
+    int32_t ToTile(float inOffset) const
+    {
+        const double tile = std::floor(double(inOffset) / double(mTileSize));
+        constexpr double cLimit = double(1 << 30);
+        return tile >= -cLimit && tile <= cLimit ? int32_t(tile)
+                                                 : (tile > 0.0   ? int32_t(cLimit)
+                                                    : tile < 0.0 ? -int32_t(cLimit)
+                                                                 : 0);
+    }
+
     float mOriginX;
     float mOriginZ;
     float mTileSize;
