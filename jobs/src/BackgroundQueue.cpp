@@ -92,6 +92,9 @@ void BackgroundTask::Cancel()
     // chunk
     if (TryTransition(BackgroundTaskState::Queued, BackgroundTaskState::Cancelled))
     {
+        // No thread calls the step any more (a queue thread that pops it fails to make it Running; the
+        // acq_rel exchange ordered the last call before this), so its captures go now, as for a task that ran
+        mStep = nullptr;
         std::lock_guard lock(mDoneMutex);
         mDone.notify_all();
     }
@@ -139,9 +142,26 @@ BackgroundQueue::BackgroundQueue() : BackgroundQueue(Settings{}) {}
 
 BackgroundQueue::BackgroundQueue(const Settings& inSettings) : mSettings(inSettings)
 {
-    const uint32_t numThreads = std::max(1u, mSettings.mNumThreads);
-    for (uint32_t i = 0; i < numThreads; ++i)
-        mThreads.emplace_back([this] { ThreadMain(); });
+    // At most 64, as the frame's JobSystem: background threads beyond the cores only contend
+    const uint32_t numThreads = std::clamp(mSettings.mNumThreads, 1u, cMaxThreads);
+    try
+    {
+        for (uint32_t i = 0; i < numThreads; ++i)
+            mThreads.emplace_back([this] { ThreadMain(); });
+    }
+    catch (...)
+    {
+        // A thread that could not start: stop the ones that did before the exception leaves the constructor
+        // (joinable threads of a half-built queue would terminate the program)
+        {
+            std::lock_guard lock(mMutex);
+            mStopping = true;
+        }
+        mHasWork.notify_all();
+        for (std::thread& thread : mThreads)
+            thread.join();
+        throw;
+    }
 }
 
 BackgroundQueue::~BackgroundQueue()

@@ -12,6 +12,22 @@ namespace cairn::jobs
 
 namespace
 {
+/// Which job run this thread is inside (0: none). A run's id is unique across threads: the thread's number
+/// in the high bits, a per-thread count below, so that taking one needs no shared counter.
+thread_local uint64_t tCurrentRun = 0;
+thread_local uint64_t tRunIdBase = 0;
+thread_local uint64_t tRunCount = 0;
+/// The JobSystem this thread is a worker of (set by WorkerMain), or null.
+thread_local const JobSystem* tWorkerOf = nullptr;
+std::atomic<uint64_t> sNextThreadNumber{1};
+
+uint64_t NextRunId()
+{
+    // Relaxed: only distinct values are needed
+    if (tRunIdBase == 0) tRunIdBase = sNextThreadNumber.fetch_add(1, std::memory_order_relaxed) << 40;
+    return tRunIdBase | (++tRunCount & ((uint64_t(1) << 40) - 1));
+}
+
 void CpuRelax()
 {
 #if defined(__x86_64__) || defined(__i386__)
@@ -54,7 +70,7 @@ JobSystem::JobSystem(const Settings& inSettings)
 
 JobSystem::~JobSystem()
 {
-    WaitIdle();
+    (void)WaitIdle(); // The owner destroys it outside any of its jobs
     {
         std::lock_guard lock(mQueueMutex);
         mStopping = true;
@@ -83,6 +99,7 @@ JobHandle JobSystem::Publish(uint32_t inIndex, const char* inName, std::span<con
 {
     JobSlot& slot = mSlots[inIndex];
     slot.mName = inName;
+    slot.mScope = tCurrentRun;
     // Relaxed: only a completion changes the generation, and this slot's job has not been queued yet
     const uint32_t generation = slot.mGeneration.load(std::memory_order_relaxed);
     // Relaxed: the slot is private until queued; the hold keeps it from being queued while prerequisites are
@@ -115,14 +132,48 @@ JobHandle JobSystem::Publish(uint32_t inIndex, const char* inName, std::span<con
 
 void JobSystem::Enqueue(uint32_t inIndex)
 {
+    bool waiters;
     {
         std::lock_guard lock(mQueueMutex);
         assert(mReadyCount < mMaxJobs);
         mReady[(mReadyHead + mReadyCount) % mMaxJobs] = inIndex;
         ++mReadyCount;
         mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners, see SpinUntil
+        // Relaxed, under the mutex that a sleeper held when it counted itself: it sees every such sleeper
+        waiters = mNumWaiters.load(std::memory_order_relaxed) > 0;
     }
-    mWake.notify_one();
+    // With waiters asleep, one wake-up could go to a waiter that may not run this job (isolation), or whose
+    // own job has just finished and which leaves: then the workers would sleep on with the job queued
+    if (waiters)
+        mWake.notify_all();
+    else
+        mWake.notify_one();
+}
+
+int JobSystem::FindRunnableFor(uint64_t inScope, uint32_t inAwaited) const
+{
+    for (uint32_t i = 0; i < mReadyCount; ++i)
+    {
+        const uint32_t index = mReady[(mReadyHead + i) % mMaxJobs];
+        if (index == inAwaited || mSlots[index].mScope == inScope) return int(i);
+    }
+    // Nothing of its own: run anything only when no worker can (each is stuck in a wait inside a job; a
+    // worker asking counts itself), or the queued jobs would never run
+    const size_t stuck = mNumStuckWorkers + (tWorkerOf == this ? 1 : 0);
+    if (mReadyCount > 0 && stuck >= mWorkers.size()) return 0;
+    return -1;
+}
+
+uint32_t JobSystem::TakeReadyAt(int inPosition)
+{
+    const uint32_t index = mReady[(mReadyHead + uint32_t(inPosition)) % mMaxJobs];
+    // Close the gap: the entries before it move up one (the order of the others is kept)
+    for (uint32_t i = uint32_t(inPosition); i > 0; --i)
+        mReady[(mReadyHead + i) % mMaxJobs] = mReady[(mReadyHead + i - 1) % mMaxJobs];
+    mReadyHead = (mReadyHead + 1) % mMaxJobs;
+    --mReadyCount;
+    mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners
+    return index;
 }
 
 bool JobSystem::TryPopReady(uint32_t& outIndex)
@@ -139,7 +190,10 @@ bool JobSystem::TryPopReady(uint32_t& outIndex)
 void JobSystem::Run(uint32_t inIndex)
 {
     JobSlot& slot = mSlots[inIndex];
+    const uint64_t outerRun = tCurrentRun;
+    tCurrentRun = NextRunId();
     slot.mFunction();
+    tCurrentRun = outerRun;
     slot.mFunction.Reset();
     uint32_t dependents[cMaxDependents];
     uint32_t numDependents;
@@ -189,19 +243,58 @@ bool JobSystem::IsDone(const JobHandle& inJob) const
 
 void JobSystem::Wait(const JobHandle& inJob)
 {
+    const uint64_t run = tCurrentRun;
+    if (run == 0)
+    {
+        // Outside any job: help with whatever is queued
+        while (!IsDone(inJob))
+        {
+            uint32_t index;
+            if (TryPopReady(index))
+            {
+                Run(index);
+                continue;
+            }
+            if (SpinUntil([&] { return IsDone(inJob); })) return;
+            if (mNumReady.load(std::memory_order_relaxed) != 0)
+                continue; // Relaxed: a hint, rechecked by the pop
+            std::unique_lock lock(mQueueMutex);
+            mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
+            mWake.wait(lock, [&] { return mReadyCount > 0 || IsDone(inJob); });
+            mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // Only ever compared with zero by Run
+        }
+        return;
+    }
+    // Inside a job: isolated (see the header). Every check is under the queue mutex; such waits are rare
+    const uint32_t awaited = inJob.IsValid() ? inJob.mIndex : JobHandle::cInvalidIndex;
+    std::unique_lock lock(mQueueMutex);
     while (!IsDone(inJob))
     {
-        uint32_t index;
-        if (TryPopReady(index))
+        if (const int position = FindRunnableFor(run, awaited); position >= 0)
         {
+            const uint32_t index = TakeReadyAt(position);
+            lock.unlock();
             Run(index);
+            lock.lock();
             continue;
         }
-        if (SpinUntil([&] { return IsDone(inJob); })) return;
-        if (mNumReady.load(std::memory_order_relaxed) != 0) continue; // Relaxed: a hint, rechecked by the pop
-        std::unique_lock lock(mQueueMutex);
+        // Stuck until something of its own is queued, the job finishes, or every worker is stuck too (then a
+        // stuck thread may run anything). A stuck worker is counted, and the others re-check when it is
+        const bool isWorker = tWorkerOf == this;
+        if (isWorker)
+        {
+            ++mNumStuckWorkers;
+            mWake.notify_all();
+        }
         mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
-        mWake.wait(lock, [&] { return mReadyCount > 0 || IsDone(inJob); });
+        // A worker is already counted here, so it must not count itself again in FindRunnableFor
+        if (isWorker) tWorkerOf = nullptr;
+        mWake.wait(lock, [&] { return IsDone(inJob) || FindRunnableFor(run, awaited) >= 0; });
+        if (isWorker)
+        {
+            tWorkerOf = this;
+            --mNumStuckWorkers;
+        }
         mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // Only ever compared with zero by Run
     }
 }
@@ -212,8 +305,9 @@ void JobSystem::WaitAll(std::span<const JobHandle> inJobs)
         Wait(job);
 }
 
-void JobSystem::WaitIdle()
+bool JobSystem::WaitIdle()
 {
+    if (tCurrentRun != 0) return false; // Its own job is in flight: it would wait forever
     // Seq_cst loads: see Run
     while (mJobsInFlight.load(std::memory_order_seq_cst) != 0)
     {
@@ -229,6 +323,7 @@ void JobSystem::WaitIdle()
                    [&] { return mReadyCount > 0 || mJobsInFlight.load(std::memory_order_seq_cst) == 0; });
         mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // As in Wait
     }
+    return true;
 }
 
 bool JobSystem::WaitForFrameIdle(std::chrono::microseconds inTimeout) const
@@ -241,6 +336,7 @@ bool JobSystem::WaitForFrameIdle(std::chrono::microseconds inTimeout) const
 
 void JobSystem::WorkerMain()
 {
+    tWorkerOf = this;
     for (;;)
     {
         uint32_t index;

@@ -162,6 +162,33 @@ TEST(BackgroundQueueTest, CancelAQueuedTaskAtOnceAndARunningOneAtItsNextChunk)
     EXPECT_FALSE(queuedRan.load());
 }
 
+TEST(BackgroundQueueTest, CancellingAQueuedTaskReleasesItsCapturesAtOnce)
+{
+    BackgroundQueue queue;
+    Gate gate;
+    auto blocker = queue.Submit("gate", 0, gate.Step());
+    gate.WaitEntered();
+    auto captured = std::make_shared<int>(7);
+    auto queued = queue.Submit("holds a capture", 0,
+                               [captured](BackgroundTaskContext&) { return BackgroundStep::Done; });
+    EXPECT_EQ(captured.use_count(), 2);
+    queued->Cancel();
+    // Before, the capture lived on in the task until a queue thread happened to sweep it out
+    EXPECT_EQ(captured.use_count(), 1);
+    gate.mOpen.store(true, std::memory_order_release);
+    EXPECT_TRUE(blocker->Wait(10s));
+}
+
+TEST(BackgroundQueueTest, AThreadCountBeyondTheLimitIsClamped)
+{
+    BackgroundQueue::Settings settings;
+    settings.mNumThreads = 10000;
+    BackgroundQueue queue(settings);
+    auto task = queue.Submit("runs", 0, [](BackgroundTaskContext&) { return BackgroundStep::Done; });
+    EXPECT_TRUE(task->Wait(10s));
+    EXPECT_EQ(queue.GetNumThreads(), BackgroundQueue::cMaxThreads);
+}
+
 TEST(BackgroundQueueTest, FailuresCarryTheirReason)
 {
     BackgroundQueue queue;

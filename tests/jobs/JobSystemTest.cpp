@@ -171,6 +171,60 @@ TEST_P(JobSystemThreads, JobsCanScheduleAndWaitForJobs)
     EXPECT_EQ(leaves.load(), 8 * (8 + 64));
 }
 
+TEST_P(JobSystemThreads, AWaitInsideAJobDoesNotRunAJobThatWaitsForIt)
+{
+    // P waits for its child Q; R, queued behind P, waits for P. Before isolation, P's wait ran R on P's own
+    // stack when Q was not first in the queue, and R then waited forever for P below it
+    JobSystem jobs(MakeSettings());
+    for (int round = 0; round < 50; ++round)
+    {
+        std::atomic<int> done{0};
+        const JobHandle p = jobs.Schedule("P",
+                                          [&]
+                                          {
+                                              const JobHandle q =
+                                                  jobs.Schedule("Q", [&] { done.fetch_add(1); });
+                                              jobs.Wait(q);
+                                              done.fetch_add(1);
+                                          });
+        const JobHandle r = jobs.Schedule("R",
+                                          [&]
+                                          {
+                                              jobs.Wait(p);
+                                              done.fetch_add(1);
+                                          });
+        jobs.Wait(r);
+        EXPECT_EQ(done.load(), 3);
+    }
+}
+
+TEST_P(JobSystemThreads, AJobCanWaitForASiblingThatIsNotReadyYet)
+{
+    // The sibling waits on a prerequisite that nobody inside the waiting job scheduled: with no other thread,
+    // the wait must still run it
+    JobSystem jobs(MakeSettings());
+    std::atomic<int> order{0};
+    int prerequisiteRan = -1, siblingRan = -1;
+    const JobHandle waiter = jobs.Schedule("waiter", [&] {});
+    const JobHandle prerequisite =
+        jobs.Schedule("prerequisite", [&] { prerequisiteRan = order.fetch_add(1); });
+    const JobHandle sibling =
+        jobs.Schedule("sibling", [&] { siblingRan = order.fetch_add(1); }, {prerequisite});
+    const JobHandle parent = jobs.Schedule("parent", [&] { jobs.Wait(sibling); }, {waiter});
+    jobs.Wait(parent);
+    EXPECT_EQ(prerequisiteRan, 0);
+    EXPECT_EQ(siblingRan, 1);
+}
+
+TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
+{
+    JobSystem jobs(MakeSettings());
+    bool result = true;
+    jobs.Wait(jobs.Schedule("asks for idle", [&] { result = jobs.WaitIdle(); }));
+    EXPECT_FALSE(result) << "its own job is in flight: it could never be idle";
+    EXPECT_TRUE(jobs.WaitIdle());
+}
+
 TEST_P(JobSystemThreads, WaitIdleRunsEverything)
 {
     std::atomic<int> ran{0};
@@ -178,7 +232,7 @@ TEST_P(JobSystemThreads, WaitIdleRunsEverything)
         JobSystem jobs(MakeSettings());
         for (int i = 0; i < 100; ++i)
             jobs.Schedule("fire and forget", [&] { ran.fetch_add(1, std::memory_order_relaxed); });
-        jobs.WaitIdle();
+        EXPECT_TRUE(jobs.WaitIdle());
         EXPECT_EQ(ran.load(), 100);
         EXPECT_EQ(jobs.GetNumJobsInFlight(), 0u);
         for (int i = 0; i < 50; ++i)

@@ -229,7 +229,7 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     struct WaitForJobs
     {
         jobs::JobSystem& mJobs;
-        ~WaitForJobs() { mJobs.WaitIdle(); }
+        ~WaitForJobs() { (void)mJobs.WaitIdle(); }
     } waitForJobs{jobSystem};
 
     result.mSummary.mInputs = inSource.GetInputNames();

@@ -118,9 +118,11 @@ private:
 class BackgroundQueue
 {
 public:
+    static constexpr uint32_t cMaxThreads = 64;
+
     struct Settings
     {
-        uint32_t mNumThreads = 1;
+        uint32_t mNumThreads = 1; ///< 1 to cMaxThreads (clamped)
         /// Frame jobs to stand aside for between chunks (may be null: then only the OS priority applies)
         const JobSystem* mFrameJobs = nullptr;
         /// Longest a thread stands aside per chunk while frame jobs stay in flight
@@ -150,6 +152,8 @@ public:
 
     /// Queues a task; an empty step function gives a task that is already Failed.
     std::shared_ptr<BackgroundTask> Submit(std::string inName, int inPriority, BackgroundStepFunction inStep);
+    /// Threads running tasks (the settings' count, clamped to 1..cMaxThreads).
+    uint32_t GetNumThreads() const { return uint32_t(mThreads.size()); }
     /// Tasks waiting for a thread (cancelled ones not yet swept out included).
     size_t GetNumQueued() const;
     Stats GetStats() const;

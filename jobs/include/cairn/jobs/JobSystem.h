@@ -112,11 +112,16 @@ public:
 
     /// True once the job has finished (its effects are then visible to this thread).
     bool IsDone(const JobHandle& inJob) const;
-    /// Returns when the job has finished, running queued jobs meanwhile.
+    /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs any
+    /// queued job. From inside a job it runs only jobs scheduled inside that job (and the awaited job
+    /// itself): an unrelated job run on this stack could wait for the job below it and never return (TBB
+    /// calls this isolation). It runs other jobs only when every worker is stuck the same way and nothing of
+    /// its own is queued, so a system of one thread still finishes a job that waits for a sibling.
     void Wait(const JobHandle& inJob);
     void WaitAll(std::span<const JobHandle> inJobs);
-    /// Returns when no frame job is queued or running, running queued jobs meanwhile.
-    void WaitIdle();
+    /// Returns true when no frame job is queued or running, running queued jobs meanwhile. From inside a job
+    /// it returns false at once: the calling job is in flight itself, so it would wait forever.
+    bool WaitIdle();
 
     /// inBody(begin, end) over [0, inCount) in chunks of inGrain, on up to GetNumThreads() threads; the
     /// caller takes part and returns when every chunk is done. Chunks are claimed from a shared cursor, so
@@ -167,6 +172,9 @@ private:
         std::mutex mMutex; ///< Guards mDependents/mNumDependents and orders the generation bump against them
         uint32_t mDependents[cMaxDependents] = {};
         uint32_t mNumDependents = 0;
+        /// The run of the job that scheduled it (0: scheduled outside any job); written before it is queued,
+        /// read under mQueueMutex by waits inside jobs (see Wait)
+        uint64_t mScope = 0;
     };
 
     uint32_t AllocateSlot();
@@ -174,6 +182,12 @@ private:
     JobHandle Publish(uint32_t inIndex, const char* inName, std::span<const JobHandle> inPrerequisites);
     void Enqueue(uint32_t inIndex);
     bool TryPopReady(uint32_t& outIndex);
+    /// Index in the ready ring (from its head) of a job a wait inside job run inScope may run for inAwaited:
+    /// one scheduled in inScope or the awaited job itself, else any job when every worker is stuck in such a
+    /// wait; -1 when none. mQueueMutex held.
+    int FindRunnableFor(uint64_t inScope, uint32_t inAwaited) const;
+    /// Removes entry inPosition (from the head) of the ready ring and returns its slot. mQueueMutex held.
+    uint32_t TakeReadyAt(int inPosition);
     void Run(uint32_t inIndex);
     void WorkerMain();
     /// Spins for up to about cSpinMicroseconds while inDone() is false and nothing is queued; true if
@@ -196,6 +210,7 @@ private:
 
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
+    size_t mNumStuckWorkers = 0;          ///< mQueueMutex: workers in a wait inside a job with nothing to run
     mutable std::mutex mIdleMutex;
     mutable std::condition_variable mIdle; ///< Notified when mJobsInFlight drops to zero
 
