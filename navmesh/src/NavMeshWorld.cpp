@@ -116,13 +116,26 @@ int NavMeshWorld::Publish()
     int changed = 0;
     for (auto& [coord, entry] : pending)
     {
-        if (const dtTileRef old = mNavMesh->getTileRefAt(coord.mX, coord.mZ, 0); old != 0)
+        BuiltTile& tile = entry.mTile;
+        const dtTileRef old = mNavMesh->getTileRefAt(coord.mX, coord.mZ, 0);
+        auto refuse = [&](const std::string& inWhy)
+        {
+            ++mRefusedTiles;
+            mLastRefusal = "tile " + std::to_string(coord.mX) + "," + std::to_string(coord.mZ) + ": " + inWhy;
+        };
+        // Checked before the old tile goes: a refused tile must not leave a hole where a good one was
+        if (tile.mData != nullptr && tile.mNumPolygons > mNavMesh->getParams()->maxPolys)
+        {
+            refuse(std::to_string(tile.mNumPolygons) + " polygons, over the " +
+                   std::to_string(mNavMesh->getParams()->maxPolys) + " a tile reference holds");
+            continue;
+        }
+        if (old != 0)
         {
             mNavMesh->removeTile(old, nullptr, nullptr); // Frees its data (added with DT_TILE_FREE_DATA)
             mTilePolygons.erase(coord);
             ++changed;
         }
-        BuiltTile& tile = entry.mTile;
         if (tile.mData == nullptr) continue;
         // On success the navmesh owns the data; on failure (out of tiles) it stays ours and is freed
         if (dtStatusSucceed(
@@ -132,8 +145,17 @@ int NavMeshWorld::Publish()
             mTilePolygons[coord] = tile.mNumPolygons;
             ++changed;
         }
+        else
+            refuse("Detour refused it (no free tile slot, or its data is invalid)");
     }
     return changed;
+}
+
+uint64_t NavMeshWorld::GetRefusedTiles(std::string* outLastReason) const
+{
+    std::shared_lock lock(mNavMeshMutex);
+    if (outLastReason != nullptr) *outLastReason = mLastRefusal;
+    return mRefusedTiles;
 }
 
 Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter,

@@ -14,12 +14,15 @@ TileScheduler::TileScheduler(PhysicsSystem& ioPhysics, NavMeshWorld& ioWorld, jo
       mCollector(ioPhysics.GetBodyManager(), ioPhysics.GetBroadPhase()),
       mBorder(float(ioWorld.GetProfile().GetBorderCells()) * ioWorld.GetProfile().mCellSize)
 {
-    mPhysics.SetBodyChangeListener(this);
+    // Several schedulers (a navmesh per agent profile) may listen to one world: each adds itself
+    if (!mPhysics.AddBodyChangeListener(this))
+        mStats.mLastError = "the physics world has no room for another body change listener: bodies that "
+                            "change will not make their tiles dirty";
 }
 
 TileScheduler::~TileScheduler()
 {
-    mPhysics.SetBodyChangeListener(nullptr);
+    mPhysics.RemoveBodyChangeListener(this);
     std::vector<std::shared_ptr<jobs::BackgroundTask>> tasks;
     {
         std::lock_guard lock(mMutex);
@@ -35,11 +38,15 @@ TileScheduler::~TileScheduler()
         }
 }
 
-TileScheduler::InvokerID TileScheduler::AddInvoker(const Vec3& inPosition, float inRadius)
+Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPosition, float inRadius)
 {
+    if (!IsValidWorldPosition(inPosition))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
+    if (!(inRadius >= 0.0f && inRadius <= 1e5f))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: radius must be in [0, 1e5] m");
     std::lock_guard lock(mMutex);
     const InvokerID id = mNextID++;
-    mInvokers[id] = {inPosition, std::isfinite(inRadius) ? std::max(inRadius, 0.0f) : 0.0f};
+    mInvokers[id] = {inPosition, inRadius};
     return id;
 }
 
@@ -56,8 +63,11 @@ void TileScheduler::RemoveInvoker(InvokerID inInvoker)
     mInvokers.erase(inInvoker);
 }
 
-TileScheduler::AreaID TileScheduler::AddArea(const AABB& inBounds)
+Result<TileScheduler::AreaID> TileScheduler::AddArea(const AABB& inBounds)
 {
+    if (!IsValidWorldPosition(inBounds.mMin) || !IsValidWorldPosition(inBounds.mMax) || inBounds.IsEmpty())
+        return MakeError(ErrorCode::InvalidArgument,
+                         "navmesh area: bounds must be inside the world, min <= max");
     std::lock_guard lock(mMutex);
     const AreaID id = mNextID++;
     mAreas[id] = inBounds;
@@ -73,8 +83,15 @@ void TileScheduler::RemoveArea(AreaID inArea)
     mAreas.erase(it);
 }
 
-TileScheduler::LinkID TileScheduler::AddOffMeshLink(const OffMeshLink& inLink)
+Result<TileScheduler::LinkID> TileScheduler::AddOffMeshLink(const OffMeshLink& inLink)
 {
+    if (!IsValidWorldPosition(inLink.mStart) || !IsValidWorldPosition(inLink.mEnd))
+        return MakeError(ErrorCode::InvalidArgument, "off-mesh link: an end is NaN or outside the world");
+    if (!(inLink.mRadius > 0.0f && inLink.mRadius <= 1e3f))
+        return MakeError(ErrorCode::InvalidArgument, "off-mesh link: radius must be in (0, 1e3] m");
+    if (inLink.mArea > cMaxAreaId)
+        return MakeError(ErrorCode::InvalidArgument, "off-mesh link: area " + std::to_string(inLink.mArea) +
+                                                         " is over " + std::to_string(cMaxAreaId));
     std::lock_guard lock(mMutex);
     const LinkID id = mNextID++;
     mLinks[id] = inLink;
@@ -193,8 +210,19 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
     TileJob& job = *ioState.mJob;
     if (!job.IsFinished())
     {
-        // Cancelled before it ever ran: no result, build again if still needed
         if (!ioState.mTask->IsFinished()) return false;
+        if (ioState.mTask->GetState() == jobs::BackgroundTaskState::Failed)
+        {
+            // The job threw (out of memory in Recast, say): a failure like a refused tile, not built again by
+            // itself every frame; a later change to the tile (dirty) retries it
+            ++mStats.mJobsFailed;
+            mStats.mLastError = "tile " + std::to_string(inTile.mX) + "," + std::to_string(inTile.mZ) + ": " +
+                                ioState.mTask->GetError();
+            ioState.mJob.reset();
+            ioState.mTask.reset();
+            return true;
+        }
+        // Cancelled before it ever ran: no result, build again if still needed
         ioState.mDirty = true;
         ioState.mJob.reset();
         ioState.mTask.reset();
@@ -287,13 +315,23 @@ int TileScheduler::Update()
         std::sort(candidates.begin(), candidates.end());
         for (const auto& [distance, tile] : candidates)
         {
-            if (running >= mSettings.mMaxConcurrentJobs) break;
+            // A budget of 0 would never build anything, and a caller waiting for IsIdle would wait forever
+            if (running >= std::max(1u, mSettings.mMaxConcurrentJobs)) break;
             StartJob(tile, mTiles[tile]);
             ++running;
         }
     }
     // The sync point: outside mMutex, since it waits for path queries in progress
-    return mWorld.Publish();
+    const int changed = mWorld.Publish();
+    std::string reason;
+    if (const uint64_t refused = mWorld.GetRefusedTiles(&reason); refused != mRefusedSeen)
+    {
+        std::lock_guard lock(mMutex);
+        mStats.mJobsFailed += refused - mRefusedSeen;
+        mStats.mLastError = "publish: " + reason;
+        mRefusedSeen = refused;
+    }
+    return changed;
 }
 
 bool TileScheduler::IsIdle() const

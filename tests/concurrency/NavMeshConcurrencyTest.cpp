@@ -49,8 +49,10 @@ NavMeshUnderTest MakeNavMesh(PhysicsSystem& ioPhysics, jobs::BackgroundQueue& io
     TileScheduler::Settings settings;
     settings.mMaxConcurrentJobs = 2;
     navMesh.mScheduler = std::make_unique<TileScheduler>(ioPhysics, *navMesh.mWorld, ioQueue, settings);
-    navMesh.mScheduler->AddArea(AABB(Vec3(-cHalfWorld + 0.1f, -5, -cHalfWorld + 0.1f),
-                                     Vec3(cHalfWorld - 0.1f, 20, cHalfWorld - 0.1f)));
+    (void)navMesh.mScheduler
+        ->AddArea(AABB(Vec3(-cHalfWorld + 0.1f, -5, -cHalfWorld + 0.1f),
+                       Vec3(cHalfWorld - 0.1f, 20, cHalfWorld - 0.1f)))
+        .Value();
     return navMesh;
 }
 

@@ -189,5 +189,31 @@ TEST(NavMeshBadInputTest, CorruptTileDataIsRefusedBeforeDetourReadsIt)
     EXPECT_NE(loadError(badIndex).find("missing vertex"), std::string::npos);
 }
 
+TEST(NavMeshBadInputTest, ATileDetourCannotTakeIsRefusedAndTheOldOneStays)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    ASSERT_TRUE(world);
+    TileGeometry geometry;
+    geometry.AddTriangle(Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 0), cDefaultArea);
+    auto build = [&] { return BuildTile(profile, grid, {0, 0}, geometry).Value(); };
+    world.Value()->SubmitTile(build());
+    ASSERT_EQ(world.Value()->Publish(), 1);
+    const int polygons = world.Value()->GetTilePolygonCount({0, 0});
+    ASSERT_GT(polygons, 0);
+
+    // As a tile of a dense scene would be: more polygons than the 32-bit references leave room for
+    BuiltTile tooMany = build();
+    tooMany.mNumPolygons = 1 << 20;
+    world.Value()->SubmitTile(std::move(tooMany));
+    EXPECT_EQ(world.Value()->Publish(), 0);
+    std::string reason;
+    EXPECT_EQ(world.Value()->GetRefusedTiles(&reason), 1u);
+    EXPECT_NE(reason.find("polygons"), std::string::npos);
+    EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons)
+        << "before, the old tile was removed first";
+}
+
 } // namespace
 } // namespace cairn::navmesh::test

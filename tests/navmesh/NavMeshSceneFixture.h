@@ -31,8 +31,9 @@ protected:
         queueSettings.mNumThreads = 1;
         mQueue = std::make_unique<jobs::BackgroundQueue>(queueSettings);
         mScheduler = std::make_unique<TileScheduler>(*mPhysics, *mWorld, *mQueue, inSettings);
-        mArea = mScheduler->AddArea(
-            AABB(Vec3(-half + 0.1f, -5, -half + 0.1f), Vec3(half - 0.1f, 20, half - 0.1f)));
+        mArea = mScheduler
+                    ->AddArea(AABB(Vec3(-half + 0.1f, -5, -half + 0.1f), Vec3(half - 0.1f, 20, half - 0.1f)))
+                    .Value();
     }
 
     void TearDown() override

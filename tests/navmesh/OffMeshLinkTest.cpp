@@ -27,7 +27,7 @@ TEST_F(OffMeshLinkTest, AJumpAcrossAGapJoinsTheSidesWhileDeclared)
     jump.mStart = Vec3(-2.5f, 0, 0);
     jump.mEnd = Vec3(2.5f, 0, 0);
     jump.mRadius = 0.6f;
-    const TileScheduler::LinkID link = mScheduler->AddOffMeshLink(jump);
+    const TileScheduler::LinkID link = mScheduler->AddOffMeshLink(jump).Value();
     ASSERT_TRUE(RunUntilIdle());
     Result<PathResult> joined = mWorld->FindPath(start, end);
     ASSERT_TRUE(joined);
@@ -53,7 +53,7 @@ TEST_F(OffMeshLinkTest, AOneWayDropIsTakenOneWayOnly)
     drop.mStart = Vec3(-2.5f, 0, 0);
     drop.mEnd = Vec3(2.5f, 0, 0);
     drop.mBidirectional = false;
-    mScheduler->AddOffMeshLink(drop);
+    ASSERT_TRUE(mScheduler->AddOffMeshLink(drop));
     ASSERT_TRUE(RunUntilIdle());
     EXPECT_TRUE(mWorld->FindPath(Vec3(-8, 0, 0), Vec3(8, 0, 0)).Value().mReachedEnd);
     EXPECT_FALSE(mWorld->FindPath(Vec3(8, 0, 0), Vec3(-8, 0, 0)).Value().mReachedEnd);

@@ -4,6 +4,7 @@
 #include "NavMeshSceneFixture.h"
 
 #include <algorithm>
+#include <limits>
 
 namespace cairn::navmesh::test
 {
@@ -29,7 +30,7 @@ TEST_F(TileSchedulerTest, AnInvokerGetsTheTilesWithinItsRadiusNearestFirstWithin
     settings.mMaxConcurrentJobs = 1;
     MakeFloorWorld(settings);
     // 2 m from the tile corner at the origin: a 5 m radius reaches the four tiles around the origin
-    mScheduler->AddInvoker(Vec3(2, 0, 2), 5.0f);
+    ASSERT_TRUE(mScheduler->AddInvoker(Vec3(2, 0, 2), 5.0f));
     std::vector<TileCoord> publishOrder;
     for (int frame = 0; frame < 2000 && !mScheduler->IsIdle(); ++frame)
     {
@@ -56,7 +57,7 @@ TEST_F(TileSchedulerTest, TilesNoInvokerNeedsAreDroppedAfterTheDelay)
     TileScheduler::Settings settings;
     settings.mDropDelayFrames = 10;
     MakeFloorWorld(settings);
-    const TileScheduler::InvokerID invoker = mScheduler->AddInvoker(Vec3(6.4f, 0, 6.4f), 1.0f);
+    const TileScheduler::InvokerID invoker = mScheduler->AddInvoker(Vec3(6.4f, 0, 6.4f), 1.0f).Value();
     ASSERT_TRUE(RunUntilIdle());
     const TileCoord before = TileAt(6.4f, 6.4f), after = TileAt(-19.2f, -19.2f);
     ASSERT_TRUE(mWorld->HasTile(before));
@@ -95,6 +96,37 @@ TEST_F(TileSchedulerTest, ATileIsPublishedOnlyAtTheSyncPoint)
     EXPECT_EQ(mWorld->GetNumTiles(), 0);
     mScheduler->Update();
     EXPECT_GT(mWorld->GetNumTiles(), 0);
+}
+
+TEST_F(TileSchedulerTest, BadInvokersAreasAndLinksAreRefused)
+{
+    MakeFloorWorld({});
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FALSE(mScheduler->AddInvoker(Vec3(nan, 0, 0), 5.0f));
+    EXPECT_FALSE(mScheduler->AddInvoker(Vec3(0, 0, 0), -1.0f));
+    EXPECT_FALSE(mScheduler->AddInvoker(Vec3(0, 0, 0), 1e9f));
+    EXPECT_FALSE(mScheduler->AddArea(AABB(Vec3(1, 1, 1), Vec3(0, 0, 0))));
+    EXPECT_FALSE(mScheduler->AddArea(AABB(Vec3(-2.5e10f, 0, 0), Vec3(2.5e10f, 1, 1))));
+    OffMeshLink link;
+    link.mStart = Vec3(1, 0, 1);
+    link.mEnd = Vec3(3, 0, 1);
+    link.mArea = 63; // Over cMaxAreaId: the tile build would refuse the whole start tile
+    EXPECT_FALSE(mScheduler->AddOffMeshLink(link));
+    link.mArea = cDefaultArea;
+    link.mRadius = 0.0f;
+    EXPECT_FALSE(mScheduler->AddOffMeshLink(link));
+    link.mRadius = 0.5f;
+    EXPECT_TRUE(mScheduler->AddOffMeshLink(link));
+}
+
+TEST_F(TileSchedulerTest, AJobBudgetOfZeroStillBuilds)
+{
+    TileScheduler::Settings settings;
+    settings.mMaxConcurrentJobs = 0;
+    MakeFloorWorld(settings);
+    ASSERT_TRUE(mScheduler->AddInvoker(Vec3(2, 0, 2), 1.0f));
+    EXPECT_TRUE(RunUntilIdle()) << "a budget of 0 never built anything, and IsIdle never came";
+    EXPECT_GE(mWorld->GetNumTiles(), 1);
 }
 
 } // namespace

@@ -175,7 +175,7 @@ PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
         TileScheduler::Settings settings;
         settings.mMaxConcurrentJobs = inBackgroundJobs;
         scheduler = std::make_unique<TileScheduler>(physics, *world, queue, settings);
-        scheduler->AddArea(area);
+        (void)scheduler->AddArea(area).Value(); // The shared world's tile: always inside the world
     }
     // Real-time frames at 60 Hz, as in a game: the step, the sync point, then the rest of the frame, in which
     // the background jobs get the CPU the frame leaves
@@ -253,8 +253,11 @@ void RunInvokerLatency(const SharedBenchData& inData)
         {
             if (invoker != 0) scheduler.RemoveInvoker(invoker);
             const int index = frame / 20;
-            invoker = scheduler.AddInvoker(
-                Vec3(6.4f + 12.8f * float(index % 30), 0.0f, 6.4f + 12.8f * float((index * 7) % 19)), 1.0f);
+            invoker = scheduler
+                          .AddInvoker(Vec3(6.4f + 12.8f * float(index % 30), 0.0f,
+                                           6.4f + 12.8f * float((index * 7) % 19)),
+                                      1.0f)
+                          .Value(); // Tile centres of the shared world: always inside it
         }
         (void)physics.Update(1.0f / 60.0f);
         scheduler.Update();

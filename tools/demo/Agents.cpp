@@ -24,7 +24,8 @@ Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, cons
     {
         Agent agent;
         agent.mPosition = mGenerator.GetPlayerPosition(when(mRandom));
-        agent.mInvoker = mScheduler.AddInvoker(agent.mPosition, cInvokerRadius);
+        // The agents start on the generated terrain, inside the world: an error here is a bug in the demo
+        agent.mInvoker = mScheduler.AddInvoker(agent.mPosition, cInvokerRadius).Value();
         mAgents.push_back(agent);
     }
 }

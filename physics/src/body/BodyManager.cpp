@@ -181,13 +181,44 @@ void BodyManager::DeactivateBody(Body& ioBody)
     NotifyChange(BodyChangeKind::FellAsleep, ioBody, ioBody.mBounds);
 }
 
+bool BodyManager::AddChangeListener(BodyChangeListener* inListener)
+{
+    if (inListener == nullptr) return false;
+    for (std::atomic<BodyChangeListener*>& slot : mChangeListeners)
+    {
+        BodyChangeListener* expected = nullptr;
+        // Release: publishes the listener's construction to NotifyChange's acquire; relaxed on failure (the
+        // slot is taken, try the next)
+        if (slot.compare_exchange_strong(expected, inListener, std::memory_order_release,
+                                         std::memory_order_relaxed))
+            return true;
+    }
+    return false;
+}
+
+void BodyManager::RemoveChangeListener(BodyChangeListener* inListener)
+{
+    for (std::atomic<BodyChangeListener*>& slot : mChangeListeners)
+    {
+        BodyChangeListener* expected = inListener;
+        // Relaxed: the contract has no thread changing bodies meanwhile, so nobody is inside the listener
+        slot.compare_exchange_strong(expected, nullptr, std::memory_order_relaxed);
+    }
+}
+
 void BodyManager::NotifyChange(BodyChangeKind inKind, const Body& inBody, const AABB& inOldBounds) const
 {
-    // Acquire: pairs with the release in SetChangeListener
-    BodyChangeListener* listener = mChangeListener.load(std::memory_order_acquire);
-    if (listener == nullptr) return;
-    listener->OnBodyChanged({inKind, inBody.mID, inBody.mMotionType, inBody.mObjectLayer, inBody.IsActive(),
-                             inOldBounds, inBody.mInWorld ? inBody.mBounds : AABB::Empty()});
+    const BodyChange change{inKind,
+                            inBody.mID,
+                            inBody.mMotionType,
+                            inBody.mObjectLayer,
+                            inBody.IsActive(),
+                            inOldBounds,
+                            inBody.mInWorld ? inBody.mBounds : AABB::Empty()};
+    for (const std::atomic<BodyChangeListener*>& slot : mChangeListeners)
+        // Acquire: pairs with the release in AddChangeListener
+        if (BodyChangeListener* listener = slot.load(std::memory_order_acquire); listener != nullptr)
+            listener->OnBodyChanged(change);
 }
 
 void BodyManager::LockAllBodies() const

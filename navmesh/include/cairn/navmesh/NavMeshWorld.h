@@ -62,8 +62,12 @@ public:
     /// Queues the removal of a tile for the next Publish. Any thread.
     void SubmitRemoval(const TileCoord& inTile);
     /// The sync point: swaps every queued tile in (or out). Returns how many tiles changed. Any thread, but
-    /// meant for one place in the frame; it waits for path queries in progress.
+    /// meant for one place in the frame; it waits for path queries in progress. A tile Detour cannot take
+    /// (more polygons than a tile reference holds, or no free tile slot) is refused: the tile already there
+    /// stays, and the refusal is counted (GetRefusedTiles).
     int Publish();
+    /// Tiles Publish refused so far, and why the last one was. Any thread.
+    uint64_t GetRefusedTiles(std::string* outLastReason = nullptr) const;
 
     /// Largest search extent of FindPath in x and z, in tiles.
     static constexpr float cMaxSearchExtentTiles = 4.0f;
@@ -93,6 +97,8 @@ private:
     mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish; shared: queries
     dtNavMesh* mNavMesh = nullptr;           ///< Guarded by mNavMeshMutex
     std::map<TileCoord, int> mTilePolygons;  ///< Guarded by mNavMeshMutex
+    uint64_t mRefusedTiles = 0;              ///< Guarded by mNavMeshMutex
+    std::string mLastRefusal;                ///< Guarded by mNavMeshMutex
     std::mutex mPendingMutex;
     struct Pending
     {

@@ -43,7 +43,7 @@ public:
     struct Settings
     {
         NavMeshInclusion mInclusion;
-        uint32_t mMaxConcurrentJobs = 2; ///< Tile jobs running at once (the job budget)
+        uint32_t mMaxConcurrentJobs = 2; ///< Tile jobs running at once (the job budget; 0 counts as 1)
         uint32_t mDropDelayFrames = 120; ///< A tile no invoker needs is dropped after this many frames
         int mJobPriority = 0;            ///< On the background queue (higher runs first)
     };
@@ -74,19 +74,23 @@ public:
     TileScheduler(const TileScheduler&) = delete;
     TileScheduler& operator=(const TileScheduler&) = delete;
 
-    /// Invokers: the tiles within inRadius (x-z distance from inPosition) are kept built. Any thread.
-    InvokerID AddInvoker(const Vec3& inPosition, float inRadius);
+    /// Invokers: the tiles within inRadius (x-z distance from inPosition) are kept built. Any thread. Error
+    /// for a position outside the world or a radius that is not in [0, 1e5] m.
+    Result<InvokerID> AddInvoker(const Vec3& inPosition, float inRadius);
     void MoveInvoker(InvokerID inInvoker, const Vec3& inPosition);
     void RemoveInvoker(InvokerID inInvoker);
     /// Areas: every tile overlapping inBounds is kept built until RemoveArea, which drops them at once
     /// (unless an invoker or another area still needs them). Any thread.
-    AreaID AddArea(const AABB& inBounds);
+    /// Error for bounds outside the world or empty.
+    Result<AreaID> AddArea(const AABB& inBounds);
     void RemoveArea(AreaID inArea);
 
     /// Off-mesh links (jumps, ladders): built into the tile that holds the start; adding or removing one
     /// makes that tile dirty. Any thread.
     using LinkID = uint32_t;
-    LinkID AddOffMeshLink(const OffMeshLink& inLink);
+    /// Error for an end outside the world, a radius not in (0, 1e3] m or an area over cMaxAreaId (the tile
+    /// build would refuse the whole tile).
+    Result<LinkID> AddOffMeshLink(const OffMeshLink& inLink);
     void RemoveOffMeshLink(LinkID inLink);
 
     /// Marks the tiles inBounds touches dirty (for changes the physics world does not report). Any thread.
@@ -146,6 +150,7 @@ private:
     uint32_t mNextID = 1;
     std::vector<TileCoord> mDropNow; ///< Tiles of removed areas, checked at the next Update
     Stats mStats;
+    uint64_t mRefusedSeen = 0; ///< NavMeshWorld's refused tiles already counted in mStats; Update's thread
 };
 
 } // namespace cairn::navmesh

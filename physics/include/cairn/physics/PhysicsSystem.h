@@ -55,9 +55,17 @@ public:
     const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
     const BroadPhase& GetBroadPhase() const { return *mBroadPhase; }
     const BodyManager& GetBodyManager() const { return *mBodies; }
-    /// Who is told about bodies added, removed, moved by hand, falling asleep and waking (null: nobody). See
-    /// BodyChangeListener.h; set and clear it while no other thread changes bodies.
-    void SetBodyChangeListener(BodyChangeListener* inListener) { mBodies->SetChangeListener(inListener); }
+    /// Adds one of those told about bodies added, removed, moved by hand, falling asleep and waking (up to
+    /// BodyManager::cMaxChangeListeners; false when full). See BodyChangeListener.h; add and remove while no
+    /// other thread changes bodies.
+    bool AddBodyChangeListener(BodyChangeListener* inListener)
+    {
+        return mBodies->AddChangeListener(inListener);
+    }
+    void RemoveBodyChangeListener(BodyChangeListener* inListener)
+    {
+        mBodies->RemoveChangeListener(inListener);
+    }
     const LayerSetup& GetLayers() const { return mLayers; }
     const PhysicsSettings& GetSettings() const { return mSettings; }
     /// Ok, or why the settings or layers given at construction were refused.

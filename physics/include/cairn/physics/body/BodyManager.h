@@ -23,6 +23,7 @@
 #include "cairn/physics/body/BodyChangeListener.h"
 #include "cairn/physics/math/Result.h"
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -70,13 +71,14 @@ public:
     /// TryGetBody.
     Body* TryGetBodyAtIndex(uint32_t inIndex) const;
 
-    /// The listener told about bodies added, removed, moved, falling asleep and waking (null: none). Set it
-    /// before other threads change bodies, and keep it alive while it is set.
-    void SetChangeListener(BodyChangeListener* inListener)
-    {
-        mChangeListener.store(inListener, std::memory_order_release); // Publishes the listener's construction
-    }
-    /// Tells the listener, if any, about a change of inBody (whose lock the caller holds, or the step).
+    static constexpr uint32_t cMaxChangeListeners = 8;
+    /// Adds a listener told about bodies added, removed, moved, falling asleep and waking (several may
+    /// listen: e.g. a navmesh per agent profile). False when cMaxChangeListeners are registered already. Add
+    /// and remove while no other thread changes bodies, and keep a listener alive while it is registered.
+    bool AddChangeListener(BodyChangeListener* inListener);
+    /// Removes a listener added before (nothing happens for one that is not registered).
+    void RemoveChangeListener(BodyChangeListener* inListener);
+    /// Tells the listeners about a change of inBody (whose lock the caller holds, or the step).
     void NotifyChange(BodyChangeKind inKind, const Body& inBody, const AABB& inOldBounds) const;
 
     /// Puts a dynamic or kinematic body in the world into the active list. Caller holds the body's mutex
@@ -116,7 +118,7 @@ private:
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
     mutable PaddedMutex mStaticMutexes[cNumBodyMutexes]; ///< Also held by writers outside the step
-    std::atomic<BodyChangeListener*> mChangeListener{nullptr};
+    std::array<std::atomic<BodyChangeListener*>, cMaxChangeListeners> mChangeListeners{}; ///< Null: free
 
     mutable std::mutex mFreeListMutex;
     std::vector<uint32_t> mFreeList; ///< Guarded by mFreeListMutex
