@@ -139,11 +139,11 @@ void JobSystem::Enqueue(uint32_t inIndex)
         mReady[(mReadyHead + mReadyCount) % mMaxJobs] = inIndex;
         ++mReadyCount;
         mNumReady.store(mReadyCount, std::memory_order_relaxed); // A hint for spinners, see SpinUntil
-        // Relaxed, under the mutex that a sleeper held when it counted itself: it sees every such sleeper
-        waiters = mNumWaiters.load(std::memory_order_relaxed) > 0;
+        waiters = mNumIsolatedSleepers > 0;
     }
-    // With waiters asleep, one wake-up could go to a waiter that may not run this job (isolation), or whose
-    // own job has just finished and which leaves: then the workers would sleep on with the job queued
+    // One wake-up could go to a wait inside a job that may not run this job (isolation), and the workers
+    // would sleep on with the job queued: then everybody re-checks. Otherwise one thread is enough (waking
+    // all made a chain of jobs bounce between threads)
     if (waiters)
         mWake.notify_all();
     else
@@ -262,6 +262,9 @@ void JobSystem::Wait(const JobHandle& inJob)
             mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
             mWake.wait(lock, [&] { return mReadyCount > 0 || IsDone(inJob); });
             mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // Only ever compared with zero by Run
+            // Woken for a queued job but leaving because its own finished: pass the wake-up on, or the
+            // workers could sleep on with the job queued
+            if (mReadyCount > 0 && IsDone(inJob)) mWake.notify_one();
         }
         return;
     }
@@ -287,9 +290,11 @@ void JobSystem::Wait(const JobHandle& inJob)
             mWake.notify_all();
         }
         mNumWaiters.fetch_add(1, std::memory_order_seq_cst); // Seq_cst: see Run
+        ++mNumIsolatedSleepers;
         // A worker is already counted here, so it must not count itself again in FindRunnableFor
         if (isWorker) tWorkerOf = nullptr;
         mWake.wait(lock, [&] { return IsDone(inJob) || FindRunnableFor(run, awaited) >= 0; });
+        --mNumIsolatedSleepers;
         if (isWorker)
         {
             tWorkerOf = this;

@@ -211,6 +211,7 @@ private:
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     size_t mNumStuckWorkers = 0;          ///< mQueueMutex: workers in a wait inside a job with nothing to run
+    uint32_t mNumIsolatedSleepers = 0;    ///< mQueueMutex: waits inside jobs asleep (Enqueue wakes them all)
     mutable std::mutex mIdleMutex;
     mutable std::condition_variable mIdle; ///< Notified when mJobsInFlight drops to zero
 
