@@ -3,7 +3,20 @@
 namespace cairn::test
 {
 
-using SleepAndWakeTest = SimulationFixture;
+class SleepAndWakeTest : public SimulationFixture
+{
+protected:
+    /// Two 1 m boxes stacked on the floor, left until their island sleeps.
+    void StackTwoBoxesAndSleep(BodyID& outBottom, BodyID& outTop)
+    {
+        AddFloor();
+        outBottom = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
+        outTop = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.5f, 0)));
+        Step(120);
+        ASSERT_FALSE(IsActive(outBottom));
+        ASSERT_FALSE(IsActive(outTop));
+    }
+};
 
 TEST_F(SleepAndWakeTest, IslandSleepsOnlyAfterHalfASecondOfRest)
 {
@@ -17,12 +30,8 @@ TEST_F(SleepAndWakeTest, IslandSleepsOnlyAfterHalfASecondOfRest)
 
 TEST_F(SleepAndWakeTest, MovingABodyThroughTheInterfaceWakesItsIsland)
 {
-    AddFloor();
-    const BodyID bottom = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
-    const BodyID top = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.5f, 0)));
-    Step(120);
-    ASSERT_FALSE(IsActive(bottom));
-    ASSERT_FALSE(IsActive(top));
+    BodyID bottom, top;
+    ASSERT_NO_FATAL_FAILURE(StackTwoBoxesAndSleep(bottom, top));
     // Shove the bottom box sideways out from under the top box
     ASSERT_TRUE(Bodies().SetPosition(bottom, Vec3(2, 0.5f, 0), Activation::Activate).IsOk());
     Step(1);
@@ -46,12 +55,8 @@ TEST_F(SleepAndWakeTest, RemovingTheSupportWakesTheBodyOnIt)
 
 TEST_F(SleepAndWakeTest, AWokenIslandWhoseOtherMemberWasDestroyedAndItsSlotReusedStillSteps)
 {
-    AddFloor();
-    const BodyID bottom = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
-    const BodyID top = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.5f, 0)));
-    Step(120);
-    ASSERT_FALSE(IsActive(bottom));
-    ASSERT_FALSE(IsActive(top));
+    BodyID bottom, top;
+    ASSERT_NO_FATAL_FAILURE(StackTwoBoxesAndSleep(bottom, top));
     // Removing the top box wakes the bottom one, whose island ring still names the top box's slot
     ASSERT_TRUE(Bodies().RemoveBody(top).IsOk());
     ASSERT_TRUE(Bodies().DestroyBody(top).IsOk());
