@@ -1,5 +1,6 @@
 #include "cairn/jobs/JobSystem.h"
 
+#include <algorithm>
 #include <cassert>
 #include <chrono>
 
@@ -156,6 +157,16 @@ int JobSystem::FindRunnableFor(uint64_t inScope, uint32_t inAwaited) const
     {
         const uint32_t index = mReady[(mReadyHead + i) % mMaxJobs];
         if (index == inAwaited || mSlots[index].mScope == inScope) return int(i);
+    }
+    // A prerequisite of the awaited job: running it is what the wait needs. (Slot mutexes are taken under the
+    // queue mutex only here, and no thread takes the queue mutex while it holds a slot mutex: no cycle.)
+    for (uint32_t i = 0; i < mReadyCount && inAwaited != JobHandle::cInvalidIndex; ++i)
+    {
+        JobSlot& slot = mSlots[mReady[(mReadyHead + i) % mMaxJobs]];
+        std::lock_guard slotLock(slot.mMutex);
+        if (std::find(slot.mDependents, slot.mDependents + slot.mNumDependents, inAwaited) !=
+            slot.mDependents + slot.mNumDependents)
+            return int(i);
     }
     // Nothing of its own: run anything only when no worker can (each is stuck in a wait inside a job; a
     // worker asking counts itself), or the queued jobs would never run

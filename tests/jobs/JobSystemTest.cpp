@@ -216,6 +216,38 @@ TEST_P(JobSystemThreads, AJobCanWaitForASiblingThatIsNotReadyYet)
     EXPECT_EQ(siblingRan, 1);
 }
 
+TEST_P(JobSystemThreads, AWaitInsideAJobRunsThePrerequisitesOfWhatItWaitsFor)
+{
+    // P waits for X, which waits for Y; R, queued before Y, waits for P. With nothing of P's own queued, a
+    // wait that ran the first queued job ran R on P's stack, and R waited forever for P below it
+    JobSystem jobs(MakeSettings());
+    for (int round = 0; round < 20; ++round)
+    {
+        std::atomic<int> done{0};
+        JobHandle x;
+        std::atomic<bool> xScheduled{false};
+        const JobHandle p = jobs.Schedule("P",
+                                          [&]
+                                          {
+                                              while (!xScheduled.load())
+                                                  std::this_thread::yield();
+                                              jobs.Wait(x);
+                                              done.fetch_add(1);
+                                          });
+        const JobHandle r = jobs.Schedule("R",
+                                          [&]
+                                          {
+                                              jobs.Wait(p);
+                                              done.fetch_add(1);
+                                          });
+        const JobHandle y = jobs.Schedule("Y", [&] { done.fetch_add(1); });
+        x = jobs.Schedule("X", [&] { done.fetch_add(1); }, {y});
+        xScheduled.store(true);
+        jobs.Wait(r);
+        EXPECT_EQ(done.load(), 4);
+    }
+}
+
 TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
 {
     JobSystem jobs(MakeSettings());

@@ -113,10 +113,11 @@ public:
     /// True once the job has finished (its effects are then visible to this thread).
     bool IsDone(const JobHandle& inJob) const;
     /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs any
-    /// queued job. From inside a job it runs only jobs scheduled inside that job (and the awaited job
-    /// itself): an unrelated job run on this stack could wait for the job below it and never return (TBB
-    /// calls this isolation). It runs other jobs only when every worker is stuck the same way and nothing of
-    /// its own is queued, so a system of one thread still finishes a job that waits for a sibling.
+    /// queued job. From inside a job it runs only jobs scheduled inside that job, the awaited job itself and
+    /// the awaited job's direct prerequisites: an unrelated job run on this stack could wait for the job
+    /// below it and never return (TBB calls this isolation). It runs other jobs only when every worker is
+    /// stuck the same way and none of those is queued, so a system of one thread still finishes deeper
+    /// chains.
     void Wait(const JobHandle& inJob);
     void WaitAll(std::span<const JobHandle> inJobs);
     /// Returns true when no frame job is queued or running, running queued jobs meanwhile. From inside a job
