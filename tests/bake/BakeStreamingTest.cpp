@@ -17,11 +17,7 @@ namespace cairn::bake
 namespace
 {
 
-std::vector<unsigned char> ReadBytes(const std::string& inPath)
-{
-    std::ifstream in(inPath, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using cairn::test::ReadBytes;
 
 TEST(BakeStreamingTest, TilesStreamedToTheFileEqualTheInMemoryBake)
 {

@@ -21,15 +21,11 @@ namespace cairn::bake
 namespace
 {
 
+using cairn::test::ReadBytes;
+
 std::string MeshPath(const char* inName)
 {
     return GetSharedDataDir() + "/recast-meshes/" + inName;
-}
-
-std::vector<unsigned char> ReadBytes(const std::string& inPath)
-{
-    std::ifstream in(inPath, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 std::string TempPath(const std::string& inName)

@@ -8,8 +8,10 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 namespace cairn::test
 {
@@ -48,5 +50,12 @@ public:
 private:
     std::filesystem::path mFolder;
 };
+
+/// A whole file's bytes (empty when it cannot be read): to compare outputs byte for byte.
+inline std::vector<unsigned char> ReadBytes(const std::string& inPath)
+{
+    std::ifstream in(inPath, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 } // namespace cairn::test
