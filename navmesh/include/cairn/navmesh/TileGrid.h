@@ -5,6 +5,7 @@
 
 #include "cairn/physics/math/AABB.h"
 
+#include <algorithm>
 #include <cmath>
 #include <compare>
 #include <cstdint>
@@ -81,11 +82,9 @@ private:
     int32_t ToTile(float inOffset) const
     {
         const double tile = std::floor(double(inOffset) / double(mTileSize));
+        if (std::isnan(tile)) return 0;
         constexpr double cLimit = double(1 << 30);
-        return tile >= -cLimit && tile <= cLimit ? int32_t(tile)
-                                                 : (tile > 0.0   ? int32_t(cLimit)
-                                                    : tile < 0.0 ? -int32_t(cLimit)
-                                                                 : 0);
+        return int32_t(std::clamp(tile, -cLimit, cLimit));
     }
 
     float mOriginX;
