@@ -56,7 +56,8 @@ JobSystem::JobSystem() : JobSystem(Settings{}) {}
 
 JobSystem::JobSystem(const Settings& inSettings)
     : mSlots(std::make_unique<JobSlot[]>(std::max<uint32_t>(1, inSettings.mMaxJobs))),
-      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs)
+      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs), mSearchMarks(mMaxJobs, 0u),
+      mSearchStack(mMaxJobs)
 {
     mFree.reserve(mMaxJobs);
     for (uint32_t i = mMaxJobs; i-- > 0;)
@@ -158,21 +159,50 @@ int JobSystem::FindRunnableFor(uint64_t inScope, uint32_t inAwaited) const
         const uint32_t index = mReady[(mReadyHead + i) % mMaxJobs];
         if (index == inAwaited || mSlots[index].mScope == inScope) return int(i);
     }
-    // A prerequisite of the awaited job: running it is what the wait needs. (Slot mutexes are taken under the
-    // queue mutex only here, and no thread takes the queue mutex while it holds a slot mutex: no cycle.)
-    for (uint32_t i = 0; i < mReadyCount && inAwaited != JobHandle::cInvalidIndex; ++i)
+    // A prerequisite of the awaited job, or a prerequisite of one of those, and so on: running it is what the
+    // wait needs, and it cannot wait for this job (it is not below it on any stack)
+    if (inAwaited != JobHandle::cInvalidIndex)
     {
-        JobSlot& slot = mSlots[mReady[(mReadyHead + i) % mMaxJobs]];
-        std::lock_guard slotLock(slot.mMutex);
-        if (std::find(slot.mDependents, slot.mDependents + slot.mNumDependents, inAwaited) !=
-            slot.mDependents + slot.mNumDependents)
-            return int(i);
+        if (++mSearchEpoch == 0) // Wrapped: marks of 2^32 searches ago could match
+        {
+            std::fill(mSearchMarks.begin(), mSearchMarks.end(), 0u);
+            mSearchEpoch = 1;
+        }
+        for (uint32_t i = 0; i < mReadyCount; ++i)
+            if (LeadsTo(mReady[(mReadyHead + i) % mMaxJobs], inAwaited)) return int(i);
     }
     // Nothing of its own: run anything only when no worker can (each is stuck in a wait inside a job; a
     // worker asking counts itself), or the queued jobs would never run
     const size_t stuck = mNumStuckWorkers + (tWorkerOf == this ? 1 : 0);
     if (mReadyCount > 0 && stuck >= mWorkers.size()) return 0;
     return -1;
+}
+
+bool JobSystem::LeadsTo(uint32_t inFrom, uint32_t inAwaited) const
+{
+    // Depth first through the dependents. A job marked in this search was explored from an earlier start and
+    // does not lead to inAwaited (or the search would have ended), so each job is explored once per search:
+    // O(jobs + dependencies), and the stack never holds more than mMaxJobs entries
+    uint32_t depth = 0;
+    mSearchStack[depth++] = inFrom;
+    mSearchMarks[inFrom] = mSearchEpoch;
+    while (depth > 0)
+    {
+        JobSlot& slot = mSlots[mSearchStack[--depth]];
+        // Slot mutexes are taken under the queue mutex only here, and no thread takes the queue mutex while
+        // it holds a slot mutex: no cycle. A job's dependents are jobs not yet queued, whose slots stay
+        // theirs
+        std::lock_guard slotLock(slot.mMutex);
+        for (uint32_t d = 0; d < slot.mNumDependents; ++d)
+        {
+            const uint32_t dependent = slot.mDependents[d];
+            if (dependent == inAwaited) return true;
+            if (mSearchMarks[dependent] == mSearchEpoch) continue;
+            mSearchMarks[dependent] = mSearchEpoch;
+            mSearchStack[depth++] = dependent;
+        }
+    }
+    return false;
 }
 
 uint32_t JobSystem::TakeReadyAt(int inPosition)

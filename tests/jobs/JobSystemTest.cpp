@@ -248,6 +248,40 @@ TEST_P(JobSystemThreads, AWaitInsideAJobRunsThePrerequisitesOfWhatItWaitsFor)
     }
 }
 
+TEST_P(JobSystemThreads, AWaitInsideAJobRunsPrerequisitesOfPrerequisites)
+{
+    // As above, one level deeper: P waits for X, X for Y, Y for Z; R, queued before Z, waits for P. Only Z is
+    // queued, two steps away from X: a wait that looked at X's direct prerequisites alone found nothing of
+    // its own and fell back to the first queued job, R, which waited forever for P below it (one thread)
+    JobSystem jobs(MakeSettings());
+    for (int round = 0; round < 20; ++round)
+    {
+        std::atomic<int> done{0};
+        JobHandle x;
+        std::atomic<bool> xScheduled{false};
+        const JobHandle p = jobs.Schedule("P",
+                                          [&]
+                                          {
+                                              while (!xScheduled.load())
+                                                  std::this_thread::yield();
+                                              jobs.Wait(x);
+                                              done.fetch_add(1);
+                                          });
+        const JobHandle r = jobs.Schedule("R",
+                                          [&]
+                                          {
+                                              jobs.Wait(p);
+                                              done.fetch_add(1);
+                                          });
+        const JobHandle z = jobs.Schedule("Z", [&] { done.fetch_add(1); });
+        const JobHandle y = jobs.Schedule("Y", [&] { done.fetch_add(1); }, {z});
+        x = jobs.Schedule("X", [&] { done.fetch_add(1); }, {y});
+        xScheduled.store(true);
+        jobs.Wait(r);
+        EXPECT_EQ(done.load(), 5);
+    }
+}
+
 TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
 {
     JobSystem jobs(MakeSettings());

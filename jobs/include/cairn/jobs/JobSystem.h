@@ -114,10 +114,9 @@ public:
     bool IsDone(const JobHandle& inJob) const;
     /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs any
     /// queued job. From inside a job it runs only jobs scheduled inside that job, the awaited job itself and
-    /// the awaited job's direct prerequisites: an unrelated job run on this stack could wait for the job
-    /// below it and never return (TBB calls this isolation). It runs other jobs only when every worker is
-    /// stuck the same way and none of those is queued, so a system of one thread still finishes deeper
-    /// chains.
+    /// the jobs the awaited job depends on, through any number of prerequisites: an unrelated job run on this
+    /// stack could wait for the job below it and never return (TBB calls this isolation). It runs other jobs
+    /// only when every worker is stuck the same way and none of those is queued.
     void Wait(const JobHandle& inJob);
     void WaitAll(std::span<const JobHandle> inJobs);
     /// Returns true when no frame job is queued or running, running queued jobs meanwhile. From inside a job
@@ -184,9 +183,13 @@ private:
     void Enqueue(uint32_t inIndex);
     bool TryPopReady(uint32_t& outIndex);
     /// Index in the ready ring (from its head) of a job a wait inside job run inScope may run for inAwaited:
-    /// one scheduled in inScope or the awaited job itself, else any job when every worker is stuck in such a
-    /// wait; -1 when none. mQueueMutex held.
+    /// one scheduled in inScope, the awaited job itself or a job it depends on (through any number of
+    /// prerequisites), else any job when every worker is stuck in such a wait; -1 when none. mQueueMutex
+    /// held.
     int FindRunnableFor(uint64_t inScope, uint32_t inAwaited) const;
+    /// True if inAwaited depends on the job in slot inFrom, directly or through other jobs. mQueueMutex held;
+    /// uses mSearchMarks/mSearchStack with the current mSearchEpoch.
+    bool LeadsTo(uint32_t inFrom, uint32_t inAwaited) const;
     /// Removes entry inPosition (from the head) of the ready ring and returns its slot. mQueueMutex held.
     uint32_t TakeReadyAt(int inPosition);
     void Run(uint32_t inIndex);
@@ -212,7 +215,12 @@ private:
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     size_t mNumStuckWorkers = 0;          ///< mQueueMutex: workers in a wait inside a job with nothing to run
-    uint32_t mNumIsolatedSleepers = 0;    ///< mQueueMutex: waits inside jobs asleep (Enqueue wakes them all)
+    /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
+    /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex
+    mutable std::vector<uint32_t> mSearchMarks;
+    mutable std::vector<uint32_t> mSearchStack;
+    mutable uint32_t mSearchEpoch = 0;
+    uint32_t mNumIsolatedSleepers = 0; ///< mQueueMutex: waits inside jobs asleep (Enqueue wakes them all)
     mutable std::mutex mIdleMutex;
     mutable std::condition_variable mIdle; ///< Notified when mJobsInFlight drops to zero
 
