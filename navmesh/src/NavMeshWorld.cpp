@@ -49,6 +49,65 @@ dtNavMeshQuery* QueryFor(uint64_t inSerial, const dtNavMesh* inNavMesh)
     return perThread.mQuery.get();
 }
 
+/// Detour's filter for a PathFilter. Detour excludes by polygon flags, not areas: an excluded area gets a
+/// prohibitive cost, and callers check the areas of what they find (IsExcluded).
+Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat)
+{
+    dtQueryFilter filter;
+    filter.setIncludeFlags(cPolyFlagWalk);
+    filter.setExcludeFlags(0);
+    for (int area = 0; area <= cMaxAreaId; ++area)
+    {
+        const bool excluded = (inFilter.mExcludedAreas >> area) & 1u;
+        const float cost = inFilter.mAreaCost[size_t(area)];
+        if (!std::isfinite(cost) || cost < 0.0f)
+            return MakeError(ErrorCode::InvalidArgument,
+                             std::string(inWhat) + ": area costs must be finite and >= 0");
+        filter.setAreaCost(ToDetourArea(area), excluded ? 1.0e30f : cost);
+    }
+    return filter;
+}
+
+/// True if the polygon's Cairn area is one inFilter excludes.
+bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilter& inFilter)
+{
+    const dtMeshTile* tile = nullptr;
+    const dtPoly* poly = nullptr;
+    inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
+    const int area = poly->getArea() == 63 ? cDefaultArea : poly->getArea();
+    return area <= cMaxAreaId && ((inFilter.mExcludedAreas >> area) & 1u) != 0;
+}
+
+/// Checks a search extent against the grid's limit (see FindPath).
+Status CheckSearchExtent(const Vec3& inSearchExtent, float inTileSize, const char* inWhat)
+{
+    if (!IsFinite(inSearchExtent) || (inSearchExtent.array() <= 0.0f).any())
+        return MakeError(ErrorCode::InvalidArgument,
+                         std::string(inWhat) + ": the search extent must be finite and positive");
+    // Detour visits every tile cell under the extent while the navmesh is locked: a huge one would stall
+    // Publish (and the frame) for minutes
+    const float maxExtent = NavMeshWorld::cMaxSearchExtentTiles * inTileSize;
+    if (inSearchExtent.x() > maxExtent || inSearchExtent.z() > maxExtent)
+        return MakeError(ErrorCode::InvalidArgument,
+                         std::string(inWhat) + ": the search extent may span at most " +
+                             std::to_string(int(NavMeshWorld::cMaxSearchExtentTiles)) +
+                             " tiles across (x and z)");
+    return {};
+}
+
+/// Detour takes its random numbers from a plain function: this thread's generator state while a query runs.
+thread_local uint64_t tRandomState = 0;
+
+float NextRandomFloat()
+{
+    // SplitMix64: a fixed, portable sequence (std::uniform_real_distribution is not the same everywhere)
+    uint64_t z = (tRandomState += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return float(z >> 40) * (1.0f / 16777216.0f); // 24 bits: in [0, 1)
+}
+
 bool IsFiniteGrid(const TileGrid& inGrid)
 {
     return std::isfinite(inGrid.GetOriginX()) && std::isfinite(inGrid.GetOriginZ()) &&
@@ -161,29 +220,15 @@ uint64_t NavMeshWorld::GetRefusedTiles(std::string* outLastReason) const
 Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter,
                                           const Vec3& inSearchExtent) const
 {
-    if (!IsValidWorldPosition(inStart) || !IsValidWorldPosition(inEnd) || !IsFinite(inSearchExtent) ||
-        (inSearchExtent.array() <= 0.0f).any())
-        return MakeError(ErrorCode::InvalidArgument, "path: start, end and search extent must be finite");
-    // Detour visits every tile cell under the extent while the navmesh is locked: a huge one would stall
-    // Publish (and the frame) for minutes
-    const float maxExtent = cMaxSearchExtentTiles * mGrid.GetTileSize();
-    if (inSearchExtent.x() > maxExtent || inSearchExtent.z() > maxExtent)
-        return MakeError(ErrorCode::InvalidArgument, "path: the search extent may span at most " +
-                                                         std::to_string(int(cMaxSearchExtentTiles)) +
-                                                         " tiles across (x and z)");
-    dtQueryFilter filter;
-    filter.setIncludeFlags(cPolyFlagWalk);
-    filter.setExcludeFlags(0);
-    for (int area = 0; area <= cMaxAreaId; ++area)
-    {
-        const bool excluded = (inFilter.mExcludedAreas >> area) & 1u;
-        const float cost = inFilter.mAreaCost[size_t(area)];
-        if (!std::isfinite(cost) || cost < 0.0f)
-            return MakeError(ErrorCode::InvalidArgument, "path: area costs must be finite and >= 0");
-        // Detour's filter excludes by polygon flags, not areas: an excluded area gets a prohibitive cost, so
-        // the search avoids it when any other way exists, and a path that must cross it is cut short below
-        filter.setAreaCost(ToDetourArea(area), excluded ? 1.0e30f : cost);
-    }
+    if (!IsValidWorldPosition(inStart) || !IsValidWorldPosition(inEnd))
+        return MakeError(ErrorCode::InvalidArgument, "path: start and end must be finite");
+    if (Status extent = CheckSearchExtent(inSearchExtent, mGrid.GetTileSize(), "path"); !extent)
+        return extent.GetError();
+    // An excluded area costs so much that the search avoids it when any other way exists; a path that must
+    // cross it is cut short below
+    Result<dtQueryFilter> detourFilter = MakeDetourFilter(inFilter, "path");
+    if (!detourFilter) return detourFilter.GetError();
+    const dtQueryFilter& filter = detourFilter.Value();
 
     std::shared_lock lock(mNavMeshMutex);
     dtNavMeshQuery* query = QueryFor(mSerial, mNavMesh);
@@ -205,11 +250,7 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
     // Cut the corridor before the first polygon of an excluded area
     for (int i = 0; i < numPolygons; ++i)
     {
-        const dtMeshTile* tile = nullptr;
-        const dtPoly* poly = nullptr;
-        mNavMesh->getTileAndPolyByRefUnsafe(corridor[i], &tile, &poly);
-        const int area = poly->getArea() == 63 ? cDefaultArea : poly->getArea();
-        if (area <= cMaxAreaId && ((inFilter.mExcludedAreas >> area) & 1u) != 0)
+        if (IsExcluded(*mNavMesh, corridor[i], inFilter))
         {
             if (i == 0)
                 return MakeError(ErrorCode::InvalidArgument, "path: the start is in an excluded area");
@@ -230,6 +271,73 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
     for (int i = 0; i < numPoints; ++i)
         result.mStraightPath.emplace_back(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
     return result;
+}
+
+Result<Vec3> NavMeshWorld::FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter,
+                                            const Vec3& inSearchExtent) const
+{
+    if (!IsValidWorldPosition(inPoint))
+        return MakeError(ErrorCode::InvalidArgument, "nearest point: the point must be finite");
+    if (Status extent = CheckSearchExtent(inSearchExtent, mGrid.GetTileSize(), "nearest point"); !extent)
+        return extent.GetError();
+    Result<dtQueryFilter> filter = MakeDetourFilter(inFilter, "nearest point");
+    if (!filter) return filter.GetError();
+
+    std::shared_lock lock(mNavMeshMutex);
+    dtNavMeshQuery* query = QueryFor(mSerial, mNavMesh);
+    if (query == nullptr)
+        return MakeError(ErrorCode::OutOfCapacity, "nearest point: Detour could not make a query object");
+    dtPolyRef polygon = 0;
+    Vec3 nearest;
+    query->findNearestPoly(inPoint.data(), inSearchExtent.data(), &filter.Value(), &polygon, nearest.data());
+    if (polygon == 0)
+        return MakeError(ErrorCode::InvalidArgument, "nearest point: no navmesh within the search extent");
+    if (IsExcluded(*mNavMesh, polygon, inFilter))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "nearest point: the nearest navmesh is in an excluded area");
+    return nearest;
+}
+
+Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
+                                                 const PathFilter& inFilter, const Vec3& inSearchExtent) const
+{
+    if (!IsValidWorldPosition(inCenter))
+        return MakeError(ErrorCode::InvalidArgument, "random point: the centre must be finite");
+    // The search is bounded by the query's node pool either way; the limit keeps the radius meaningful
+    const float maxRadius = cMaxSearchExtentTiles * mGrid.GetTileSize();
+    if (!(inRadius > 0.0f && inRadius <= maxRadius))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "random point: the radius must be in (0, " + std::to_string(maxRadius) + "] m");
+    if (Status extent = CheckSearchExtent(inSearchExtent, mGrid.GetTileSize(), "random point"); !extent)
+        return extent.GetError();
+    Result<dtQueryFilter> filter = MakeDetourFilter(inFilter, "random point");
+    if (!filter) return filter.GetError();
+
+    std::shared_lock lock(mNavMeshMutex);
+    dtNavMeshQuery* query = QueryFor(mSerial, mNavMesh);
+    if (query == nullptr)
+        return MakeError(ErrorCode::OutOfCapacity, "random point: Detour could not make a query object");
+    dtPolyRef start = 0;
+    float startPoint[3];
+    query->findNearestPoly(inCenter.data(), inSearchExtent.data(), &filter.Value(), &start, startPoint);
+    if (start == 0)
+        return MakeError(ErrorCode::InvalidArgument, "random point: the centre is not on the navmesh");
+    // Detour picks among every polygon it reaches, excluded areas included (its filter knows only flags):
+    // a point in one is drawn again
+    constexpr int cMaxTries = 16;
+    tRandomState = inSeed;
+    for (int attempt = 0; attempt < cMaxTries; ++attempt)
+    {
+        dtPolyRef polygon = 0;
+        Vec3 point;
+        if (dtStatusFailed(query->findRandomPointAroundCircle(start, startPoint, inRadius, &filter.Value(),
+                                                              NextRandomFloat, &polygon, point.data())) ||
+            polygon == 0)
+            return MakeError(ErrorCode::InvalidArgument,
+                             "random point: Detour found no polygon around the centre");
+        if (!IsExcluded(*mNavMesh, polygon, inFilter)) return point;
+    }
+    return MakeError(ErrorCode::InvalidArgument, "random point: every point drawn was in an excluded area");
 }
 
 int NavMeshWorld::GetNumTiles() const

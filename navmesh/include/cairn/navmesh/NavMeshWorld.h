@@ -78,6 +78,22 @@ public:
     Result<PathResult> FindPath(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter = {},
                                 const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
 
+    /// The navmesh point nearest inPoint within inSearchExtent (half extents; at most cMaxSearchExtentTiles
+    /// tiles in x and z), as FindPath snaps its ends: to pick a goal an agent can stand on. Error when no
+    /// polygon is within the extent, when the nearest one is in an area inFilter excludes, and for bad
+    /// numbers. Any thread.
+    Result<Vec3> FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter = {},
+                                  const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+    /// A random navmesh point reachable from inCenter (snapped within inSearchExtent) without leaving the
+    /// circle of inRadius around it: the wander goal of an agent. Polygons are chosen in proportion to their
+    /// area, among those the circle touches, so the point may lie up to one polygon beyond inRadius (Detour's
+    /// findRandomPointAroundCircle). The same inSeed on the same navmesh gives the same point. Areas inFilter
+    /// excludes are avoided (a few tries, then an error). Error when inCenter is off the navmesh, inRadius is
+    /// not in (0, cMaxSearchExtentTiles tiles], or a number is bad. Any thread.
+    Result<Vec3> FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
+                                       const PathFilter& inFilter = {},
+                                       const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+
     /// Published tiles.
     int GetNumTiles() const;
     bool HasTile(const TileCoord& inTile) const;
