@@ -9,7 +9,10 @@ namespace
 {
 constexpr float cSpeed = 3.0f;          ///< m/s
 constexpr float cInvokerRadius = 20.0f; ///< m of navmesh each agent asks for
-constexpr float cTargetRange = 15.0f;   ///< Targets within this of the player
+constexpr float cWanderRadius = 15.0f;  ///< Goals within this of the agent, reachable from where it stands
+constexpr float cFollowDistance =
+    25.0f;                             ///< Further from the player than this, the agent heads for the player
+constexpr float cRetrySeconds = 0.25f; ///< Wait before asking again when there was no navmesh to ask
 } // namespace
 
 Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, const TileStreamer& inStreamer,
@@ -59,28 +62,37 @@ bool Agents::GoesThroughWall(const std::vector<Vec3>& inPath) const
 
 void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
 {
-    std::uniform_real_distribution<float> offset(-cTargetRange, cTargetRange);
-    const float x = inPlayer.x() + offset(mRandom), z = inPlayer.z() + offset(mRandom);
-    const Vec3 target(x, mGenerator.GetTerrainHeight(x, z), z);
+    ioAgent.mPath.clear();
+    ioAgent.mNext = 0;
+    ioAgent.mRepathIn = cRetrySeconds;
     const auto start = std::chrono::steady_clock::now();
-    Result<navmesh::PathResult> path = mNavMesh.FindPath(ioAgent.mPosition, target);
+    // The goal is a navmesh point, as a game's AI picks one: a random point reachable from the agent, or the
+    // navmesh under the player when it has fallen behind. A random point on the terrain was inside a prop or
+    // on an unreachable roof most of the time
+    const float toPlayer =
+        (Vec3(inPlayer.x(), 0, inPlayer.z()) - Vec3(ioAgent.mPosition.x(), 0, ioAgent.mPosition.z())).norm();
+    const Vec3 player(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
+    Result<Vec3> goal = toPlayer > cFollowDistance
+                            ? mNavMesh.FindNearestPoint(player, {}, Vec3(4.0f, 8.0f, 4.0f))
+                            : mNavMesh.FindRandomPointAround(ioAgent.mPosition, cWanderRadius, mRandom());
+    Result<navmesh::PathResult> path = goal ? mNavMesh.FindPath(ioAgent.mPosition, goal.Value())
+                                            : Result<navmesh::PathResult>(goal.GetError());
     mStats.mPathMicros +=
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     ++mStats.mPathQueries;
-    ioAgent.mPath.clear();
-    ioAgent.mNext = 0;
-    ioAgent.mRepathIn = 2.0f;
     if (!path)
     {
-        // The navmesh there is not built yet, or the agent stands where it has none: back to the player's
-        // path, which is kept clear, and try again soon
-        if (path.GetError().mMessage.find("start") != std::string::npos)
-            ioAgent.mPosition =
-                Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
+        // No navmesh under the agent or the goal yet (its tiles are still being built). An agent that stands
+        // where there is none goes back to the player's path, which is kept clear
+        ++mStats.mPathsWithoutNavMesh;
+        if (path.GetError().mMessage.find("start") != std::string::npos ||
+            path.GetError().mMessage.find("centre") != std::string::npos)
+            ioAgent.mPosition = player;
         return;
     }
-    if (path.Value().mReachedEnd) ++mStats.mPathsFound;
+    ++(path.Value().mReachedEnd ? mStats.mPathsFound : mStats.mPathsPartial);
     ioAgent.mPath = path.Value().mStraightPath;
+    ioAgent.mRepathIn = 2.0f;
     if (GoesThroughWall(ioAgent.mPath)) ++mStats.mPathsThroughWalls;
 }
 
@@ -89,7 +101,10 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
     for (Agent& agent : mAgents)
     {
         agent.mRepathIn -= inDeltaTime;
-        if (agent.mNext >= agent.mPath.size() || agent.mRepathIn <= 0.0f) Repath(agent, inPlayer);
+        // Arrived, or time for a fresh path (the navmesh changes); an agent without a path waits for its
+        // retry
+        if (agent.mRepathIn <= 0.0f || (!agent.mPath.empty() && agent.mNext >= agent.mPath.size()))
+            Repath(agent, inPlayer);
         // Walk along the straight path
         float step = cSpeed * inDeltaTime;
         while (step > 0.0f && agent.mNext < agent.mPath.size())

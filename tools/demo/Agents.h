@@ -1,9 +1,10 @@
 #pragma once
 
 // Agents: the demo's AI. Each agent is a navmesh invoker (the tiles within its radius are built in the
-// background) and walks paths on the navmesh as it appears and changes: it picks a target near the player,
-// asks the NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it
-// arrives, when the path was partial (the navmesh there was not built yet) or every few seconds. Every new
+// background) and walks paths on the navmesh as it appears and changes: it picks a goal on the navmesh (a
+// random point reachable within 15 m, or the navmesh under the player when it falls behind), asks the
+// NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it arrives or
+// every two seconds (a quarter of a second when there was no navmesh to ask yet). Every new
 // path is checked against the physics world: a point of it inside a wall (a static body at chest height)
 // counts as a path through a wall, which must never happen.
 //
@@ -26,9 +27,11 @@ public:
     struct Stats
     {
         uint64_t mPathQueries = 0;
-        uint64_t mPathsFound = 0; ///< Reaching the target
-        double mPathMicros = 0.0; ///< Summed
-        double mDistance = 0.0;   ///< Metres walked by all agents
+        uint64_t mPathsFound = 0;          ///< Reaching the goal
+        uint64_t mPathsPartial = 0;        ///< Ending at the reachable point nearest the goal
+        uint64_t mPathsWithoutNavMesh = 0; ///< No navmesh under the agent or around it yet: no path
+        double mPathMicros = 0.0;          ///< Summed
+        double mDistance = 0.0;            ///< Metres walked by all agents
         uint32_t mPathsThroughWalls = 0;
         std::vector<std::string> mErrors;
     };

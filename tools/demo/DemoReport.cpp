@@ -255,8 +255,12 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
         perThread += (i == 0 ? "" : ", ") + Micros(inRun.mQueryMicrosPerThread[i]);
     if (perThread.empty()) perThread = "n/a";
 
-    const double foundPercent =
-        inRun.mPathQueries == 0 ? 0.0 : 100.0 * double(inRun.mPathsFound) / double(inRun.mPathQueries);
+    auto ofQueries = [&](uint64_t inCount)
+    {
+        const double percent =
+            inRun.mPathQueries == 0 ? 0.0 : 100.0 * double(inCount) / double(inRun.mPathQueries);
+        return Count(inCount) + Format(" (%.1f%%)", percent);
+    };
 
     std::vector<Section> sections;
     sections.push_back({"physics ms/frame",
@@ -299,7 +303,9 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"max", frames(latency.mMax)}}});
     sections.push_back({"path queries",
                         {{"queries", Count(inRun.mPathQueries)},
-                         {"found", Count(inRun.mPathsFound) + Format(" (%.1f%%)", foundPercent)},
+                         {"reached goal", ofQueries(inRun.mPathsFound)},
+                         {"partial", ofQueries(inRun.mPathsPartial)},
+                         {"no navmesh yet", ofQueries(inRun.mPathsWithoutNavMesh)},
                          {"mean µs", Micros(inRun.mPathQueryMicrosMean)}}});
     sections.push_back(
         {"agents",

@@ -160,6 +160,8 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     const Agents::Stats& agentStats = agents->GetStats();
     result.mPathQueries = agentStats.mPathQueries;
     result.mPathsFound = agentStats.mPathsFound;
+    result.mPathsPartial = agentStats.mPathsPartial;
+    result.mPathsWithoutNavMesh = agentStats.mPathsWithoutNavMesh;
     result.mPathQueryMicrosMean =
         agentStats.mPathQueries == 0 ? 0.0 : agentStats.mPathMicros / double(agentStats.mPathQueries);
     result.mAgentDistanceMetres = agentStats.mDistance;
