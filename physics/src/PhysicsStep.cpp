@@ -137,15 +137,23 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // Islands share no dynamic body and no constraint. Large (colored) islands first, one at a time with
     // every thread on each; then the others at once, the largest first so that the longest starts early and
     // the small ones fill in around it
-    const uint32_t numIslands = mIslands.GetNumIslands();
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime);
-    ParallelFor(numIslands, 1,
+    ParallelFor(uint32_t(mSolvedIslands.size()), 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        if (const uint32_t island = mIslandOrder[i]; mIslandFirstColor[island] == UINT32_MAX)
-                            SolveIsland(island, inDeltaTime);
+                        SolveIsland(mSolvedIslands[i], inDeltaTime);
+                });
+    // A body with nothing to solve keeps the velocity its forces gave it. One chunk per island made the
+    // threads fight over the chunk cursor when thousands of bodies fall freely
+    ParallelFor(uint32_t(mUnconstrainedBodies.size()), 256,
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                        if (Body& body = *mBodies.TryGetBodyAtIndex(active[mUnconstrainedBodies[i]]);
+                            body.IsDynamic())
+                            IntegratePositions(body, inDeltaTime);
                 });
 }
 
@@ -511,23 +519,36 @@ void PhysicsStep::OrderConstraints()
     const uint32_t coloredMin =
         std::max(cColoredIslandMinConstraints, uint32_t(mConstraints.size() / cColoredIslandMinShare));
     // Islands by size, largest first (ties by number): the order both the colored ones and the others are
-    // solved in
-    mIslandOrder.resize(numIslands);
+    // solved in. A counting sort: most islands are one or two bodies, and comparing thousands of them took a
+    // tenth of a step of falling bodies
+    size_t largest = 0;
     for (uint32_t island = 0; island < numIslands; ++island)
-        mIslandOrder[island] = island;
-    std::sort(mIslandOrder.begin(), mIslandOrder.end(),
-              [&](uint32_t inL, uint32_t inR)
-              {
-                  const size_t l = mIslands.GetBodies(inL).size(), r = mIslands.GetBodies(inR).size();
-                  return l > r || (l == r && inL < inR);
-              });
+        largest = std::max(largest, mIslands.GetBodies(island).size());
+    mIslandSizeStart.assign(largest + 2, 0);
+    for (uint32_t island = 0; island < numIslands; ++island)
+        ++mIslandSizeStart[largest - mIslands.GetBodies(island).size() + 1]; // Bucket 0: the largest
+    for (size_t bucket = 1; bucket < mIslandSizeStart.size(); ++bucket)
+        mIslandSizeStart[bucket] += mIslandSizeStart[bucket - 1];
+    mIslandOrder.resize(numIslands);
+    for (uint32_t island = 0; island < numIslands; ++island) // In number order: ties stay so
+        mIslandOrder[mIslandSizeStart[largest - mIslands.GetBodies(island).size()]++] = island;
     mIslandFirstColor.assign(numIslands, UINT32_MAX);
     mColorStart.clear();
     mColorIsSerial.clear();
     mColoredIslands.clear();
+    mSolvedIslands.clear();
+    mUnconstrainedBodies.clear();
     for (uint32_t island : mIslandOrder)
-        if (mConstraintStart[island + 1] - mConstraintStart[island] >= coloredMin)
+    {
+        const uint32_t numConstraints = mConstraintStart[island + 1] - mConstraintStart[island];
+        if (numConstraints >= coloredMin)
             mColoredIslands.push_back(island);
+        else if (numConstraints > 0)
+            mSolvedIslands.push_back(island);
+        else
+            for (uint32_t activeIndex : mIslands.GetBodies(island)) // One body: contacts would link more
+                mUnconstrainedBodies.push_back(activeIndex);
+    }
     for (uint32_t island : mColoredIslands)
         ColorIsland(island);
 }

@@ -152,13 +152,18 @@ private:
     std::vector<std::vector<BodyPair>> mPairChunks;   ///< Scratch: pairs found per chunk of active bodies
     std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs
     std::vector<uint32_t> mIslandOrder;               ///< Scratch: islands, largest first
+    std::vector<uint32_t> mIslandSizeStart;           ///< Scratch: the counting sort of mIslandOrder
     /// Islands with this many constraints or more are colored and solved by all threads together, whatever
     /// the number of threads (so results do not depend on it): one large island must not serialise the step
     static constexpr uint32_t cColoredIslandMinConstraints = 128;
     static constexpr uint32_t cColoredIslandMinShare = 4; ///< ... and at least 1/4 of the step's constraints
     static constexpr uint32_t cSerialColor =
-        64;                                  ///< Constraints that found no free color among 64: solved alone
-    std::vector<uint32_t> mColoredIslands;   ///< This step's colored islands, largest first
+        64;                                ///< Constraints that found no free color among 64: solved alone
+    std::vector<uint32_t> mColoredIslands; ///< This step's colored islands, largest first
+    /// This step's other islands that have constraints, largest first; and the active indices of the bodies
+    /// alone in an island without any (falling, flying): they only integrate, many to a chunk
+    std::vector<uint32_t> mSolvedIslands;
+    std::vector<uint32_t> mUnconstrainedBodies;
     std::vector<uint32_t> mIslandFirstColor; ///< Per island: first entry in mColorStart (colored ones)
     std::vector<uint32_t>
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
