@@ -13,6 +13,7 @@
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace cairn
@@ -86,6 +87,10 @@ private:
     std::vector<CachedManifold> mCurrent;       ///< In creation order until EndStep
     std::vector<CachedBodyPair> mPreviousPairs; ///< Sorted by bodies, each with its manifolds in mPrevious
     std::vector<CachedBodyPair> mCurrentPairs;  ///< In creation order until EndStep
+    std::vector<CachedManifold> mScratch;       ///< EndStep's sorting buffers, kept for their capacity
+    std::vector<CachedBodyPair> mScratchPairs;
+    std::vector<std::pair<ContactKey, uint32_t>> mManifoldOrder;
+    std::vector<std::pair<std::pair<BodyID, BodyID>, uint32_t>> mPairOrder;
 };
 
 } // namespace cairn

@@ -1,0 +1,133 @@
+// ContactCache: what one step stores, the next finds, whatever order the narrow phase added it in.
+
+#include "cairn/physics/solver/ContactCache.h"
+
+#include <algorithm>
+#include <gtest/gtest.h>
+#include <random>
+
+namespace cairn
+{
+namespace
+{
+
+/// A pair (a, b) with inNumManifolds manifolds, sub-shapes 0.., each impulse marking pair and manifold.
+struct StepContent
+{
+    std::vector<CachedBodyPair> mPairs;
+    std::vector<std::vector<CachedManifold>> mManifolds; ///< Per pair
+};
+
+StepContent MakeStep(int inNumPairs, uint32_t inSeed)
+{
+    std::mt19937 random(inSeed);
+    StepContent step;
+    for (int p = 0; p < inNumPairs; ++p)
+    {
+        CachedBodyPair pair{};
+        pair.mDeltaPosition = Vec3::Zero();
+        pair.mDeltaRotation = Quat::Identity();
+        pair.mMaxSeparation = 0.0f;
+        pair.mBodyA = BodyID(uint32_t(random() % 500), random() % 3);
+        pair.mBodyB = BodyID(500 + uint32_t(p), 0); // Unique: no two records of one pair
+        pair.mNumManifolds = 1 + random() % 3;
+        std::vector<CachedManifold> manifolds;
+        for (uint32_t m = 0; m < pair.mNumManifolds; ++m)
+        {
+            CachedManifold manifold;
+            for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+            {
+                manifold.mLocalOnA[i] = manifold.mLocalOnB[i] = Vec3::Zero();
+                manifold.mNormalImpulse[i] = manifold.mDeferredBounce[i] = 0.0f;
+            }
+            manifold.mKey = {pair.mBodyA, pair.mBodyB, SubShapeID(7 - m), SubShapeID(m)};
+            manifold.mNumPoints = 1;
+            manifold.mNormalImpulse[0] = float(p) + 0.1f * float(m);
+            manifolds.push_back(manifold);
+        }
+        step.mPairs.push_back(pair);
+        step.mManifolds.push_back(manifolds);
+    }
+    return step;
+}
+
+/// Stores inStep as the narrow phase would (each pair, then its manifolds), in inOrder of pairs.
+void Store(ContactCache& ioCache, const StepContent& inStep, const std::vector<size_t>& inOrder)
+{
+    ioCache.BeginStep();
+    for (size_t p : inOrder)
+    {
+        ioCache.AddPair(inStep.mPairs[p]);
+        for (const CachedManifold& manifold : inStep.mManifolds[p])
+            (void)ioCache.Add(manifold);
+    }
+    ioCache.EndStep();
+    ioCache.BeginStep(); // The next step: what was stored is now "previous"
+}
+
+void ExpectAllFound(const ContactCache& inCache, const StepContent& inStep)
+{
+    for (size_t p = 0; p < inStep.mPairs.size(); ++p)
+    {
+        const CachedBodyPair& pair = inStep.mPairs[p];
+        const CachedBodyPair* found = inCache.FindPreviousPair(pair.mBodyA, pair.mBodyB);
+        ASSERT_NE(found, nullptr) << "pair " << p;
+        const std::span<const CachedManifold> manifolds = inCache.GetPreviousManifolds(*found);
+        ASSERT_EQ(manifolds.size(), inStep.mManifolds[p].size()) << "pair " << p;
+        for (const CachedManifold& expected : inStep.mManifolds[p])
+        {
+            const auto match =
+                std::find_if(manifolds.begin(), manifolds.end(),
+                             [&](const CachedManifold& inM) { return inM.mKey == expected.mKey; });
+            ASSERT_NE(match, manifolds.end()) << "pair " << p;
+            EXPECT_EQ(match->mNormalImpulse[0], expected.mNormalImpulse[0]);
+            const CachedManifold* byKey = inCache.FindPrevious(expected.mKey);
+            ASSERT_NE(byKey, nullptr);
+            EXPECT_EQ(byKey->mNormalImpulse[0], expected.mNormalImpulse[0]);
+        }
+    }
+    EXPECT_EQ(inCache.FindPreviousPair(BodyID(9999, 0), BodyID(10000, 0)), nullptr);
+}
+
+TEST(ContactCacheTest, FindsWhatTheLastStepStoredInSortedOrder)
+{
+    const StepContent step = MakeStep(300, 1);
+    std::vector<size_t> order(step.mPairs.size());
+    for (size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    // The narrow phase's canonical order: by bodies
+    std::sort(order.begin(), order.end(),
+              [&](size_t inL, size_t inR)
+              {
+                  return std::pair(step.mPairs[inL].mBodyA, step.mPairs[inL].mBodyB) <
+                         std::pair(step.mPairs[inR].mBodyA, step.mPairs[inR].mBodyB);
+              });
+    ContactCache cache;
+    Store(cache, step, order);
+    ExpectAllFound(cache, step);
+}
+
+TEST(ContactCacheTest, FindsWhatTheLastStepStoredInAnyOrder)
+{
+    for (uint32_t seed = 1; seed <= 5; ++seed)
+    {
+        const StepContent step = MakeStep(300, seed);
+        std::vector<size_t> order(step.mPairs.size());
+        for (size_t i = 0; i < order.size(); ++i)
+            order[i] = i;
+        std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+        ContactCache cache;
+        Store(cache, step, order);
+        ExpectAllFound(cache, step);
+        // A second step over the same cache (its buffers reused) stores and finds as well
+        const StepContent next = MakeStep(200, seed + 100);
+        std::vector<size_t> nextOrder(next.mPairs.size());
+        for (size_t i = 0; i < nextOrder.size(); ++i)
+            nextOrder[i] = nextOrder.size() - 1 - i;
+        Store(cache, next, nextOrder);
+        ExpectAllFound(cache, next);
+    }
+}
+
+} // namespace
+} // namespace cairn
