@@ -393,7 +393,8 @@ bool PhysicsStep::ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, Cached
                                  NarrowPhaseChunk& ioOut) const
 {
     if (mSettings.mPairCacheMaxDeltaPosition <= 0.0f) return false;
-    const CachedBodyPair* previous = mContactCache.FindPreviousPair(ioRecord.mBodyA, ioRecord.mBodyB);
+    const CachedBodyPair* previous =
+        mContactCache.FindPreviousPair(ioRecord.mBodyA, ioRecord.mBodyB, &ioOut.mPreviousPairHint);
     if (previous == nullptr) return false;
     // Compared with the pose the manifolds were made at, not last step's: slow drift adds up and is caught.
     // The look-ahead grows with the closing speed: a pair that starts to move fast needs speculative points

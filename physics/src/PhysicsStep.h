@@ -54,8 +54,10 @@ private:
         std::vector<BodyPair> mDeferredLinks;        ///< Island links with a body woken at the merge
         uint32_t mNumWarmStartedPoints = 0;
         uint32_t mNumReusedPairs = 0;
+        uint32_t mPreviousPairHint = 0; ///< See ContactCache::FindPreviousPair
         void Clear()
         {
+            mPreviousPairHint = 0;
             mConstraints.clear();
             mCached.clear();
             mCachedPairs.clear();

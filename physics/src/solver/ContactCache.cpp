@@ -13,12 +13,34 @@ void ContactCache::BeginStep()
     mCurrentPairs.clear();
 }
 
-const CachedBodyPair* ContactCache::FindPreviousPair(BodyID inBodyA, BodyID inBodyB) const
+const CachedBodyPair* ContactCache::FindPreviousPair(BodyID inBodyA, BodyID inBodyB, uint32_t* ioHint) const
 {
     const std::pair key(inBodyA, inBodyB);
-    auto it = std::lower_bound(mPreviousPairs.begin(), mPreviousPairs.end(), key,
-                               [](const CachedBodyPair& inP, const std::pair<BodyID, BodyID>& inK)
-                               { return std::pair(inP.mBodyA, inP.mBodyB) < inK; });
+    auto less = [](const CachedBodyPair& inP, const std::pair<BodyID, BodyID>& inK)
+    { return std::pair(inP.mBodyA, inP.mBodyB) < inK; };
+    const size_t count = mPreviousPairs.size();
+    size_t begin = 0, end = count;
+    if (ioHint != nullptr && *ioHint < count)
+    {
+        // Lookups in the narrow phase's pair order come in increasing order: gallop from the last one
+        const size_t hint = *ioHint;
+        if (less(mPreviousPairs[hint], key))
+        {
+            begin = hint + 1; // Everything before begin is below the key
+            size_t step = 1;
+            while (hint + step < count && less(mPreviousPairs[hint + step], key))
+            {
+                begin = hint + step + 1;
+                step *= 2;
+            }
+            end = std::min(hint + step + 1, count); // mPreviousPairs[hint + step] is not below the key
+        }
+        else
+            end = hint + 1; // mPreviousPairs[hint] is not below the key
+    }
+    const auto it = std::lower_bound(mPreviousPairs.begin() + ptrdiff_t(begin),
+                                     mPreviousPairs.begin() + ptrdiff_t(end), key, less);
+    if (ioHint != nullptr) *ioHint = uint32_t(it - mPreviousPairs.begin());
     return it != mPreviousPairs.end() && it->mBodyA == inBodyA && it->mBodyB == inBodyB ? &*it : nullptr;
 }
 

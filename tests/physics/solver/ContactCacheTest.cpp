@@ -129,5 +129,41 @@ TEST(ContactCacheTest, FindsWhatTheLastStepStoredInAnyOrder)
     }
 }
 
+TEST(ContactCacheTest, HintedPairLookupsFindTheSameAsUnhinted)
+{
+    const StepContent step = MakeStep(500, 7);
+    std::vector<size_t> order(step.mPairs.size());
+    for (size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    ContactCache cache;
+    Store(cache, step, order);
+    // Queries: every stored pair and as many absent ones, sorted (as the narrow phase asks), then shuffled
+    std::vector<std::pair<BodyID, BodyID>> queries;
+    for (const CachedBodyPair& pair : step.mPairs)
+    {
+        queries.emplace_back(pair.mBodyA, pair.mBodyB);
+        queries.emplace_back(pair.mBodyA, BodyID(pair.mBodyB.GetIndex(), 5)); // Another sequence: absent
+    }
+    queries.emplace_back(BodyID(0, 0), BodyID(0, 0));
+    queries.emplace_back(BodyID(100000, 0), BodyID(100001, 0));
+    std::sort(queries.begin(), queries.end());
+    for (int pass = 0; pass < 2; ++pass)
+    {
+        uint32_t hint = 0;
+        int found = 0;
+        for (const auto& [a, b] : queries)
+        {
+            const CachedBodyPair* unhinted = cache.FindPreviousPair(a, b);
+            const CachedBodyPair* hinted = cache.FindPreviousPair(a, b, &hint);
+            EXPECT_EQ(hinted, unhinted) << "pass " << pass;
+            found += hinted != nullptr ? 1 : 0;
+        }
+        EXPECT_EQ(found, 500);
+        std::shuffle(queries.begin(), queries.end(), std::mt19937(3));
+    }
+    uint32_t wild = 123456; // Out of range: still right
+    EXPECT_NE(cache.FindPreviousPair(step.mPairs[0].mBodyA, step.mPairs[0].mBodyB, &wild), nullptr);
+}
+
 } // namespace
 } // namespace cairn

@@ -68,8 +68,10 @@ public:
     /// Stores a manifold of this step; returns its index for Get().
     uint32_t Add(const CachedManifold& inManifold);
     CachedManifold& Get(uint32_t inIndex) { return mCurrent[inIndex]; }
-    /// Last step's record of the pair (A, B), or nullptr.
-    const CachedBodyPair* FindPreviousPair(BodyID inBodyA, BodyID inBodyB) const;
+    /// Last step's record of the pair (A, B), or nullptr. ioHint (optional, start at 0): where the previous
+    /// lookup of this caller ended; lookups in increasing pair order then cost a few steps instead of a
+    /// binary search of the whole array. Any value gives the right answer.
+    const CachedBodyPair* FindPreviousPair(BodyID inBodyA, BodyID inBodyB, uint32_t* ioHint = nullptr) const;
     /// Last step's manifolds of a pair from FindPreviousPair.
     std::span<const CachedManifold> GetPreviousManifolds(const CachedBodyPair& inPair) const
     {
