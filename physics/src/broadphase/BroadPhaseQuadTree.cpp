@@ -79,24 +79,47 @@ ObjectLayerMask BroadPhaseQuadTree::MaskForTree(uint32_t inTree, ObjectLayerMask
 
 BroadPhase::AddState BroadPhaseQuadTree::AddBodiesPrepare(std::span<const BroadPhaseBody> inBodies)
 {
-    // Split by broad-phase layer; off the hot path (loading thread), so the heap is fine here
-    std::array<std::vector<BroadPhaseBody>, cMaxBroadPhaseLayers> perLayer;
-    for (const BroadPhaseBody& body : inBodies)
+    // Split by broad-phase layer; off the hot path (loading thread), so the heap is fine here. A batch of one
+    // layer (a streamed tile's statics) is used as it is: copying it cost a page fault every 4 KB
+    auto isValid = [&](const BroadPhaseBody& inBody)
     {
-        const bool ok = !body.mID.IsInvalid() && body.mID.GetIndex() < mMaxBodies &&
-                        mLayerSetup.IsValid(body.mLayer) && IsValidBroadPhaseBounds(body.mBounds);
+        const bool ok = !inBody.mID.IsInvalid() && inBody.mID.GetIndex() < mMaxBodies &&
+                        mLayerSetup.IsValid(inBody.mLayer) && IsValidBroadPhaseBounds(inBody.mBounds);
         assert(ok && "BroadPhaseQuadTree: invalid body id, object layer or bounds");
-        if (ok) perLayer[mLayerSetup.GetBroadPhaseLayer(body.mLayer)].push_back(body);
+        return ok;
+    };
+    std::array<size_t, cMaxBroadPhaseLayers> counts{};
+    bool allValid = true;
+    for (const BroadPhaseBody& body : inBodies)
+        if (isValid(body))
+            ++counts[mLayerSetup.GetBroadPhaseLayer(body.mLayer)];
+        else
+            allValid = false;
+    std::array<std::vector<BroadPhaseBody>, cMaxBroadPhaseLayers> perLayer;
+    std::array<std::span<const BroadPhaseBody>, cMaxBroadPhaseLayers> bodiesOf;
+    for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
+    {
+        if (allValid && counts[layer] == inBodies.size())
+        {
+            bodiesOf[layer] = inBodies;
+            break;
+        }
+        if (counts[layer] == 0) continue;
+        perLayer[layer].reserve(counts[layer]);
+        for (const BroadPhaseBody& body : inBodies)
+            if (isValid(body) && mLayerSetup.GetBroadPhaseLayer(body.mLayer) == layer)
+                perLayer[layer].push_back(body);
+        bodiesOf[layer] = perLayer[layer];
     }
     auto batch = std::make_unique<Batch>();
     for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
     {
-        if (perLayer[layer].empty()) continue;
-        batch->mSubTrees[layer] = mTrees[layer]->BuildSubTree(perLayer[layer]);
+        if (bodiesOf[layer].empty()) continue;
+        batch->mSubTrees[layer] = mTrees[layer]->BuildSubTree(bodiesOf[layer]);
         // Valid bodies but no sub-tree: the layer's node pool is out of nodes (bodies already present are
         // skipped silently, as documented, and give a sub-tree of the others or an empty one)
         bool anyNew = false;
-        for (const BroadPhaseBody& body : perLayer[layer])
+        for (const BroadPhaseBody& body : bodiesOf[layer])
             // Relaxed: the caller owns these bodies' operations
             anyNew |= mBodies[body.mID.GetIndex()].mLocation.load(std::memory_order_relaxed) ==
                       QuadTreeBodyTable::cInvalidLocation;

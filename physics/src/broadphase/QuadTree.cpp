@@ -303,8 +303,11 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
 
 QuadTree::SubTree QuadTree::BuildSubTree(std::span<const BroadPhaseBody> inBodies)
 {
-    // Off the hot path (loading thread): the item list may use the heap; nodes come from the pool
-    std::vector<BuildItem> items;
+    // Off the hot path (loading thread): the item list is this thread's, kept for its capacity. A fresh one
+    // per batch cost a page fault every 4 KB (0.64 MB for a 20,000-body batch) and its unmapping; nodes come
+    // from the pool
+    thread_local std::vector<BuildItem> items;
+    items.clear();
     items.reserve(inBodies.size());
     for (const BroadPhaseBody& body : inBodies)
     {
