@@ -7,7 +7,12 @@
 #include <array>
 #include <bit>
 #include <cassert>
+#include <cstddef>
 #include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace cairn
 {
@@ -136,6 +141,24 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     // go through Eigen reductions, which dominated the build)
     auto centreBounds = [](const BuildItem* inB, const BuildItem* inE)
     {
+#if defined(__SSE2__)
+        // Four lanes at once: min.xyz and max.xyz each read with one 16-byte load that runs one float past
+        // (into max.x and mOldLocation, both inside the item); lane 3 is ignored. The scalar loop spent a
+        // third of the build here
+        static_assert(offsetof(BuildItem, mBounds) + sizeof(AABB) + sizeof(uint32_t) <= sizeof(BuildItem));
+        __m128 lo = _mm_set1_ps(cLargeFloat), hi = _mm_set1_ps(-cLargeFloat);
+        for (const BuildItem* it = inB; it != inE; ++it)
+        {
+            const __m128 centre2 =
+                _mm_add_ps(_mm_loadu_ps(it->mBounds.mMin.data()), _mm_loadu_ps(it->mBounds.mMax.data()));
+            lo = _mm_min_ps(lo, centre2);
+            hi = _mm_max_ps(hi, centre2);
+        }
+        alignas(16) float loOut[4], hiOut[4];
+        _mm_store_ps(loOut, lo);
+        _mm_store_ps(hiOut, hi);
+        return AABB(Vec3(loOut[0], loOut[1], loOut[2]), Vec3(hiOut[0], hiOut[1], hiOut[2]));
+#else
         Vec3 lo = Vec3::Constant(cLargeFloat), hi = Vec3::Constant(-cLargeFloat);
         for (const BuildItem* it = inB; it != inE; ++it)
         {
@@ -144,6 +167,7 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
             hi = hi.cwiseMax(centre2);
         }
         return AABB(lo, hi);
+#endif
     };
     // Splits [inB, inE) at the midpoint of the longest axis of the centres (inCentres: their bounds);
     // halves when degenerate
