@@ -121,8 +121,21 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     ParallelFor(uint32_t(mIslandConstraints.size()), 512,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
+                    // The sources are scattered over the narrow phase's chunks: fetching each one's cache
+                    // lines a few constraints ahead overlaps the misses that the copy otherwise waits for in
+                    // turn
+                    constexpr uint32_t cAhead = 4;
+                    auto prefetch = [&](uint32_t inIndex)
+                    {
+                        const char* source = reinterpret_cast<const char*>(mIslandConstraints[inIndex]);
+                        for (size_t offset = 0; offset < sizeof(ContactConstraint); offset += 64)
+                            __builtin_prefetch(source + offset);
+                    };
+                    for (uint32_t i = inBegin; i < std::min(inEnd, inBegin + cAhead); ++i)
+                        prefetch(i);
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
+                        if (i + cAhead < inEnd) prefetch(i + cAhead);
                         ContactConstraint& c = mSolveOrder[i];
                         c = *mIslandConstraints[i];
                         mIslandConstraints[i] = &c;
