@@ -316,6 +316,10 @@ void JobSystem::Wait(const JobHandle& inJob)
     {
         if (const int position = FindRunnableFor(run, awaited); position >= 0)
         {
+            // The awaited job finishes without the queue mutex: if it did before the search, its slot may
+            // already hold a new job, and the match would be a job of that one. Still running now means the
+            // search saw the right slot
+            if (IsDone(inJob)) break;
             const uint32_t index = TakeReadyAt(position);
             lock.unlock();
             Run(index);
