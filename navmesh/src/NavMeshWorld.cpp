@@ -5,6 +5,7 @@
 
 #include <DetourNavMesh.h>
 #include <DetourNavMeshQuery.h>
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -322,8 +323,11 @@ Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inR
     query->findNearestPoly(inCenter.data(), inSearchExtent.data(), &filter.Value(), &start, startPoint);
     if (start == 0)
         return MakeError(ErrorCode::InvalidArgument, "random point: the centre is not on the navmesh");
-    // Detour picks among every polygon it reaches, excluded areas included (its filter knows only flags):
-    // a point in one is drawn again
+    if (IsExcluded(*mNavMesh, start, inFilter))
+        return MakeError(ErrorCode::InvalidArgument, "random point: the centre is in an excluded area");
+    // Detour spreads through every polygon the circle touches, excluded areas included (its filter knows only
+    // flags, and its spread no costs): a point in an excluded area, or one that can only be reached through
+    // one, is drawn again
     constexpr int cMaxTries = 16;
     tRandomState = inSeed;
     for (int attempt = 0; attempt < cMaxTries; ++attempt)
@@ -335,9 +339,22 @@ Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inR
             polygon == 0)
             return MakeError(ErrorCode::InvalidArgument,
                              "random point: Detour found no polygon around the centre");
-        if (!IsExcluded(*mNavMesh, polygon, inFilter)) return point;
+        if (IsExcluded(*mNavMesh, polygon, inFilter)) continue;
+        if (inFilter.mExcludedAreas == 0) return point; // Detour's spread went there: reachable
+        // An excluded area costs so much that the search goes around it if it can; a way that must cross
+        // one ends at or before it
+        dtPolyRef corridor[cMaxPathPolygons];
+        int numPolygons = 0;
+        if (dtStatusFailed(query->findPath(start, polygon, startPoint, point.data(), &filter.Value(),
+                                           corridor, &numPolygons, cMaxPathPolygons)) ||
+            numPolygons == 0 || corridor[numPolygons - 1] != polygon)
+            continue;
+        if (std::none_of(corridor, corridor + numPolygons,
+                         [&](dtPolyRef inPolygon) { return IsExcluded(*mNavMesh, inPolygon, inFilter); }))
+            return point;
     }
-    return MakeError(ErrorCode::InvalidArgument, "random point: every point drawn was in an excluded area");
+    return MakeError(ErrorCode::InvalidArgument,
+                     "random point: every point drawn was in an excluded area or reachable only through one");
 }
 
 int NavMeshWorld::GetNumTiles() const

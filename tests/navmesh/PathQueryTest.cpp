@@ -140,6 +140,10 @@ TEST_F(PathQueryTest, RandomPointsAreReachableRepeatableAndAvoidExcludedAreas)
             << "a point in the excluded water: " << dry.Value().transpose();
         points.push_back(dry.Value());
 
+        Result<PathResult> dryPath = mWorld->FindPath(mStart, dry.Value(), noSwimming);
+        ASSERT_TRUE(dryPath);
+        EXPECT_TRUE(dryPath.Value().mReachedEnd) << "seed " << seed << ": " << dry.Value().transpose();
+
         Result<Vec3> again = mWorld->FindRandomPointAround(mStart, 8.0f, seed, noSwimming);
         ASSERT_TRUE(again);
         EXPECT_EQ(again.Value(), dry.Value()) << "the same seed gives the same point";
@@ -149,6 +153,34 @@ TEST_F(PathQueryTest, RandomPointsAreReachableRepeatableAndAvoidExcludedAreas)
     for (size_t i = 1; i < points.size(); ++i)
         distinct += (points[i] - points[0]).norm() > 0.1f ? 1 : 0;
     EXPECT_GT(distinct, 30);
+}
+
+TEST_F(PathQueryTest, RandomPointsBeyondAnExcludedAreaWithNoWayAroundAreNotDrawn)
+{
+    // As AnExcludedAreaThatIsTheOnlyWayCutsThePathShort: no bridge. The circle reaches over the water to the
+    // north bank, which can only be reached by swimming
+    AddStaticBox(Vec3(0, -0.5f, -5.5f), Vec3(10, 0.5f, 4.5f));
+    AddStaticBox(Vec3(0, -0.5f, 5.5f), Vec3(10, 0.5f, 4.5f));
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(10, 0.5f, 1), cWater);
+    MakeNavMesh();
+    ASSERT_TRUE(RunUntilIdle());
+    PathFilter noSwimming;
+    noSwimming.mExcludedAreas = uint64_t(1) << cWater;
+    int northWithWater = 0;
+    for (uint64_t seed = 1; seed <= 40; ++seed)
+    {
+        Result<Vec3> any = mWorld->FindRandomPointAround(mStart, 9.0f, seed);
+        ASSERT_TRUE(any);
+        northWithWater += any.Value().z() > 1.0f ? 1 : 0;
+        Result<Vec3> dry = mWorld->FindRandomPointAround(mStart, 9.0f, seed, noSwimming);
+        ASSERT_TRUE(dry) << dry.GetError().mMessage;
+        EXPECT_LT(dry.Value().z(), -0.9f) << "seed " << seed << ": only the south bank is reachable dry";
+    }
+    EXPECT_GT(northWithWater, 0) << "the circle reaches the north bank: swimming, some points are there";
+    // From the water itself: refused, as FindPath refuses such a start
+    Result<Vec3> wet = mWorld->FindRandomPointAround(Vec3(-5, 0, 0), 5.0f, 1, noSwimming);
+    ASSERT_FALSE(wet);
+    EXPECT_NE(wet.GetError().mMessage.find("excluded"), std::string::npos);
 }
 
 TEST_F(PathQueryTest, BadPointQueriesGetClearErrors)

@@ -84,12 +84,14 @@ public:
     /// numbers. Any thread.
     Result<Vec3> FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter = {},
                                   const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
-    /// A random navmesh point reachable from inCenter (snapped within inSearchExtent) without leaving the
-    /// circle of inRadius around it: the wander goal of an agent. Polygons are chosen in proportion to their
-    /// area, among those the circle touches, so the point may lie up to one polygon beyond inRadius (Detour's
-    /// findRandomPointAroundCircle). The same inSeed on the same navmesh gives the same point. Areas inFilter
-    /// excludes are avoided (a few tries, then an error). Error when inCenter is off the navmesh, inRadius is
-    /// not in (0, cMaxSearchExtentTiles tiles], or a number is bad. Any thread.
+    /// A random navmesh point reachable from inCenter (snapped within inSearchExtent) through the polygons
+    /// that the circle of inRadius around it touches: the wander goal of an agent. Polygons are chosen in
+    /// proportion to their area, so the point may lie up to one polygon beyond inRadius (Detour's
+    /// findRandomPointAroundCircle). The same inSeed on the same navmesh (same tiles, published in the same
+    /// order) gives the same point. With areas inFilter excludes, the point is in none of them and FindPath
+    /// reaches it without crossing one, perhaps around them outside the circle (a few draws, then an error).
+    /// Error when inCenter is off the navmesh or in an excluded area, inRadius is not in (0,
+    /// cMaxSearchExtentTiles tiles], or a number is bad. Any thread.
     Result<Vec3> FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
                                        const PathFilter& inFilter = {},
                                        const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
