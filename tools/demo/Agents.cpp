@@ -7,12 +7,12 @@ namespace cairn::demo
 
 namespace
 {
-constexpr float cSpeed = 3.0f;          ///< m/s
-constexpr float cInvokerRadius = 20.0f; ///< m of navmesh each agent asks for
-constexpr float cWanderRadius = 15.0f;  ///< Goals within this of the agent, reachable from where it stands
-constexpr float cFollowDistance =
-    25.0f;                             ///< Further from the player than this, the agent heads for the player
-constexpr float cRetrySeconds = 0.25f; ///< Wait before asking again when there was no navmesh to ask
+constexpr float cSpeed = 3.0f;           ///< m/s
+constexpr float cInvokerRadius = 20.0f;  ///< m of navmesh each agent asks for
+constexpr float cWanderRadius = 15.0f;   ///< Goals within this of the agent, reachable from where it stands
+constexpr float cFollowDistance = 25.0f; ///< Further from the player, the agent heads for the player
+constexpr float cRetrySeconds = 0.25f;   ///< Wait before asking again when there was no navmesh to ask
+constexpr float cPartialRetrySeconds = 0.5f; ///< ... and after a path that ended short of its goal
 } // namespace
 
 Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, const TileStreamer& inStreamer,
@@ -92,7 +92,9 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
     }
     ++(path.Value().mReachedEnd ? mStats.mPathsFound : mStats.mPathsPartial);
     ioAgent.mPath = path.Value().mStraightPath;
-    ioAgent.mRepathIn = 2.0f;
+    ioAgent.mPathReachesGoal = path.Value().mReachedEnd;
+    // A partial path ends where the built navmesh does: asking again at once would get the same path
+    ioAgent.mRepathIn = path.Value().mReachedEnd ? 2.0f : cPartialRetrySeconds;
     if (GoesThroughWall(ioAgent.mPath)) ++mStats.mPathsThroughWalls;
 }
 
@@ -103,7 +105,8 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
         agent.mRepathIn -= inDeltaTime;
         // Arrived, or time for a fresh path (the navmesh changes); an agent without a path waits for its
         // retry
-        if (agent.mRepathIn <= 0.0f || (!agent.mPath.empty() && agent.mNext >= agent.mPath.size()))
+        if (agent.mRepathIn <= 0.0f ||
+            (agent.mPathReachesGoal && !agent.mPath.empty() && agent.mNext >= agent.mPath.size()))
             Repath(agent, inPlayer);
         // Walk along the straight path
         float step = cSpeed * inDeltaTime;
@@ -130,6 +133,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
             agent.mPosition =
                 Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
             agent.mPath.clear();
+            agent.mRepathIn = 0.0f; // A new goal from where it stands now
         }
         mScheduler.MoveInvoker(agent.mInvoker, agent.mPosition);
     }

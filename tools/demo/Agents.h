@@ -3,10 +3,10 @@
 // Agents: the demo's AI. Each agent is a navmesh invoker (the tiles within its radius are built in the
 // background) and walks paths on the navmesh as it appears and changes: it picks a goal on the navmesh (a
 // random point reachable within 15 m, or the navmesh under the player when it falls behind), asks the
-// NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it arrives or
-// every two seconds (a quarter of a second when there was no navmesh to ask yet). Every new
-// path is checked against the physics world: a point of it inside a wall (a static body at chest height)
-// counts as a path through a wall, which must never happen.
+// NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it arrives at its
+// goal or every two seconds (half a second after a path that ended short of its goal, a quarter when there
+// was no navmesh to ask yet). Every new path is checked against the physics world: a point of it inside a
+// wall (a static body at chest height) counts as a path through a wall, which must never happen.
 //
 // Threads: the main thread only (path queries may come from any thread; the demo keeps them on one).
 
@@ -50,8 +50,9 @@ private:
         Vec3 mPosition;
         navmesh::TileScheduler::InvokerID mInvoker = 0;
         std::vector<Vec3> mPath;
-        size_t mNext = 0;       ///< Next corner of mPath
-        float mRepathIn = 0.0f; ///< Seconds until it asks again
+        size_t mNext = 0;              ///< Next corner of mPath
+        float mRepathIn = 0.0f;        ///< Seconds until it asks again
+        bool mPathReachesGoal = false; ///< mPath ends at its goal (arriving asks for a new one at once)
     };
 
     void Repath(Agent& ioAgent, const Vec3& inPlayer);
