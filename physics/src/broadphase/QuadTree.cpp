@@ -147,10 +147,13 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
         // third of the build here
         static_assert(offsetof(BuildItem, mBounds) + sizeof(AABB) + sizeof(uint32_t) <= sizeof(BuildItem));
         __m128 lo = _mm_set1_ps(cLargeFloat), hi = _mm_set1_ps(-cLargeFloat);
+        // Lane 3 of the max row is mOldLocation's bits, a NaN or a denormal as a float: zeroed, so that lane
+        // adds max.x and 0 (denormal operands can be slow, and NaN ones raise the invalid flag)
+        const __m128 xyzMask = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
         for (const BuildItem* it = inB; it != inE; ++it)
         {
-            const __m128 centre2 =
-                _mm_add_ps(_mm_loadu_ps(it->mBounds.mMin.data()), _mm_loadu_ps(it->mBounds.mMax.data()));
+            const __m128 centre2 = _mm_add_ps(_mm_loadu_ps(it->mBounds.mMin.data()),
+                                              _mm_and_ps(_mm_loadu_ps(it->mBounds.mMax.data()), xyzMask));
             lo = _mm_min_ps(lo, centre2);
             hi = _mm_max_ps(hi, centre2);
         }
