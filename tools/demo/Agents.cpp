@@ -84,10 +84,8 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
     {
         // No navmesh under the agent or the goal yet (its tiles are still being built). An agent that stands
         // where there is none goes back to the player's path, which is kept clear
-        ++mStats.mPathsWithoutNavMesh;
-        if (path.GetError().mMessage.find("start") != std::string::npos ||
-            path.GetError().mMessage.find("centre") != std::string::npos)
-            ioAgent.mPosition = player;
+        ++mStats.mPathsFailed;
+        if (!mNavMesh.FindNearestPoint(ioAgent.mPosition)) ioAgent.mPosition = player;
         return;
     }
     ++(path.Value().mReachedEnd ? mStats.mPathsFound : mStats.mPathsPartial);

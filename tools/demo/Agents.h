@@ -27,11 +27,11 @@ public:
     struct Stats
     {
         uint64_t mPathQueries = 0;
-        uint64_t mPathsFound = 0;          ///< Reaching the goal
-        uint64_t mPathsPartial = 0;        ///< Ending at the reachable point nearest the goal
-        uint64_t mPathsWithoutNavMesh = 0; ///< No navmesh under the agent or around it yet: no path
-        double mPathMicros = 0.0;          ///< Summed
-        double mDistance = 0.0;            ///< Metres walked by all agents
+        uint64_t mPathsFound = 0;   ///< Reaching the goal
+        uint64_t mPathsPartial = 0; ///< Ending at the reachable point nearest the goal
+        uint64_t mPathsFailed = 0;  ///< No path: mostly no navmesh under the agent or its goal yet
+        double mPathMicros = 0.0;   ///< Summed
+        double mDistance = 0.0;     ///< Metres walked by all agents
         uint32_t mPathsThroughWalls = 0;
         std::vector<std::string> mErrors;
     };

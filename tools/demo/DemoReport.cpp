@@ -305,7 +305,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                         {{"queries", Count(inRun.mPathQueries)},
                          {"reached goal", ofQueries(inRun.mPathsFound)},
                          {"partial", ofQueries(inRun.mPathsPartial)},
-                         {"no navmesh yet", ofQueries(inRun.mPathsWithoutNavMesh)},
+                         {"failed (mostly no navmesh yet)", ofQueries(inRun.mPathsFailed)},
                          {"mean µs", Micros(inRun.mPathQueryMicrosMean)}}});
     sections.push_back(
         {"agents",

@@ -57,9 +57,9 @@ struct DemoRunResult
     uint64_t mNavTilesBuilt = 0;
     std::vector<uint32_t> mNavTileLatencyFrames; ///< Request to publication, per tile
     uint64_t mPathQueries = 0;
-    uint64_t mPathsFound = 0;          ///< Reaching the goal
-    uint64_t mPathsPartial = 0;        ///< Ending short of it
-    uint64_t mPathsWithoutNavMesh = 0; ///< No navmesh there yet
+    uint64_t mPathsFound = 0;   ///< Reaching the goal
+    uint64_t mPathsPartial = 0; ///< Ending short of it
+    uint64_t mPathsFailed = 0;  ///< No path (mostly: no navmesh there yet)
     double mPathQueryMicrosMean = 0.0;
     int mAgents = 0;
     double mAgentDistanceMetres = 0.0; ///< Walked by all agents along their paths

@@ -161,7 +161,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mPathQueries = agentStats.mPathQueries;
     result.mPathsFound = agentStats.mPathsFound;
     result.mPathsPartial = agentStats.mPathsPartial;
-    result.mPathsWithoutNavMesh = agentStats.mPathsWithoutNavMesh;
+    result.mPathsFailed = agentStats.mPathsFailed;
     result.mPathQueryMicrosMean =
         agentStats.mPathQueries == 0 ? 0.0 : agentStats.mPathMicros / double(agentStats.mPathQueries);
     result.mAgentDistanceMetres = agentStats.mDistance;
