@@ -35,6 +35,8 @@ const CachedBodyPair* ContactCache::FindPreviousPair(BodyID inBodyA, BodyID inBo
             }
             end = std::min(hint + step + 1, count); // mPreviousPairs[hint + step] is not below the key
         }
+        else if (hint == 0 || less(mPreviousPairs[hint - 1], key))
+            begin = end = hint; // The key belongs right at the hint (a new pair between two cached ones)
         else
             end = hint + 1; // mPreviousPairs[hint] is not below the key
     }
