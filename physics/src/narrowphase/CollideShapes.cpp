@@ -97,7 +97,8 @@ int CollideShapes(const Shape& inShapeA, const Transform& inTransformA, const Sh
 
     if (a == ShapeType::Compound || b == ShapeType::Compound)
     {
-        // Recurse into the compound side (A first); each child's manifolds are tagged with its index
+        // Recurse into the compound side (A first); each child's manifolds are tagged with its index and keep
+        // the child's own id (a mesh child's triangle) above it, so that they keep distinct cache keys
         const bool splitA = a == ShapeType::Compound;
         const CompoundShape& compound = static_cast<const CompoundShape&>(splitA ? inShapeA : inShapeB);
         const Transform& compoundTransform = splitA ? inTransformA : inTransformB;
@@ -110,11 +111,11 @@ int CollideShapes(const Shape& inShapeA, const Transform& inTransformA, const Sh
         {
             const Transform childTransform = compoundTransform * children[i].mLocalTransform;
             if (!children[i].mShape->GetWorldBounds(childTransform).Overlaps(otherBounds)) continue;
-            const SubShapeID id = static_cast<SubShapeID>(i);
             const auto tag = [&](const ContactManifold& inManifold)
             {
                 ContactManifold m = inManifold;
-                (splitA ? m.mSubShapeA : m.mSubShapeB) = id;
+                SubShapeID& id = splitA ? m.mSubShapeA : m.mSubShapeB;
+                id = CompoundShape::MakeManifoldSubShapeID(uint32_t(i), children.size(), id);
                 inVisitor(m);
             };
             count += splitA ? CollideShapes(*children[i].mShape, childTransform, other, otherTransform,

@@ -1,5 +1,6 @@
 #include "cairn/physics/shapes/CompoundShape.h"
 
+#include <bit>
 #include <string>
 
 namespace cairn
@@ -79,6 +80,31 @@ MassProperties CompoundShape::GetMassProperties(float inDensity) const
             child.mInertia + child.mMass * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
     }
     return total;
+}
+
+namespace
+{
+int ChildBits(size_t inNumChildren)
+{
+    return inNumChildren <= 1 ? 0 : int(std::bit_width(uint64_t(inNumChildren - 1)));
+}
+} // namespace
+
+SubShapeID CompoundShape::MakeManifoldSubShapeID(uint32_t inChild, size_t inNumChildren,
+                                                 SubShapeID inChildSubShape)
+{
+    const int bits = ChildBits(inNumChildren);
+    if (bits >= 32) return inChild; // Cannot happen with a vector's worth of children; be safe
+    if ((uint64_t(inChildSubShape) << bits) <= 0xffffffffull) return inChildSubShape << bits | inChild;
+    // Too many triangles for the bits left: a mix of both, with the child index kept in the low bits
+    uint64_t mixed = (uint64_t(inChildSubShape) * 0x9e3779b97f4a7c15ull) >> 32;
+    return SubShapeID(mixed << bits) | inChild;
+}
+
+uint32_t CompoundShape::GetManifoldChild(SubShapeID inID, size_t inNumChildren)
+{
+    const int bits = ChildBits(inNumChildren);
+    return bits == 0 ? 0u : inID & ((1u << bits) - 1u);
 }
 
 bool CompoundShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const

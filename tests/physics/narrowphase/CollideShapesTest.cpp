@@ -11,6 +11,7 @@
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 
+#include <algorithm>
 #include <array>
 #include <gtest/gtest.h>
 #include <random>
@@ -184,6 +185,49 @@ TEST(CollideShapesTest, CompoundOfTwoSpheresOnBox)
     ASSERT_EQ(swapped.size(), 2u);
     EXPECT_NE(swapped[0].mSubShapeB, swapped[1].mSubShapeB);
     EXPECT_GT(swapped[0].mNormal.y(), 0.9999f);
+}
+
+TEST(CollideShapesTest, ManifoldsOfAMeshInsideACompoundKeepTheirTriangles)
+{
+    // A box lying across both triangles of a quad that is child 0 of a compound: one manifold per triangle.
+    // Tagged with the child index alone, both had the same contact-cache key and one lost its warm start
+    const auto quad = MakeQuad(10.0f);
+    const auto far = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+    const auto compound = CompoundShape::Create({{quad, Transform()},
+                                                 {far, {Vec3(50, 0, 0), Quat::Identity()}},
+                                                 {far, {Vec3(-50, 0, 0), Quat::Identity()}}})
+                              .Value();
+    const auto box = BoxShape::Create(Vec3(2, 0.5f, 2)).Value();
+    for (const bool compoundFirst : {true, false})
+    {
+        const Transform boxAt(Vec3(5, 0.49f, 5), Quat::Identity()); // On the quad's diagonal
+        const auto manifolds =
+            compoundFirst ? Collide(*compound, {}, *box, boxAt) : Collide(*box, boxAt, *compound, {});
+        ASSERT_GE(manifolds.size(), 2u);
+        std::vector<SubShapeID> ids;
+        for (const ContactManifold& m : manifolds)
+        {
+            const SubShapeID id = compoundFirst ? m.mSubShapeA : m.mSubShapeB;
+            EXPECT_EQ(CompoundShape::GetManifoldChild(id, 3), 0u);
+            ids.push_back(id);
+        }
+        std::sort(ids.begin(), ids.end());
+        EXPECT_EQ(std::adjacent_find(ids.begin(), ids.end()), ids.end()) << "two manifolds share an id";
+    }
+}
+
+TEST(CollideShapesTest, ManifoldSubShapeIDsOfCompounds)
+{
+    EXPECT_EQ(CompoundShape::MakeManifoldSubShapeID(2, 3, 0), 2u); // A convex child: its index, as before
+    EXPECT_EQ(CompoundShape::MakeManifoldSubShapeID(2, 3, 5), 5u << 2 | 2u);
+    EXPECT_EQ(CompoundShape::GetManifoldChild(5u << 2 | 2u, 3), 2u);
+    EXPECT_EQ(CompoundShape::MakeManifoldSubShapeID(0, 1, 7), 7u); // One child needs no bits
+    // Too large to shift: mixed in, the child still in the low bits, different ids stay different
+    const SubShapeID a = CompoundShape::MakeManifoldSubShapeID(1, 4, 0xfffffff0u);
+    const SubShapeID b = CompoundShape::MakeManifoldSubShapeID(1, 4, 0xfffffff1u);
+    EXPECT_EQ(CompoundShape::GetManifoldChild(a, 4), 1u);
+    EXPECT_EQ(CompoundShape::GetManifoldChild(b, 4), 1u);
+    EXPECT_NE(a, b);
 }
 
 TEST(CollideShapesTest, CompoundAgainstCompoundAndMesh)

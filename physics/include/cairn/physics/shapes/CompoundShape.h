@@ -1,7 +1,9 @@
 #pragma once
 
 // A compound: sub-shapes at local transforms. Sub-shapes may be any shape except another compound's cycle
-// (shapes are immutable, so cycles cannot be built). SubShapeID of a compound hit = the child's index.
+// (shapes are immutable, so cycles cannot be built). SubShapeID of a compound's ray hit or triangle = the
+// child's index. A contact manifold's SubShapeID also keeps the child's own id (a mesh child's triangle), see
+// MakeManifoldSubShapeID: it keys the contact cache, and every triangle's manifold needs a key of its own.
 // Immutable: safe to share between threads.
 
 #include "cairn/physics/math/Result.h"
@@ -25,6 +27,14 @@ public:
     static Result<std::shared_ptr<const CompoundShape>> Create(std::vector<SubShape> inSubShapes);
 
     std::span<const SubShape> GetSubShapes() const { return mSubShapes; }
+
+    /// The id of a manifold of child inChild (of inNumChildren) whose own id is inChildSubShape: the child
+    /// index in the low bits (as many as inNumChildren needs), the child's id above them. An id too large to
+    /// fit is mixed in instead (still distinct from the others in practice, no longer decodable).
+    static SubShapeID MakeManifoldSubShapeID(uint32_t inChild, size_t inNumChildren,
+                                             SubShapeID inChildSubShape);
+    /// The child index of an id made by MakeManifoldSubShapeID (when it fitted).
+    static uint32_t GetManifoldChild(SubShapeID inID, size_t inNumChildren);
 
     AABB GetLocalBounds() const override;
     AABB GetWorldBounds(const Transform& inTransform) const override;
