@@ -216,70 +216,54 @@ TEST_P(JobSystemThreads, AJobCanWaitForASiblingThatIsNotReadyYet)
     EXPECT_EQ(siblingRan, 1);
 }
 
-TEST_P(JobSystemThreads, AWaitInsideAJobRunsThePrerequisitesOfWhatItWaitsFor)
+/// P waits for X, which waits for a chain of inDepth queued-later prerequisites (X <- Y1 <- ... <- Yn, only
+/// Yn runnable); R, queued before the chain, waits for P. With nothing of P's own queued, a wait that ran the
+/// first queued job ran R on P's stack, and R waited forever for P below it (one thread). Checks that every
+/// job ran, in every round.
+void WaitThroughAChainOfPrerequisites(JobSystem& ioJobs, int inDepth)
 {
-    // P waits for X, which waits for Y; R, queued before Y, waits for P. With nothing of P's own queued, a
-    // wait that ran the first queued job ran R on P's stack, and R waited forever for P below it
-    JobSystem jobs(MakeSettings());
     for (int round = 0; round < 20; ++round)
     {
         std::atomic<int> done{0};
         JobHandle x;
         std::atomic<bool> xScheduled{false};
-        const JobHandle p = jobs.Schedule("P",
-                                          [&]
-                                          {
-                                              while (!xScheduled.load())
-                                                  std::this_thread::yield();
-                                              jobs.Wait(x);
-                                              done.fetch_add(1);
-                                          });
-        const JobHandle r = jobs.Schedule("R",
-                                          [&]
-                                          {
-                                              jobs.Wait(p);
-                                              done.fetch_add(1);
-                                          });
-        const JobHandle y = jobs.Schedule("Y", [&] { done.fetch_add(1); });
-        x = jobs.Schedule("X", [&] { done.fetch_add(1); }, {y});
+        const JobHandle p = ioJobs.Schedule("P",
+                                            [&]
+                                            {
+                                                while (!xScheduled.load())
+                                                    std::this_thread::yield();
+                                                ioJobs.Wait(x);
+                                                done.fetch_add(1);
+                                            });
+        const JobHandle r = ioJobs.Schedule("R",
+                                            [&]
+                                            {
+                                                ioJobs.Wait(p);
+                                                done.fetch_add(1);
+                                            });
+        JobHandle below = ioJobs.Schedule("Y", [&] { done.fetch_add(1); });
+        for (int level = 1; level < inDepth; ++level)
+            below = ioJobs.Schedule("Y", [&] { done.fetch_add(1); }, {below});
+        x = ioJobs.Schedule("X", [&] { done.fetch_add(1); }, {below});
         xScheduled.store(true);
-        jobs.Wait(r);
-        EXPECT_EQ(done.load(), 4);
+        ioJobs.Wait(r);
+        EXPECT_EQ(done.load(), 3 + inDepth) << "depth " << inDepth;
     }
+}
+
+TEST_P(JobSystemThreads, AWaitInsideAJobRunsThePrerequisitesOfWhatItWaitsFor)
+{
+    JobSystem jobs(MakeSettings());
+    WaitThroughAChainOfPrerequisites(jobs, 1);
 }
 
 TEST_P(JobSystemThreads, AWaitInsideAJobRunsPrerequisitesOfPrerequisites)
 {
-    // As above, one level deeper: P waits for X, X for Y, Y for Z; R, queued before Z, waits for P. Only Z is
-    // queued, two steps away from X: a wait that looked at X's direct prerequisites alone found nothing of
-    // its own and fell back to the first queued job, R, which waited forever for P below it (one thread)
+    // Only the last of the chain is queued, two and more steps away from X: a wait that looked at X's direct
+    // prerequisites alone found nothing of its own and fell back to R (the test hung with one thread)
     JobSystem jobs(MakeSettings());
-    for (int round = 0; round < 20; ++round)
-    {
-        std::atomic<int> done{0};
-        JobHandle x;
-        std::atomic<bool> xScheduled{false};
-        const JobHandle p = jobs.Schedule("P",
-                                          [&]
-                                          {
-                                              while (!xScheduled.load())
-                                                  std::this_thread::yield();
-                                              jobs.Wait(x);
-                                              done.fetch_add(1);
-                                          });
-        const JobHandle r = jobs.Schedule("R",
-                                          [&]
-                                          {
-                                              jobs.Wait(p);
-                                              done.fetch_add(1);
-                                          });
-        const JobHandle z = jobs.Schedule("Z", [&] { done.fetch_add(1); });
-        const JobHandle y = jobs.Schedule("Y", [&] { done.fetch_add(1); }, {z});
-        x = jobs.Schedule("X", [&] { done.fetch_add(1); }, {y});
-        xScheduled.store(true);
-        jobs.Wait(r);
-        EXPECT_EQ(done.load(), 5);
-    }
+    for (const int depth : {2, 5})
+        WaitThroughAChainOfPrerequisites(jobs, depth);
 }
 
 TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
