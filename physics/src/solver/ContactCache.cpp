@@ -73,14 +73,13 @@ void SortByKey(std::vector<Item>& ioItems, std::vector<Item>& ioScratch,
     if (std::is_sorted(ioItems.begin(), ioItems.end(),
                        [&](const Item& inA, const Item& inB) { return inKeyOf(inA) < inKeyOf(inB); }))
         return;
-    std::vector<std::pair<Key, uint32_t>>& order = ioOrder;
-    order.resize(ioItems.size());
+    ioOrder.resize(ioItems.size());
     for (size_t i = 0; i < ioItems.size(); ++i)
-        order[i] = {inKeyOf(ioItems[i]), uint32_t(i)};
-    std::sort(order.begin(), order.end());
+        ioOrder[i] = {inKeyOf(ioItems[i]), uint32_t(i)};
+    std::sort(ioOrder.begin(), ioOrder.end());
     ioScratch.resize(ioItems.size());
-    for (size_t i = 0; i < order.size(); ++i)
-        ioScratch[i] = ioItems[order[i].second];
+    for (size_t i = 0; i < ioOrder.size(); ++i)
+        ioScratch[i] = ioItems[ioOrder[i].second];
     ioItems.swap(ioScratch);
 }
 } // namespace
