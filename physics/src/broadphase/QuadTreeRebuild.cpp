@@ -180,9 +180,14 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 PropagateUp(reparent.mNode, UnionOfSlots(kept));
         }
 
-        // b. Bodies move to their new leaves with their current bounds
-        for (const quadtree::Relocation& relocation : relocations)
+        // b. Bodies move to their new leaves with their current bounds. Their table entries are scattered
+        // (the new tree's order is spatial): each is fetched a few relocations ahead, so the misses overlap
+        // and the exclusive section, which modifiers wait for, is shorter
+        constexpr size_t cAhead = 8;
+        for (size_t i = 0; i < relocations.size(); ++i)
         {
+            if (i + cAhead < relocations.size()) __builtin_prefetch(&mBodies[relocations[i + cAhead].mBody]);
+            const quadtree::Relocation& relocation = relocations[i];
             QuadTreeBodyTable::Entry& entry = mBodies[relocation.mBody];
             const uint32_t newNode = relocation.mNewLocation >> 2;
             const int newSlot = int(relocation.mNewLocation & 3);
