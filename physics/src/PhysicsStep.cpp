@@ -653,7 +653,7 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     else
         for (int i = 0; i < solver.mVelocityIterations; ++i)
             forEachColor([&](std::span<ContactConstraint* const> inC)
-                         { SequentialImpulseSolver::SolveVelocities(inC, solverBodies); });
+                         { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, i); });
     forEachColor([&](std::span<ContactConstraint* const> inC)
                  { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
@@ -724,7 +724,7 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                 SequentialImpulseSolver::SolveVelocities(
                     std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[color],
                                                         mIslandConstraints.data() + mColorStart[color + 1]),
-                    solverBodies);
+                    solverBodies, iteration);
                 continue;
             }
             // The batches of one color share no dynamic body: one contiguous part per thread, as in
@@ -736,7 +736,7 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                 uint32_t(batches.size()),
                 [&](uint32_t inBegin, uint32_t inEnd) {
                     WideContactSolver::SolveVelocities(batches.subspan(inBegin, inEnd - inBegin),
-                                                       solverBodies);
+                                                       solverBodies, iteration);
                 },
                 8);
         }
@@ -759,7 +759,7 @@ void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
     const std::span<SolverBody> solverBodies(mSolverBodies);
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
-        SequentialImpulseSolver::SolveVelocities(constraints, solverBodies);
+        SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, i);
     SequentialImpulseSolver::ApplyRestitution(constraints, solverBodies, solver);
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();

@@ -209,18 +209,21 @@ void SequentialImpulseSolver::WarmStart(std::span<ContactConstraint* const> ioCo
 }
 
 void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const> ioConstraints,
-                                              std::span<SolverBody> ioBodies)
+                                              std::span<SolverBody> ioBodies, int inIteration)
 {
+    const bool backwards = (inIteration & 1) != 0;
     for (ContactConstraint* c : ioConstraints)
     {
         const BodyPair bodies = BodiesOf(*c, ioBodies);
         // Friction first, against last iteration's normal impulse: normal is solved last so that
         // non-penetration, the more important constraint, wins when the two disagree
         SolvePatchFriction(*c, bodies);
-        for (int i = 0; i < c->mNumPoints; ++i)
-            SolveNormal(*c, bodies, c->mPoints[i]);
-        for (int i = c->mNumPoints - 1; i >= 0; --i)
-            SolveNormal(*c, bodies, c->mPoints[i]);
+        if (backwards)
+            for (int i = c->mNumPoints - 1; i >= 0; --i)
+                SolveNormal(*c, bodies, c->mPoints[i]);
+        else
+            for (int i = 0; i < c->mNumPoints; ++i)
+                SolveNormal(*c, bodies, c->mPoints[i]);
     }
 }
 

@@ -234,19 +234,23 @@ void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
     }
 }
 
-void WideContactSolver::SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies)
+void WideContactSolver::SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies,
+                                        int inIteration)
 {
+    const bool backwards = (inIteration & 1) != 0;
     for (WideContactBatch& batch : ioBatches)
     {
         BodiesX4 a = Gather(ioBodies, batch.mBodyA);
         BodiesX4 b = Gather(ioBodies, batch.mBodyB);
         // As the scalar solver: friction against last iteration's normal impulses, then the points forwards
-        // and backwards
+        // or backwards by the iteration's parity
         SolvePatchFriction(batch, a, b);
-        for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
-            SolveNormal(batch, i, a, b);
-        for (int i = ContactManifold::cMaxPoints - 1; i >= 0; --i)
-            SolveNormal(batch, i, a, b);
+        if (backwards)
+            for (int i = ContactManifold::cMaxPoints - 1; i >= 0; --i)
+                SolveNormal(batch, i, a, b);
+        else
+            for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+                SolveNormal(batch, i, a, b);
         Scatter(a, ioBodies, batch.mBodyA);
         Scatter(b, ioBodies, batch.mBodyB);
     }

@@ -73,8 +73,8 @@ namespace WideContactSolver
 /// here.
 void Pack(std::span<ContactConstraint* const> inConstraints, std::span<SolverBody> ioBodies,
           WideContactBatch& ioBatch);
-/// One velocity iteration over the batches, in order.
-void SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies);
+/// Velocity iteration inIteration over the batches, in order (points swept as the scalar solver does).
+void SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies, int inIteration);
 /// Copies the batch's impulses back into its constraints.
 void Unpack(const WideContactBatch& inBatch, std::span<ContactConstraint* const> ioConstraints);
 } // namespace WideContactSolver
