@@ -267,8 +267,10 @@ float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const
     {
         Body& a = *c->mBodyA;
         Body& b = *c->mBodyB;
-        const Mat3 invIA = a.GetInverseInertiaWorld();
-        const Mat3 invIB = b.GetInverseInertiaWorld();
+        // The world inverse inertias are made on the first point that needs a correction: in a settled stack
+        // most constraints need none
+        Mat3 invIA, invIB;
+        bool haveInertia = false;
         for (int i = 0; i < c->mNumPoints; ++i)
         {
             const ContactConstraintPoint& p = c->mPoints[i];
@@ -281,6 +283,12 @@ float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const
                 std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
                            -inSettings.mMaxPenetrationCorrection, 0.0f);
             if (correction == 0.0f) continue;
+            if (!haveInertia)
+            {
+                invIA = a.GetInverseInertiaWorld();
+                invIB = b.GetInverseInertiaWorld();
+                haveInertia = true;
+            }
             AxisImpulse axis;
             InitAxis(c->mNormal, rA, rB, invIA, invIB, a.GetInverseMass(), b.GetInverseMass(), axis);
             const float impulse = -correction * axis.mEffectiveMass;
