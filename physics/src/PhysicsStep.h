@@ -55,6 +55,8 @@ private:
         uint32_t mNumWarmStartedPoints = 0;
         uint32_t mNumReusedPairs = 0;
         uint32_t mPreviousPairHint = 0; ///< See ContactCache::FindPreviousPair
+        uint32_t mFirstCachedPair = 0;  ///< Set at the merge: where its pairs go in the contact cache
+        uint32_t mFirstManifold = 0;    ///< Set at the merge: the first of its manifolds in this step's order
         void Clear()
         {
             mPreviousPairHint = 0;
@@ -148,9 +150,10 @@ private:
     BroadPhase& mBroadPhase;
 
     ContactCache mContactCache;
-    AtomicUnionFind mIslands;         ///< Linked by the narrow phase's threads as they find contacts
-    jobs::JobSystem* mJobs = nullptr; ///< During Run only
-    std::vector<BodyPair> mPairs;     ///< Scratch: pairs of the slice being collided
+    AtomicUnionFind mIslands;            ///< Linked by the narrow phase's threads as they find contacts
+    jobs::JobSystem* mJobs = nullptr;    ///< During Run only
+    std::vector<BodyPair> mPairs;        ///< Scratch: pairs of the slice being collided
+    std::vector<BodyPair> mPairsScratch; ///< Scratch: the radix sort's second buffer
     std::vector<std::vector<BodyPair>> mPairChunks;   ///< Scratch: pairs found per chunk of active bodies
     std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs
     std::vector<uint32_t> mIslandOrder;               ///< Scratch: islands, largest first
@@ -158,6 +161,8 @@ private:
     /// Islands with this many constraints or more are colored and solved by all threads together, whatever
     /// the number of threads (so results do not depend on it): one large island must not serialise the step
     static constexpr uint32_t cColoredIslandMinConstraints = 128;
+    /// An island's solve-order sort uses RadixSort from this many constraints (std::sort below).
+    static constexpr size_t cRadixSortMinItems = 256;
     static constexpr uint32_t cColoredIslandMinShare = 4; ///< ... and at least 1/4 of the step's constraints
     static constexpr uint32_t cSerialColor =
         64;                                ///< Constraints that found no free color among 64: solved alone
@@ -177,13 +182,15 @@ private:
         uint32_t mCacheIndex; ///< Tie-break (unique)
         ContactConstraint* mConstraint;
     };
-    std::vector<OrderItem> mOrderItems; ///< Scratch: the hashed solve order's sort
+    std::vector<OrderItem> mOrderItems;   ///< Scratch: the hashed solve order's sort
+    std::vector<OrderItem> mOrderScratch; ///< Scratch: the radix sort's second buffer
     struct ColorItem
     {
         uint64_t mKey;      ///< color << 32 | lowest dynamic active index
         uint32_t mPosition; ///< In the island's hashed order
     };
     std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
+    std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
     std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks
     uint32_t mNumChunksUsed = 0;                   ///< Narrow-phase chunks used by this step's rounds

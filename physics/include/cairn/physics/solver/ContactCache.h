@@ -5,9 +5,11 @@
 // body A (within cPointMatchDistance). It also remembers each body pair the narrow phase saw, with the pose
 // of B relative to A when its manifolds were made, so that a pair that has not moved relative to itself takes
 // its manifolds over without colliding the shapes again (a resting pile is most of a game's pairs).
-// Flat arrays are swapped each step and reused, so a warm scene allocates nothing. Written by the physics
-// step's updating thread only (merge and EndStep); the narrow phase's threads read the previous step's
-// arrays, which nothing writes until the next BeginStep: no locks.
+// Flat arrays are swapped each step and reused, so a warm scene allocates nothing. Sized by the physics
+// step's updating thread only (Add, AddPair, Append*, EndStep); the slots that Append* makes room for may
+// then be filled by the step's worker threads, each its own, before the updating thread goes on (the job
+// system's wait orders the writes). The narrow phase's threads read the previous step's arrays, which
+// nothing writes until the next BeginStep: no locks.
 
 #include "cairn/physics/body/BodyID.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
@@ -68,6 +70,13 @@ public:
     /// Stores a manifold of this step; returns its index for Get().
     uint32_t Add(const CachedManifold& inManifold);
     CachedManifold& Get(uint32_t inIndex) { return mCurrent[inIndex]; }
+    /// Makes room for inCount more manifolds of this step (filled through Get) and returns the first's index.
+    uint32_t AppendManifolds(uint32_t inCount)
+    {
+        const size_t first = mCurrent.size();
+        mCurrent.resize(first + inCount);
+        return uint32_t(first);
+    }
     /// Last step's record of the pair (A, B), or nullptr. ioHint (optional, start at 0): where the previous
     /// lookup of this caller ended; lookups in increasing pair order then cost a few steps instead of a
     /// binary search of the whole array. Any value gives the right answer.
@@ -79,6 +88,15 @@ public:
     }
     /// Stores a body pair of this step: its manifolds are the next inPair.mNumManifolds given to Add().
     void AddPair(const CachedBodyPair& inPair) { mCurrentPairs.push_back(inPair); }
+    /// Makes room for inCount more body pairs of this step (filled through GetPair) and returns the first's
+    /// index. Their manifolds are those in the same places of the manifolds appended, as with AddPair.
+    uint32_t AppendPairs(uint32_t inCount)
+    {
+        const size_t first = mCurrentPairs.size();
+        mCurrentPairs.resize(first + inCount);
+        return uint32_t(first);
+    }
+    CachedBodyPair& GetPair(uint32_t inIndex) { return mCurrentPairs[inIndex]; }
     /// Sorts this step's manifolds and pairs for lookup next step. Indices from Add() are invalid afterwards.
     void EndStep();
     size_t GetNumManifolds() const { return mCurrent.size(); }
