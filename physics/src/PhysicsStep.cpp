@@ -459,24 +459,28 @@ bool PhysicsStep::ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, Cached
             point.mPositionOnB = ioB.mPosition + ioB.mRotation * cached.mLocalOnB[i];
             point.mPenetration = (point.mPositionOnA - point.mPositionOnB).dot(manifold.mNormal);
         }
-        AddConstraint(ioA, ioB, manifold, inDeltaTime, &cached, ioOut);
+        AddConstraint(ioA, ioB, manifold, inDeltaTime, &cached, ioOut, true);
     }
     ++ioOut.mNumReusedPairs;
     return true;
 }
 
 void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
-                                const CachedManifold* inPrevious, NarrowPhaseChunk& ioOut) const
+                                const CachedManifold* inPrevious, NarrowPhaseChunk& ioOut,
+                                bool inTakenOver) const
 {
     if (inManifold.mNumPoints <= 0) return;
     ContactConstraint& c = ioOut.mConstraints.emplace_back();
-    SequentialImpulseSolver::InitConstraint(ioA, ioB, InverseInertiaOf(ioA), InverseInertiaOf(ioB),
-                                            inManifold, inDeltaTime, c);
+    // A manifold taken over from the cache has its points in the bodies' frames already, and its points are
+    // last step's, one for one
+    SequentialImpulseSolver::InitConstraint(
+        ioA, ioB, InverseInertiaOf(ioA), InverseInertiaOf(ioB), inManifold, inDeltaTime, c,
+        inTakenOver ? inPrevious->mLocalOnA : nullptr, inTakenOver ? inPrevious->mLocalOnB : nullptr);
 
-    CachedManifold cached;
+    CachedManifold& cached = ioOut.mCached.emplace_back();
     cached.mKey = {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB};
     cached.mNumPoints = c.mNumPoints;
-    cached.mNormalOnA = ioA.mRotation.conjugate() * c.mNormal;
+    cached.mNormalOnA = inTakenOver ? inPrevious->mNormalOnA : Vec3(ioA.mRotation.conjugate() * c.mNormal);
     const CachedManifold* previous = inPrevious;
     if (previous != nullptr)
     {
@@ -492,6 +496,13 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
         cached.mNormalImpulse[i] = 0.0f;
         cached.mDeferredBounce[i] = 0.0f;
         if (previous == nullptr) continue;
+        if (inTakenOver)
+        {
+            p.mNormal.mAccumulated = previous->mNormalImpulse[i];
+            p.mApproachVelocity = std::min(p.mApproachVelocity, previous->mDeferredBounce[i]); // As below
+            ++ioOut.mNumWarmStartedPoints;
+            continue;
+        }
         // Warm start from the nearest point of last step's manifold, if it is the same contact
         for (int j = 0; j < previous->mNumPoints; ++j)
             if ((previous->mLocalOnA[j] - p.mLocalOnA).squaredNorm() <
@@ -504,7 +515,6 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
                 break;
             }
     }
-    ioOut.mCached.push_back(cached);
     c.mOrderKey = MixBits((uint64_t(ioA.GetID().GetIndex()) << 32 | ioB.GetID().GetIndex()) ^
                           (uint64_t(inManifold.mSubShapeA) << 40) ^ inManifold.mSubShapeB);
 }

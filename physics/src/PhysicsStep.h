@@ -116,9 +116,11 @@ private:
     /// false if the shapes must be collided. ioRecord: the pose recorded with them.
     bool ReuseManifolds(Body& ioA, Body& ioB, float inDeltaTime, CachedBodyPair& ioRecord,
                         NarrowPhaseChunk& ioOut) const;
-    /// inPrevious: last step's manifold with the same key (for the warm start), or null.
+    /// inPrevious: last step's manifold with the same key (for the warm start), or null. inTakenOver: the
+    /// manifold was made from inPrevious by ReuseManifolds (same points, in the same order).
     void AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inManifold, float inDeltaTime,
-                       const CachedManifold* inPrevious, NarrowPhaseChunk& ioOut) const;
+                       const CachedManifold* inPrevious, NarrowPhaseChunk& ioOut,
+                       bool inTakenOver = false) const;
     /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
     void BuildIslands();
     /// The solver's order: hashed within each island; large islands colored. Counted as solver time.

@@ -135,7 +135,8 @@ void SolvePatchFriction(ContactConstraint& ioC, const BodyPair& ioBodies)
 
 void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Mat3& inInvIA, const Mat3& inInvIB,
                                              const ContactManifold& inManifold, float inDeltaTime,
-                                             ContactConstraint& outConstraint)
+                                             ContactConstraint& outConstraint, const Vec3* inLocalOnA,
+                                             const Vec3* inLocalOnB)
 {
     ContactConstraint& c = outConstraint;
     c.mBodyA = &ioA;
@@ -160,8 +161,8 @@ void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Mat3& i
         ContactConstraintPoint& p = c.mPoints[i];
         const Vec3 rA = mp.mPositionOnA - xA;
         const Vec3 rB = mp.mPositionOnB - xB;
-        p.mLocalOnA = ioA.GetRotation().conjugate() * rA;
-        p.mLocalOnB = ioB.GetRotation().conjugate() * rB;
+        p.mLocalOnA = inLocalOnA != nullptr ? inLocalOnA[i] : Vec3(ioA.GetRotation().conjugate() * rA);
+        p.mLocalOnB = inLocalOnB != nullptr ? inLocalOnB[i] : Vec3(ioB.GetRotation().conjugate() * rB);
         InitAxis(c.mNormal, rA, rB, invIA, invIB, ioA.GetInverseMass(), ioB.GetInverseMass(), p.mNormal);
         // A speculative point (separated by s) may close its gap this step, but no more
         p.mSeparation = -mp.mPenetration;

@@ -27,9 +27,12 @@ namespace cairn
 namespace SequentialImpulseSolver
 {
 /// Fills a constraint from a manifold between A and B (world space). Impulses start at zero. inInvIA/B: the
-/// bodies' world inverse inertia (zero for static and kinematic ones).
+/// bodies' world inverse inertia (zero for static and kinematic ones). inLocalOnA/B (optional): the points in
+/// A's and B's centre-of-mass frames when they are known (a manifold taken over from the contact cache),
+/// which saves turning each world point back into them.
 void InitConstraint(Body& ioA, Body& ioB, const Mat3& inInvIA, const Mat3& inInvIB,
-                    const ContactManifold& inManifold, float inDeltaTime, ContactConstraint& outConstraint);
+                    const ContactManifold& inManifold, float inDeltaTime, ContactConstraint& outConstraint,
+                    const Vec3* inLocalOnA = nullptr, const Vec3* inLocalOnB = nullptr);
 // The velocity passes work on ioBodies, indexed by each constraint's mSolverBodyA/B; a static or kinematic
 // body must have an inverse mass of 0 there (and a zero inverse inertia in the constraint, as InitConstraint
 // gives it), so that impulses leave it unchanged.
