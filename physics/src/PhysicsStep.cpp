@@ -705,14 +705,16 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     };
     const SolverSettings& solver = mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
-    forEachColor([&](std::span<ContactConstraint* const> inC)
-                 { SequentialImpulseSolver::WarmStart(inC, solverBodies); });
     if (CAIRN_WIDE_SOLVER && solver.mWideColoredIslands)
-        SolveColoredVelocitiesWide(firstColor, lastColor);
+        SolveColoredVelocitiesWide(firstColor, lastColor); // The warm start too, four manifolds at a time
     else
+    {
+        forEachColor([&](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::WarmStart(inC, solverBodies); });
         for (int i = 0; i < solver.mVelocityIterations; ++i)
             forEachColor([&](std::span<ContactConstraint* const> inC)
                          { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, i); });
+    }
     forEachColor([&](std::span<ContactConstraint* const> inC)
                  { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
@@ -775,30 +777,37 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                                                 mWideBatches[i]);
                 });
 
-    for (int iteration = 0; iteration < mSettings.mSolver.mVelocityIterations; ++iteration)
+    // One pass over the colors in turn: the serial range by the scalar solver, the batches of one color (they
+    // share no dynamic body) in one contiguous part per thread, as in SolveColoredIsland (8 batches are the
+    // 32 constraints a part needs to pay)
+    auto forEachColor = [&](const auto& inSerial, const auto& inWide)
+    {
         for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
         {
             if (mColorIsSerial[color] != 0)
             {
-                SequentialImpulseSolver::SolveVelocities(
+                inSerial(
                     std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[color],
-                                                        mIslandConstraints.data() + mColorStart[color + 1]),
-                    solverBodies, iteration);
+                                                        mIslandConstraints.data() + mColorStart[color + 1]));
                 continue;
             }
-            // The batches of one color share no dynamic body: one contiguous part per thread, as in
-            // SolveColoredIsland (8 batches are the 32 constraints a part needs to pay)
             const std::span<WideContactBatch> batches(
                 mWideBatches.data() + mColorBatchStart[color - inFirstColor],
                 mWideBatches.data() + mColorBatchStart[color - inFirstColor + 1]);
             ForEachThreadPart(
                 uint32_t(batches.size()),
-                [&](uint32_t inBegin, uint32_t inEnd) {
-                    WideContactSolver::SolveVelocities(batches.subspan(inBegin, inEnd - inBegin),
-                                                       solverBodies, iteration);
-                },
+                [&](uint32_t inBegin, uint32_t inEnd) { inWide(batches.subspan(inBegin, inEnd - inBegin)); },
                 8);
         }
+    };
+    forEachColor([&](std::span<ContactConstraint* const> inC)
+                 { SequentialImpulseSolver::WarmStart(inC, solverBodies); },
+                 [&](std::span<WideContactBatch> inB) { WideContactSolver::WarmStart(inB, solverBodies); });
+    for (int iteration = 0; iteration < mSettings.mSolver.mVelocityIterations; ++iteration)
+        forEachColor([&](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, iteration); },
+                     [&](std::span<WideContactBatch> inB)
+                     { WideContactSolver::SolveVelocities(inB, solverBodies, iteration); });
 
     ParallelFor(numBatches, 64,
                 [&](uint32_t inBegin, uint32_t inEnd)

@@ -104,6 +104,17 @@ float* Floats(SolverBody& ioBody)
     ioB.mAngular.mZ = _mm_add_ps(ioB.mAngular.mZ, _mm_mul_ps(inLambda, inPart.mInvIB_RBxAxis[2]));
 }
 
+[[gnu::always_inline]] inline void ApplyTwist(const WideContactBatch& inC, BodiesX4& ioA, BodiesX4& ioB,
+                                              __m128 inLambda)
+{
+    ioA.mAngular.mX = _mm_sub_ps(ioA.mAngular.mX, _mm_mul_ps(inLambda, inC.mInvIA_Normal[0]));
+    ioA.mAngular.mY = _mm_sub_ps(ioA.mAngular.mY, _mm_mul_ps(inLambda, inC.mInvIA_Normal[1]));
+    ioA.mAngular.mZ = _mm_sub_ps(ioA.mAngular.mZ, _mm_mul_ps(inLambda, inC.mInvIA_Normal[2]));
+    ioB.mAngular.mX = _mm_add_ps(ioB.mAngular.mX, _mm_mul_ps(inLambda, inC.mInvIB_Normal[0]));
+    ioB.mAngular.mY = _mm_add_ps(ioB.mAngular.mY, _mm_mul_ps(inLambda, inC.mInvIB_Normal[1]));
+    ioB.mAngular.mZ = _mm_add_ps(ioB.mAngular.mZ, _mm_mul_ps(inLambda, inC.mInvIB_Normal[2]));
+}
+
 [[gnu::always_inline]] inline void SolvePatchFriction(WideContactBatch& ioC, BodiesX4& ioA, BodiesX4& ioB)
 {
     // The points' accumulated impulses summed in order (padding points are zero and change nothing)
@@ -139,13 +150,7 @@ float* Floats(SolverBody& ioBody)
         _mm_sub_ps(ioC.mTwistAccumulated, _mm_mul_ps(ioC.mTwistEffectiveMass, relativeTwist));
     // std::clamp(v, lo, hi) is v < lo ? lo : (hi < v ? hi : v); _mm_max_ps(a, b) is a > b ? a : b
     const __m128 twist = _mm_min_ps(maxTwist, _mm_max_ps(minTwist, unclamped));
-    const __m128 applied = _mm_sub_ps(twist, ioC.mTwistAccumulated);
-    ioA.mAngular.mX = _mm_sub_ps(ioA.mAngular.mX, _mm_mul_ps(applied, ioC.mInvIA_Normal[0]));
-    ioA.mAngular.mY = _mm_sub_ps(ioA.mAngular.mY, _mm_mul_ps(applied, ioC.mInvIA_Normal[1]));
-    ioA.mAngular.mZ = _mm_sub_ps(ioA.mAngular.mZ, _mm_mul_ps(applied, ioC.mInvIA_Normal[2]));
-    ioB.mAngular.mX = _mm_add_ps(ioB.mAngular.mX, _mm_mul_ps(applied, ioC.mInvIB_Normal[0]));
-    ioB.mAngular.mY = _mm_add_ps(ioB.mAngular.mY, _mm_mul_ps(applied, ioC.mInvIB_Normal[1]));
-    ioB.mAngular.mZ = _mm_add_ps(ioB.mAngular.mZ, _mm_mul_ps(applied, ioC.mInvIB_Normal[2]));
+    ApplyTwist(ioC, ioA, ioB, _mm_sub_ps(twist, ioC.mTwistAccumulated));
     ioC.mTwistAccumulated = twist;
 }
 
@@ -231,6 +236,23 @@ void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
             SetLane(ioBatch.mVelocityBias[i], l, c.mPoints[i].mVelocityBias);
             SetLane(ioBatch.mMaxNormalImpulse[i], l, c.mPoints[i].mMaxNormalImpulse);
         }
+    }
+}
+
+void WideContactSolver::WarmStart(std::span<const WideContactBatch> inBatches, std::span<SolverBody> ioBodies)
+{
+    for (const WideContactBatch& batch : inBatches)
+    {
+        BodiesX4 a = Gather(ioBodies, batch.mBodyA);
+        BodiesX4 b = Gather(ioBodies, batch.mBodyB);
+        // As the scalar warm start: the points, the two tangents, then the twist (padding applies zero)
+        for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+            ApplyImpulse(a, b, batch.mNormal, batch.mPoint[i], batch.mPoint[i].mAccumulated);
+        for (int t = 0; t < 2; ++t)
+            ApplyImpulse(a, b, batch.mTangent[t], batch.mTangentAxis[t], batch.mTangentAxis[t].mAccumulated);
+        ApplyTwist(batch, a, b, batch.mTwistAccumulated);
+        Scatter(a, ioBodies, batch.mBodyA);
+        Scatter(b, ioBodies, batch.mBodyB);
     }
 }
 

@@ -73,6 +73,8 @@ namespace WideContactSolver
 /// here.
 void Pack(std::span<ContactConstraint* const> inConstraints, std::span<SolverBody> ioBodies,
           WideContactBatch& ioBatch);
+/// Applies the batches' accumulated (warm-start) impulses, as SequentialImpulseSolver::WarmStart does.
+void WarmStart(std::span<const WideContactBatch> inBatches, std::span<SolverBody> ioBodies);
 /// Velocity iteration inIteration over the batches, in order (points swept as the scalar solver does).
 void SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies, int inIteration);
 /// Copies the batch's impulses back into its constraints.
