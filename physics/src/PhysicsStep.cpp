@@ -526,11 +526,13 @@ void PhysicsStep::BuildIslands()
 
     const uint32_t numIslands = mIslands.GetNumIslands();
     mConstraintStart.assign(numIslands + 1, 0);
+    mIslandBounces.assign(numIslands, 0);
     for (ContactConstraint* c : mConstraints)
     {
         const Body& dynamicBody = c->mBodyA->IsDynamic() ? *c->mBodyA : *c->mBodyB;
         c->mIsland = mIslands.GetIsland(dynamicBody.GetActiveIndex());
         ++mConstraintStart[c->mIsland + 1];
+        mIslandBounces[c->mIsland] |= c->mRestitution != 0.0f ? 1 : 0;
     }
     for (uint32_t i = 0; i < numIslands; ++i)
         mConstraintStart[i + 1] += mConstraintStart[i];
@@ -715,8 +717,10 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
             forEachColor([&](std::span<ContactConstraint* const> inC)
                          { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, i); });
     }
-    forEachColor([&](std::span<ContactConstraint* const> inC)
-                 { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
+    // Only where something bounces: the pass costs a barrier per color
+    if (mIslandBounces[inIsland] != 0)
+        forEachColor([&](std::span<ContactConstraint* const> inC)
+                     { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const std::span<const uint32_t> bodies = mIslands.GetBodies(inIsland);

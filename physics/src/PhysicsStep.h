@@ -191,7 +191,8 @@ private:
         uint64_t mKey;      ///< color << 32 | lowest dynamic active index
         uint32_t mPosition; ///< In the island's hashed order
     };
-    std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
+    std::vector<uint8_t> mIslandBounces; ///< Per island: 1 if a constraint has restitution (BuildIslands)
+    std::vector<ColorItem> mColorItems;  ///< Scratch per constraint of the island being colored
     std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
     std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks

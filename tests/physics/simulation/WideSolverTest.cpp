@@ -3,6 +3,7 @@
 
 #include "SimulationFixture.h"
 
+#include <algorithm>
 #include <vector>
 
 namespace cairn::test
@@ -94,6 +95,47 @@ TEST(WideSolverTest, SameStatesAsTheScalarSolverOnTwoThreads)
     jobs::JobSystem jobSystem(settings);
     PyramidRun scalar = MakePyramid(false), wide = MakePyramid(true);
     StepBoth(scalar, wide, &jobSystem, 100);
+}
+
+/// Drops a ball of the given restitution onto the settled pyramid's top box; returns its fastest upward speed
+/// after it hit (the ball joins the pyramid's colored island).
+float BounceOnPyramid(float inRestitution)
+{
+    PyramidRun run = MakePyramid(true);
+    for (int step = 0; step < 60; ++step)
+        EXPECT_TRUE(run.mSystem->Update(1.0f / 60.0f).IsOk());
+    BodyInterface& bodies = run.mSystem->GetBodyInterface();
+    BodyCreationSettings ball;
+    ball.mShape = SphereShape::Create(0.5f).Value();
+    ball.mPosition = bodies.GetPosition(run.mBoxes.back()).Value() + Vec3(0.0f, 3.5f, 0.0f);
+    ball.mMotionType = MotionType::Dynamic;
+    ball.mObjectLayer = Layers::cMoving;
+    ball.mRestitution = inRestitution;
+    const BodyID id = bodies.CreateAndAddBody(ball, Activation::Activate).Value();
+    bool fell = false, joined = false;
+    float fastestUp = 0.0f;
+    for (int step = 0; step < 90; ++step)
+    {
+        EXPECT_TRUE(run.mSystem->Update(1.0f / 60.0f).IsOk());
+        const float vy = bodies.GetLinearVelocity(id).Value().y();
+        fell |= vy < -5.0f;
+        if (fell) fastestUp = std::max(fastestUp, vy);
+        const StepStatistics& stats = run.mSystem->GetLastStepStatistics();
+        joined |= stats.mNumIslands == 1 && stats.mNumManifolds >= 128;
+    }
+    EXPECT_TRUE(fell) << "the ball did not fall";
+    EXPECT_TRUE(joined) << "the ball never made one colored island with the pyramid";
+    return fastestUp;
+}
+
+// The restitution pass of a colored island runs only where a constraint bounces (it costs a barrier per
+// color): a bouncy ball landing on the pyramid must still bounce, a dead one must not
+TEST(WideSolverTest, BallBouncesOnAColoredIsland)
+{
+    const float bouncy = BounceOnPyramid(0.9f);
+    const float dead = BounceOnPyramid(0.0f);
+    EXPECT_GT(bouncy, 3.0f) << "a ball of restitution 0.9 hit at about 7 m/s";
+    EXPECT_LT(dead, 1.0f);
 }
 
 } // namespace
