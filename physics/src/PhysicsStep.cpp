@@ -573,16 +573,9 @@ void PhysicsStep::OrderConstraints()
             std::sort(items.begin(), items.end(), byKeyThenCacheIndex);
             continue;
         }
-        auto highHalf = [](const OrderItem& inItem) { return inItem.mOrderKey >> 32; };
-        RadixSort(items, mOrderScratch, highHalf, 32);
-        for (size_t first = 0; first < items.size();)
-        {
-            size_t last = first + 1;
-            while (last < items.size() && highHalf(items[last]) == highHalf(items[first]))
-                ++last;
-            if (last - first > 1) std::sort(items.begin() + first, items.begin() + last, byKeyThenCacheIndex);
-            first = last;
-        }
+        RadixSortByHighHalf(
+            items, mOrderScratch, [](const OrderItem& inItem) { return inItem.mOrderKey; },
+            byKeyThenCacheIndex);
     }
     for (size_t i = 0; i < mIslandConstraints.size(); ++i)
         mIslandConstraints[i] = mOrderItems[i].mConstraint;
@@ -658,6 +651,7 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
     // Keys computed once: the sort does not chase the constraints' body pointers. The items are in position
     // order, so a stable sort by key gives the (key, position) order. Radix: a key has few significant bytes
     // (the color and an active index), and the digit passes that are the same for all items are skipped
+    static_assert(cSerialColor < 256, "the color must fit the key's 40 bits");
     RadixSort(
         std::span<ColorItem>(mColorItems), mColorItemsScratch,
         [](const ColorItem& inItem) { return inItem.mKey; }, 40);

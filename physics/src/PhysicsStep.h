@@ -7,8 +7,10 @@
 // With a job system, the parallel phases run on its threads (ParallelFor; the updating thread takes part):
 // velocities, pair finding (per active body), the narrow phase (per chunk of pairs), islands (largest first),
 // bounds and the broad-phase notify. Each parallel task writes only its own bodies or its own chunk's output;
-// everything shared (the constraint list, the contact cache, the active list, waking) is merged afterwards on
-// the updating thread in pair order, so results do not depend on the number of threads or their timing.
+// everything shared (the constraint list, the contact cache, the active list, waking) is merged afterwards in
+// pair order: the updating thread wakes bodies and reserves each chunk's places in the constraint list and
+// the contact cache, then the chunks are copied into their places in parallel. Results do not depend on the
+// number of threads or their timing.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSettings.h"
@@ -163,7 +165,8 @@ private:
     /// Islands with this many constraints or more are colored and solved by all threads together, whatever
     /// the number of threads (so results do not depend on it): one large island must not serialise the step
     static constexpr uint32_t cColoredIslandMinConstraints = 128;
-    /// An island's solve-order sort uses RadixSort from this many constraints (std::sort below).
+    /// The solve-order sort of an island and the sort of the pair list use RadixSort from this many items
+    /// (std::sort below; the coloring, only for large islands, always uses RadixSort).
     static constexpr size_t cRadixSortMinItems = 256;
     static constexpr uint32_t cColoredIslandMinShare = 4; ///< ... and at least 1/4 of the step's constraints
     static constexpr uint32_t cSerialColor =

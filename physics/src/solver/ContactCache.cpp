@@ -66,10 +66,11 @@ namespace
 /// them in its canonical pair order, which is nearly always sorted already: then one check is all. Otherwise
 /// the keys are sorted with their positions and the items moved once, where sorting the items themselves
 /// (up to 200 bytes each) moved each of them log n times.
-template <class Item, class Key, class KeyOf>
-void SortByKey(std::vector<Item>& ioItems, std::vector<Item>& ioScratch,
-               std::vector<std::pair<Key, uint32_t>>& ioOrder, const KeyOf& inKeyOf)
+template <class Items, class Key, class KeyOf>
+void SortByKey(Items& ioItems, Items& ioScratch, std::vector<std::pair<Key, uint32_t>>& ioOrder,
+               const KeyOf& inKeyOf)
 {
+    using Item = typename Items::value_type;
     if (std::is_sorted(ioItems.begin(), ioItems.end(),
                        [&](const Item& inA, const Item& inB) { return inKeyOf(inA) < inKeyOf(inB); }))
         return;

@@ -270,7 +270,7 @@ float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const
         Body& b = *c->mBodyB;
         // The world inverse inertias are made on the first point that needs a correction: in a settled stack
         // most constraints need none
-        Mat3 invIA, invIB;
+        Mat3 invIA = Mat3::Zero(), invIB = Mat3::Zero(); // Set before use; zeroed so no path reads garbage
         bool haveInertia = false;
         for (int i = 0; i < c->mNumPoints; ++i)
         {

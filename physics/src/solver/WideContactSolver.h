@@ -1,11 +1,12 @@
 #pragma once
 
-// The velocity iterations of a colored island, four manifolds at a time, one in each lane of an SSE register.
-// Within one color no two constraints share a dynamic body (and each static or kinematic side has a
-// SolverBody block of its own), so four of them can be solved at once without conflict. Each lane does the
-// arithmetic of SequentialImpulseSolver::SolveVelocities in the same order, so the bodies end with the same
-// velocities bit for bit (PhysicsStep tests compare the two); what changes is speed: the scalar solver waits
-// on one long chain of dependent operations per contact row, where here four chains run side by side.
+// The warm start and velocity iterations of a colored island, four manifolds at a time, one in each lane of
+// an SSE register. Within one color no two constraints share a dynamic body (and each static or kinematic
+// side has a SolverBody block of its own), so four of them can be solved at once without conflict. Each lane
+// does the arithmetic of SequentialImpulseSolver::WarmStart and SolveVelocities in the same order, so the
+// bodies end with the same velocities bit for bit (PhysicsStep tests compare the two); what changes is speed:
+// the scalar solver waits on one long chain of dependent operations per contact row, where here four chains
+// run side by side.
 //
 // A batch is packed from its constraints once per step, solved by one thread per iteration (the thread that
 // owns its part of the color), and its impulses are unpacked back into the constraints for the restitution

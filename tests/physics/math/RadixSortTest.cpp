@@ -64,4 +64,21 @@ TEST(RadixSortTest, SortsThousandsOfHashedKeysAndKeepsEqualKeysInInputOrder)
     EXPECT_EQ(items, expected);
     EXPECT_EQ(scratch.size(), items.size()) << "the scratch buffer is kept for its capacity";
 }
+// The solve order's sort: high halves forced to a few values, so that the runs the fix-up re-sorts are long
+RC_GTEST_PROP(RadixSortTest, ByHighHalfOrdersAsTheFullComparison, ())
+{
+    const auto raw = *rc::gen::container<std::vector<uint64_t>>(rc::gen::arbitrary<uint64_t>());
+    std::vector<Keyed> items;
+    for (uint32_t i = 0; i < raw.size(); ++i)
+        items.push_back({(raw[i] % 3) << 32 | (raw[i] >> 40), uint32_t(raw[i] % 7) * 1000 + i});
+    // Key, then a tie-break that is not the input order (as the cache index is not)
+    auto less = [](const Keyed& inL, const Keyed& inR)
+    { return inL.mKey < inR.mKey || (inL.mKey == inR.mKey && inL.mInputPosition > inR.mInputPosition); };
+    std::vector<Keyed> expected = items;
+    std::sort(expected.begin(), expected.end(), less);
+    std::vector<Keyed> scratch;
+    RadixSortByHighHalf(std::span<Keyed>(items), scratch, KeyOf, less);
+    RC_ASSERT(items == expected);
+}
+
 } // namespace cairn::test

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -25,6 +26,7 @@ void RadixSort(std::span<Item> ioItems, std::vector<Item>& ioScratch, const KeyO
     constexpr uint32_t cBuckets = 1u << cDigitBits;
     const size_t count = ioItems.size();
     if (count < 2) return;
+    assert(count <= UINT32_MAX && "RadixSort: the digit counts are 32-bit");
     const int passes = std::clamp((inKeyBits + cDigitBits - 1) / cDigitBits, 1, 8);
     std::array<std::array<uint32_t, cBuckets>, 8> counts{};
     for (const Item& item : ioItems)
@@ -49,6 +51,26 @@ void RadixSort(std::span<Item> ioItems, std::vector<Item>& ioScratch, const KeyO
         std::swap(source, target);
     }
     if (source != ioItems.data()) std::copy(source, source + count, ioItems.data());
+}
+
+/// Sorts ioItems by inLess, a strict total order whose first criterion is inKeyOf(item), a uint64_t:
+/// RadixSort on the key's high 32 bits (half the passes of the whole key), then each run of items whose high
+/// halves are equal sorted by inLess. For hashed keys such runs are rare and short; the result is std::sort's
+/// by inLess.
+template <class Item, class KeyOf, class Less>
+void RadixSortByHighHalf(std::span<Item> ioItems, std::vector<Item>& ioScratch, const KeyOf& inKeyOf,
+                         const Less& inLess)
+{
+    auto highHalf = [&](const Item& inItem) { return uint64_t(inKeyOf(inItem)) >> 32; };
+    RadixSort(ioItems, ioScratch, highHalf, 32);
+    for (size_t first = 0; first < ioItems.size();)
+    {
+        size_t last = first + 1;
+        while (last < ioItems.size() && highHalf(ioItems[last]) == highHalf(ioItems[first]))
+            ++last;
+        if (last - first > 1) std::sort(ioItems.begin() + first, ioItems.begin() + last, inLess);
+        first = last;
+    }
 }
 
 } // namespace cairn

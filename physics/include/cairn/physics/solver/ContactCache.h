@@ -1,17 +1,20 @@
 #pragma once
 
 // ContactCache: remembers each manifold's accumulated impulses from one step to the next, so the solver can
-// warm-start. Keyed by (body A, body B, sub-shape A, sub-shape B); points are matched by their position on
-// body A (within cPointMatchDistance). It also remembers each body pair the narrow phase saw, with the pose
+// warm-start. Keyed by (body A, body B, sub-shape A, sub-shape B); points of a newly collided manifold are
+// matched by their position on body A (within cPointMatchDistance), those of a manifold taken over one for
+// one. It also remembers each body pair the narrow phase saw, with the pose
 // of B relative to A when its manifolds were made, so that a pair that has not moved relative to itself takes
 // its manifolds over without colliding the shapes again (a resting pile is most of a game's pairs).
 // Flat arrays are swapped each step and reused, so a warm scene allocates nothing. Sized by the physics
 // step's updating thread only (Add, AddPair, Append*, EndStep); the slots that Append* makes room for may
 // then be filled by the step's worker threads, each its own, before the updating thread goes on (the job
-// system's wait orders the writes). The narrow phase's threads read the previous step's arrays, which
+// system's wait orders the writes); so may the impulses of this step's manifolds (through Get), each island's
+// by the thread that solves it. The narrow phase's threads read the previous step's arrays, which
 // nothing writes until the next BeginStep: no locks.
 
 #include "cairn/physics/body/BodyID.h"
+#include "cairn/physics/math/DefaultInitAllocator.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
 #include <span>
@@ -103,12 +106,15 @@ public:
     void Clear();
 
 private:
-    std::vector<CachedManifold> mPrevious;      ///< Sorted by key
-    std::vector<CachedManifold> mCurrent;       ///< In creation order until EndStep
-    std::vector<CachedBodyPair> mPreviousPairs; ///< Sorted by bodies, each with its manifolds in mPrevious
-    std::vector<CachedBodyPair> mCurrentPairs;  ///< In creation order until EndStep
-    std::vector<CachedManifold> mScratch;       ///< EndStep's sorting buffers, kept for their capacity
-    std::vector<CachedBodyPair> mScratchPairs;
+    // Grown by Append* and then filled: default-initialised, so the growth does not zero them first
+    using Manifolds = std::vector<CachedManifold, DefaultInitAllocator<CachedManifold>>;
+    using Pairs = std::vector<CachedBodyPair, DefaultInitAllocator<CachedBodyPair>>;
+    Manifolds mPrevious;  ///< Sorted by key
+    Manifolds mCurrent;   ///< In creation order until EndStep
+    Pairs mPreviousPairs; ///< Sorted by bodies, each with its manifolds in mPrevious
+    Pairs mCurrentPairs;  ///< In creation order until EndStep
+    Manifolds mScratch;   ///< EndStep's sorting buffers, kept for their capacity
+    Pairs mScratchPairs;
     std::vector<std::pair<ContactKey, uint32_t>> mManifoldOrder;
     std::vector<std::pair<std::pair<BodyID, BodyID>, uint32_t>> mPairOrder;
 };
