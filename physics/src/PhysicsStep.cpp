@@ -7,6 +7,10 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <thread>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace cairn
 {
@@ -169,6 +173,18 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
                             body.IsDynamic())
                             IntegratePositions(body, inDeltaTime);
                 });
+}
+
+void PhysicsStep::WaitABit(uint32_t inSpins)
+{
+    if (inSpins < 256)
+    {
+#if defined(__SSE2__)
+        _mm_pause();
+#endif
+    }
+    else
+        std::this_thread::yield();
 }
 
 void PhysicsStep::LoadSolverBody(const Body& inBody, SolverBody& outBlock)
@@ -682,39 +698,52 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     uint32_t lastColor = firstColor;
     while (mColorStart[lastColor + 1] != mConstraintStart[inIsland + 1])
         ++lastColor;
-    auto forEachColor = [&](const auto& inSolve)
+    // inPasses passes over the colors in turn, each color a stage: inSolve(pass, constraints). Within a color
+    // no two constraints share a dynamic body, so its parts may run at once (one per thread, the same region
+    // for the same thread in every color); the range of constraints that found no color shares bodies and
+    // runs as one part
+    const uint32_t numColors = lastColor - firstColor + 1;
+    auto colorPasses = [&](int inPasses, const auto& inSolve)
     {
-        for (uint32_t color = firstColor; color <= lastColor; ++color)
+        auto constraintsOf = [&](uint32_t inColor)
         {
-            const std::span<ContactConstraint* const> constraints(
-                mIslandConstraints.data() + mColorStart[color],
-                mIslandConstraints.data() + mColorStart[color + 1]);
-            // Within a color no two constraints share a dynamic body, so its parts may run at once (one per
-            // thread, the same region for the same thread in every color); the range of constraints that
-            // found no color shares bodies and runs as one part
-            if (mColorIsSerial[color] != 0)
-                inSolve(constraints);
-            else
-                ForEachThreadPart(uint32_t(constraints.size()), [&](uint32_t inBegin, uint32_t inEnd)
-                                  { inSolve(constraints.subspan(inBegin, inEnd - inBegin)); });
-        }
+            return std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[inColor],
+                                                       mIslandConstraints.data() + mColorStart[inColor + 1]);
+        };
+        RunStages(
+            uint32_t(std::max(inPasses, 0)) * numColors,
+            [&](uint32_t inStage)
+            {
+                const uint32_t color = firstColor + inStage % numColors;
+                return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(constraintsOf(color).size()), 32);
+            },
+            [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
+            {
+                const std::span<ContactConstraint* const> constraints =
+                    constraintsOf(firstColor + inStage % numColors);
+                const uint32_t count = uint32_t(constraints.size());
+                inSolve(int(inStage / numColors),
+                        constraints.subspan(inPart * count / inParts,
+                                            (inPart + 1) * count / inParts - inPart * count / inParts));
+            });
     };
     const SolverSettings& solver = mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
     if (CAIRN_WIDE_SOLVER && solver.mWideColoredIslands)
         SolveColoredVelocitiesWide(firstColor, lastColor); // The warm start too, four manifolds at a time
     else
-    {
-        forEachColor([&](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::WarmStart(inC, solverBodies); });
-        for (int i = 0; i < solver.mVelocityIterations; ++i)
-            forEachColor([&](std::span<ContactConstraint* const> inC)
-                         { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, i); });
-    }
-    // Only where something bounces: the pass costs a barrier per color
+        colorPasses(1 + solver.mVelocityIterations,
+                    [&](int inPass, std::span<ContactConstraint* const> inC)
+                    {
+                        if (inPass == 0)
+                            SequentialImpulseSolver::WarmStart(inC, solverBodies);
+                        else
+                            SequentialImpulseSolver::SolveVelocities(inC, solverBodies, inPass - 1);
+                    });
+    // Only where something bounces: the pass costs a stage per color
     if (mIslandBounces[inIsland] != 0)
-        forEachColor([&](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
+        colorPasses(1, [&](int, std::span<ContactConstraint* const> inC)
+                    { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const std::span<const uint32_t> bodies = mIslands.GetBodies(inIsland);
@@ -725,9 +754,8 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
                         StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[bodies[i]]),
                                                     inDeltaTime);
                 });
-    for (int i = 0; i < solver.mPositionIterations; ++i)
-        forEachColor([&](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::SolvePositions(inC, solver); });
+    colorPasses(solver.mPositionIterations, [&](int, std::span<ContactConstraint* const> inC)
+                { SequentialImpulseSolver::SolvePositions(inC, solver); });
 
     const std::span<ContactConstraint* const> all(mIslandConstraints.data() + mConstraintStart[inIsland],
                                                   mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
@@ -775,37 +803,47 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                                                 mWideBatches[i]);
                 });
 
-    // One pass over the colors in turn: the serial range by the scalar solver, the batches of one color (they
-    // share no dynamic body) in one contiguous part per thread, as in SolveColoredIsland (8 batches are the
-    // 32 constraints a part needs to pay)
-    auto forEachColor = [&](const auto& inSerial, const auto& inWide)
+    // The warm start, then the iterations: each a pass over the colors in turn, each color a stage. The
+    // serial range by the scalar solver in one part; the batches of a color (they share no dynamic body) in
+    // one contiguous part per thread, as in SolveColoredIsland (8 batches are the 32 constraints a part
+    // needs)
+    const uint32_t numColors = inLastColor - inFirstColor + 1;
+    auto batchesOf = [&](uint32_t inColor)
     {
-        for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
-        {
-            if (mColorIsSerial[color] != 0)
-            {
-                inSerial(
-                    std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[color],
-                                                        mIslandConstraints.data() + mColorStart[color + 1]));
-                continue;
-            }
-            const std::span<WideContactBatch> batches(
-                mWideBatches.data() + mColorBatchStart[color - inFirstColor],
-                mWideBatches.data() + mColorBatchStart[color - inFirstColor + 1]);
-            ForEachThreadPart(
-                uint32_t(batches.size()),
-                [&](uint32_t inBegin, uint32_t inEnd) { inWide(batches.subspan(inBegin, inEnd - inBegin)); },
-                8);
-        }
+        return std::span<WideContactBatch>(mWideBatches.data() + mColorBatchStart[inColor - inFirstColor],
+                                           mWideBatches.data() +
+                                               mColorBatchStart[inColor - inFirstColor + 1]);
     };
-    forEachColor([&](std::span<ContactConstraint* const> inC)
-                 { SequentialImpulseSolver::WarmStart(inC, solverBodies); },
-                 [&](std::span<WideContactBatch> inB) { WideContactSolver::WarmStart(inB, solverBodies); });
-    for (int iteration = 0; iteration < mSettings.mSolver.mVelocityIterations; ++iteration)
-        forEachColor([&](std::span<ContactConstraint* const> inC)
-                     { SequentialImpulseSolver::SolveVelocities(inC, solverBodies, iteration); },
-                     [&](std::span<WideContactBatch> inB)
-                     { WideContactSolver::SolveVelocities(inB, solverBodies, iteration); });
+    RunStages((1 + uint32_t(mSettings.mSolver.mVelocityIterations)) * numColors,
+              [&](uint32_t inStage)
+              {
+                  const uint32_t color = inFirstColor + inStage % numColors;
+                  return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(batchesOf(color).size()), 8);
+              },
+              [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
+              {
+                  const uint32_t color = inFirstColor + inStage % numColors;
+                  const int pass = int(inStage / numColors); // 0: the warm start; then iteration pass - 1
+                  if (mColorIsSerial[color] != 0)
+                  {
+                      const std::span<ContactConstraint* const> constraints(
+                          mIslandConstraints.data() + mColorStart[color],
+                          mIslandConstraints.data() + mColorStart[color + 1]);
+                      if (pass == 0)
+                          SequentialImpulseSolver::WarmStart(constraints, solverBodies);
+                      else
+                          SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, pass - 1);
+                      return;
+                  }
+                  const std::span<WideContactBatch> batches = batchesOf(color);
+                  const uint32_t count = uint32_t(batches.size());
+                  const std::span<WideContactBatch> part = batches.subspan(
+                      inPart * count / inParts, (inPart + 1) * count / inParts - inPart * count / inParts);
+                  if (pass == 0)
+                      WideContactSolver::WarmStart(part, solverBodies);
+                  else
+                      WideContactSolver::SolveVelocities(part, solverBodies, pass - 1);
+              });
 
     ParallelFor(numBatches, 64,
                 [&](uint32_t inBegin, uint32_t inEnd)

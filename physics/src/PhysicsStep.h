@@ -23,6 +23,8 @@
 #include "solver/WideContactSolver.h"
 
 #include <algorithm>
+#include <atomic>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -82,27 +84,77 @@ private:
                 inBody(begin, std::min(inCount, begin + inGrain));
     }
 
-    /// inBody(begin, end) over [0, inCount) split into one contiguous part per thread: part 0 on this thread,
-    /// part t on the t-th job, so with a stable assignment the same thread sees the same part every time.
-    /// At least inMinPerPart items a part: below that a job costs more than it saves.
-    template <class Body>
-    void ForEachThreadPart(uint32_t inCount, const Body& inBody, uint32_t inMinPerPart = 32)
+    /// Runs inNumStages stages in order, every thread of the job system on each: stage s has inPartsOf(s)
+    /// parts (1 to the thread count) and inRunPart(s, part, parts) does one. A stage starts only when every
+    /// part of the one before has finished: the threads wait on a counter, not on a job per part (a colored
+    /// island's velocity iterations are a stage per color per iteration, over a hundred a step). Thread t
+    /// takes part t first, so it keeps its region of the island in every color; a part whose thread has not
+    /// come yet is taken by another, so no thread waits for one that the job system has not started. Which
+    /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job.
+    template <class PartsOf, class RunPart>
+    void RunStages(uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
-        const uint32_t parts =
-            mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / inMinPerPart));
-        if (parts <= 1)
+        static_assert(jobs::JobSystem::cMaxThreads <= 64, "a stage's claims are one bit per part in 64");
+        const uint32_t threads = mJobs == nullptr ? 1 : mJobs->GetNumThreads();
+        if (threads <= 1)
         {
-            if (inCount > 0) inBody(0, inCount);
+            for (uint32_t stage = 0; stage < inNumStages; ++stage)
+                for (uint32_t part = 0, parts = inPartsOf(stage); part < parts; ++part)
+                    inRunPart(stage, part, parts);
             return;
         }
+        if (mStageCapacity < inNumStages)
+        {
+            mStages = std::make_unique<StageCounters[]>(inNumStages);
+            mStageCapacity = inNumStages;
+        }
+        for (uint32_t stage = 0; stage < inNumStages; ++stage)
+        {
+            // Relaxed: the helper jobs are scheduled below, and scheduling orders these stores before them
+            mStages[stage].mClaimed.store(0, std::memory_order_relaxed);
+            mStages[stage].mDone.store(0, std::memory_order_relaxed);
+        }
+        auto team = [&](uint32_t inThread)
+        {
+            for (uint32_t stage = 0; stage < inNumStages; ++stage)
+            {
+                const uint32_t parts = inPartsOf(stage);
+                StageCounters& counters = mStages[stage];
+                auto tryRun = [&](uint32_t inPart)
+                {
+                    const uint64_t bit = uint64_t(1) << inPart;
+                    // Relaxed: a claim only decides who runs the part; the data the part reads was ordered by
+                    // the previous stage's completion (the acquire below)
+                    if ((counters.mClaimed.load(std::memory_order_relaxed) & bit) != 0 ||
+                        (counters.mClaimed.fetch_or(bit, std::memory_order_relaxed) & bit) != 0)
+                        return;
+                    inRunPart(stage, inPart, parts);
+                    // Release: the part's writes happen before the reads of whoever sees the stage complete
+                    counters.mDone.fetch_add(1, std::memory_order_release);
+                };
+                if (inThread < parts) tryRun(inThread);
+                for (uint32_t part = 0; part < parts; ++part)
+                    if (part != inThread) tryRun(part);
+                // Acquire: pairs with every part's release, so the next stage sees all of this one's writes
+                for (uint32_t spins = 0; counters.mDone.load(std::memory_order_acquire) < parts; ++spins)
+                    WaitABit(spins);
+            }
+        };
         jobs::JobHandle handles[jobs::JobSystem::cMaxThreads];
-        for (uint32_t part = 1; part < parts; ++part)
-            handles[part] =
-                mJobs->Schedule("part", [&inBody, part, parts, inCount]
-                                { inBody(part * inCount / parts, (part + 1) * inCount / parts); });
-        inBody(0, inCount / parts);
-        mJobs->WaitAll({handles + 1, parts - 1});
+        for (uint32_t thread = 1; thread < threads; ++thread)
+            handles[thread] = mJobs->Schedule("stages", [&team, thread] { team(thread); });
+        team(0);
+        mJobs->WaitAll({handles + 1, threads - 1});
     }
+    /// Parts for inCount items with at least inMinPerPart in each (below that a part costs more than it
+    /// saves), at most one per thread.
+    uint32_t PartsFor(uint32_t inCount, uint32_t inMinPerPart) const
+    {
+        return mJobs == nullptr ? 1 : std::min(mJobs->GetNumThreads(), std::max(1u, inCount / inMinPerPart));
+    }
+    /// A pause while another thread finishes its part: a CPU hint at first, then a yield of the time slice
+    /// (two cores: the other part's thread may be waiting for this core).
+    static void WaitABit(uint32_t inSpins);
 
     /// Wakes the sleeping islands of bodies that were woken from outside the step since the last one.
     void WakeIslandsOfWokenBodies();
@@ -194,6 +246,13 @@ private:
         uint64_t mKey;      ///< color << 32 | lowest dynamic active index
         uint32_t mPosition; ///< In the island's hashed order
     };
+    struct alignas(64) StageCounters
+    {
+        std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread
+        std::atomic<uint32_t> mDone;    ///< Parts finished
+    };
+    std::unique_ptr<StageCounters[]> mStages; ///< RunStages' counters; threads: see RunStages
+    uint32_t mStageCapacity = 0;
     std::vector<uint8_t> mIslandBounces; ///< Per island: 1 if a constraint has restitution (BuildIslands)
     std::vector<ColorItem> mColorItems;  ///< Scratch per constraint of the island being colored
     std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
