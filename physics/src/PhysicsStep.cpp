@@ -5,6 +5,7 @@
 #include "cairn/physics/solver/SequentialImpulseSolver.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <thread>
@@ -110,7 +111,10 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const uint32_t numActive = uint32_t(active.size());
     mPaddingBlocksFirst = numActive + 2 * uint32_t(mIslandConstraints.size());
-    mSolverBodies.resize(mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * mColorStart.size());
+    mSolverBodies.resize(mPaddingBlocksFirst +
+                         WideContactSolver::cPaddingBlocks * (mColorStart.size() + mNumIslandGroups));
+    const uint32_t groupPaddingFirst =
+        mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * uint32_t(mColorStart.size());
     ParallelFor(numActive, 512,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
@@ -157,11 +161,20 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // the small ones fill in around it
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime);
-    ParallelFor(uint32_t(mSolvedIslands.size()), 1,
+    ParallelFor(uint32_t(mSolveItems.size()), 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        SolveIsland(mSolvedIslands[i], inDeltaTime);
+                    {
+                        const SolveItem& item = mSolveItems[i];
+                        if (item.mGroup == UINT32_MAX)
+                            SolveIsland(mSolvedIslands[item.mFirst], inDeltaTime);
+                        else
+                            SolveIslandGroup(
+                                std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
+                                groupPaddingFirst + WideContactSolver::cPaddingBlocks * item.mGroup,
+                                inDeltaTime);
+                    }
                 });
     // A body with nothing to solve keeps the velocity its forces gave it. One chunk per island made the
     // threads fight over the chunk cursor when thousands of bodies fall freely
@@ -633,6 +646,34 @@ void PhysicsStep::OrderConstraints()
     }
     for (uint32_t island : mColoredIslands)
         ColorIsland(island);
+
+    // What the other islands' solve runs over: the larger ones one by one (largest first), then the small
+    // ones (a crate on the ground, two touching) four at a time in the wide solver's lanes, where one at a
+    // time the scalar solver waited on one short chain of operations after another. Neither depends on the
+    // thread count
+    mSolveItems.clear();
+    mNumIslandGroups = 0;
+    const bool groupSmall = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
+    auto isSmall = [&](uint32_t inIsland) {
+        return groupSmall &&
+               mConstraintStart[inIsland + 1] - mConstraintStart[inIsland] <= cGroupMaxConstraints;
+    };
+    mSmallIslands.clear();
+    uint32_t numLarge = 0;
+    for (uint32_t island : mSolvedIslands)
+        if (isSmall(island))
+            mSmallIslands.push_back(island);
+        else
+        {
+            mSolveItems.push_back({numLarge, 1, UINT32_MAX});
+            mSolvedIslands[numLarge++] = island;
+        }
+    std::copy(mSmallIslands.begin(), mSmallIslands.end(), mSolvedIslands.begin() + numLarge);
+    for (uint32_t first = numLarge; first < mSolvedIslands.size(); first += 4)
+    {
+        const uint32_t count = std::min<uint32_t>(4, uint32_t(mSolvedIslands.size()) - first);
+        mSolveItems.push_back({first, count, count == 1 ? UINT32_MAX : mNumIslandGroups++});
+    }
 }
 
 void PhysicsStep::ColorIsland(uint32_t inIsland)
@@ -864,7 +905,53 @@ void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
         SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, i);
-    SequentialImpulseSolver::ApplyRestitution(constraints, solverBodies, solver);
+    FinishIsland(inIsland, inDeltaTime);
+}
+
+void PhysicsStep::SolveIslandGroup([[maybe_unused]] std::span<const uint32_t> inIslands,
+                                   [[maybe_unused]] uint32_t inPaddingFirst,
+                                   [[maybe_unused]] float inDeltaTime)
+{
+#if CAIRN_WIDE_SOLVER
+    // Row r holds constraint r of each island, one island per lane (null: padding). Each lane then does its
+    // island's scalar arithmetic in its order, so the result is SolveIsland's bit for bit
+    std::array<std::array<ContactConstraint*, 4>, cGroupMaxConstraints> rows{};
+    uint32_t numRows = 0;
+    for (uint32_t lane = 0; lane < inIslands.size(); ++lane)
+    {
+        const uint32_t island = inIslands[lane];
+        const uint32_t count = mConstraintStart[island + 1] - mConstraintStart[island];
+        for (uint32_t row = 0; row < count; ++row)
+            rows[row][lane] = mIslandConstraints[mConstraintStart[island] + row];
+        numRows = std::max(numRows, count);
+    }
+    const std::span<SolverBody> solverBodies(mSolverBodies);
+    WideContactBatch batches[cGroupMaxConstraints];
+    for (uint32_t row = 0; row < numRows; ++row)
+    {
+        batches[row].mFirst = 0;
+        batches[row].mCount = 4;
+        batches[row].mPaddingFirst = inPaddingFirst;
+        WideContactSolver::Pack(rows[row], solverBodies, batches[row]);
+    }
+    const std::span<WideContactBatch> all(batches, numRows);
+    WideContactSolver::WarmStart(all, solverBodies);
+    for (int i = 0; i < mSettings.mSolver.mVelocityIterations; ++i)
+        WideContactSolver::SolveVelocities(all, solverBodies, i);
+    for (uint32_t row = 0; row < numRows; ++row)
+        WideContactSolver::Unpack(batches[row], rows[row]);
+    for (uint32_t island : inIslands)
+        FinishIsland(island, inDeltaTime);
+#endif
+}
+
+void PhysicsStep::FinishIsland(uint32_t inIsland, float inDeltaTime)
+{
+    const std::span<ContactConstraint* const> constraints(
+        mIslandConstraints.data() + mConstraintStart[inIsland],
+        mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const SolverSettings& solver = mSettings.mSolver;
+    SequentialImpulseSolver::ApplyRestitution(constraints, std::span<SolverBody>(mSolverBodies), solver);
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     for (uint32_t activeIndex : mIslands.GetBodies(inIsland))

@@ -183,6 +183,13 @@ private:
     /// others at once, largest first.
     void SolveIslands(float inDeltaTime);
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
+    /// Solves two to four small islands (at most cGroupMaxConstraints constraints each) together, one per
+    /// lane of the wide solver, with the same results as SolveIsland on each; inPaddingFirst: the group's
+    /// padding blocks.
+    void SolveIslandGroup(std::span<const uint32_t> inIslands, uint32_t inPaddingFirst, float inDeltaTime);
+    /// An island's restitution pass, integration, position iterations and impulse store, after its
+    /// velocities.
+    void FinishIsland(uint32_t inIsland, float inDeltaTime);
     /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
     void ColorIsland(uint32_t inIsland);
     /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn.
@@ -227,6 +234,19 @@ private:
     /// This step's other islands that have constraints, largest first; and the active indices of the bodies
     /// alone in an island without any (falling, flying): they only integrate, many to a chunk
     std::vector<uint32_t> mSolvedIslands;
+    /// A unit of the other islands' solve: one island (mGroup = UINT32_MAX) or up to four small ones solved
+    /// together (SolveIslandGroup), mCount islands of mSolvedIslands from mFirst.
+    struct SolveItem
+    {
+        uint32_t mFirst;
+        uint32_t mCount;
+        uint32_t mGroup; ///< Which group's padding blocks
+    };
+    std::vector<SolveItem> mSolveItems;
+    std::vector<uint32_t> mSmallIslands; ///< Scratch for OrderConstraints
+    uint32_t mNumIslandGroups = 0;
+    /// An island with at most this many constraints is solved in a group of four (one per SSE lane).
+    static constexpr uint32_t cGroupMaxConstraints = 4;
     std::vector<uint32_t> mUnconstrainedBodies;
     std::vector<uint32_t> mIslandFirstColor; ///< Per island: first entry in mColorStart (colored ones)
     std::vector<uint32_t>

@@ -1,7 +1,8 @@
 // A colored island (a pyramid of boxes on a floor, one island of a few hundred contacts) solved by every
 // thread of the job system at once: the colors' stages synchronise on counters, the parts of a color go to
-// whichever thread takes them first. Under ThreadSanitizer (this suite's label) that must show no race, and
-// with 2 and 4 threads the bodies must end exactly where one thread puts them.
+// whichever thread takes them first. And small islands solved four at a time, groups on all threads. Under
+// ThreadSanitizer (this suite's label) that must show no race, and with 2 and 4 threads the bodies must end
+// exactly where one thread puts them.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
@@ -23,9 +24,11 @@ struct Pose
     Vec3 mVelocity;
 };
 
-/// Steps a 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points) on inThreads job
-/// threads (0: none) and returns the boxes' final positions and velocities.
-std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLargestIslandConstraints)
+/// Steps a 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points), or with inSmall
+/// instead 40 small stacks of one to three boxes (islands of up to four constraints, solved four at a time),
+/// on inThreads job threads (0: none) and returns the boxes' final positions and velocities.
+std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLargestIslandConstraints,
+                              bool inSmall = false)
 {
     std::unique_ptr<jobs::JobSystem> jobSystem;
     if (inThreads > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{inThreads});
@@ -42,7 +45,18 @@ std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLarg
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     std::vector<BodyID> boxes;
     constexpr int cLayers = 7;
-    for (int layer = 0; layer < cLayers; ++layer)
+    for (int i = 0; inSmall && i < 40; ++i)
+        for (int level = 0; level <= i % 3; ++level)
+        {
+            BodyCreationSettings body;
+            body.mShape = box;
+            body.mPosition =
+                Vec3(-25.0f + 2.5f * float(i % 20), 0.6f + 1.1f * float(level), 3.0f * float(i / 20));
+            body.mRotation = Quat(Eigen::AngleAxisf(0.3f * float(i % 4), Vec3::UnitY()));
+            body.mObjectLayer = Layers::cMoving;
+            boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
+        }
+    for (int layer = 0; !inSmall && layer < cLayers; ++layer)
         for (int i = 0; i < cLayers - layer; ++i)
             for (int k = 0; k < cLayers - layer; ++k)
             {
@@ -90,6 +104,22 @@ TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
                 << "box " << i << " with " << threads << " threads: " << poses[i].mPosition.transpose()
                 << " against " << reference[i].mPosition.transpose();
         }
+    }
+}
+
+TEST(ColoredIslandThreadsTest, SmallIslandGroupsSameResultOnOneTwoAndFourThreads)
+{
+    constexpr int cSteps = 40;
+    uint32_t unused = 0;
+    const std::vector<Pose> reference = StepPyramid(0, cSteps, unused, true);
+    for (uint32_t threads : {2u, 4u})
+    {
+        const std::vector<Pose> poses = StepPyramid(threads, cSteps, unused, true);
+        ASSERT_EQ(poses.size(), reference.size());
+        for (size_t i = 0; i < poses.size(); ++i)
+            EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
+                        poses[i].mVelocity == reference[i].mVelocity)
+                << "box " << i << " with " << threads << " threads";
     }
 }
 

@@ -207,7 +207,7 @@ void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
     ioBatch.mPaddingFirst = paddingFirst;
     for (uint32_t lane = 0; lane < 4; ++lane)
     {
-        if (lane >= count)
+        if (lane >= count || inConstraints[lane] == nullptr)
         {
             ioBatch.mBodyA[lane] = paddingFirst + 2 * lane;
             ioBatch.mBodyB[lane] = paddingFirst + 2 * lane + 1;
@@ -283,6 +283,7 @@ void WideContactSolver::Unpack(const WideContactBatch& inBatch,
 {
     for (uint32_t lane = 0; lane < inBatch.mCount; ++lane)
     {
+        if (ioConstraints[lane] == nullptr) continue;
         ContactConstraint& c = *ioConstraints[lane];
         const int l = int(lane);
         c.mPatch.mTwistAccumulated = GetLane(inBatch.mTwistAccumulated, l);

@@ -69,16 +69,16 @@ struct WideContactBatch
 
 namespace WideContactSolver
 {
-/// Packs inConstraints (mCount of them, already bound to their SolverBody blocks) into ioBatch, whose mFirst,
-/// mCount and mPaddingFirst are set (and kept). Padding lanes use the blocks from mPaddingFirst on, zeroed
-/// here.
+/// Packs inConstraints (mCount of them, already bound to their SolverBody blocks; a null one is a padding
+/// lane) into ioBatch, whose mFirst, mCount and mPaddingFirst are set (and kept). Padding lanes use the
+/// blocks from mPaddingFirst on, zeroed here.
 void Pack(std::span<ContactConstraint* const> inConstraints, std::span<SolverBody> ioBodies,
           WideContactBatch& ioBatch);
 /// Applies the batches' accumulated (warm-start) impulses, as SequentialImpulseSolver::WarmStart does.
 void WarmStart(std::span<const WideContactBatch> inBatches, std::span<SolverBody> ioBodies);
 /// Velocity iteration inIteration over the batches, in order (points swept as the scalar solver does).
 void SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies, int inIteration);
-/// Copies the batch's impulses back into its constraints.
+/// Copies the batch's impulses back into its constraints (null ones skipped).
 void Unpack(const WideContactBatch& inBatch, std::span<ContactConstraint* const> ioConstraints);
 } // namespace WideContactSolver
 

@@ -97,6 +97,50 @@ TEST(WideSolverTest, SameStatesAsTheScalarSolverOnTwoThreads)
     StepBoth(scalar, wide, &jobSystem, 100);
 }
 
+/// Small islands: single boxes, stacks of two and three, and tilted boxes on a floor (one to four
+/// constraints each, so groups of four islands have rows of padding), some bouncy.
+PyramidRun MakeSmallIslands(bool inWide)
+{
+    PhysicsSettings settings;
+    settings.mAllowSleeping = false;
+    settings.mSolver.mWideColoredIslands = inWide;
+    PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
+    BodyInterface& bodies = run.mSystem->GetBodyInterface();
+    BodyCreationSettings floor;
+    floor.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
+    floor.mPosition = Vec3(0, -1, 0);
+    floor.mMotionType = MotionType::Static;
+    floor.mObjectLayer = Layers::cStatic;
+    (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
+    const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+    for (int i = 0; i < 23; ++i)
+        for (int level = 0; level <= i % 3; ++level)
+        {
+            BodyCreationSettings settings;
+            settings.mShape = box;
+            settings.mPosition =
+                Vec3(-30.0f + 2.5f * float(i), 0.6f + 1.1f * float(level), 0.1f * float(i % 5));
+            settings.mRotation =
+                Quat(Eigen::AngleAxisf(0.3f * float(i % 4), Vec3(0.2f, 1.0f, 0.1f).normalized()));
+            settings.mMotionType = MotionType::Dynamic;
+            settings.mObjectLayer = Layers::cMoving;
+            settings.mFriction = 0.5f;
+            settings.mRestitution = i % 4 == 0 ? 0.5f : 0.0f;
+            run.mBoxes.push_back(bodies.CreateAndAddBody(settings, Activation::Activate).Value());
+        }
+    return run;
+}
+
+// Islands of up to four constraints are solved four at a time, one per lane of the wide solver: the same
+// states as the scalar solver on each island alone
+TEST(WideSolverTest, SmallIslandsInGroupsSameAsAlone)
+{
+    PyramidRun scalar = MakeSmallIslands(false), wide = MakeSmallIslands(true);
+    StepBoth(scalar, wide, nullptr, 150);
+    EXPECT_GE(wide.mSystem->GetLastStepStatistics().mNumIslands, 8u)
+        << "the scene was meant to be many islands";
+}
+
 /// Drops a ball of the given restitution onto the settled pyramid's top box; returns its fastest upward speed
 /// after it hit (the ball joins the pyramid's colored island).
 float BounceOnPyramid(float inRestitution)
