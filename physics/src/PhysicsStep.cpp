@@ -798,8 +798,7 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     colorPasses(solver.mPositionIterations, [&](int, std::span<ContactConstraint* const> inC)
                 { SequentialImpulseSolver::SolvePositions(inC, solver); });
 
-    const std::span<ContactConstraint* const> all(mIslandConstraints.data() + mConstraintStart[inIsland],
-                                                  mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const std::span<ContactConstraint* const> all = ConstraintsOf(inIsland);
     ParallelFor(uint32_t(all.size()), 256,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 { StoreImpulses(all.subspan(inBegin, inEnd - inBegin)); });
@@ -897,9 +896,7 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
 
 void PhysicsStep::SolveIsland(uint32_t inIsland, float inDeltaTime)
 {
-    const std::span<ContactConstraint* const> constraints(
-        mIslandConstraints.data() + mConstraintStart[inIsland],
-        mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const std::span<ContactConstraint* const> constraints = ConstraintsOf(inIsland);
     const SolverSettings& solver = mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
@@ -947,9 +944,7 @@ void PhysicsStep::SolveIslandGroup([[maybe_unused]] std::span<const uint32_t> in
 
 void PhysicsStep::FinishIsland(uint32_t inIsland, float inDeltaTime)
 {
-    const std::span<ContactConstraint* const> constraints(
-        mIslandConstraints.data() + mConstraintStart[inIsland],
-        mIslandConstraints.data() + mConstraintStart[inIsland + 1]);
+    const std::span<ContactConstraint* const> constraints = ConstraintsOf(inIsland);
     const SolverSettings& solver = mSettings.mSolver;
     SequentialImpulseSolver::ApplyRestitution(constraints, std::span<SolverBody>(mSolverBodies), solver);
 

@@ -182,6 +182,12 @@ private:
     /// Integrates kinematic bodies and solves every island: colored ones first, each by all threads, then the
     /// others at once, largest first.
     void SolveIslands(float inDeltaTime);
+    /// An island's constraints, in solve order once OrderConstraints has run.
+    std::span<ContactConstraint* const> ConstraintsOf(uint32_t inIsland) const
+    {
+        return {mIslandConstraints.data() + mConstraintStart[inIsland],
+                mIslandConstraints.data() + mConstraintStart[inIsland + 1]};
+    }
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
     /// Solves two to four small islands (at most cGroupMaxConstraints constraints each) together, one per
     /// lane of the wide solver, with the same results as SolveIsland on each; inPaddingFirst: the group's

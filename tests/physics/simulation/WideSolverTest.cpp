@@ -17,20 +17,27 @@ struct PyramidRun
     std::vector<BodyID> mBoxes;
 };
 
-/// A pyramid of boxes, offset layer on layer, on a floor: one island large enough to be colored.
-PyramidRun MakePyramid(bool inWide)
+/// A world without sleeping, with the wide solver on or off, and a static 80 m x 80 m floor at y = 0.
+PyramidRun MakeWorldWithFloor(bool inWide)
 {
     PhysicsSettings settings;
     settings.mAllowSleeping = false;
     settings.mSolver.mWideColoredIslands = inWide;
     PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
-    BodyInterface& bodies = run.mSystem->GetBodyInterface();
     BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(30, 1, 30)).Value();
+    floor.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
     floor.mPosition = Vec3(0, -1, 0);
     floor.mMotionType = MotionType::Static;
     floor.mObjectLayer = Layers::cStatic;
-    (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
+    (void)run.mSystem->GetBodyInterface().CreateAndAddBody(floor, Activation::DontActivate);
+    return run;
+}
+
+/// A pyramid of boxes, offset layer on layer, on a floor: one island large enough to be colored.
+PyramidRun MakePyramid(bool inWide)
+{
+    PyramidRun run = MakeWorldWithFloor(inWide);
+    BodyInterface& bodies = run.mSystem->GetBodyInterface();
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     constexpr int cLayers = 6;
     for (int layer = 0; layer < cLayers; ++layer)
@@ -101,17 +108,8 @@ TEST(WideSolverTest, SameStatesAsTheScalarSolverOnTwoThreads)
 /// constraints each, so groups of four islands have rows of padding), some bouncy.
 PyramidRun MakeSmallIslands(bool inWide)
 {
-    PhysicsSettings settings;
-    settings.mAllowSleeping = false;
-    settings.mSolver.mWideColoredIslands = inWide;
-    PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
+    PyramidRun run = MakeWorldWithFloor(inWide);
     BodyInterface& bodies = run.mSystem->GetBodyInterface();
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
-    (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     for (int i = 0; i < 23; ++i)
         for (int level = 0; level <= i % 3; ++level)
