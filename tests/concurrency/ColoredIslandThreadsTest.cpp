@@ -7,6 +7,7 @@
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/StaticFloor.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -36,11 +37,7 @@ std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLarg
     settings.mAllowSleeping = false;
     PhysicsSystem system(settings);
     BodyInterface& bodies = system.GetBodyInterface();
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(30, 1, 30)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
+    const BodyCreationSettings floor = test::StaticFloorSettings(30.0f);
     EXPECT_TRUE(bodies.CreateAndAddBody(floor, Activation::DontActivate).IsOk());
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     std::vector<BodyID> boxes;

@@ -6,6 +6,7 @@
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/StaticFloor.h"
 
 #include <atomic>
 #include <gtest/gtest.h>
@@ -31,11 +32,7 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
     if (GetParam() > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{GetParam()});
     PhysicsSystem system;
     BodyInterface& bodies = system.GetBodyInterface();
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(50, 1, 50)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
+    const BodyCreationSettings floor = test::StaticFloorSettings(50.0f);
     const BodyID floorID = bodies.CreateAndAddBody(floor, Activation::DontActivate).Value();
 
     std::vector<BodyID> boxes;

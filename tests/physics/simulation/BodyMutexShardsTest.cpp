@@ -4,6 +4,7 @@
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/StaticFloor.h"
 
 #include <gtest/gtest.h>
 #include <thread>
@@ -40,12 +41,8 @@ std::vector<Vec3> DropBoxes(uint32_t inShards, int inSteps)
     settings.mMaxBodies = 256;
     settings.mNumBodyMutexes = inShards;
     PhysicsSystem physics(settings);
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(20, 1, 20)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
-    (void)physics.GetBodyInterface().CreateAndAddBody(floor, Activation::DontActivate);
+    (void)physics.GetBodyInterface().CreateAndAddBody(test::StaticFloorSettings(20.0f),
+                                                      Activation::DontActivate);
     std::vector<BodyID> boxes;
     for (int i = 0; i < 40; ++i)
     {

@@ -3,6 +3,7 @@
 // threads (pairs, contacts, waking and islands are made canonical, see PhysicsStep.h).
 
 #include "SimulationFixture.h"
+#include "common/StaticFloor.h"
 
 #include <cstring>
 #include <vector>
@@ -42,11 +43,7 @@ std::vector<BodyState> RunPile(uint32_t inThreads)
     }
     PhysicsSystem system;
     BodyInterface& bodies = system.GetBodyInterface();
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
+    const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
     BodyCreationSettings ramp = floor;
     ramp.mShape = BoxShape::Create(Vec3(6, 0.5f, 6)).Value();

@@ -1,5 +1,6 @@
 #include "SimulationFixture.h"
 #include "common/AllocationCounter.h"
+#include "common/StaticFloor.h"
 
 namespace cairn::test
 {
@@ -47,11 +48,7 @@ TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
     {
         PhysicsSystem system;
         BodyInterface& bodies = system.GetBodyInterface();
-        BodyCreationSettings floor;
-        floor.mShape = BoxShape::Create(Vec3(20, 1, 20)).Value();
-        floor.mPosition = Vec3(0, -1, 0);
-        floor.mMotionType = MotionType::Static;
-        floor.mObjectLayer = Layers::cStatic;
+        const BodyCreationSettings floor = test::StaticFloorSettings(20.0f);
         (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
         std::vector<BodyID> ids;
         for (int i = 0; i < 30; ++i)

@@ -2,6 +2,7 @@
 // in the same order: the same scene gives the same body states either way, step after step.
 
 #include "SimulationFixture.h"
+#include "common/StaticFloor.h"
 
 #include <algorithm>
 #include <vector>
@@ -24,11 +25,7 @@ PyramidRun MakeWorldWithFloor(bool inWide)
     settings.mAllowSleeping = false;
     settings.mSolver.mWideColoredIslands = inWide;
     PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
+    const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)run.mSystem->GetBodyInterface().CreateAndAddBody(floor, Activation::DontActivate);
     return run;
 }
