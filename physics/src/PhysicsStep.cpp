@@ -631,6 +631,11 @@ void PhysicsStep::OrderConstraints()
     mColorStart.clear();
     mColorIsSerial.clear();
     mColoredIslands.clear();
+    // The other islands with at most cGroupMaxConstraints constraints are solved in groups (see below)
+    const bool groupSmall = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
+    auto isSmall = [&](uint32_t inNumConstraints)
+    { return groupSmall && inNumConstraints <= cGroupMaxConstraints; };
+    mSmallIslands.clear();
     mSolvedIslands.clear();
     mUnconstrainedBodies.clear();
     for (uint32_t island : mIslandOrder)
@@ -639,7 +644,7 @@ void PhysicsStep::OrderConstraints()
         if (numConstraints >= coloredMin)
             mColoredIslands.push_back(island);
         else if (numConstraints > 0)
-            mSolvedIslands.push_back(island);
+            (isSmall(numConstraints) ? mSmallIslands : mSolvedIslands).push_back(island);
         else
             for (uint32_t activeIndex : mIslands.GetBodies(island)) // One body: contacts would link more
                 mUnconstrainedBodies.push_back(activeIndex);
@@ -653,25 +658,13 @@ void PhysicsStep::OrderConstraints()
     // thread count
     mSolveItems.clear();
     mNumIslandGroups = 0;
-    const bool groupSmall = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
-    auto isSmall = [&](uint32_t inIsland) {
-        return groupSmall &&
-               mConstraintStart[inIsland + 1] - mConstraintStart[inIsland] <= cGroupMaxConstraints;
-    };
-    mSmallIslands.clear();
-    uint32_t numLarge = 0;
-    for (uint32_t island : mSolvedIslands)
-        if (isSmall(island))
-            mSmallIslands.push_back(island);
-        else
-        {
-            mSolveItems.push_back({numLarge, 1, UINT32_MAX});
-            mSolvedIslands[numLarge++] = island;
-        }
-    std::copy(mSmallIslands.begin(), mSmallIslands.end(), mSolvedIslands.begin() + numLarge);
-    for (uint32_t first = numLarge; first < mSolvedIslands.size(); first += 4)
+    const uint32_t numLarge = uint32_t(mSolvedIslands.size());
+    for (uint32_t i = 0; i < numLarge; ++i)
+        mSolveItems.push_back({i, 1, UINT32_MAX});
+    mSolvedIslands.insert(mSolvedIslands.end(), mSmallIslands.begin(), mSmallIslands.end());
+    for (uint32_t first = numLarge; first < mSolvedIslands.size(); first += cGroupIslands)
     {
-        const uint32_t count = std::min<uint32_t>(4, uint32_t(mSolvedIslands.size()) - first);
+        const uint32_t count = std::min(cGroupIslands, uint32_t(mSolvedIslands.size()) - first);
         mSolveItems.push_back({first, count, count == 1 ? UINT32_MAX : mNumIslandGroups++});
     }
 }
@@ -746,26 +739,18 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     const uint32_t numColors = lastColor - firstColor + 1;
     auto colorPasses = [&](int inPasses, const auto& inSolve)
     {
-        auto constraintsOf = [&](uint32_t inColor)
-        {
-            return std::span<ContactConstraint* const>(mIslandConstraints.data() + mColorStart[inColor],
-                                                       mIslandConstraints.data() + mColorStart[inColor + 1]);
-        };
         RunStages(
             uint32_t(std::max(inPasses, 0)) * numColors,
             [&](uint32_t inStage)
             {
                 const uint32_t color = firstColor + inStage % numColors;
-                return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(constraintsOf(color).size()), 32);
+                return mColorIsSerial[color] != 0 ? 1u
+                                                  : PartsFor(uint32_t(ColorConstraints(color).size()), 32);
             },
             [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
             {
-                const std::span<ContactConstraint* const> constraints =
-                    constraintsOf(firstColor + inStage % numColors);
-                const uint32_t count = uint32_t(constraints.size());
                 inSolve(int(inStage / numColors),
-                        constraints.subspan(inPart * count / inParts,
-                                            (inPart + 1) * count / inParts - inPart * count / inParts));
+                        PartOf(ColorConstraints(firstColor + inStage % numColors), inPart, inParts));
             });
     };
     const SolverSettings& solver = mSettings.mSolver;
@@ -866,19 +851,14 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                   const int pass = int(inStage / numColors); // 0: the warm start; then iteration pass - 1
                   if (mColorIsSerial[color] != 0)
                   {
-                      const std::span<ContactConstraint* const> constraints(
-                          mIslandConstraints.data() + mColorStart[color],
-                          mIslandConstraints.data() + mColorStart[color + 1]);
+                      const std::span<ContactConstraint* const> constraints = ColorConstraints(color);
                       if (pass == 0)
                           SequentialImpulseSolver::WarmStart(constraints, solverBodies);
                       else
                           SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, pass - 1);
                       return;
                   }
-                  const std::span<WideContactBatch> batches = batchesOf(color);
-                  const uint32_t count = uint32_t(batches.size());
-                  const std::span<WideContactBatch> part = batches.subspan(
-                      inPart * count / inParts, (inPart + 1) * count / inParts - inPart * count / inParts);
+                  const std::span<WideContactBatch> part = PartOf(batchesOf(color), inPart, inParts);
                   if (pass == 0)
                       WideContactSolver::WarmStart(part, solverBodies);
                   else
@@ -912,22 +892,21 @@ void PhysicsStep::SolveIslandGroup([[maybe_unused]] std::span<const uint32_t> in
 #if CAIRN_WIDE_SOLVER
     // Row r holds constraint r of each island, one island per lane (null: padding). Each lane then does its
     // island's scalar arithmetic in its order, so the result is SolveIsland's bit for bit
-    std::array<std::array<ContactConstraint*, 4>, cGroupMaxConstraints> rows{};
+    std::array<std::array<ContactConstraint*, cGroupIslands>, cGroupMaxConstraints> rows{};
     uint32_t numRows = 0;
     for (uint32_t lane = 0; lane < inIslands.size(); ++lane)
     {
-        const uint32_t island = inIslands[lane];
-        const uint32_t count = mConstraintStart[island + 1] - mConstraintStart[island];
-        for (uint32_t row = 0; row < count; ++row)
-            rows[row][lane] = mIslandConstraints[mConstraintStart[island] + row];
-        numRows = std::max(numRows, count);
+        const std::span<ContactConstraint* const> constraints = ConstraintsOf(inIslands[lane]);
+        for (uint32_t row = 0; row < constraints.size(); ++row)
+            rows[row][lane] = constraints[row];
+        numRows = std::max(numRows, uint32_t(constraints.size()));
     }
     const std::span<SolverBody> solverBodies(mSolverBodies);
     WideContactBatch batches[cGroupMaxConstraints];
     for (uint32_t row = 0; row < numRows; ++row)
     {
         batches[row].mFirst = 0;
-        batches[row].mCount = 4;
+        batches[row].mCount = cGroupIslands;
         batches[row].mPaddingFirst = inPaddingFirst;
         WideContactSolver::Pack(rows[row], solverBodies, batches[row]);
     }

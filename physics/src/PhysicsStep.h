@@ -188,6 +188,18 @@ private:
         return {mIslandConstraints.data() + mConstraintStart[inIsland],
                 mIslandConstraints.data() + mConstraintStart[inIsland + 1]};
     }
+    /// The constraints of color inColor (of the colored islands), in solve order.
+    std::span<ContactConstraint* const> ColorConstraints(uint32_t inColor) const
+    {
+        return {mIslandConstraints.data() + mColorStart[inColor],
+                mIslandConstraints.data() + mColorStart[inColor + 1]};
+    }
+    /// Part inPart of inItems cut into inParts contiguous parts of (nearly) equal size.
+    template <class T> static std::span<T> PartOf(std::span<T> inItems, uint32_t inPart, uint32_t inParts)
+    {
+        const size_t begin = inPart * inItems.size() / inParts, end = (inPart + 1) * inItems.size() / inParts;
+        return inItems.subspan(begin, end - begin);
+    }
     void SolveIsland(uint32_t inIsland, float inDeltaTime);
     /// Solves two to four small islands (at most cGroupMaxConstraints constraints each) together, one per
     /// lane of the wide solver, with the same results as SolveIsland on each; inPaddingFirst: the group's
@@ -249,10 +261,11 @@ private:
         uint32_t mGroup; ///< Which group's padding blocks
     };
     std::vector<SolveItem> mSolveItems;
-    std::vector<uint32_t> mSmallIslands; ///< Scratch for OrderConstraints
+    std::vector<uint32_t> mSmallIslands; ///< Scratch for OrderConstraints: the islands solved in groups
     uint32_t mNumIslandGroups = 0;
-    /// An island with at most this many constraints is solved in a group of four (one per SSE lane).
+    /// An island with at most this many constraints is solved in a group of cGroupIslands, one per SSE lane.
     static constexpr uint32_t cGroupMaxConstraints = 4;
+    static constexpr uint32_t cGroupIslands = 4;
     std::vector<uint32_t> mUnconstrainedBodies;
     std::vector<uint32_t> mIslandFirstColor; ///< Per island: first entry in mColorStart (colored ones)
     std::vector<uint32_t>
@@ -272,6 +285,11 @@ private:
         uint64_t mKey;      ///< color << 32 | lowest dynamic active index
         uint32_t mPosition; ///< In the island's hashed order
     };
+    std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
+    std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
+    std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
+    std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks
+    uint32_t mNumChunksUsed = 0;                   ///< Narrow-phase chunks used by this step's rounds
     struct alignas(64) StageCounters
     {
         std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread
@@ -279,13 +297,8 @@ private:
     };
     std::unique_ptr<StageCounters[]> mStages; ///< RunStages' counters; threads: see RunStages
     uint32_t mStageCapacity = 0;
-    std::vector<uint8_t> mIslandBounces; ///< Per island: 1 if a constraint has restitution (BuildIslands)
-    std::vector<ColorItem> mColorItems;  ///< Scratch per constraint of the island being colored
-    std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
-    std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
-    std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks
-    uint32_t mNumChunksUsed = 0;                   ///< Narrow-phase chunks used by this step's rounds
-    std::vector<uint32_t> mConstraintStart;        ///< Per island offsets into mIslandConstraints
+    std::vector<uint8_t> mIslandBounces;    ///< Per island: 1 if a constraint has restitution (BuildIslands)
+    std::vector<uint32_t> mConstraintStart; ///< Per island offsets into mIslandConstraints
     std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
     std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
     std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
