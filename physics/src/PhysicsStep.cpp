@@ -20,6 +20,14 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 
+/// Starts fetching every cache line of a constraint (they lie scattered over the narrow phase's chunks).
+void PrefetchConstraint(const ContactConstraint* inConstraint)
+{
+    const char* bytes = reinterpret_cast<const char*>(inConstraint);
+    for (size_t offset = 0; offset < sizeof(ContactConstraint); offset += 64)
+        __builtin_prefetch(bytes + offset);
+}
+
 double MillisecondsSince(Clock::time_point& ioStart)
 {
     const Clock::time_point now = Clock::now();
@@ -122,34 +130,48 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
                         LoadSolverBody(*mBodies.TryGetBodyAtIndex(active[i]), mSolverBodies[i]);
                 });
 
-    // The solver walks each island's constraints ten times and more: copied into solve order they are read
-    // front to back (the hardware prefetcher streams them), where through the pointers they were a cache miss
-    // each (a third of the solver's time). The wide solver packs its batches from this copy too: tried,
-    // packing straight from the narrow phase's buffers made the other passes over them slower than the copy
+    // The scalar solver walks each island's constraints ten times and more: copied into solve order they are
+    // read front to back (the hardware prefetcher streams them), where through the pointers they were a cache
+    // miss each (a third of the solver's time). Not the colored islands that the wide solver packs: their
+    // iterations read the packed batches, which are made straight from the narrow phase's buffers, and the
+    // copy (4.7 MB read and written in a pyramid of 8,500 manifolds) was a tenth of that step
+    const bool packColored = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
     mSolveOrder.resize(mIslandConstraints.size());
-    ParallelFor(uint32_t(mIslandConstraints.size()), 512,
+    mPositionConstraints.resize(mIslandConstraints.size());
+    mCopyRanges.clear();
+    constexpr uint32_t cCopyTask = 512;
+    for (uint32_t island = 0; island < mIslands.GetNumIslands(); ++island)
+    {
+        if (packColored && mIslandFirstColor[island] != UINT32_MAX) continue;
+        // Neighbouring islands share a task up to its size: most islands are a constraint or two
+        for (uint32_t begin = mConstraintStart[island], end = mConstraintStart[island + 1]; begin < end;)
+        {
+            const bool extend = !mCopyRanges.empty() && mCopyRanges.back().second == begin &&
+                                mCopyRanges.back().second - mCopyRanges.back().first < cCopyTask;
+            if (!extend) mCopyRanges.push_back({begin, begin});
+            begin = std::min(end, mCopyRanges.back().first + cCopyTask);
+            mCopyRanges.back().second = begin;
+        }
+    }
+    ParallelFor(uint32_t(mCopyRanges.size()), 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
-                    // The sources are scattered over the narrow phase's chunks: fetching each one's cache
-                    // lines a few constraints ahead overlaps the misses that the copy otherwise waits for in
-                    // turn
-                    constexpr uint32_t cAhead = 4;
-                    auto prefetch = [&](uint32_t inIndex)
+                    for (uint32_t range = inBegin; range < inEnd; ++range)
                     {
-                        const char* source = reinterpret_cast<const char*>(mIslandConstraints[inIndex]);
-                        for (size_t offset = 0; offset < sizeof(ContactConstraint); offset += 64)
-                            __builtin_prefetch(source + offset);
-                    };
-                    for (uint32_t i = inBegin; i < std::min(inEnd, inBegin + cAhead); ++i)
-                        prefetch(i);
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                    {
-                        if (i + cAhead < inEnd) prefetch(i + cAhead);
-                        ContactConstraint& c = mSolveOrder[i];
-                        c = *mIslandConstraints[i];
-                        mIslandConstraints[i] = &c;
-                        c.mSolverBodyA = SolverBodyIndex(*c.mBodyA, numActive + 2 * i);
-                        c.mSolverBodyB = SolverBodyIndex(*c.mBodyB, numActive + 2 * i + 1);
+                        const auto [begin, end] = mCopyRanges[range];
+                        // The sources are scattered over the narrow phase's chunks: fetching each one's cache
+                        // lines a few constraints ahead overlaps the misses that the copy otherwise waits for
+                        // in turn
+                        constexpr uint32_t cAhead = 4;
+                        for (uint32_t i = begin; i < std::min(end, begin + cAhead); ++i)
+                            PrefetchConstraint(mIslandConstraints[i]);
+                        for (uint32_t i = begin; i < end; ++i)
+                        {
+                            if (i + cAhead < end) PrefetchConstraint(mIslandConstraints[i + cAhead]);
+                            mSolveOrder[i] = *mIslandConstraints[i];
+                            mIslandConstraints[i] = &mSolveOrder[i];
+                            PrepareForSolve(i, numActive);
+                        }
                     }
                 });
 
@@ -206,6 +228,14 @@ void PhysicsStep::LoadSolverBody(const Body& inBody, SolverBody& outBlock)
     outBlock.mAngularVelocity = inBody.mAngularVelocity;
     outBlock.mInverseMass = inBody.IsDynamic() ? inBody.mInvMass : 0.0f;
     outBlock.mPadding = 0.0f;
+}
+
+void PhysicsStep::PrepareForSolve(uint32_t inIndex, uint32_t inNumActive)
+{
+    ContactConstraint& c = *mIslandConstraints[inIndex];
+    c.mSolverBodyA = SolverBodyIndex(*c.mBodyA, inNumActive + 2 * inIndex);
+    c.mSolverBodyB = SolverBodyIndex(*c.mBodyB, inNumActive + 2 * inIndex + 1);
+    SequentialImpulseSolver::MakePositionConstraint(c, mPositionConstraints[inIndex]);
 }
 
 uint32_t PhysicsStep::SolverBodyIndex(const Body& inBody, uint32_t inPrivateBlock)
@@ -736,8 +766,9 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     // no two constraints share a dynamic body, so its parts may run at once (one per thread, the same region
     // for the same thread in every color); the range of constraints that found no color shares bodies and
     // runs as one part
+    // inItems: per entry of mIslandConstraints (the constraints or their position constraints)
     const uint32_t numColors = lastColor - firstColor + 1;
-    auto colorPasses = [&](int inPasses, const auto& inSolve)
+    auto colorPasses = [&](int inPasses, auto inItems, const auto& inSolve)
     {
         RunStages(
             uint32_t(std::max(inPasses, 0)) * numColors,
@@ -749,16 +780,23 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
             },
             [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
             {
-                inSolve(int(inStage / numColors),
-                        PartOf(ColorConstraints(firstColor + inStage % numColors), inPart, inParts));
+                const uint32_t color = firstColor + inStage % numColors;
+                inSolve(
+                    int(inStage / numColors),
+                    PartOf(inItems.subspan(mColorStart[color], mColorStart[color + 1] - mColorStart[color]),
+                           inPart, inParts));
             });
     };
+    const std::span<ContactConstraint* const> constraints(mIslandConstraints);
     const SolverSettings& solver = mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
-    if (CAIRN_WIDE_SOLVER && solver.mWideColoredIslands)
-        SolveColoredVelocitiesWide(firstColor, lastColor); // The warm start too, four manifolds at a time
+    // Without a restitution pass the impulses go from the wide solver's batches to the cache directly
+    const bool bounces = mIslandBounces[inIsland] != 0;
+    const bool wide = CAIRN_WIDE_SOLVER && solver.mWideColoredIslands;
+    if (wide)
+        SolveColoredVelocitiesWide(firstColor, lastColor, !bounces); // The warm start too, four at a time
     else
-        colorPasses(1 + solver.mVelocityIterations,
+        colorPasses(1 + solver.mVelocityIterations, constraints,
                     [&](int inPass, std::span<ContactConstraint* const> inC)
                     {
                         if (inPass == 0)
@@ -767,8 +805,9 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
                             SequentialImpulseSolver::SolveVelocities(inC, solverBodies, inPass - 1);
                     });
     // Only where something bounces: the pass costs a stage per color
-    if (mIslandBounces[inIsland] != 0)
-        colorPasses(1, [&](int, std::span<ContactConstraint* const> inC)
+    if (bounces)
+        colorPasses(1, constraints,
+                    [&](int, std::span<ContactConstraint* const> inC)
                     { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
@@ -780,9 +819,11 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
                         StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[bodies[i]]),
                                                     inDeltaTime);
                 });
-    colorPasses(solver.mPositionIterations, [&](int, std::span<ContactConstraint* const> inC)
+    colorPasses(solver.mPositionIterations, std::span<const PositionConstraint>(mPositionConstraints),
+                [&](int, std::span<const PositionConstraint> inC)
                 { SequentialImpulseSolver::SolvePositions(inC, solver); });
 
+    if (wide && !bounces) return; // Stored already
     const std::span<ContactConstraint* const> all = ConstraintsOf(inIsland);
     ParallelFor(uint32_t(all.size()), 256,
                 [&](uint32_t inBegin, uint32_t inEnd)
@@ -790,7 +831,8 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
 }
 
 void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstColor,
-                                             [[maybe_unused]] uint32_t inLastColor)
+                                             [[maybe_unused]] uint32_t inLastColor,
+                                             [[maybe_unused]] bool inStoreImpulses)
 {
 #if CAIRN_WIDE_SOLVER
     // Each color's constraints in batches of four, in order; the last batch of a color may be partial
@@ -820,12 +862,27 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
         return std::span<ContactConstraint* const>(mIslandConstraints.data() + inBatch.mFirst,
                                                    inBatch.mCount);
     };
+    // The constraints are where the narrow phase made them (not copied: see SolveIslands), scattered over its
+    // chunks: each batch's are fetched a batch ahead, and bound and given position constraints as they are
+    // packed, while their cache lines are at hand. The range that found no color is prepared here
+    const uint32_t numActive = uint32_t(mBodies.GetActiveBodiesForStep().size());
+    for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+        if (mColorIsSerial[color] != 0)
+            for (uint32_t i = mColorStart[color]; i < mColorStart[color + 1]; ++i)
+                PrepareForSolve(i, numActive);
     ParallelFor(numBatches, 64,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        WideContactSolver::Pack(constraintsOf(mWideBatches[i]), solverBodies,
-                                                mWideBatches[i]);
+                    {
+                        if (i + 1 < inEnd)
+                            for (ContactConstraint* next : constraintsOf(mWideBatches[i + 1]))
+                                PrefetchConstraint(next);
+                        const WideContactBatch& batch = mWideBatches[i];
+                        for (uint32_t lane = 0; lane < batch.mCount; ++lane)
+                            PrepareForSolve(batch.mFirst + lane, numActive);
+                        WideContactSolver::Pack(constraintsOf(batch), solverBodies, mWideBatches[i]);
+                    }
                 });
 
     // The warm start, then the iterations: each a pass over the colors in turn, each color a stage. The
@@ -869,8 +926,14 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
-                        WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
+                        if (inStoreImpulses)
+                            WideContactSolver::StoreImpulses(mWideBatches[i], mContactCache);
+                        else
+                            WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
                 });
+    if (inStoreImpulses)
+        for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+            if (mColorIsSerial[color] != 0) StoreImpulses(ColorConstraints(color));
 #endif
 }
 
@@ -932,7 +995,7 @@ void PhysicsStep::FinishIsland(uint32_t inIsland, float inDeltaTime)
         StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[activeIndex]), inDeltaTime);
 
     for (int i = 0; i < solver.mPositionIterations; ++i)
-        SequentialImpulseSolver::SolvePositions(constraints, solver);
+        SequentialImpulseSolver::SolvePositions(PositionConstraintsOf(inIsland), solver);
 
     StoreImpulses(constraints);
 }

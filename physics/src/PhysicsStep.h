@@ -26,6 +26,7 @@
 #include <atomic>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace cairn
@@ -188,6 +189,12 @@ private:
         return {mIslandConstraints.data() + mConstraintStart[inIsland],
                 mIslandConstraints.data() + mConstraintStart[inIsland + 1]};
     }
+    /// An island's position constraints (mPositionConstraints), in solve order.
+    std::span<const PositionConstraint> PositionConstraintsOf(uint32_t inIsland) const
+    {
+        return {mPositionConstraints.data() + mConstraintStart[inIsland],
+                mPositionConstraints.data() + mConstraintStart[inIsland + 1]};
+    }
     /// The constraints of color inColor (of the colored islands), in solve order.
     std::span<ContactConstraint* const> ColorConstraints(uint32_t inColor) const
     {
@@ -213,8 +220,12 @@ private:
     /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn.
     void SolveColoredIsland(uint32_t inIsland, float inDeltaTime);
     /// The velocity iterations of a colored island whose colors are [inFirstColor, inLastColor], four
-    /// manifolds at a time (WideContactSolver).
-    void SolveColoredVelocitiesWide(uint32_t inFirstColor, uint32_t inLastColor);
+    /// manifolds at a time (WideContactSolver), on constraints that were not copied (see SolveIslands): this
+    /// also gives them their solver blocks and position constraints. inStoreImpulses: store the impulses in
+    /// the contact cache straight from the batches (no restitution pass follows); else unpack them.
+    void SolveColoredVelocitiesWide(uint32_t inFirstColor, uint32_t inLastColor, bool inStoreImpulses);
+    /// Binds constraint inIndex of mIslandConstraints to its solver blocks and makes its position constraint.
+    void PrepareForSolve(uint32_t inIndex, uint32_t inNumActive);
     /// Stores the constraints' impulses in the contact cache for next step's warm start.
     void StoreImpulses(std::span<ContactConstraint* const> inConstraints);
     void IntegratePositions(Body& ioBody, float inDeltaTime);
@@ -299,8 +310,13 @@ private:
     uint32_t mStageCapacity = 0;
     std::vector<uint8_t> mIslandBounces;    ///< Per island: 1 if a constraint has restitution (BuildIslands)
     std::vector<uint32_t> mConstraintStart; ///< Per island offsets into mIslandConstraints
-    std::vector<ContactConstraint*> mIslandConstraints; ///< Constraints grouped by island (into mSolveOrder)
-    std::vector<ContactConstraint> mSolveOrder;         ///< This step's constraints copied in solve order
+    /// Constraints grouped by island: into mSolveOrder, or into the narrow phase's chunks for the colored
+    /// islands that the wide solver packs
+    std::vector<ContactConstraint*> mIslandConstraints;
+    std::vector<ContactConstraint> mSolveOrder; ///< The other islands' constraints copied in solve order
+    /// Ranges of mIslandConstraints copied into mSolveOrder, each one task of the copy
+    std::vector<std::pair<uint32_t, uint32_t>> mCopyRanges;
+    std::vector<PositionConstraint> mPositionConstraints; ///< Per entry of mIslandConstraints
     std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
     std::vector<SolverBody> mSolverBodies;
     uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color

@@ -260,25 +260,38 @@ void SequentialImpulseSolver::ApplyRestitution(std::span<ContactConstraint* cons
     }
 }
 
-float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const> ioConstraints,
+void SequentialImpulseSolver::MakePositionConstraint(const ContactConstraint& inConstraint,
+                                                     PositionConstraint& outConstraint)
+{
+    outConstraint.mBodyA = inConstraint.mBodyA;
+    outConstraint.mBodyB = inConstraint.mBodyB;
+    outConstraint.mNormal = inConstraint.mNormal;
+    outConstraint.mNumPoints = inConstraint.mNumPoints;
+    for (int i = 0; i < inConstraint.mNumPoints; ++i)
+    {
+        outConstraint.mLocalOnA[i] = inConstraint.mPoints[i].mLocalOnA;
+        outConstraint.mLocalOnB[i] = inConstraint.mPoints[i].mLocalOnB;
+    }
+}
+
+float SequentialImpulseSolver::SolvePositions(std::span<const PositionConstraint> inConstraints,
                                               const SolverSettings& inSettings)
 {
     float maxPenetration = 0.0f;
-    for (ContactConstraint* c : ioConstraints)
+    for (const PositionConstraint& c : inConstraints)
     {
-        Body& a = *c->mBodyA;
-        Body& b = *c->mBodyB;
+        Body& a = *c.mBodyA;
+        Body& b = *c.mBodyB;
         // The world inverse inertias are made on the first point that needs a correction: in a settled stack
         // most constraints need none
         Mat3 invIA = Mat3::Zero(), invIB = Mat3::Zero(); // Set before use; zeroed so no path reads garbage
         bool haveInertia = false;
-        for (int i = 0; i < c->mNumPoints; ++i)
+        for (int i = 0; i < c.mNumPoints; ++i)
         {
-            const ContactConstraintPoint& p = c->mPoints[i];
             // Penetration from the bodies' current poses (they moved since the manifold was made)
-            const Vec3 rA = SolverAccess::Q(a) * p.mLocalOnA;
-            const Vec3 rB = SolverAccess::Q(b) * p.mLocalOnB;
-            const float separation = c->mNormal.dot((SolverAccess::X(b) + rB) - (SolverAccess::X(a) + rA));
+            const Vec3 rA = SolverAccess::Q(a) * c.mLocalOnA[i];
+            const Vec3 rB = SolverAccess::Q(b) * c.mLocalOnB[i];
+            const float separation = c.mNormal.dot((SolverAccess::X(b) + rB) - (SolverAccess::X(a) + rA));
             maxPenetration = std::max(maxPenetration, -separation - inSettings.mPenetrationSlop);
             const float correction =
                 std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
@@ -291,17 +304,17 @@ float SequentialImpulseSolver::SolvePositions(std::span<ContactConstraint* const
                 haveInertia = true;
             }
             AxisImpulse axis;
-            InitAxis(c->mNormal, rA, rB, invIA, invIB, a.GetInverseMass(), b.GetInverseMass(), axis);
+            InitAxis(c.mNormal, rA, rB, invIA, invIB, a.GetInverseMass(), b.GetInverseMass(), axis);
             const float impulse = -correction * axis.mEffectiveMass;
             // Move positions directly (a pseudo-impulse): it corrects the overlap without adding velocity
             if (a.IsDynamic())
             {
-                SolverAccess::X(a) -= (a.GetInverseMass() * impulse) * c->mNormal;
+                SolverAccess::X(a) -= (a.GetInverseMass() * impulse) * c.mNormal;
                 SolverAccess::Q(a) = IntegrateRotation(SolverAccess::Q(a), -impulse * axis.mInvIA_RAxAxis);
             }
             if (b.IsDynamic())
             {
-                SolverAccess::X(b) += (b.GetInverseMass() * impulse) * c->mNormal;
+                SolverAccess::X(b) += (b.GetInverseMass() * impulse) * c.mNormal;
                 SolverAccess::Q(b) = IntegrateRotation(SolverAccess::Q(b), impulse * axis.mInvIB_RBxAxis);
             }
         }

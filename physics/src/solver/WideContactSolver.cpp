@@ -185,14 +185,37 @@ void SetLane(__m128 (&ioVector)[3], int inLane, const Vec3& inValue)
         SetLane(ioVector[i], inLane, inValue[i]);
 }
 
-void SetLane(WideAxis& ioAxis, int inLane, const AxisImpulse& inValue)
+// A WideAxis's 14 rows are AxisImpulse's 14 floats in the same order, so packing four of them is a 4x4
+// transpose per run of four floats (lane by lane it was 56 scalar stores, half of Pack)
+static_assert(sizeof(AxisImpulse) == 14 * sizeof(float) && sizeof(WideAxis) == 14 * sizeof(__m128),
+              "WideAxis rows mirror AxisImpulse's floats");
+constexpr int cAxisFloats = 14;
+
+/// What a lane without an axis (padding, or a point beyond its manifold's count) packs: zeros.
+alignas(16) constexpr float cZeroAxis[16] = {};
+
+const float* Floats(const AxisImpulse& inAxis)
 {
-    SetLane(ioAxis.mRAxAxis, inLane, inValue.mRAxAxis);
-    SetLane(ioAxis.mRBxAxis, inLane, inValue.mRBxAxis);
-    SetLane(ioAxis.mInvIA_RAxAxis, inLane, inValue.mInvIA_RAxAxis);
-    SetLane(ioAxis.mInvIB_RBxAxis, inLane, inValue.mInvIB_RBxAxis);
-    SetLane(ioAxis.mEffectiveMass, inLane, inValue.mEffectiveMass);
-    SetLane(ioAxis.mAccumulated, inLane, inValue.mAccumulated);
+    return reinterpret_cast<const float*>(&inAxis);
+}
+
+/// Four lanes' axes (inLanes[l]: cAxisFloats floats, or cZeroAxis) into outAxis.
+void PackAxis(const float* const (&inLanes)[4], WideAxis& outAxis)
+{
+    __m128* rows = reinterpret_cast<__m128*>(&outAxis);
+    for (int k = 0; k + 4 <= cAxisFloats; k += 4)
+    {
+        __m128 r0 = _mm_loadu_ps(inLanes[0] + k), r1 = _mm_loadu_ps(inLanes[1] + k),
+               r2 = _mm_loadu_ps(inLanes[2] + k), r3 = _mm_loadu_ps(inLanes[3] + k);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        rows[k] = r0;
+        rows[k + 1] = r1;
+        rows[k + 2] = r2;
+        rows[k + 3] = r3;
+    }
+    // The last two rows (effective mass, accumulated): a 16-byte load would read past the axis
+    for (int k = cAxisFloats / 4 * 4; k < cAxisFloats; ++k)
+        rows[k] = _mm_setr_ps(inLanes[0][k], inLanes[1][k], inLanes[2][k], inLanes[3][k]);
 }
 } // namespace
 
@@ -205,20 +228,39 @@ void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
     ioBatch.mFirst = first;
     ioBatch.mCount = count;
     ioBatch.mPaddingFirst = paddingFirst;
+    const ContactConstraint* lanes[4] = {};
+    for (uint32_t lane = 0; lane < count; ++lane)
+        lanes[lane] = inConstraints[lane];
+    const float* axes[4];
+    for (int t = 0; t < 2; ++t)
+    {
+        for (int l = 0; l < 4; ++l)
+            axes[l] = lanes[l] != nullptr ? Floats(lanes[l]->mPatch.mTangent[t]) : cZeroAxis;
+        PackAxis(axes, ioBatch.mTangentAxis[t]);
+    }
+    for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+    {
+        for (int l = 0; l < 4; ++l)
+            axes[l] = lanes[l] != nullptr && i < lanes[l]->mNumPoints ? Floats(lanes[l]->mPoints[i].mNormal)
+                                                                      : cZeroAxis;
+        PackAxis(axes, ioBatch.mPoint[i]);
+    }
     for (uint32_t lane = 0; lane < 4; ++lane)
     {
-        if (lane >= count || inConstraints[lane] == nullptr)
+        if (lanes[lane] == nullptr)
         {
             ioBatch.mBodyA[lane] = paddingFirst + 2 * lane;
             ioBatch.mBodyB[lane] = paddingFirst + 2 * lane + 1;
+            ioBatch.mCacheIndex[lane] = cInvalidCacheIndex;
             std::memset(static_cast<void*>(&ioBodies[ioBatch.mBodyA[lane]]), 0, sizeof(SolverBody));
             std::memset(static_cast<void*>(&ioBodies[ioBatch.mBodyB[lane]]), 0, sizeof(SolverBody));
             continue;
         }
-        const ContactConstraint& c = *inConstraints[lane];
+        const ContactConstraint& c = *lanes[lane];
         const int l = int(lane);
         ioBatch.mBodyA[lane] = c.mSolverBodyA;
         ioBatch.mBodyB[lane] = c.mSolverBodyB;
+        ioBatch.mCacheIndex[lane] = c.mCacheIndex;
         SetLane(ioBatch.mNormal, l, c.mNormal);
         SetLane(ioBatch.mTangent[0], l, c.mTangent[0]);
         SetLane(ioBatch.mTangent[1], l, c.mTangent[1]);
@@ -228,11 +270,8 @@ void WideContactSolver::Pack(std::span<ContactConstraint* const> inConstraints,
         SetLane(ioBatch.mTwistEffectiveMass, l, c.mPatch.mTwistEffectiveMass);
         SetLane(ioBatch.mTwistAccumulated, l, c.mPatch.mTwistAccumulated);
         SetLane(ioBatch.mTwistRadius, l, c.mPatch.mTwistRadius);
-        SetLane(ioBatch.mTangentAxis[0], l, c.mPatch.mTangent[0]);
-        SetLane(ioBatch.mTangentAxis[1], l, c.mPatch.mTangent[1]);
         for (int i = 0; i < c.mNumPoints; ++i)
         {
-            SetLane(ioBatch.mPoint[i], l, c.mPoints[i].mNormal);
             SetLane(ioBatch.mVelocityBias[i], l, c.mPoints[i].mVelocityBias);
             SetLane(ioBatch.mMaxNormalImpulse[i], l, c.mPoints[i].mMaxNormalImpulse);
         }
@@ -294,6 +333,28 @@ void WideContactSolver::Unpack(const WideContactBatch& inBatch,
             c.mPoints[i].mNormal.mAccumulated = GetLane(inBatch.mPoint[i].mAccumulated, l);
             c.mPoints[i].mMaxNormalImpulse = GetLane(inBatch.mMaxNormalImpulse[i], l);
         }
+    }
+}
+
+void WideContactSolver::StoreImpulses(const WideContactBatch& inBatch, ContactCache& ioCache)
+{
+    for (uint32_t lane = 0; lane < inBatch.mCount; ++lane)
+    {
+        if (inBatch.mCacheIndex[lane] == cInvalidCacheIndex) continue;
+        CachedManifold& cached = ioCache.Get(inBatch.mCacheIndex[lane]);
+        const int l = int(lane);
+        // Points beyond the lane's count hold zeros, and the cache never reads past its count
+        for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
+        {
+            cached.mNormalImpulse[i] = GetLane(inBatch.mPoint[i].mAccumulated, l);
+            cached.mDeferredBounce[i] = 0.0f;
+        }
+        const float friction[2] = {GetLane(inBatch.mTangentAxis[0].mAccumulated, l),
+                                   GetLane(inBatch.mTangentAxis[1].mAccumulated, l)};
+        for (int k = 0; k < 3; ++k)
+            cached.mFrictionImpulse[k] = friction[0] * GetLane(inBatch.mTangent[0][k], l) +
+                                         friction[1] * GetLane(inBatch.mTangent[1][k], l);
+        cached.mTwistImpulse = GetLane(inBatch.mTwistAccumulated, l);
     }
 }
 

@@ -9,9 +9,11 @@
 // run side by side.
 //
 // A batch is packed from its constraints once per step, solved by one thread per iteration (the thread that
-// owns its part of the color), and its impulses are unpacked back into the constraints for the restitution
-// pass and the contact cache. No locks: the batches of one color are split between threads, colors in turn.
+// owns its part of the color), and its impulses are either unpacked back into the constraints (for the
+// restitution pass) or stored straight into the contact cache. No locks: the batches of one color are split
+// between threads, colors in turn.
 
+#include "cairn/physics/solver/ContactCache.h"
 #include "cairn/physics/solver/ContactConstraint.h"
 #include "cairn/physics/solver/SolverBody.h"
 
@@ -31,6 +33,8 @@ namespace WideContactSolver
 {
 /// SolverBody blocks a batch needs for its padding lanes (two per lane: A and B), zeroed by Pack.
 inline constexpr uint32_t cPaddingBlocks = 8;
+/// WideContactBatch::mCacheIndex of a padding lane.
+inline constexpr uint32_t cInvalidCacheIndex = 0xffffffffu;
 } // namespace WideContactSolver
 
 #if CAIRN_WIDE_SOLVER
@@ -53,6 +57,7 @@ struct WideContactBatch
     uint32_t mPaddingFirst; ///< First of the cPaddingBlocks SolverBody blocks its padding lanes use
     uint32_t mBodyA[4];     ///< SolverBody blocks of each lane
     uint32_t mBodyB[4];
+    uint32_t mCacheIndex[4]; ///< Each lane's ContactConstraint::mCacheIndex (padding: cInvalidCacheIndex)
     __m128 mNormal[3];
     __m128 mTangent[2][3];
     __m128 mInvIA_Normal[3];
@@ -80,6 +85,10 @@ void WarmStart(std::span<const WideContactBatch> inBatches, std::span<SolverBody
 void SolveVelocities(std::span<WideContactBatch> ioBatches, std::span<SolverBody> ioBodies, int inIteration);
 /// Copies the batch's impulses back into its constraints (null ones skipped).
 void Unpack(const WideContactBatch& inBatch, std::span<ContactConstraint* const> ioConstraints);
+/// Stores the batch's impulses in the contact cache for next step's warm start, as PhysicsStep::StoreImpulses
+/// does from unpacked constraints whose restitution pass did not run (no deferred bounces): for an island
+/// where nothing bounces, the constraints need not be unpacked at all.
+void StoreImpulses(const WideContactBatch& inBatch, ContactCache& ioCache);
 } // namespace WideContactSolver
 
 #endif

@@ -52,8 +52,10 @@ void SolveVelocities(std::span<ContactConstraint* const> ioConstraints, std::spa
 /// The restitution pass, after the velocity iterations.
 void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies,
                       const SolverSettings& inSettings);
+/// The part of inConstraint that the position iterations need.
+void MakePositionConstraint(const ContactConstraint& inConstraint, PositionConstraint& outConstraint);
 /// One position iteration; returns the largest remaining penetration beyond the slop.
-float SolvePositions(std::span<ContactConstraint* const> ioConstraints, const SolverSettings& inSettings);
+float SolvePositions(std::span<const PositionConstraint> inConstraints, const SolverSettings& inSettings);
 } // namespace SequentialImpulseSolver
 
 } // namespace cairn
