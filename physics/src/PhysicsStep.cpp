@@ -80,6 +80,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     mNumBodyPairs = 0;
     mNumWarmStartedPoints = 0;
     mNumReusedPairs = 0;
+    mNumContactPoints = 0;
     WakeIslandsOfWokenBodies();
     mIslands.Reset(uint32_t(mBodies.GetActiveBodiesForStep().size()));
     CollideNewlyActive(0, inDeltaTime);
@@ -99,8 +100,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mNumWarmStartedPoints += mNumWarmStartedPoints;
     ioStatistics.mNumReusedBodyPairs += mNumReusedPairs;
     ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
-    for (const ContactConstraint* c : mConstraints)
-        ioStatistics.mNumContactPoints += uint32_t(c->mNumPoints);
+    ioStatistics.mNumContactPoints += mNumContactPoints;
     ioStatistics.mNumIslands += numIslands;
     ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
 
@@ -360,11 +360,13 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
                     mBodies.ActivateBody(body);
             mNumWarmStartedPoints += out.mNumWarmStartedPoints;
             mNumReusedPairs += out.mNumReusedPairs;
+            mNumContactPoints += out.mNumContactPoints;
         }
         const uint32_t firstCachedPair = mContactCache.AppendPairs(numPairs);
         const uint32_t firstCacheIndex = mContactCache.AppendManifolds(numManifolds);
         const size_t firstConstraint = mConstraints.size();
         mConstraints.resize(firstConstraint + numManifolds);
+        mConstraintInfo.resize(firstConstraint + numManifolds);
         ParallelFor(numChunks, 4,
                     [&](uint32_t inB, uint32_t inE)
                     {
@@ -381,6 +383,12 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
                                 c.mCacheIndex = firstCacheIndex + place;
                                 mContactCache.Get(c.mCacheIndex) = out.mCached[i];
                                 mConstraints[firstConstraint + place] = &c;
+                                // The bodies were woken (given active indices) above
+                                auto activeIndex = [](const Body& inBody)
+                                { return inBody.IsDynamic() ? inBody.GetActiveIndex() : UINT32_MAX; };
+                                mConstraintInfo[firstConstraint + place] = {
+                                    c.mOrderKey, c.mCacheIndex, activeIndex(*c.mBodyA),
+                                    activeIndex(*c.mBodyB), c.mRestitution != 0.0f ? 1u : 0u};
                             }
                         }
                     });
@@ -574,6 +582,7 @@ void PhysicsStep::AddConstraint(Body& ioA, Body& ioB, const ContactManifold& inM
                 break;
             }
     }
+    ioOut.mNumContactPoints += uint32_t(c.mNumPoints);
     c.mOrderKey = MixBits((uint64_t(ioA.GetID().GetIndex()) << 32 | ioB.GetID().GetIndex()) ^
                           (uint64_t(inManifold.mSubShapeA) << 40) ^ inManifold.mSubShapeB);
 }
@@ -584,22 +593,27 @@ void PhysicsStep::BuildIslands()
     mIslands.Finalize();
 
     const uint32_t numIslands = mIslands.GetNumIslands();
+    const uint32_t numConstraints = uint32_t(mConstraints.size());
     mConstraintStart.assign(numIslands + 1, 0);
     mIslandBounces.assign(numIslands, 0);
-    for (ContactConstraint* c : mConstraints)
+    mConstraintIsland.resize(numConstraints);
+    for (uint32_t i = 0; i < numConstraints; ++i)
     {
-        const Body& dynamicBody = c->mBodyA->IsDynamic() ? *c->mBodyA : *c->mBodyB;
-        c->mIsland = mIslands.GetIsland(dynamicBody.GetActiveIndex());
-        ++mConstraintStart[c->mIsland + 1];
-        mIslandBounces[c->mIsland] |= c->mRestitution != 0.0f ? 1 : 0;
+        const ConstraintInfo& info = mConstraintInfo[i];
+        const uint32_t island = mIslands.GetIsland(info.mBodyA != UINT32_MAX ? info.mBodyA : info.mBodyB);
+        mConstraintIsland[i] = island;
+        ++mConstraintStart[island + 1];
+        mIslandBounces[island] |= uint8_t(info.mBounces);
     }
     for (uint32_t i = 0; i < numIslands; ++i)
         mConstraintStart[i + 1] += mConstraintStart[i];
-    mIslandConstraints.resize(mConstraints.size());
+    // The sort items of OrderConstraints, in island order (each island's are then sorted in place)
+    mOrderItems.resize(numConstraints);
     thread_local std::vector<uint32_t> cursor;
     cursor.assign(mConstraintStart.begin(), mConstraintStart.end() - 1);
-    for (ContactConstraint* c : mConstraints)
-        mIslandConstraints[cursor[c->mIsland]++] = c;
+    for (uint32_t i = 0; i < numConstraints; ++i)
+        mOrderItems[cursor[mConstraintIsland[i]]++] = {mConstraintInfo[i].mOrderKey,
+                                                       mConstraintInfo[i].mCacheIndex, i};
 }
 
 void PhysicsStep::OrderConstraints()
@@ -608,12 +622,8 @@ void PhysicsStep::OrderConstraints()
     // Solve order: a hash of the bodies and sub-shapes, the same on every run. Creation order follows body
     // indices, which usually follow the geometry (a stack is built bottom-up); a solver sweeping in geometric
     // order drifts in that direction, and a wall of boxes leaned over
-    // The keys are gathered once into a compact array: a comparator that read them through the constraint
+    // The keys are in a compact array (BuildIslands): a comparator that read them through the constraint
     // pointers took a cache miss per comparison
-    mOrderItems.resize(mIslandConstraints.size());
-    for (size_t i = 0; i < mIslandConstraints.size(); ++i)
-        mOrderItems[i] = {mIslandConstraints[i]->mOrderKey, mIslandConstraints[i]->mCacheIndex,
-                          mIslandConstraints[i]};
     auto byKeyThenCacheIndex = [](const OrderItem& inL, const OrderItem& inR)
     {
         return inL.mOrderKey < inR.mOrderKey ||
@@ -636,8 +646,9 @@ void PhysicsStep::OrderConstraints()
             items, mOrderScratch, [](const OrderItem& inItem) { return inItem.mOrderKey; },
             byKeyThenCacheIndex);
     }
-    for (size_t i = 0; i < mIslandConstraints.size(); ++i)
-        mIslandConstraints[i] = mOrderItems[i].mConstraint;
+    mIslandConstraints.resize(mOrderItems.size());
+    for (size_t i = 0; i < mOrderItems.size(); ++i)
+        mIslandConstraints[i] = mConstraints[mOrderItems[i].mConstraint];
 
     // Only an island that holds a good share of the step's work is colored: smaller ones are better solved
     // whole, several at once. Both limits ignore the thread count, so results do not depend on it
@@ -709,10 +720,9 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
     // bodies has yet (static and kinematic bodies are only read by the solver, so they may repeat in a color)
     for (uint32_t i = begin; i < end; ++i)
     {
-        const ContactConstraint& c = *mIslandConstraints[i];
-        const bool dynamicA = c.mBodyA->IsDynamic(), dynamicB = c.mBodyB->IsDynamic();
-        const uint32_t indexA = dynamicA ? c.mBodyA->GetActiveIndex() : UINT32_MAX;
-        const uint32_t indexB = dynamicB ? c.mBodyB->GetActiveIndex() : UINT32_MAX;
+        const ConstraintInfo& info = mConstraintInfo[mOrderItems[i].mConstraint];
+        const uint32_t indexA = info.mBodyA, indexB = info.mBodyB;
+        const bool dynamicA = indexA != UINT32_MAX, dynamicB = indexB != UINT32_MAX;
         const uint64_t taken = (dynamicA ? mBodyColors[indexA] : 0) | (dynamicB ? mBodyColors[indexB] : 0);
         const uint32_t color = taken == ~uint64_t(0) ? cSerialColor : uint32_t(std::countr_zero(~taken));
         if (color != cSerialColor)

@@ -59,6 +59,7 @@ private:
         std::vector<BodyPair> mDeferredLinks;        ///< Island links with a body woken at the merge
         uint32_t mNumWarmStartedPoints = 0;
         uint32_t mNumReusedPairs = 0;
+        uint32_t mNumContactPoints = 0;
         uint32_t mPreviousPairHint = 0; ///< See ContactCache::FindPreviousPair
         uint32_t mFirstCachedPair = 0;  ///< Set at the merge: where its pairs go in the contact cache
         uint32_t mFirstManifold = 0;    ///< Set at the merge: the first of its manifolds in this step's order
@@ -72,6 +73,7 @@ private:
             mToWake.clear();
             mDeferredLinks.clear();
             mNumWarmStartedPoints = 0;
+            mNumContactPoints = 0;
         }
     };
 
@@ -283,13 +285,28 @@ private:
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
     std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
     std::vector<uint64_t> mBodyColors;   ///< Scratch per active body: colors its constraints took
+    /// What the island grouping, the solve-order sort and the coloring need of each constraint of
+    /// mConstraints, gathered by the merge's parallel copies: read through the constraint pointers (640 bytes
+    /// each, scattered over the chunks), these single-threaded passes took a cache miss per constraint.
+    struct ConstraintInfo
+    {
+        uint64_t mOrderKey;   ///< ContactConstraint::mOrderKey
+        uint32_t mCacheIndex; ///< ContactConstraint::mCacheIndex
+        uint32_t mBodyA;      ///< Active index of A if it is dynamic, else UINT32_MAX
+        uint32_t mBodyB;      ///< Likewise for B (at least one of them is dynamic)
+        uint32_t mBounces;    ///< 1 if the constraint has restitution
+    };
+    std::vector<ConstraintInfo> mConstraintInfo; ///< Per entry of mConstraints
+    std::vector<uint32_t> mConstraintIsland;     ///< Scratch for BuildIslands: per entry of mConstraints
+    uint32_t mNumContactPoints = 0;              ///< Counter of the running step
     struct OrderItem
     {
         uint64_t mOrderKey;
         uint32_t mCacheIndex; ///< Tie-break (unique)
-        ContactConstraint* mConstraint;
+        uint32_t mConstraint; ///< Index into mConstraints and mConstraintInfo
     };
-    std::vector<OrderItem> mOrderItems;   ///< Scratch: the hashed solve order's sort
+    /// Per entry of mIslandConstraints once sorted (until ColorIsland reorders a colored island's entries)
+    std::vector<OrderItem> mOrderItems;
     std::vector<OrderItem> mOrderScratch; ///< Scratch: the radix sort's second buffer
     struct ColorItem
     {

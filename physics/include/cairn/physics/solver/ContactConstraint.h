@@ -67,7 +67,6 @@ struct ContactConstraint
     float mFriction;       ///< Combined: sqrt(frictionA * frictionB)
     float mRestitution;    ///< Combined: max(restitutionA, restitutionB)
     uint32_t mCacheIndex;  ///< Where this manifold's impulses are stored for next step's warm start
-    uint32_t mIsland;      ///< Island this constraint is solved in
     uint32_t mSolverBodyA; ///< A's velocities in the step's SolverBody array, set before solving
     uint32_t mSolverBodyB;
     uint64_t mOrderKey; ///< Hash of bodies and sub-shapes: the solve order within the island
