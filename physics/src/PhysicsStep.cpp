@@ -81,6 +81,9 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     mNumWarmStartedPoints = 0;
     mNumReusedPairs = 0;
     mNumContactPoints = 0;
+    mCacheInOrder = true;
+    mLastCachedPair.reset();
+    mLastCachedKey.reset();
     WakeIslandsOfWokenBodies();
     mIslands.Reset(uint32_t(mBodies.GetActiveBodiesForStep().size()));
     CollideNewlyActive(0, inDeltaTime);
@@ -93,7 +96,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     SolveIslands(inDeltaTime);
     const uint32_t numIslands = mIslands.GetNumIslands();
     const uint32_t largestIsland = numIslands == 0 ? 0 : uint32_t(mIslands.GetBodies(mIslandOrder[0]).size());
-    mContactCache.EndStep();
+    mContactCache.EndStep(mCacheInOrder);
     ioStatistics.mSolveMs += MillisecondsSince(phase);
 
     ioStatistics.mNumBodyPairs += mNumBodyPairs;
@@ -361,6 +364,19 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
             mNumWarmStartedPoints += out.mNumWarmStartedPoints;
             mNumReusedPairs += out.mNumReusedPairs;
             mNumContactPoints += out.mNumContactPoints;
+            // The contact cache's order across chunks (and rounds); within each chunk the copies check it
+            if (!out.mCachedPairs.empty())
+            {
+                if (mLastCachedPair.has_value() && PairKeyOf(out.mCachedPairs.front()) < *mLastCachedPair)
+                    mCacheInOrder = false;
+                mLastCachedPair = PairKeyOf(out.mCachedPairs.back());
+            }
+            if (!out.mCached.empty())
+            {
+                if (mLastCachedKey.has_value() && out.mCached.front().mKey < *mLastCachedKey)
+                    mCacheInOrder = false;
+                mLastCachedKey = out.mCached.back().mKey;
+            }
         }
         const uint32_t firstCachedPair = mContactCache.AppendPairs(numPairs);
         const uint32_t firstCacheIndex = mContactCache.AppendManifolds(numManifolds);
@@ -373,11 +389,24 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
                         for (uint32_t chunk = inB; chunk < inE; ++chunk)
                         {
                             NarrowPhaseChunk& out = mNarrowPhaseChunks[firstChunk + chunk];
+                            // Each pair's manifolds follow the ones before in the same order: where they
+                            // start holds once the cache is in key order (else EndStep finds them)
+                            uint32_t pairManifolds = firstCacheIndex + out.mFirstManifold;
+                            out.mInOrder = true;
                             for (size_t i = 0; i < out.mCachedPairs.size(); ++i)
-                                mContactCache.GetPair(firstCachedPair + out.mFirstCachedPair + uint32_t(i)) =
-                                    out.mCachedPairs[i];
+                            {
+                                CachedBodyPair& pair = mContactCache.GetPair(
+                                    firstCachedPair + out.mFirstCachedPair + uint32_t(i));
+                                pair = out.mCachedPairs[i];
+                                pair.mFirstManifold = pairManifolds;
+                                pairManifolds += pair.mNumManifolds;
+                                if (i > 0 && PairKeyOf(pair) < PairKeyOf(out.mCachedPairs[i - 1]))
+                                    out.mInOrder = false;
+                            }
                             for (size_t i = 0; i < out.mConstraints.size(); ++i)
                             {
+                                if (i > 0 && out.mCached[i].mKey < out.mCached[i - 1].mKey)
+                                    out.mInOrder = false;
                                 const uint32_t place = out.mFirstManifold + uint32_t(i);
                                 ContactConstraint& c = out.mConstraints[i];
                                 c.mCacheIndex = firstCacheIndex + place;
@@ -392,6 +421,8 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
                             }
                         }
                     });
+        for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+            mCacheInOrder = mCacheInOrder && mNarrowPhaseChunks[firstChunk + chunk].mInOrder;
         mIslands.Grow(uint32_t(active.size())); // The woken bodies, before their links
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
             for (const BodyPair& link : mNarrowPhaseChunks[firstChunk + chunk].mDeferredLinks)

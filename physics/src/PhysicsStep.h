@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -41,6 +42,8 @@ public:
     /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics. ioJobs (may be null: all
     /// on this thread) runs the parallel phases.
     void Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs);
+    /// See PhysicsSystem::IsContactCacheConsistent.
+    bool IsContactCacheConsistent() const { return mContactCache.IsConsistent(); }
 
 private:
     struct BodyPair
@@ -63,6 +66,7 @@ private:
         uint32_t mPreviousPairHint = 0; ///< See ContactCache::FindPreviousPair
         uint32_t mFirstCachedPair = 0;  ///< Set at the merge: where its pairs go in the contact cache
         uint32_t mFirstManifold = 0;    ///< Set at the merge: the first of its manifolds in this step's order
+        bool mInOrder = true; ///< Set by the merge's copy: its cache entries are in the cache's key order
         void Clear()
         {
             mPreviousPairHint = 0;
@@ -299,6 +303,16 @@ private:
     std::vector<ConstraintInfo> mConstraintInfo; ///< Per entry of mConstraints
     std::vector<uint32_t> mConstraintIsland;     ///< Scratch for BuildIslands: per entry of mConstraints
     uint32_t mNumContactPoints = 0;              ///< Counter of the running step
+    /// Whether this step's contact-cache entries are in key order, as they nearly always are (the pairs are
+    /// collided in sorted order): then ContactCache::EndStep has nothing to do. Checked by the merge, the
+    /// chunks' own entries in parallel and where chunks (and rounds) meet here, from the last entry so far.
+    bool mCacheInOrder = true;
+    std::optional<std::pair<BodyID, BodyID>> mLastCachedPair;
+    std::optional<ContactKey> mLastCachedKey;
+    static std::pair<BodyID, BodyID> PairKeyOf(const CachedBodyPair& inPair)
+    {
+        return {inPair.mBodyA, inPair.mBodyB};
+    }
     struct OrderItem
     {
         uint64_t mOrderKey;

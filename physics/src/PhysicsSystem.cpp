@@ -56,6 +56,11 @@ PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup
 
 PhysicsSystem::~PhysicsSystem() = default;
 
+bool PhysicsSystem::IsContactCacheConsistent() const
+{
+    return mStep->IsContactCacheConsistent();
+}
+
 Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
 {
     return UpdateImpl(inDeltaTime, inCollisionSteps, nullptr);

@@ -85,8 +85,9 @@ void SortByKey(Items& ioItems, Items& ioScratch, std::vector<std::pair<Key, uint
 }
 } // namespace
 
-void ContactCache::EndStep()
+void ContactCache::EndStep(bool inInOrder)
 {
+    if (inInOrder) return;
     SortByKey(mCurrent, mScratch, mManifoldOrder, [](const CachedManifold& inM) { return inM.mKey; });
     SortByKey(mCurrentPairs, mScratchPairs, mPairOrder,
               [](const CachedBodyPair& inP) { return std::pair(inP.mBodyA, inP.mBodyB); });
@@ -101,6 +102,27 @@ void ContactCache::EndStep()
         pair.mFirstManifold = next;
         next += pair.mNumManifolds;
     }
+}
+
+bool ContactCache::IsConsistent() const
+{
+    for (size_t i = 1; i < mCurrent.size(); ++i)
+        if (!(mCurrent[i - 1].mKey < mCurrent[i].mKey)) return false;
+    uint32_t next = 0;
+    for (size_t i = 0; i < mCurrentPairs.size(); ++i)
+    {
+        const CachedBodyPair& pair = mCurrentPairs[i];
+        if (i > 0 && !(std::pair(mCurrentPairs[i - 1].mBodyA, mCurrentPairs[i - 1].mBodyB) <
+                       std::pair(pair.mBodyA, pair.mBodyB)))
+            return false;
+        if (pair.mFirstManifold != next || pair.mFirstManifold + pair.mNumManifolds > mCurrent.size())
+            return false;
+        for (uint32_t m = pair.mFirstManifold; m < pair.mFirstManifold + pair.mNumManifolds; ++m)
+            if (mCurrent[m].mKey.mBodyA != pair.mBodyA || mCurrent[m].mKey.mBodyB != pair.mBodyB)
+                return false;
+        next += pair.mNumManifolds;
+    }
+    return next == mCurrent.size();
 }
 
 void ContactCache::Clear()

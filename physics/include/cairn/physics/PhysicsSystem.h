@@ -72,6 +72,9 @@ public:
     const Status& GetSetupStatus() const { return mSetupStatus; }
     /// Figures of the last Update. Read it from the thread that calls Update.
     const StepStatistics& GetLastStepStatistics() const { return mLastStatistics; }
+    /// A self-check for tests, between updates: the contact cache that the next step warm-starts from is in
+    /// key order and every body pair in it finds its manifolds. O(contacts).
+    bool IsContactCacheConsistent() const;
 
 private:
     Status mSetupStatus; ///< Set at construction, constant afterwards

@@ -14,10 +14,11 @@
 // nothing writes until the next BeginStep: no locks.
 
 #include "cairn/physics/body/BodyID.h"
-#include "cairn/physics/math/DefaultInitAllocator.h"
+#include "cairn/physics/math/UninitializedAllocator.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -73,7 +74,8 @@ public:
     /// Stores a manifold of this step; returns its index for Get().
     uint32_t Add(const CachedManifold& inManifold);
     CachedManifold& Get(uint32_t inIndex) { return mCurrent[inIndex]; }
-    /// Makes room for inCount more manifolds of this step (filled through Get) and returns the first's index.
+    /// Makes room for inCount more manifolds of this step and returns the first's index. They are unset: the
+    /// caller must fill each (through Get) before EndStep.
     uint32_t AppendManifolds(uint32_t inCount)
     {
         const size_t first = mCurrent.size();
@@ -91,8 +93,9 @@ public:
     }
     /// Stores a body pair of this step: its manifolds are the next inPair.mNumManifolds given to Add().
     void AddPair(const CachedBodyPair& inPair) { mCurrentPairs.push_back(inPair); }
-    /// Makes room for inCount more body pairs of this step (filled through GetPair) and returns the first's
-    /// index. Their manifolds are those in the same places of the manifolds appended, as with AddPair.
+    /// Makes room for inCount more body pairs of this step (unset: each to be filled through GetPair) and
+    /// returns the first's index. Their manifolds are those in the same places of the manifolds appended, as
+    /// with AddPair.
     uint32_t AppendPairs(uint32_t inCount)
     {
         const size_t first = mCurrentPairs.size();
@@ -101,14 +104,24 @@ public:
     }
     CachedBodyPair& GetPair(uint32_t inIndex) { return mCurrentPairs[inIndex]; }
     /// Sorts this step's manifolds and pairs for lookup next step. Indices from Add() are invalid afterwards.
-    void EndStep();
+    /// inInOrder: the caller knows that both are in key order already (each strictly after the one before)
+    /// and has set each pair's mFirstManifold (the narrow phase's merge does both in parallel): then nothing
+    /// is left to do. Otherwise they are checked, sorted if need be, and the pairs' manifolds found.
+    void EndStep(bool inInOrder = false);
     size_t GetNumManifolds() const { return mCurrent.size(); }
+    /// After EndStep: whether this step's manifolds and pairs are in strictly increasing key order and each
+    /// pair's manifolds are where its mFirstManifold says, one after another (what next step's lookups rely
+    /// on). A self-check for tests: O(n).
+    bool IsConsistent() const;
     void Clear();
 
 private:
-    // Grown by Append* and then filled: default-initialised, so the growth does not zero them first
-    using Manifolds = std::vector<CachedManifold, DefaultInitAllocator<CachedManifold>>;
-    using Pairs = std::vector<CachedBodyPair, DefaultInitAllocator<CachedBodyPair>>;
+    // Grown by Append* and then filled: the growth writes nothing (see UninitializedAllocator)
+    static_assert(std::is_aggregate_v<CachedManifold> && std::is_trivially_destructible_v<CachedManifold> &&
+                      std::is_aggregate_v<CachedBodyPair> && std::is_trivially_destructible_v<CachedBodyPair>,
+                  "implicit-lifetime types: Append* leaves their bytes unset");
+    using Manifolds = std::vector<CachedManifold, UninitializedAllocator<CachedManifold>>;
+    using Pairs = std::vector<CachedBodyPair, UninitializedAllocator<CachedBodyPair>>;
     Manifolds mPrevious;  ///< Sorted by key
     Manifolds mCurrent;   ///< In creation order until EndStep
     Pairs mPreviousPairs; ///< Sorted by bodies, each with its manifolds in mPrevious
