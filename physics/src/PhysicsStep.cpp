@@ -445,7 +445,7 @@ void PhysicsStep::FindPairs(size_t inBegin)
     const uint32_t numChunks = uint32_t((sliceIDs.size() + cBodiesPerChunk - 1) / cBodiesPerChunk);
     if (mPairChunks.size() < numChunks) mPairChunks.resize(numChunks);
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
-        mPairChunks[chunk].clear();
+        mPairChunks[chunk].mPairs.clear();
     const ParallelRanges ranges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
     { ParallelFor(inCount, cBodiesPerChunk, inRange); };
     mBroadPhase.FindCollidingPairs(
@@ -460,14 +460,14 @@ void PhysicsStep::FindPairs(size_t inBegin)
             if (self == nullptr || other == nullptr || !other->IsInWorld() ||
                 (other->IsActive() && other->GetActiveIndex() < inBegin))
                 return;
-            mPairChunks[(self->GetActiveIndex() - inBegin) / cBodiesPerChunk].push_back(
+            mPairChunks[(self->GetActiveIndex() - inBegin) / cBodiesPerChunk].mPairs.push_back(
                 {std::min(inActive.GetIndex(), inOther.GetIndex()),
                  std::max(inActive.GetIndex(), inOther.GetIndex())});
         },
         &ranges);
     mPairs.clear();
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
-        mPairs.insert(mPairs.end(), mPairChunks[chunk].begin(), mPairChunks[chunk].end());
+        mPairs.insert(mPairs.end(), mPairChunks[chunk].mPairs.begin(), mPairChunks[chunk].mPairs.end());
     // Canonical order: the same scene gives the same contacts whatever order the broad phase reports. Each
     // pair is reported once, so the keys are unique and the radix sort's order is the comparison's
     auto keyOf = [](const BodyPair& inPair) { return uint64_t(inPair.mA) << 32 | inPair.mB; };

@@ -52,8 +52,10 @@ private:
         uint32_t mB;
     };
 
-    /// What the narrow phase of one chunk of pairs produced, merged in chunk order afterwards.
-    struct NarrowPhaseChunk
+    /// What the narrow phase of one chunk of pairs produced, merged in chunk order afterwards. Cache-line
+    /// aligned: neighbouring chunks run on different threads at once, and every append writes the vectors'
+    /// ends (sharing lines, the chunks' threads took them from each other all through the narrow phase).
+    struct alignas(64) NarrowPhaseChunk
     {
         std::vector<ContactConstraint> mConstraints; ///< mCacheIndex set at the merge
         std::vector<CachedManifold> mCached;         ///< One per constraint
@@ -252,7 +254,12 @@ private:
     jobs::JobSystem* mJobs = nullptr;    ///< During Run only
     std::vector<BodyPair> mPairs;        ///< Scratch: pairs of the slice being collided
     std::vector<BodyPair> mPairsScratch; ///< Scratch: the radix sort's second buffer
-    std::vector<std::vector<BodyPair>> mPairChunks;   ///< Scratch: pairs found per chunk of active bodies
+    /// Pairs found by one chunk of active bodies; cache-line aligned for the same reason as NarrowPhaseChunk.
+    struct alignas(64) PairChunk
+    {
+        std::vector<BodyPair> mPairs;
+    };
+    std::vector<PairChunk> mPairChunks;               ///< Scratch: per chunk of active bodies
     std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs
     std::vector<uint32_t> mIslandOrder;               ///< Scratch: islands, largest first
     std::vector<uint32_t> mIslandSizeStart;           ///< Scratch: the counting sort of mIslandOrder
