@@ -185,15 +185,18 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // every thread on each; then the others at once, the largest first so that the longest starts early and
     // the small ones fill in around it
     for (uint32_t island : mColoredIslands)
-        SolveColoredIsland(island, inDeltaTime);
+        SolveColoredIsland(island, inDeltaTime, false);
     ParallelFor(uint32_t(mSolveItems.size()), 1,
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
                         const SolveItem& item = mSolveItems[i];
-                        if (item.mGroup == UINT32_MAX)
-                            SolveIsland(mSolvedIslands[item.mFirst], inDeltaTime);
+                        const uint32_t island = mSolvedIslands[item.mFirst];
+                        if (item.mGroup == UINT32_MAX && mIslandFirstColor[island] != UINT32_MAX)
+                            SolveColoredIsland(island, inDeltaTime, true);
+                        else if (item.mGroup == UINT32_MAX)
+                            SolveIsland(island, inDeltaTime);
                         else
                             SolveIslandGroup(
                                 std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
@@ -704,9 +707,9 @@ void PhysicsStep::OrderConstraints()
     mColorIsSerial.clear();
     mColoredIslands.clear();
     // The other islands with at most cGroupMaxConstraints constraints are solved in groups (see below)
-    const bool groupSmall = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
+    const bool wide = CAIRN_WIDE_SOLVER && mSettings.mSolver.mWideColoredIslands;
     auto isSmall = [&](uint32_t inNumConstraints)
-    { return groupSmall && inNumConstraints <= cGroupMaxConstraints; };
+    { return wide && inNumConstraints <= cGroupMaxConstraints; };
     mSmallIslands.clear();
     mSolvedIslands.clear();
     mUnconstrainedBodies.clear();
@@ -715,6 +718,14 @@ void PhysicsStep::OrderConstraints()
         const uint32_t numConstraints = mConstraintStart[island + 1] - mConstraintStart[island];
         if (numConstraints >= coloredMin)
             mColoredIslands.push_back(island);
+        else if (wide && numConstraints >= cColoredIslandMinConstraints)
+        {
+            // Large, but not a share of the step that needs every thread: colored all the same, for the wide
+            // solver, and solved by one thread (a pyramid's layers before they settle into one island were
+            // solved by the scalar solver, a tenth of those steps)
+            ColorIsland(island);
+            mSolvedIslands.push_back(island);
+        }
         else if (numConstraints > 0)
             (isSmall(numConstraints) ? mSmallIslands : mSolvedIslands).push_back(island);
         else
@@ -796,7 +807,7 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
     mColorIsSerial.push_back(0); // The end marker
 }
 
-void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
+void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime, bool inAlone)
 {
     const uint32_t firstColor = mIslandFirstColor[inIsland];
     // The island's colors are the ranges [mColorStart[k], mColorStart[k + 1]) up to its end
@@ -812,7 +823,7 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     auto colorPasses = [&](int inPasses, auto inItems, const auto& inSolve)
     {
         RunStages(
-            uint32_t(std::max(inPasses, 0)) * numColors,
+            inAlone, uint32_t(std::max(inPasses, 0)) * numColors,
             [&](uint32_t inStage)
             {
                 const uint32_t color = firstColor + inStage % numColors;
@@ -835,7 +846,7 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
     const bool bounces = mIslandBounces[inIsland] != 0;
     const bool wide = CAIRN_WIDE_SOLVER && solver.mWideColoredIslands;
     if (wide)
-        SolveColoredVelocitiesWide(firstColor, lastColor, !bounces); // The warm start too, four at a time
+        SolveColoredVelocitiesWide(firstColor, lastColor, !bounces, inAlone); // The warm start too
     else
         colorPasses(1 + solver.mVelocityIterations, constraints,
                     [&](int inPass, std::span<ContactConstraint* const> inC)
@@ -853,46 +864,54 @@ void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime)
 
     const std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const std::span<const uint32_t> bodies = mIslands.GetBodies(inIsland);
-    ParallelFor(uint32_t(bodies.size()), 256,
-                [&](uint32_t inBegin, uint32_t inEnd)
-                {
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                        StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[bodies[i]]),
-                                                    inDeltaTime);
-                });
+    ParallelForUnlessAlone(inAlone, uint32_t(bodies.size()), 256,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           {
+                               for (uint32_t i = inBegin; i < inEnd; ++i)
+                                   StoreVelocitiesAndIntegrate(*mBodies.TryGetBodyAtIndex(active[bodies[i]]),
+                                                               inDeltaTime);
+                           });
     colorPasses(solver.mPositionIterations, std::span<const PositionConstraint>(mPositionConstraints),
                 [&](int, std::span<const PositionConstraint> inC)
                 { SequentialImpulseSolver::SolvePositions(inC, solver); });
 
     if (wide && !bounces) return; // Stored already
     const std::span<ContactConstraint* const> all = ConstraintsOf(inIsland);
-    ParallelFor(uint32_t(all.size()), 256,
-                [&](uint32_t inBegin, uint32_t inEnd)
-                { StoreImpulses(all.subspan(inBegin, inEnd - inBegin)); });
+    ParallelForUnlessAlone(inAlone, uint32_t(all.size()), 256,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           { StoreImpulses(all.subspan(inBegin, inEnd - inBegin)); });
 }
 
 void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstColor,
                                              [[maybe_unused]] uint32_t inLastColor,
-                                             [[maybe_unused]] bool inStoreImpulses)
+                                             [[maybe_unused]] bool inStoreImpulses,
+                                             [[maybe_unused]] bool inAlone)
 {
 #if CAIRN_WIDE_SOLVER
+    // The batches are this thread's: islands solved alone run at once on different threads (an island that
+    // all threads solve together is the updating thread's, which the others read through the captures)
+    // (named by references: a lambda that named the thread_local itself would get the running thread's)
+    thread_local std::vector<WideContactBatch> tWideBatches;
+    thread_local std::vector<uint32_t> tColorBatchStart;
+    std::vector<WideContactBatch>& wideBatches = tWideBatches;
+    std::vector<uint32_t>& colorBatchStart = tColorBatchStart;
     // Each color's constraints in batches of four, in order; the last batch of a color may be partial
-    mColorBatchStart.clear();
+    colorBatchStart.clear();
     uint32_t numBatches = 0;
     for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
     {
-        mColorBatchStart.push_back(numBatches);
+        colorBatchStart.push_back(numBatches);
         if (mColorIsSerial[color] == 0) numBatches += (mColorStart[color + 1] - mColorStart[color] + 3) / 4;
     }
-    mColorBatchStart.push_back(numBatches);
-    mWideBatches.resize(numBatches);
+    colorBatchStart.push_back(numBatches);
+    wideBatches.resize(numBatches);
     for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
     {
-        const uint32_t firstBatch = mColorBatchStart[color - inFirstColor];
-        const uint32_t lastBatch = mColorBatchStart[color - inFirstColor + 1];
+        const uint32_t firstBatch = colorBatchStart[color - inFirstColor];
+        const uint32_t lastBatch = colorBatchStart[color - inFirstColor + 1];
         for (uint32_t batch = firstBatch; batch < lastBatch; ++batch)
         {
-            WideContactBatch& b = mWideBatches[batch];
+            WideContactBatch& b = wideBatches[batch];
             b.mFirst = mColorStart[color] + 4 * (batch - firstBatch);
             b.mCount = std::min(4u, mColorStart[color + 1] - b.mFirst);
             b.mPaddingFirst = mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * color;
@@ -911,20 +930,21 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
         if (mColorIsSerial[color] != 0)
             for (uint32_t i = mColorStart[color]; i < mColorStart[color + 1]; ++i)
                 PrepareForSolve(i, numActive);
-    ParallelFor(numBatches, 64,
-                [&](uint32_t inBegin, uint32_t inEnd)
-                {
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                    {
-                        if (i + 1 < inEnd)
-                            for (ContactConstraint* next : constraintsOf(mWideBatches[i + 1]))
-                                PrefetchConstraint(next);
-                        const WideContactBatch& batch = mWideBatches[i];
-                        for (uint32_t lane = 0; lane < batch.mCount; ++lane)
-                            PrepareForSolve(batch.mFirst + lane, numActive);
-                        WideContactSolver::Pack(constraintsOf(batch), solverBodies, mWideBatches[i]);
-                    }
-                });
+    ParallelForUnlessAlone(inAlone, numBatches, 64,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           {
+                               for (uint32_t i = inBegin; i < inEnd; ++i)
+                               {
+                                   if (i + 1 < inEnd)
+                                       for (ContactConstraint* next : constraintsOf(wideBatches[i + 1]))
+                                           PrefetchConstraint(next);
+                                   const WideContactBatch& batch = wideBatches[i];
+                                   for (uint32_t lane = 0; lane < batch.mCount; ++lane)
+                                       PrepareForSolve(batch.mFirst + lane, numActive);
+                                   WideContactSolver::Pack(constraintsOf(batch), solverBodies,
+                                                           wideBatches[i]);
+                               }
+                           });
 
     // The warm start, then the iterations: each a pass over the colors in turn, each color a stage. The
     // serial range by the scalar solver in one part; the batches of a color (they share no dynamic body) in
@@ -933,45 +953,46 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
     const uint32_t numColors = inLastColor - inFirstColor + 1;
     auto batchesOf = [&](uint32_t inColor)
     {
-        return std::span<WideContactBatch>(mWideBatches.data() + mColorBatchStart[inColor - inFirstColor],
-                                           mWideBatches.data() +
-                                               mColorBatchStart[inColor - inFirstColor + 1]);
+        return std::span<WideContactBatch>(wideBatches.data() + colorBatchStart[inColor - inFirstColor],
+                                           wideBatches.data() + colorBatchStart[inColor - inFirstColor + 1]);
     };
-    RunStages((1 + uint32_t(mSettings.mSolver.mVelocityIterations)) * numColors,
-              [&](uint32_t inStage)
-              {
-                  const uint32_t color = inFirstColor + inStage % numColors;
-                  return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(batchesOf(color).size()), 8);
-              },
-              [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
-              {
-                  const uint32_t color = inFirstColor + inStage % numColors;
-                  const int pass = int(inStage / numColors); // 0: the warm start; then iteration pass - 1
-                  if (mColorIsSerial[color] != 0)
-                  {
-                      const std::span<ContactConstraint* const> constraints = ColorConstraints(color);
-                      if (pass == 0)
-                          SequentialImpulseSolver::WarmStart(constraints, solverBodies);
-                      else
-                          SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, pass - 1);
-                      return;
-                  }
-                  const std::span<WideContactBatch> part = PartOf(batchesOf(color), inPart, inParts);
-                  if (pass == 0)
-                      WideContactSolver::WarmStart(part, solverBodies);
-                  else
-                      WideContactSolver::SolveVelocities(part, solverBodies, pass - 1);
-              });
+    RunStages(
+        inAlone, (1 + uint32_t(mSettings.mSolver.mVelocityIterations)) * numColors,
+        [&](uint32_t inStage)
+        {
+            const uint32_t color = inFirstColor + inStage % numColors;
+            return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(batchesOf(color).size()), 8);
+        },
+        [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
+        {
+            const uint32_t color = inFirstColor + inStage % numColors;
+            const int pass = int(inStage / numColors); // 0: the warm start; then iteration pass - 1
+            if (mColorIsSerial[color] != 0)
+            {
+                const std::span<ContactConstraint* const> constraints = ColorConstraints(color);
+                if (pass == 0)
+                    SequentialImpulseSolver::WarmStart(constraints, solverBodies);
+                else
+                    SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, pass - 1);
+                return;
+            }
+            const std::span<WideContactBatch> part = PartOf(batchesOf(color), inPart, inParts);
+            if (pass == 0)
+                WideContactSolver::WarmStart(part, solverBodies);
+            else
+                WideContactSolver::SolveVelocities(part, solverBodies, pass - 1);
+        });
 
-    ParallelFor(numBatches, 64,
-                [&](uint32_t inBegin, uint32_t inEnd)
-                {
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                        if (inStoreImpulses)
-                            WideContactSolver::StoreImpulses(mWideBatches[i], mContactCache);
-                        else
-                            WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
-                });
+    ParallelForUnlessAlone(inAlone, numBatches, 64,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           {
+                               for (uint32_t i = inBegin; i < inEnd; ++i)
+                                   if (inStoreImpulses)
+                                       WideContactSolver::StoreImpulses(wideBatches[i], mContactCache);
+                                   else
+                                       WideContactSolver::Unpack(wideBatches[i],
+                                                                 constraintsOf(wideBatches[i]));
+                           });
     if (inStoreImpulses)
         for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
             if (mColorIsSerial[color] != 0) StoreImpulses(ColorConstraints(color));

@@ -100,11 +100,12 @@ private:
     /// takes part t first, so it keeps its region of the island in every color; a part whose thread has not
     /// come yet is taken by another, so no thread waits for one that the job system has not started. Which
     /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job.
+    /// inAlone: this thread runs every part, in order (for a job that solves its island by itself).
     template <class PartsOf, class RunPart>
-    void RunStages(uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
+    void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
         static_assert(jobs::JobSystem::cMaxThreads <= 64, "a stage's claims are one bit per part in 64");
-        const uint32_t threads = mJobs == nullptr ? 1 : mJobs->GetNumThreads();
+        const uint32_t threads = mJobs == nullptr || inAlone ? 1 : mJobs->GetNumThreads();
         if (threads <= 1)
         {
             for (uint32_t stage = 0; stage < inNumStages; ++stage)
@@ -154,6 +155,15 @@ private:
             handles[thread] = mJobs->Schedule("stages", [&team, thread] { team(thread); });
         team(0);
         mJobs->WaitAll({handles + 1, threads - 1});
+    }
+    /// ParallelFor, or all on this thread when inAlone (inside a job that solves its island by itself).
+    template <class Body>
+    void ParallelForUnlessAlone(bool inAlone, uint32_t inCount, uint32_t inGrain, const Body& inBody)
+    {
+        if (!inAlone)
+            ParallelFor(inCount, inGrain, inBody);
+        else if (inCount > 0)
+            inBody(0u, inCount);
     }
     /// Parts for inCount items with at least inMinPerPart in each (below that a part costs more than it
     /// saves), at most one per thread.
@@ -225,13 +235,15 @@ private:
     void FinishIsland(uint32_t inIsland, float inDeltaTime);
     /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
     void ColorIsland(uint32_t inIsland);
-    /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn.
-    void SolveColoredIsland(uint32_t inIsland, float inDeltaTime);
+    /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn;
+    /// or, inAlone, on this thread only (the same results: within a color the order changes nothing).
+    void SolveColoredIsland(uint32_t inIsland, float inDeltaTime, bool inAlone);
     /// The velocity iterations of a colored island whose colors are [inFirstColor, inLastColor], four
     /// manifolds at a time (WideContactSolver), on constraints that were not copied (see SolveIslands): this
     /// also gives them their solver blocks and position constraints. inStoreImpulses: store the impulses in
     /// the contact cache straight from the batches (no restitution pass follows); else unpack them.
-    void SolveColoredVelocitiesWide(uint32_t inFirstColor, uint32_t inLastColor, bool inStoreImpulses);
+    void SolveColoredVelocitiesWide(uint32_t inFirstColor, uint32_t inLastColor, bool inStoreImpulses,
+                                    bool inAlone);
     /// Binds constraint inIndex of mIslandConstraints to its solver blocks and makes its position constraint.
     void PrepareForSolve(uint32_t inIndex, uint32_t inNumActive);
     /// Stores the constraints' impulses in the contact cache for next step's warm start.
@@ -356,13 +368,8 @@ private:
     std::vector<std::pair<uint32_t, uint32_t>> mCopyRanges;
     std::vector<PositionConstraint> mPositionConstraints; ///< Per entry of mIslandConstraints
     std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
-    std::vector<SolverBody> mSolverBodies;
-    uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
-#if CAIRN_WIDE_SOLVER
-    std::vector<WideContactBatch> mWideBatches; ///< Scratch: the colored island being solved, color by color
-#endif
-    std::vector<uint32_t> mColorBatchStart;   ///< Scratch: per color of that island, its first batch    ///<
-                                              ///< Velocities being solved: see SolveIslands
+    std::vector<SolverBody> mSolverBodies; ///< Velocities being solved: see SolveIslands
+    uint32_t mPaddingBlocksFirst = 0;      ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
     std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;   ///< Scratch
     uint32_t mNumBodyPairs = 0;               ///< Counters of the running step

@@ -1,6 +1,7 @@
 // A colored island (a pyramid of boxes on a floor, one island of a few hundred contacts) solved by every
 // thread of the job system at once: the colors' stages synchronise on counters, the parts of a color go to
-// whichever thread takes them first. And small islands solved four at a time, groups on all threads. Under
+// whichever thread takes them first. And small islands solved four at a time, groups on all threads; and
+// several colored islands too small to need every thread, each solved by one thread at once. Under
 // ThreadSanitizer (this suite's label) that must show no race, and with 2 and 4 threads the bodies must end
 // exactly where one thread puts them.
 
@@ -25,11 +26,16 @@ struct Pose
     Vec3 mVelocity;
 };
 
-/// Steps a 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points), or with inSmall
-/// instead 40 small stacks of one to three boxes (islands of up to four constraints, solved four at a time),
-/// on inThreads job threads (0: none) and returns the boxes' final positions and velocities.
-std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLargestIslandConstraints,
-                              bool inSmall = false)
+enum class Scene
+{
+    Pyramid,        ///< One 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points)
+    SmallStacks,    ///< 40 stacks of one to three boxes (islands of up to four constraints)
+    SeveralPyramids ///< Six 5-layer pyramids apart: six colored islands, each under a quarter of the step
+};
+
+/// Steps inScene on inThreads job threads (0: none) and returns the boxes' final positions and velocities;
+/// outStats: the last step's statistics.
+std::vector<Pose> StepScene(Scene inScene, uint32_t inThreads, int inSteps, StepStatistics& outStats)
 {
     std::unique_ptr<jobs::JobSystem> jobSystem;
     if (inThreads > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{inThreads});
@@ -41,8 +47,7 @@ std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLarg
     EXPECT_TRUE(bodies.CreateAndAddBody(floor, Activation::DontActivate).IsOk());
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     std::vector<BodyID> boxes;
-    constexpr int cLayers = 7;
-    for (int i = 0; inSmall && i < 40; ++i)
+    for (int i = 0; inScene == Scene::SmallStacks && i < 40; ++i)
         for (int level = 0; level <= i % 3; ++level)
         {
             BodyCreationSettings body;
@@ -53,28 +58,27 @@ std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLarg
             body.mObjectLayer = Layers::cMoving;
             boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
         }
-    for (int layer = 0; !inSmall && layer < cLayers; ++layer)
-        for (int i = 0; i < cLayers - layer; ++i)
-            for (int k = 0; k < cLayers - layer; ++k)
-            {
-                BodyCreationSettings body;
-                body.mShape = box;
-                body.mPosition = Vec3(float(i) + 0.5f * float(layer), 0.5f + 1.05f * float(layer),
-                                      float(k) + 0.5f * float(layer));
-                body.mRotation = Quat(Eigen::AngleAxisf(0.02f * float(i + k), Vec3::UnitY()));
-                body.mObjectLayer = Layers::cMoving;
-                body.mFriction = 0.6f;
-                boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
-            }
-    outLargestIslandConstraints = 0;
+    const int numPyramids = inScene == Scene::Pyramid ? 1 : inScene == Scene::SeveralPyramids ? 6 : 0;
+    const int layers = inScene == Scene::Pyramid ? 7 : 5;
+    for (int pyramid = 0; pyramid < numPyramids; ++pyramid)
+        for (int layer = 0; layer < layers; ++layer)
+            for (int i = 0; i < layers - layer; ++i)
+                for (int k = 0; k < layers - layer; ++k)
+                {
+                    BodyCreationSettings body;
+                    body.mShape = box;
+                    body.mPosition = Vec3(float(i) + 0.5f * float(layer) + 8.0f * float(pyramid % 3) - 12.0f,
+                                          0.5f + 1.05f * float(layer),
+                                          float(k) + 0.5f * float(layer) + 8.0f * float(pyramid / 3));
+                    body.mRotation = Quat(Eigen::AngleAxisf(0.02f * float(i + k), Vec3::UnitY()));
+                    body.mObjectLayer = Layers::cMoving;
+                    body.mFriction = 0.6f;
+                    boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
+                }
     for (int step = 0; step < inSteps; ++step)
-    {
         EXPECT_TRUE(
             (jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f)).IsOk());
-        const StepStatistics& stats = system.GetLastStepStatistics();
-        if (stats.mNumIslands == 1)
-            outLargestIslandConstraints = std::max(outLargestIslandConstraints, stats.mNumManifolds);
-    }
+    outStats = system.GetLastStepStatistics();
     std::vector<Pose> poses;
     for (const BodyID& id : boxes)
         poses.push_back({bodies.GetPosition(id).Value(), bodies.GetLinearVelocity(id).Value()});
@@ -84,14 +88,14 @@ std::vector<Pose> StepPyramid(uint32_t inThreads, int inSteps, uint32_t& outLarg
 TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
 {
     constexpr int cSteps = 40;
-    uint32_t constraints = 0;
-    const std::vector<Pose> reference = StepPyramid(0, cSteps, constraints);
+    StepStatistics stats;
+    const std::vector<Pose> reference = StepScene(Scene::Pyramid, 0, cSteps, stats);
     // Large enough to be colored (PhysicsStep colors islands of 128 constraints and more)
-    EXPECT_GE(constraints, 128u) << "the pyramid was not one colored island";
+    EXPECT_EQ(stats.mNumIslands, 1u);
+    EXPECT_GE(stats.mNumManifolds, 128u) << "the pyramid was not one colored island";
     for (uint32_t threads : {2u, 4u})
     {
-        uint32_t unused = 0;
-        const std::vector<Pose> poses = StepPyramid(threads, cSteps, unused);
+        const std::vector<Pose> poses = StepScene(Scene::Pyramid, threads, cSteps, stats);
         ASSERT_EQ(poses.size(), reference.size());
         for (size_t i = 0; i < poses.size(); ++i)
         {
@@ -107,11 +111,31 @@ TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
 TEST(ColoredIslandThreadsTest, SmallIslandGroupsSameResultOnOneTwoAndFourThreads)
 {
     constexpr int cSteps = 40;
-    uint32_t unused = 0;
-    const std::vector<Pose> reference = StepPyramid(0, cSteps, unused, true);
+    StepStatistics stats;
+    const std::vector<Pose> reference = StepScene(Scene::SmallStacks, 0, cSteps, stats);
     for (uint32_t threads : {2u, 4u})
     {
-        const std::vector<Pose> poses = StepPyramid(threads, cSteps, unused, true);
+        const std::vector<Pose> poses = StepScene(Scene::SmallStacks, threads, cSteps, stats);
+        ASSERT_EQ(poses.size(), reference.size());
+        for (size_t i = 0; i < poses.size(); ++i)
+            EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
+                        poses[i].mVelocity == reference[i].mVelocity)
+                << "box " << i << " with " << threads << " threads";
+    }
+}
+
+TEST(ColoredIslandThreadsTest, IslandsSolvedAloneSameResultOnOneTwoAndFourThreads)
+{
+    constexpr int cSteps = 40;
+    StepStatistics stats;
+    const std::vector<Pose> reference = StepScene(Scene::SeveralPyramids, 0, cSteps, stats);
+    // Six islands of 128 constraints or more (colored), each under a quarter of the step's constraints: each
+    // is solved by one thread, several at once
+    EXPECT_EQ(stats.mNumIslands, 6u);
+    EXPECT_GE(stats.mNumManifolds, 6u * 128u);
+    for (uint32_t threads : {2u, 4u})
+    {
+        const std::vector<Pose> poses = StepScene(Scene::SeveralPyramids, threads, cSteps, stats);
         ASSERT_EQ(poses.size(), reference.size());
         for (size_t i = 0; i < poses.size(); ++i)
             EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
