@@ -85,19 +85,19 @@ std::vector<Pose> StepScene(Scene inScene, uint32_t inThreads, int inSteps, Step
     return poses;
 }
 
-TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
+/// Steps inScene without a job system and returns the last step's statistics; expects the same poses on 2
+/// and 4 job threads.
+StepStatistics ExpectSameOnTwoAndFourThreads(Scene inScene)
 {
     constexpr int cSteps = 40;
     StepStatistics stats;
-    const std::vector<Pose> reference = StepScene(Scene::Pyramid, 0, cSteps, stats);
-    // Large enough to be colored (PhysicsStep colors islands of 128 constraints and more)
-    EXPECT_EQ(stats.mNumIslands, 1u);
-    EXPECT_GE(stats.mNumManifolds, 128u) << "the pyramid was not one colored island";
+    const std::vector<Pose> reference = StepScene(inScene, 0, cSteps, stats);
     for (uint32_t threads : {2u, 4u})
     {
-        const std::vector<Pose> poses = StepScene(Scene::Pyramid, threads, cSteps, stats);
-        ASSERT_EQ(poses.size(), reference.size());
-        for (size_t i = 0; i < poses.size(); ++i)
+        StepStatistics unused;
+        const std::vector<Pose> poses = StepScene(inScene, threads, cSteps, unused);
+        EXPECT_EQ(poses.size(), reference.size());
+        for (size_t i = 0; i < std::min(poses.size(), reference.size()); ++i)
         {
             // == rather than a bit compare: an impulse of zero may turn a -0 velocity into +0
             EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
@@ -106,42 +106,30 @@ TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
                 << " against " << reference[i].mPosition.transpose();
         }
     }
+    return stats;
+}
+
+TEST(ColoredIslandThreadsTest, SameResultOnOneTwoAndFourThreads)
+{
+    const StepStatistics stats = ExpectSameOnTwoAndFourThreads(Scene::Pyramid);
+    // Large enough to be colored (PhysicsStep colors islands of 128 constraints and more)
+    EXPECT_EQ(stats.mNumIslands, 1u);
+    EXPECT_GE(stats.mNumManifolds, 128u) << "the pyramid was not one colored island";
 }
 
 TEST(ColoredIslandThreadsTest, SmallIslandGroupsSameResultOnOneTwoAndFourThreads)
 {
-    constexpr int cSteps = 40;
-    StepStatistics stats;
-    const std::vector<Pose> reference = StepScene(Scene::SmallStacks, 0, cSteps, stats);
-    for (uint32_t threads : {2u, 4u})
-    {
-        const std::vector<Pose> poses = StepScene(Scene::SmallStacks, threads, cSteps, stats);
-        ASSERT_EQ(poses.size(), reference.size());
-        for (size_t i = 0; i < poses.size(); ++i)
-            EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
-                        poses[i].mVelocity == reference[i].mVelocity)
-                << "box " << i << " with " << threads << " threads";
-    }
+    const StepStatistics stats = ExpectSameOnTwoAndFourThreads(Scene::SmallStacks);
+    EXPECT_GE(stats.mNumIslands, 20u) << "the stacks were not separate small islands";
 }
 
 TEST(ColoredIslandThreadsTest, IslandsSolvedAloneSameResultOnOneTwoAndFourThreads)
 {
-    constexpr int cSteps = 40;
-    StepStatistics stats;
-    const std::vector<Pose> reference = StepScene(Scene::SeveralPyramids, 0, cSteps, stats);
+    const StepStatistics stats = ExpectSameOnTwoAndFourThreads(Scene::SeveralPyramids);
     // Six islands of 128 constraints or more (colored), each under a quarter of the step's constraints: each
     // is solved by one thread, several at once
     EXPECT_EQ(stats.mNumIslands, 6u);
     EXPECT_GE(stats.mNumManifolds, 6u * 128u);
-    for (uint32_t threads : {2u, 4u})
-    {
-        const std::vector<Pose> poses = StepScene(Scene::SeveralPyramids, threads, cSteps, stats);
-        ASSERT_EQ(poses.size(), reference.size());
-        for (size_t i = 0; i < poses.size(); ++i)
-            EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
-                        poses[i].mVelocity == reference[i].mVelocity)
-                << "box " << i << " with " << threads << " threads";
-    }
 }
 
 } // namespace
