@@ -181,9 +181,12 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     for (uint32_t index : active)
         if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
             IntegratePositions(body, inDeltaTime);
-    // Islands share no dynamic body and no constraint. Large (colored) islands first, one at a time with
-    // every thread on each; then the others at once, the largest first so that the longest starts early and
-    // the small ones fill in around it
+            // Islands share no dynamic body and no constraint. Large (colored) islands first, one at a time
+            // with every thread on each; then the others at once, the largest first so that the longest
+            // starts early and the small ones fill in around it
+#if CAIRN_WIDE_SOLVER
+    mWideBatches.resize(mNumWideBatches); // Each colored island's slice: see ColorIsland
+#endif
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime, false);
     ParallelFor(uint32_t(mSolveItems.size()), 1,
@@ -704,6 +707,8 @@ void PhysicsStep::OrderConstraints()
         mIslandOrder[mIslandSizeStart[largest - mIslands.GetBodies(island).size()]++] = island;
     mIslandFirstColor.assign(numIslands, UINT32_MAX);
     mColorStart.clear();
+    mColorFirstBatch.clear();
+    mNumWideBatches = 0;
     mColorIsSerial.clear();
     mColoredIslands.clear();
     // The other islands with at most cGroupMaxConstraints constraints are solved in groups (see below)
@@ -800,11 +805,14 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
         {
             mColorStart.push_back(offset);
             mColorIsSerial.push_back(color == cSerialColor ? 1 : 0);
+            mColorFirstBatch.push_back(mNumWideBatches);
+            if (color != cSerialColor) mNumWideBatches += (count[color] + 3) / 4;
         }
         offset += count[color];
     }
     mColorStart.push_back(end);
     mColorIsSerial.push_back(0); // The end marker
+    mColorFirstBatch.push_back(mNumWideBatches);
 }
 
 void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime, bool inAlone)
@@ -888,30 +896,16 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                                              [[maybe_unused]] bool inAlone)
 {
 #if CAIRN_WIDE_SOLVER
-    // The batches are this thread's: islands solved alone run at once on different threads (an island that
-    // all threads solve together is the updating thread's, which the others read through the captures)
-    // (named by references: a lambda that named the thread_local itself would get the running thread's)
-    thread_local std::vector<WideContactBatch> tWideBatches;
-    thread_local std::vector<uint32_t> tColorBatchStart;
-    std::vector<WideContactBatch>& wideBatches = tWideBatches;
-    std::vector<uint32_t>& colorBatchStart = tColorBatchStart;
-    // Each color's constraints in batches of four, in order; the last batch of a color may be partial
-    colorBatchStart.clear();
-    uint32_t numBatches = 0;
+    // Each color's constraints in batches of four, in order; the last batch of a color may be partial. The
+    // island's batches are its own slice of the step's (mColorFirstBatch): islands solved alone run at once
+    const uint32_t islandFirstBatch = mColorFirstBatch[inFirstColor];
+    const uint32_t numBatches = mColorFirstBatch[inLastColor + 1] - islandFirstBatch;
     for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
     {
-        colorBatchStart.push_back(numBatches);
-        if (mColorIsSerial[color] == 0) numBatches += (mColorStart[color + 1] - mColorStart[color] + 3) / 4;
-    }
-    colorBatchStart.push_back(numBatches);
-    wideBatches.resize(numBatches);
-    for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
-    {
-        const uint32_t firstBatch = colorBatchStart[color - inFirstColor];
-        const uint32_t lastBatch = colorBatchStart[color - inFirstColor + 1];
-        for (uint32_t batch = firstBatch; batch < lastBatch; ++batch)
+        const uint32_t firstBatch = mColorFirstBatch[color];
+        for (uint32_t batch = firstBatch; batch < mColorFirstBatch[color + 1]; ++batch)
         {
-            WideContactBatch& b = wideBatches[batch];
+            WideContactBatch& b = mWideBatches[batch];
             b.mFirst = mColorStart[color] + 4 * (batch - firstBatch);
             b.mCount = std::min(4u, mColorStart[color + 1] - b.mFirst);
             b.mPaddingFirst = mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * color;
@@ -933,16 +927,16 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
     ParallelForUnlessAlone(inAlone, numBatches, 64,
                            [&](uint32_t inBegin, uint32_t inEnd)
                            {
-                               for (uint32_t i = inBegin; i < inEnd; ++i)
+                               for (uint32_t i = islandFirstBatch + inBegin; i < islandFirstBatch + inEnd;
+                                    ++i)
                                {
-                                   if (i + 1 < inEnd)
-                                       for (ContactConstraint* next : constraintsOf(wideBatches[i + 1]))
+                                   if (i + 1 < islandFirstBatch + inEnd)
+                                       for (ContactConstraint* next : constraintsOf(mWideBatches[i + 1]))
                                            PrefetchConstraint(next);
-                                   const WideContactBatch& batch = wideBatches[i];
+                                   WideContactBatch& batch = mWideBatches[i];
                                    for (uint32_t lane = 0; lane < batch.mCount; ++lane)
                                        PrepareForSolve(batch.mFirst + lane, numActive);
-                                   WideContactSolver::Pack(constraintsOf(batch), solverBodies,
-                                                           wideBatches[i]);
+                                   WideContactSolver::Pack(constraintsOf(batch), solverBodies, batch);
                                }
                            });
 
@@ -953,8 +947,8 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
     const uint32_t numColors = inLastColor - inFirstColor + 1;
     auto batchesOf = [&](uint32_t inColor)
     {
-        return std::span<WideContactBatch>(wideBatches.data() + colorBatchStart[inColor - inFirstColor],
-                                           wideBatches.data() + colorBatchStart[inColor - inFirstColor + 1]);
+        return std::span<WideContactBatch>(mWideBatches.data() + mColorFirstBatch[inColor],
+                                           mWideBatches.data() + mColorFirstBatch[inColor + 1]);
     };
     RunStages(
         inAlone, (1 + uint32_t(mSettings.mSolver.mVelocityIterations)) * numColors,
@@ -983,16 +977,16 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                 WideContactSolver::SolveVelocities(part, solverBodies, pass - 1);
         });
 
-    ParallelForUnlessAlone(inAlone, numBatches, 64,
-                           [&](uint32_t inBegin, uint32_t inEnd)
-                           {
-                               for (uint32_t i = inBegin; i < inEnd; ++i)
-                                   if (inStoreImpulses)
-                                       WideContactSolver::StoreImpulses(wideBatches[i], mContactCache);
-                                   else
-                                       WideContactSolver::Unpack(wideBatches[i],
-                                                                 constraintsOf(wideBatches[i]));
-                           });
+    ParallelForUnlessAlone(
+        inAlone, numBatches, 64,
+        [&](uint32_t inBegin, uint32_t inEnd)
+        {
+            for (uint32_t i = islandFirstBatch + inBegin; i < islandFirstBatch + inEnd; ++i)
+                if (inStoreImpulses)
+                    WideContactSolver::StoreImpulses(mWideBatches[i], mContactCache);
+                else
+                    WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
+        });
     if (inStoreImpulses)
         for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
             if (mColorIsSerial[color] != 0) StoreImpulses(ColorConstraints(color));

@@ -99,8 +99,9 @@ private:
     /// island's velocity iterations are a stage per color per iteration, over a hundred a step). Thread t
     /// takes part t first, so it keeps its region of the island in every color; a part whose thread has not
     /// come yet is taken by another, so no thread waits for one that the job system has not started. Which
-    /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job.
-    /// inAlone: this thread runs every part, in order (for a job that solves its island by itself).
+    /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job;
+    /// or with inAlone, by any thread: it then runs every part itself, in order (a job that solves its island
+    /// by itself).
     template <class PartsOf, class RunPart>
     void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
@@ -198,8 +199,9 @@ private:
     void BuildIslands();
     /// The solver's order: hashed within each island; large islands colored. Counted as solver time.
     void OrderConstraints();
-    /// Integrates kinematic bodies and solves every island: colored ones first, each by all threads, then the
-    /// others at once, largest first.
+    /// Integrates kinematic bodies and solves every island: the colored ones that hold a quarter of the step
+    /// first, each by all threads; then the others at once, largest first (colored ones among them by one
+    /// thread each).
     void SolveIslands(float inDeltaTime);
     /// An island's constraints, in solve order once OrderConstraints has run.
     std::span<ContactConstraint* const> ConstraintsOf(uint32_t inIsland) const
@@ -275,16 +277,19 @@ private:
     std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs
     std::vector<uint32_t> mIslandOrder;               ///< Scratch: islands, largest first
     std::vector<uint32_t> mIslandSizeStart;           ///< Scratch: the counting sort of mIslandOrder
-    /// Islands with this many constraints or more are colored and solved by all threads together, whatever
-    /// the number of threads (so results do not depend on it): one large island must not serialise the step
+    /// Islands with this many constraints or more are colored (with the wide solver; without it, only those
+    /// that also hold cColoredIslandMinShare of the step), whatever the number of threads, so results do not
+    /// depend on it. Those with a quarter of the step are solved by all threads together: one large island
+    /// must not serialise the step
     static constexpr uint32_t cColoredIslandMinConstraints = 128;
     /// The solve-order sort of an island and the sort of the pair list use RadixSort from this many items
     /// (std::sort below; the coloring, only for large islands, always uses RadixSort).
     static constexpr size_t cRadixSortMinItems = 256;
     static constexpr uint32_t cColoredIslandMinShare = 4; ///< ... and at least 1/4 of the step's constraints
     static constexpr uint32_t cSerialColor =
-        64;                                ///< Constraints that found no free color among 64: solved alone
-    std::vector<uint32_t> mColoredIslands; ///< This step's colored islands, largest first
+        64; ///< Constraints that found no free color among 64: solved alone
+    std::vector<uint32_t>
+        mColoredIslands; ///< This step's colored islands solved by all threads, largest first
     /// This step's other islands that have constraints, largest first; and the active indices of the bodies
     /// alone in an island without any (falling, flying): they only integrate, many to a chunk
     std::vector<uint32_t> mSolvedIslands;
@@ -307,7 +312,11 @@ private:
     std::vector<uint32_t>
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
     std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
-    std::vector<uint64_t> mBodyColors;   ///< Scratch per active body: colors its constraints took
+    /// Per mColorStart entry: the color's first batch of four in mWideBatches (the end marker: the island's
+    /// end). Every colored island has its own slice, so islands solved alone at once never share batches
+    std::vector<uint32_t> mColorFirstBatch;
+    uint32_t mNumWideBatches = 0;      ///< The step's wide batches, all colored islands together
+    std::vector<uint64_t> mBodyColors; ///< Scratch per active body: colors its constraints took
     /// What the island grouping, the solve-order sort and the coloring need of each constraint of
     /// mConstraints, gathered by the merge's parallel copies: read through the constraint pointers (640 bytes
     /// each, scattered over the chunks), these single-threaded passes took a cache miss per constraint.
@@ -369,7 +378,12 @@ private:
     std::vector<PositionConstraint> mPositionConstraints; ///< Per entry of mIslandConstraints
     std::vector<Mat3> mInverseInertia; ///< Per active dynamic body: world inverse inertia, from ApplyForces
     std::vector<SolverBody> mSolverBodies; ///< Velocities being solved: see SolveIslands
-    uint32_t mPaddingBlocksFirst = 0;      ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
+#if CAIRN_WIDE_SOLVER
+    /// The colored islands' packed constraints (see mColorFirstBatch). Each island's slice is written by the
+    /// thread that solves it alone, or by all threads in parts of a color between two stages of RunStages
+    std::vector<WideContactBatch> mWideBatches;
+#endif
+    uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
     std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
     std::vector<uint32_t> mSleepingIslands;   ///< Scratch
     uint32_t mNumBodyPairs = 0;               ///< Counters of the running step

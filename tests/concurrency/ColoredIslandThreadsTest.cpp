@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <gtest/gtest.h>
 #include <memory>
+#include <thread>
 #include <vector>
 
 namespace cairn
@@ -33,20 +34,22 @@ enum class Scene
     SeveralPyramids ///< Six 5-layer pyramids apart: six colored islands, each under a quarter of the step
 };
 
-/// Steps inScene on inThreads job threads (0: none) and returns the boxes' final positions and velocities;
-/// outStats: the last step's statistics.
-std::vector<Pose> StepScene(Scene inScene, uint32_t inThreads, int inSteps, StepStatistics& outStats)
+struct SceneWorld
 {
-    std::unique_ptr<jobs::JobSystem> jobSystem;
-    if (inThreads > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{inThreads});
+    std::unique_ptr<PhysicsSystem> mSystem;
+    std::vector<BodyID> mBoxes;
+};
+
+SceneWorld MakeScene(Scene inScene)
+{
     PhysicsSettings settings;
     settings.mAllowSleeping = false;
-    PhysicsSystem system(settings);
-    BodyInterface& bodies = system.GetBodyInterface();
+    SceneWorld world{std::make_unique<PhysicsSystem>(settings), {}};
+    BodyInterface& bodies = world.mSystem->GetBodyInterface();
+    std::vector<BodyID>& boxes = world.mBoxes;
     const BodyCreationSettings floor = test::StaticFloorSettings(30.0f);
     EXPECT_TRUE(bodies.CreateAndAddBody(floor, Activation::DontActivate).IsOk());
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
-    std::vector<BodyID> boxes;
     for (int i = 0; inScene == Scene::SmallStacks && i < 40; ++i)
         for (int level = 0; level <= i % 3; ++level)
         {
@@ -75,14 +78,46 @@ std::vector<Pose> StepScene(Scene inScene, uint32_t inThreads, int inSteps, Step
                     body.mFriction = 0.6f;
                     boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
                 }
+    return world;
+}
+
+/// Steps inWorld inSteps times (on ioJobs, or without a job system) and returns the boxes' final positions
+/// and velocities.
+std::vector<Pose> StepWorld(SceneWorld& ioWorld, jobs::JobSystem* ioJobs, int inSteps)
+{
+    PhysicsSystem& system = *ioWorld.mSystem;
     for (int step = 0; step < inSteps; ++step)
-        EXPECT_TRUE(
-            (jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f)).IsOk());
-    outStats = system.GetLastStepStatistics();
+        EXPECT_TRUE((ioJobs ? system.Update(1.0f / 60.0f, 1, *ioJobs) : system.Update(1.0f / 60.0f)).IsOk());
     std::vector<Pose> poses;
-    for (const BodyID& id : boxes)
-        poses.push_back({bodies.GetPosition(id).Value(), bodies.GetLinearVelocity(id).Value()});
+    for (const BodyID& id : ioWorld.mBoxes)
+        poses.push_back({system.GetBodyInterface().GetPosition(id).Value(),
+                         system.GetBodyInterface().GetLinearVelocity(id).Value()});
     return poses;
+}
+
+/// Steps inScene on inThreads job threads (0: none) and returns the boxes' final positions and velocities;
+/// outStats: the last step's statistics.
+std::vector<Pose> StepScene(Scene inScene, uint32_t inThreads, int inSteps, StepStatistics& outStats)
+{
+    std::unique_ptr<jobs::JobSystem> jobSystem;
+    if (inThreads > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{inThreads});
+    SceneWorld world = MakeScene(inScene);
+    std::vector<Pose> poses = StepWorld(world, jobSystem.get(), inSteps);
+    outStats = world.mSystem->GetLastStepStatistics();
+    return poses;
+}
+
+/// Whether two runs ended with the same poses (== rather than a bit compare: an impulse of zero may turn a -0
+/// velocity into +0).
+void ExpectSamePoses(const std::vector<Pose>& inPoses, const std::vector<Pose>& inReference,
+                     const char* inWhat)
+{
+    EXPECT_EQ(inPoses.size(), inReference.size());
+    for (size_t i = 0; i < std::min(inPoses.size(), inReference.size()); ++i)
+        EXPECT_TRUE(inPoses[i].mPosition == inReference[i].mPosition &&
+                    inPoses[i].mVelocity == inReference[i].mVelocity)
+            << "box " << i << " " << inWhat << ": " << inPoses[i].mPosition.transpose() << " against "
+            << inReference[i].mPosition.transpose();
 }
 
 /// Steps inScene without a job system and returns the last step's statistics; expects the same poses on 2
@@ -95,16 +130,8 @@ StepStatistics ExpectSameOnTwoAndFourThreads(Scene inScene)
     for (uint32_t threads : {2u, 4u})
     {
         StepStatistics unused;
-        const std::vector<Pose> poses = StepScene(inScene, threads, cSteps, unused);
-        EXPECT_EQ(poses.size(), reference.size());
-        for (size_t i = 0; i < std::min(poses.size(), reference.size()); ++i)
-        {
-            // == rather than a bit compare: an impulse of zero may turn a -0 velocity into +0
-            EXPECT_TRUE(poses[i].mPosition == reference[i].mPosition &&
-                        poses[i].mVelocity == reference[i].mVelocity)
-                << "box " << i << " with " << threads << " threads: " << poses[i].mPosition.transpose()
-                << " against " << reference[i].mPosition.transpose();
-        }
+        ExpectSamePoses(StepScene(inScene, threads, cSteps, unused), reference,
+                        threads == 2 ? "with 2 threads" : "with 4 threads");
     }
     return stats;
 }
@@ -130,6 +157,25 @@ TEST(ColoredIslandThreadsTest, IslandsSolvedAloneSameResultOnOneTwoAndFourThread
     // is solved by one thread, several at once
     EXPECT_EQ(stats.mNumIslands, 6u);
     EXPECT_GE(stats.mNumManifolds, 6u * 128u);
+}
+
+TEST(ColoredIslandThreadsTest, TwoWorldsOnOneJobSystemAtOnce)
+{
+    // Two worlds updated at once from two threads on one job system: a thread that waits for its own world's
+    // jobs runs the other world's meanwhile. One world's island is solved by all threads, the other's islands
+    // each by one thread: neither may touch the other's solver data (each world's batches are its own)
+    constexpr int cSteps = 30;
+    SceneWorld pyramidAlone = MakeScene(Scene::Pyramid), severalAlone = MakeScene(Scene::SeveralPyramids);
+    const std::vector<Pose> pyramidReference = StepWorld(pyramidAlone, nullptr, cSteps);
+    const std::vector<Pose> severalReference = StepWorld(severalAlone, nullptr, cSteps);
+    jobs::JobSystem jobSystem(jobs::JobSystem::Settings{4});
+    SceneWorld pyramid = MakeScene(Scene::Pyramid), several = MakeScene(Scene::SeveralPyramids);
+    std::vector<Pose> pyramidPoses, severalPoses;
+    std::thread other([&] { severalPoses = StepWorld(several, &jobSystem, cSteps); });
+    pyramidPoses = StepWorld(pyramid, &jobSystem, cSteps);
+    other.join();
+    ExpectSamePoses(pyramidPoses, pyramidReference, "of the pyramid");
+    ExpectSamePoses(severalPoses, severalReference, "of the six pyramids");
 }
 
 } // namespace

@@ -104,7 +104,7 @@ public:
     }
     CachedBodyPair& GetPair(uint32_t inIndex) { return mCurrentPairs[inIndex]; }
     /// Sorts this step's manifolds and pairs for lookup next step. Indices from Add() are invalid afterwards.
-    /// inInOrder: the caller knows that both are in key order already (each strictly after the one before)
+    /// inInOrder: the caller knows that both are in key order already (no entry before the one before it)
     /// and has set each pair's mFirstManifold (the narrow phase's merge does both in parallel): then nothing
     /// is left to do. Otherwise they are checked, sorted if need be, and the pairs' manifolds found.
     void EndStep(bool inInOrder = false);
