@@ -30,10 +30,11 @@ struct Pose
 
 enum class Scene
 {
-    Pyramid,        ///< One 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points)
-    SmallStacks,    ///< 40 stacks of one to three boxes (islands of up to four constraints)
-    SeveralPyramids ///< Six 5-layer pyramids apart, a bouncy ball on each: six colored islands, each under a
-                    ///< quarter of the step
+    Pyramid,         ///< One 7-layer pyramid (140 boxes, slightly turned so contacts have 1 to 4 points)
+    SmallStacks,     ///< 40 stacks of one to three boxes (islands of up to four constraints)
+    SeveralPyramids, ///< Six 5-layer pyramids apart, a bouncy ball on each: six colored islands, each under a
+                     ///< quarter of the step
+    LoadedPlank ///< 144 boxes on one dynamic plank: its 145 contacts cannot all take one of the 64 colors
 };
 
 struct SceneWorld
@@ -80,6 +81,25 @@ SceneWorld MakeScene(Scene inScene)
                     body.mFriction = 0.6f;
                     boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
                 }
+    // The plank shares a body with every one of its contacts, so each needs a color of its own: the 81 that
+    // find none of the 64 free form the island's serial range, solved by one thread in the solve order
+    if (inScene == Scene::LoadedPlank)
+    {
+        BodyCreationSettings plank;
+        plank.mShape = BoxShape::Create(Vec3(8.0f, 0.25f, 8.0f)).Value();
+        plank.mPosition = Vec3(0.0f, 0.25f, 0.0f);
+        plank.mObjectLayer = Layers::cMoving;
+        boxes.push_back(bodies.CreateAndAddBody(plank, Activation::Activate).Value());
+        for (int i = 0; i < 12; ++i)
+            for (int k = 0; k < 12; ++k)
+            {
+                BodyCreationSettings body;
+                body.mShape = box;
+                body.mPosition = Vec3(-6.6f + 1.2f * float(i), 1.0f, -6.6f + 1.2f * float(k));
+                body.mObjectLayer = Layers::cMoving;
+                boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
+            }
+    }
     // A bouncy ball dropped onto each of the six pyramids: their islands (solved alone) take the restitution
     // pass, with the impulses unpacked from the batches
     const ShapeRef ball = SphereShape::Create(0.3f).Value();
@@ -192,6 +212,13 @@ TEST(ColoredIslandThreadsTest, TwoWorldsOnOneJobSystemAtOnce)
     other.join();
     ExpectSamePoses(pyramidPoses, pyramidReference, "of the pyramid");
     ExpectSamePoses(severalPoses, severalReference, "of the six pyramids");
+}
+
+TEST(ColoredIslandThreadsTest, IslandWithAnUncoloredRangeSameResultOnOneTwoAndFourThreads)
+{
+    const StepStatistics stats = ExpectSameOnTwoAndFourThreads(Scene::LoadedPlank);
+    EXPECT_EQ(stats.mNumIslands, 1u);
+    EXPECT_GE(stats.mNumManifolds, 128u) << "the plank's island was too small to be colored";
 }
 
 } // namespace
