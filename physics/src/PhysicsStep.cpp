@@ -181,12 +181,12 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     for (uint32_t index : active)
         if (Body& body = *mBodies.TryGetBodyAtIndex(index); body.IsKinematic())
             IntegratePositions(body, inDeltaTime);
-            // Islands share no dynamic body and no constraint. Large (colored) islands first, one at a time
-            // with every thread on each; then the others at once, the largest first so that the longest
-            // starts early and the small ones fill in around it
 #if CAIRN_WIDE_SOLVER
     mWideBatches.resize(mNumWideBatches); // Each colored island's slice: see ColorIsland
 #endif
+    // Islands share no dynamic body and no constraint. The colored islands with a quarter of the step first,
+    // one at a time with every thread on each; then the others at once, the largest first so that the longest
+    // starts early and the small ones fill in around it (colored ones among them by one thread each)
     for (uint32_t island : mColoredIslands)
         SolveColoredIsland(island, inDeltaTime, false);
     ParallelFor(uint32_t(mSolveItems.size()), 1,
@@ -356,6 +356,13 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         // Merge in pair order: the same constraints, cache entries and wake order whatever the threads did.
         // Here the places and the wakes; the copies (a megabyte in a pyramid of 7,000 manifolds) in parallel
         uint32_t numPairs = 0, numManifolds = 0;
+        // Whether inItems' keys go on from the last one so far (ioLast), which becomes their last
+        auto continuesInOrder = [&](const auto& inItems, const auto& inKeyOf, auto& ioLast)
+        {
+            if (inItems.empty()) return;
+            if (ioLast.has_value() && inKeyOf(inItems.front()) < *ioLast) mCacheInOrder = false;
+            ioLast = inKeyOf(inItems.back());
+        };
         for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
         {
             NarrowPhaseChunk& out = mNarrowPhaseChunks[firstChunk + chunk];
@@ -371,18 +378,9 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
             mNumReusedPairs += out.mNumReusedPairs;
             mNumContactPoints += out.mNumContactPoints;
             // The contact cache's order across chunks (and rounds); within each chunk the copies check it
-            if (!out.mCachedPairs.empty())
-            {
-                if (mLastCachedPair.has_value() && PairKeyOf(out.mCachedPairs.front()) < *mLastCachedPair)
-                    mCacheInOrder = false;
-                mLastCachedPair = PairKeyOf(out.mCachedPairs.back());
-            }
-            if (!out.mCached.empty())
-            {
-                if (mLastCachedKey.has_value() && out.mCached.front().mKey < *mLastCachedKey)
-                    mCacheInOrder = false;
-                mLastCachedKey = out.mCached.back().mKey;
-            }
+            continuesInOrder(out.mCachedPairs, PairKeyOf, mLastCachedPair);
+            continuesInOrder(
+                out.mCached, [](const CachedManifold& inM) { return inM.mKey; }, mLastCachedKey);
         }
         const uint32_t firstCachedPair = mContactCache.AppendPairs(numPairs);
         const uint32_t firstCacheIndex = mContactCache.AppendManifolds(numManifolds);

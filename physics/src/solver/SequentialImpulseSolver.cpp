@@ -71,24 +71,27 @@ void InitNormalAxes(ContactConstraint& ioC, const Vec3 (&inRA)[4], const Vec3 (&
             outV[row] =
                 Dot3(splat(inM(row, 0)), splat(inM(row, 1)), splat(inM(row, 2)), inV[0], inV[1], inV[2]);
     };
+    auto dot = [](const __m128(&inA)[3], const __m128(&inB)[3])
+    { return Dot3(inA[0], inA[1], inA[2], inB[0], inB[1], inB[2]); };
+    __m128 rAxN[3], rBxN[3], invIA_rAxN[3], invIB_rBxN[3];
+    crossNormal(inRA, rAxN);
+    crossNormal(inRB, rBxN);
+    timesMatrix(inInvIA, rAxN, invIA_rAxN);
+    timesMatrix(inInvIB, rBxN, invIB_rBxN);
+    const __m128 k =
+        _mm_add_ps(_mm_add_ps(splat(inInvMassA + inInvMassB), dot(rAxN, invIA_rAxN)), dot(rBxN, invIB_rBxN));
+    const __m128 effectiveMass = _mm_and_ps(_mm_cmpgt_ps(k, _mm_setzero_ps()), _mm_div_ps(splat(1.0f), k));
+    const __m128 angularA[3] = {splat(inAngularA.x()), splat(inAngularA.y()), splat(inAngularA.z())};
+    const __m128 angularB[3] = {splat(inAngularB.x()), splat(inAngularB.y()), splat(inAngularB.z())};
+    const __m128 approach =
+        _mm_sub_ps(_mm_add_ps(splat(inNormalVelocity), dot(rBxN, angularB)), dot(rAxN, angularA));
     // The rows of the four AxisImpulses, in their field order: rA x n, rB x n, their inertia products, the
     // effective mass and the accumulated impulse (zero)
-    __m128 rows[16];
-    crossNormal(inRA, *reinterpret_cast<__m128(*)[3]>(&rows[0]));
-    crossNormal(inRB, *reinterpret_cast<__m128(*)[3]>(&rows[3]));
-    timesMatrix(inInvIA, *reinterpret_cast<const __m128(*)[3]>(&rows[0]),
-                *reinterpret_cast<__m128(*)[3]>(&rows[6]));
-    timesMatrix(inInvIB, *reinterpret_cast<const __m128(*)[3]>(&rows[3]),
-                *reinterpret_cast<__m128(*)[3]>(&rows[9]));
-    const __m128 k = _mm_add_ps(_mm_add_ps(splat(inInvMassA + inInvMassB),
-                                           Dot3(rows[0], rows[1], rows[2], rows[6], rows[7], rows[8])),
-                                Dot3(rows[3], rows[4], rows[5], rows[9], rows[10], rows[11]));
-    rows[12] = _mm_and_ps(_mm_cmpgt_ps(k, _mm_setzero_ps()), _mm_div_ps(splat(1.0f), k));
-    rows[13] = rows[14] = rows[15] = _mm_setzero_ps();
-    const __m128 approach = _mm_sub_ps(
-        _mm_add_ps(splat(inNormalVelocity), Dot3(rows[3], rows[4], rows[5], splat(inAngularB.x()),
-                                                 splat(inAngularB.y()), splat(inAngularB.z()))),
-        Dot3(rows[0], rows[1], rows[2], splat(inAngularA.x()), splat(inAngularA.y()), splat(inAngularA.z())));
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 rows[16] = {rAxN[0],       rAxN[1],       rAxN[2],       rBxN[0],
+                             rBxN[1],       rBxN[2],       invIA_rAxN[0], invIA_rAxN[1],
+                             invIA_rAxN[2], invIB_rBxN[0], invIB_rBxN[1], invIB_rBxN[2],
+                             effectiveMass, zero,          zero,          zero};
     alignas(16) float approachLanes[4];
     _mm_store_ps(approachLanes, approach);
     // Four rows at a time turned into four points' runs of four floats; the last run is two floats
