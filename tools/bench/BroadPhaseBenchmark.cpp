@@ -8,7 +8,9 @@
 // body write lock plus a broad-phase AABB update per move), as fast as it can. Reported: wall-clock us per
 // query per thread, moves per second, and the same queries' time with no mover (uncontended). Wall time on
 // purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2 the mover shares a core;
-// the threads' CPU time per query is printed too, to tell time descheduled or blocked from work.
+// the threads' CPU time per query is printed too, to tell time descheduled or blocked from work, and the wall
+// time less the time each thread stood runnable in the run queue (Linux schedstat): what a query costs a
+// thread with a core of its own, lock waits included (the `own_core` counters).
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
@@ -380,6 +382,7 @@ struct QueryTiming
 {
     double mWallMicroseconds = 0;
     double mCpuMicroseconds = 0;
+    double mOwnCoreMicroseconds = 0; ///< Wall less the run-queue wait; wall where schedstat cannot be read
 };
 
 /// Microseconds of CPU this thread has used.
@@ -388,6 +391,18 @@ double ThreadCpuMicroseconds()
     timespec time{};
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &time);
     return double(time.tv_sec) * 1.0e6 + double(time.tv_nsec) * 1.0e-3;
+}
+
+/// Microseconds this thread has stood runnable but waiting for a CPU (second field of Linux's per-thread
+/// schedstat), or 0 where that cannot be read.
+double ThreadRunQueueMicroseconds()
+{
+    std::FILE* file = std::fopen("/proc/thread-self/schedstat", "r");
+    if (file == nullptr) return 0.0;
+    unsigned long long onCpu = 0, waiting = 0;
+    const int read = std::fscanf(file, "%llu %llu", &onCpu, &waiting);
+    std::fclose(file);
+    return read == 2 ? double(waiting) * 1.0e-3 : 0.0;
 }
 
 /// Runs inPasses passes of the query boxes on inThreads threads.
@@ -402,10 +417,13 @@ QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPas
             {
                 const auto start = Clock::now();
                 const double cpuStart = ThreadCpuMicroseconds();
+                const double runQueueStart = ThreadRunQueueMicroseconds();
                 for (int pass = 0; pass < inPasses; ++pass)
                     hits[t] += QueryAllBoxes(inBroadPhase);
                 timings[t].mCpuMicroseconds = ThreadCpuMicroseconds() - cpuStart;
                 timings[t].mWallMicroseconds = 1000.0 * MillisecondsSince(start);
+                timings[t].mOwnCoreMicroseconds =
+                    timings[t].mWallMicroseconds - (ThreadRunQueueMicroseconds() - runQueueStart);
             });
     for (std::thread& thread : threads)
         thread.join();
@@ -416,6 +434,7 @@ QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPas
     {
         perQuery.mWallMicroseconds += timings[t].mWallMicroseconds / queries;
         perQuery.mCpuMicroseconds += timings[t].mCpuMicroseconds / queries;
+        perQuery.mOwnCoreMicroseconds += timings[t].mOwnCoreMicroseconds / queries;
         outHits += hits[t];
     }
     return perQuery;
@@ -471,6 +490,8 @@ void BM_QueryContended(benchmark::State& ioState)
     ioState.counters["ratio"] = contended.mWallMicroseconds / uncontended.mWallMicroseconds;
     ioState.counters["cpu_us_per_query"] = contended.mCpuMicroseconds;
     ioState.counters["cpu_us_per_query_uncontended"] = uncontended.mCpuMicroseconds;
+    ioState.counters["own_core_us_per_query"] = contended.mOwnCoreMicroseconds;
+    ioState.counters["own_core_ratio"] = contended.mOwnCoreMicroseconds / uncontended.mOwnCoreMicroseconds;
     ioState.counters["moves_per_s"] = movesPerSecond;
     ioState.counters["hits"] = double(hits);
     ioState.SetLabel(std::string(KindName(kind)) + ", " + std::to_string(queryThreads) + " query thread(s)");
