@@ -6,6 +6,7 @@
 #include "common/AllocationCounter.h"
 
 #include <atomic>
+#include <chrono>
 #include <gtest/gtest.h>
 #include <random>
 #include <thread>
@@ -148,6 +149,61 @@ TEST_P(JobSystemThreads, ParallelForVisitsEveryIndexOnce)
             for (uint32_t i = 0; i < count; ++i)
                 ASSERT_EQ(visits[i].load(), 1) << "count " << count << " grain " << grain << " index " << i;
         }
+}
+
+TEST(JobSystemParallelForTest, TheCallerTakesItsRegionFromTheFrontAndTheOthersFromTheBack)
+{
+    // Two threads; the worker is held by a job, so the caller runs every chunk itself: its own region (the
+    // first half) in order, then the worker's region from the back. The order proves each thread keeps to a
+    // contiguous part of the data and that a thread out of work takes chunks its owner would reach last
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    std::atomic<bool> holding{false}, release{false};
+    const JobHandle holder = jobs.Schedule("holder",
+                                           [&]
+                                           {
+                                               holding.store(true);
+                                               while (!release.load())
+                                                   std::this_thread::yield();
+                                           });
+    while (!holding.load())
+        std::this_thread::yield();
+    std::vector<uint32_t> order;
+    const std::thread::id caller = std::this_thread::get_id();
+    bool allOnCaller = true;
+    jobs.ParallelFor(80, 10,
+                     [&](uint32_t inBegin, uint32_t)
+                     {
+                         allOnCaller = allOnCaller && std::this_thread::get_id() == caller;
+                         order.push_back(inBegin / 10);
+                     });
+    release.store(true);
+    jobs.Wait(holder);
+    EXPECT_TRUE(allOnCaller);
+    EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2, 3, 7, 6, 5, 4}));
+}
+
+TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
+{
+    // The first chunks are slow, so threads that finish their region take chunks from the back of the slow
+    // one while its owner still takes from the front: each chunk must still run exactly once
+    JobSystem jobs(MakeSettings());
+    for (int round = 0; round < 20; ++round)
+    {
+        constexpr uint32_t cCount = 512;
+        std::vector<std::atomic<int>> visits(cCount);
+        jobs.ParallelFor(cCount, 4,
+                         [&](uint32_t inBegin, uint32_t inEnd)
+                         {
+                             if (inBegin < cCount / 8)
+                                 std::this_thread::sleep_for(std::chrono::microseconds(50));
+                             for (uint32_t i = inBegin; i < inEnd; ++i)
+                                 visits[i].fetch_add(1, std::memory_order_relaxed);
+                         });
+        for (uint32_t i = 0; i < cCount; ++i)
+            ASSERT_EQ(visits[i].load(), 1) << "round " << round << " index " << i;
+    }
 }
 
 TEST_P(JobSystemThreads, JobsCanScheduleAndWaitForJobs)

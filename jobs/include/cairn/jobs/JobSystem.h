@@ -124,30 +124,42 @@ public:
     bool WaitIdle();
 
     /// inBody(begin, end) over [0, inCount) in chunks of inGrain, on up to GetNumThreads() threads; the
-    /// caller takes part and returns when every chunk is done. Chunks are claimed from a shared cursor, so
-    /// uneven work balances itself.
+    /// caller takes part and returns when every chunk is done. Each taking part (the caller first) owns one
+    /// contiguous region of the chunks and works through it from the front; one that runs out takes chunks
+    /// from the back of the others' regions, so uneven work still balances itself. Contiguous regions keep
+    /// each thread on its own part of the data (with two threads, the caller on the first half in every
+    /// loop): neighbouring chunks handed to both threads in turn, as one shared cursor did, made them write
+    /// the same cache lines (bodies, island links) and fetch each other's results.
     template <class Body> void ParallelFor(uint32_t inCount, uint32_t inGrain, const Body& inBody)
     {
         if (inCount == 0) return;
         const uint64_t grain = std::max<uint32_t>(1, inGrain);
         const uint64_t chunks = (uint64_t(inCount) + grain - 1) / grain;
-        const uint32_t helpers = uint32_t(std::min<uint64_t>(chunks, GetNumThreads())) - 1;
-        // Relaxed: the fetch_add hands out each chunk once; the results reach the caller through Wait
-        std::atomic<uint64_t> cursor{0};
-        auto work = [&cursor, &inBody, grain, inCount]
+        const uint32_t parts = uint32_t(std::min<uint64_t>(chunks, GetNumThreads()));
+        ChunkRegion regions[cMaxThreads];
+        for (uint32_t p = 0; p < parts; ++p)
+            // Relaxed: the helper jobs are scheduled below, and scheduling orders these stores before them
+            regions[p].mRange.store(ChunkRegion::Pack(chunks * p / parts, chunks * (p + 1) / parts),
+                                    std::memory_order_relaxed);
+        auto work = [&regions, &inBody, parts, grain, inCount](uint32_t inPart)
         {
-            for (;;)
+            auto run = [&](uint64_t inChunk)
             {
-                const uint64_t begin = cursor.fetch_add(grain, std::memory_order_relaxed);
-                if (begin >= inCount) return;
+                const uint64_t begin = inChunk * grain;
                 inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
-            }
+            };
+            uint64_t chunk;
+            while (regions[inPart].TakeFront(chunk))
+                run(chunk);
+            for (uint32_t other = 1; other < parts; ++other)
+                while (regions[(inPart + other) % parts].TakeBack(chunk))
+                    run(chunk);
         };
         JobHandle handles[cMaxThreads];
-        for (uint32_t i = 0; i < helpers; ++i)
-            handles[i] = Schedule("ParallelFor", work);
-        work();
-        WaitAll({handles, helpers});
+        for (uint32_t p = 1; p < parts; ++p)
+            handles[p - 1] = Schedule("ParallelFor", [&work, p] { work(p); });
+        work(0);
+        WaitAll({handles, parts - 1});
     }
 
     /// Frame jobs scheduled and not yet finished.
@@ -161,6 +173,38 @@ public:
     Stats GetStats() const;
 
 private:
+    /// One ParallelFor part's chunks not yet taken, [front, back), packed in one word so that its owner (from
+    /// the front) and threads that ran out of their own (from the back) claim each chunk exactly once. A
+    /// cache line each: the parts' owners update theirs at once.
+    struct alignas(64) ChunkRegion
+    {
+        std::atomic<uint64_t> mRange{0}; ///< front in the low 32 bits, back in the high 32
+
+        static uint64_t Pack(uint64_t inFront, uint64_t inBack) { return inBack << 32 | inFront; }
+        bool TakeFront(uint64_t& outChunk) { return Take(outChunk, true); }
+        bool TakeBack(uint64_t& outChunk) { return Take(outChunk, false); }
+
+    private:
+        bool Take(uint64_t& outChunk, bool inFront)
+        {
+            // Relaxed: the exchange only hands out each chunk once; the chunks' results reach the caller
+            // through its WaitAll on the jobs (and its own program order)
+            uint64_t range = mRange.load(std::memory_order_relaxed);
+            for (;;)
+            {
+                const uint64_t front = range & 0xffffffffu, back = range >> 32;
+                if (front >= back) return false;
+                const uint64_t taken = inFront ? Pack(front + 1, back) : Pack(front, back - 1);
+                if (mRange.compare_exchange_weak(range, taken, std::memory_order_relaxed,
+                                                 std::memory_order_relaxed))
+                {
+                    outChunk = inFront ? front : back - 1;
+                    return true;
+                }
+            }
+        }
+    };
+
     struct JobSlot
     {
         InlineFunction<cFunctionCapacity> mFunction;
