@@ -136,6 +136,14 @@ public:
         const uint64_t grain = std::max<uint32_t>(1, inGrain);
         const uint64_t chunks = (uint64_t(inCount) + grain - 1) / grain;
         const uint32_t parts = uint32_t(std::min<uint64_t>(chunks, GetNumThreads()));
+        if (parts == 1)
+        {
+            // One thread or one chunk: in order, no claims (the regions below cost a 4 KB array and an
+            // exchange per chunk)
+            for (uint64_t begin = 0; begin < inCount; begin += grain)
+                inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
+            return;
+        }
         ChunkRegion regions[cMaxThreads];
         for (uint32_t p = 0; p < parts; ++p)
             // Relaxed: the helper jobs are scheduled below, and scheduling orders these stores before them
