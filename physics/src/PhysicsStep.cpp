@@ -71,8 +71,27 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     mJobs = ioJobs;
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
-    mBroadPhase.Update();
-    ioStatistics.mBroadPhaseUpdateMs += MillisecondsSince(phase);
+    // The broad-phase rebuild (single-threaded) runs on another thread while this one applies forces and
+    // finds the pairs on the tree as it stands: queries are exact in any state of the tree, so the pairs are
+    // the same, and the rebuild no longer holds up the step (it was most of the time the second thread
+    // waited)
+    const bool overlapUpdate =
+        mJobs != nullptr && mJobs->GetNumThreads() > 1 && mBroadPhase.CanFindPairsDuringUpdate();
+    double updateMs = 0.0;
+    jobs::JobHandle update;
+    if (overlapUpdate)
+        update = mJobs->Schedule("broad-phase update",
+                                 [this, &updateMs]
+                                 {
+                                     Clock::time_point updateStart = Clock::now();
+                                     mBroadPhase.Update();
+                                     updateMs = MillisecondsSince(updateStart);
+                                 });
+    else
+    {
+        mBroadPhase.Update();
+        updateMs = MillisecondsSince(phase);
+    }
 
     mContactCache.BeginStep();
     mConstraints.clear();
@@ -87,6 +106,11 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     WakeIslandsOfWokenBodies();
     mIslands.Reset(uint32_t(mBodies.GetActiveBodiesForStep().size()));
     CollideNewlyActive(0, inDeltaTime);
+    // The rebuild is the step's: done before the step's moves reach the broad phase (UpdateBoundsAndSleep)
+    // and before the next step's Update, which a rebuild still running would refuse
+    if (overlapUpdate) mJobs->Wait(update);
+    ioStatistics.mBroadPhaseUpdateMs +=
+        updateMs; // Its own time; with a job system it overlaps the next phase
     ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
 
     BuildIslands();

@@ -26,22 +26,23 @@ template <class Lock> Lock LockIf(bool inLock, WriterFairSharedMutex& inMutex)
 
 } // namespace
 
-/// Admits one physics-step call (Update, RebuildAll, FindCollidingPairs) at a time; a second one that
-/// overlaps it is a caller bug (two threads stepping one world) and is refused and counted instead of racing
-/// on the rebuild state and the active scratch.
+/// Admits one call of a kind of physics-step call at a time (Update and RebuildAll share the rebuild state;
+/// FindCollidingPairs owns the active marks); a second one of the same kind that overlaps it is a caller bug
+/// (two threads stepping one world) and is refused and counted instead of racing on that state.
 class BroadPhaseQuadTree::StepCallGuard
 {
 public:
-    explicit StepCallGuard(const BroadPhaseQuadTree& inBroadPhase) : mBroadPhase(inBroadPhase)
+    StepCallGuard(const BroadPhaseQuadTree& inBroadPhase, std::atomic<bool>& ioActive)
+        : mBroadPhase(inBroadPhase), mActive(ioActive)
     {
-        // Acquire: we take over the state the previous step call left behind (released below)
-        mOwner = !mBroadPhase.mStepCallActive.exchange(true, std::memory_order_acquire);
+        // Acquire: we take over the state the previous call of this kind left behind (released below)
+        mOwner = !mActive.exchange(true, std::memory_order_acquire);
         if (!mOwner) mBroadPhase.mRefusedStepCalls.fetch_add(1, std::memory_order_relaxed); // Statistic
     }
     ~StepCallGuard()
     {
-        // Release: the next step call sees everything this one wrote
-        if (mOwner) mBroadPhase.mStepCallActive.store(false, std::memory_order_release);
+        // Release: the next call of this kind sees everything this one wrote
+        if (mOwner) mActive.store(false, std::memory_order_release);
     }
     StepCallGuard(const StepCallGuard&) = delete;
     StepCallGuard& operator=(const StepCallGuard&) = delete;
@@ -49,6 +50,7 @@ public:
 
 private:
     const BroadPhaseQuadTree& mBroadPhase;
+    std::atomic<bool>& mActive;
     bool mOwner;
 };
 
@@ -217,7 +219,7 @@ void BroadPhaseQuadTree::RebuildAll()
 
 void BroadPhaseQuadTree::UpdateImpl(bool inFull)
 {
-    const StepCallGuard guard(*this);
+    const StepCallGuard guard(*this, mUpdateActive);
     if (!guard.IsOwner()) return;
     auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     mLastUpdate = {};
@@ -293,7 +295,7 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
                                             const LayerSetup& inLayers, BodyPairVisitor inVisitor,
                                             const ParallelRanges* inParallel) const
 {
-    const StepCallGuard guard(*this);
+    const StepCallGuard guard(*this, mPairsActive);
     if (!guard.IsOwner()) return;
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     auto isPresent = [&](BodyID inID)

@@ -5,7 +5,8 @@
 // reads body memory and takes no body lock.
 //
 // Threads: every method may be called from any thread at any time, except
-//  - FindCollidingPairs and Update: the physics step only (one thread at a time);
+//  - FindCollidingPairs and Update: the physics step only (one thread at a time each; the two at once only
+//    where CanFindPairsDuringUpdate says so);
 //  - AddBodiesFinalize / AddBodiesAbort: exactly once per AddState, from any one thread.
 // A body id is added at most once; the caller (BodyInterface) serialises add/remove of the same body.
 // Queries report every body whose stored AABB overlaps; a body added, moved or removed concurrently with a
@@ -77,6 +78,9 @@ public:
 
     /// Optimises the structure after moves, adds and removes (re-sort, rebuild). Physics step only.
     virtual void Update() = 0;
+    /// True when FindCollidingPairs may run on one thread while Update runs on another, with the same pairs
+    /// as after it (the step then overlaps the two). False by default: a re-sort under a sweep races.
+    virtual bool CanFindPairsDuringUpdate() const { return false; }
 
     /// Bodies whose AABB overlaps inBox.
     virtual void CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,

@@ -11,9 +11,11 @@
 //    thread; each tree's modification lock is taken shared (per-thread stripe) only to stay out of a
 //    rebuild's commit. The caller serialises operations on one body.
 //  - Update (rebuild of changed parts + freeing of old nodes) and FindCollidingPairs: the physics step only.
-//    The table's mActiveInStep bytes belong to FindCollidingPairs. A second step call that overlaps a running
-//    one (two threads stepping one world) is refused and counted (GetRefusedStepCalls), never run
-//    concurrently.
+//    The two may run at once on two threads (CanFindPairsDuringUpdate): the pair queries are queries like any
+//    other, exact whatever the tree's state, and the table's mActiveInStep bytes belong to FindCollidingPairs
+//    alone. A second Update (or RebuildAll) that overlaps a running one, or a second FindCollidingPairs that
+//    overlaps a running one (two threads stepping one world), is refused and counted (GetRefusedStepCalls),
+//    never run concurrently.
 // LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
 // and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
 // comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
@@ -87,6 +89,8 @@ public:
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
     /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
     void Update() override;
+    /// In LockMode::LockFree only: the global mutex would make the pair queries wait for the update.
+    bool CanFindPairsDuringUpdate() const override { return mMode == LockMode::LockFree; }
     /// Update with a full rebuild of every tree (benchmarks, level loads).
     void RebuildAll();
 
@@ -151,7 +155,8 @@ private:
     std::atomic<int64_t> mBodyCount{0};                 ///< Bodies linked (relaxed: a statistic)
     mutable WriterFairSharedMutex mGlobalMutex;         ///< LockMode::GlobalMutex only
     UpdateStats mLastUpdate;                            ///< Physics step only
-    mutable std::atomic<bool> mStepCallActive{false};   ///< A step call is running (see StepCallGuard)
+    mutable std::atomic<bool> mUpdateActive{false};     ///< Update or RebuildAll is running (StepCallGuard)
+    mutable std::atomic<bool> mPairsActive{false};      ///< FindCollidingPairs is running (StepCallGuard)
     mutable std::atomic<uint64_t> mRefusedStepCalls{0}; ///< Statistic
 };
 
