@@ -69,6 +69,10 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs)
 {
     mJobs = ioJobs;
+    // The step's parallel loops are separated by single-threaded stretches (merges, sorts, the coloring) that
+    // outlast the workers' spin: without this, each loop after one began with waking a worker
+    const jobs::JobSystem::StayAwake stayAwake(mJobs != nullptr && mJobs->GetNumThreads() > 1 ? mJobs
+                                                                                              : nullptr);
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
     // The broad-phase rebuild (single-threaded) runs on another thread while this one applies forces and

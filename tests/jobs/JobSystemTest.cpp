@@ -206,6 +206,33 @@ TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
     }
 }
 
+TEST(JobSystemStayAwakeTest, IdleWorkersDoNotSleepWhileAScopeIsOpen)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    // Idle long past the spin: the worker goes to sleep
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const uint64_t sleepsBefore = jobs.GetStats().mWorkerSleeps;
+    EXPECT_GE(sleepsBefore, 1u);
+    {
+        const JobSystem::StayAwake awake(&jobs);
+        // The opening woke it; give it time to be back in its loop, then idle far longer than the spin
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        const uint64_t sleepsInScope = jobs.GetStats().mWorkerSleeps;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        EXPECT_EQ(jobs.GetStats().mWorkerSleeps, sleepsInScope) << "a worker slept while the scope was open";
+        // And it still runs jobs, nested scopes included
+        const JobSystem::StayAwake nested(&jobs);
+        std::atomic<int> ran{0};
+        jobs.ParallelFor(64, 1, [&](uint32_t, uint32_t) { ran.fetch_add(1); });
+        EXPECT_EQ(ran.load(), 64);
+    }
+    // Closed: idle workers sleep again
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_GT(jobs.GetStats().mWorkerSleeps, sleepsBefore);
+}
+
 TEST_P(JobSystemThreads, JobsCanScheduleAndWaitForJobs)
 {
     JobSystem jobs(MakeSettings());
