@@ -589,6 +589,25 @@ uint32_t QuadTree::FindLocation(BodyID inBody) const
     return location;
 }
 
+void QuadTree::PrefetchNodeOf(uint32_t inIndex) const
+{
+    if (inIndex >= mBodies.GetMaxBodies()) return;
+    const QuadTreeBodyTable::Entry& entry = mBodies[inIndex];
+    // Relaxed: only an address to prefetch; a stale or foreign location costs a useless fetch, nothing else
+    const uint32_t location = entry.mLocation.load(std::memory_order_relaxed);
+    if (location >= QuadTreeBodyTable::cPendingLocation ||
+        entry.mTree.load(std::memory_order_relaxed) != mTreeId)
+        return;
+    const uint32_t node = location >> 2;
+    if (node >= mAllocator.GetCapacity()) return;
+    // Relaxed: a chunk is never freed while the tree lives; an unset one is skipped
+    const Node* chunk = mChunks[node >> cChunkShift].load(std::memory_order_relaxed);
+    if (chunk == nullptr) return;
+    const char* bytes = reinterpret_cast<const char*>(&chunk[node & (cChunkSize - 1)]);
+    __builtin_prefetch(bytes, 1); // For writing: a move grows the slot
+    __builtin_prefetch(bytes + 64, 1);
+}
+
 AABB QuadTree::GetBodySlotBounds(BodyID inBody) const
 {
     EpochReclaimer::ReadScope scope(mReclaimer);

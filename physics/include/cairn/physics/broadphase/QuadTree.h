@@ -160,6 +160,10 @@ public:
 
     /// True when the body (exact id) is in a built or linked sub-tree of this tree.
     bool Contains(BodyID inBody) const;
+    /// Starts fetching the cache lines of the node that holds body index inIndex, if it is in this tree: a
+    /// hint for a caller about to move it (the moves of a batch otherwise wait for each node in turn).
+    /// Reads nothing it relies on; any thread.
+    void PrefetchNodeOf(uint32_t inIndex) const;
     /// Bounds of a body of this tree: exact when readable, else its slot bounds (a superset); empty if
     /// absent.
     AABB GetBodyBounds(BodyID inBody) const;
