@@ -228,6 +228,25 @@ bool JobSystem::TryPopReady(uint32_t& outIndex)
     return true;
 }
 
+bool JobSystem::TryPopAwaited(const JobHandle& inJob, uint32_t& outIndex)
+{
+    std::lock_guard lock(mQueueMutex);
+    if (mReadyCount == 0) return false;
+    // Still running means its slot holds it (a finished job's slot may already hold a new one)
+    if (inJob.IsValid() && !IsDone(inJob))
+    {
+        const uint32_t searched = std::min(mReadyCount, cAwaitedSearch);
+        for (uint32_t position = 0; position < searched; ++position)
+            if (mReady[(mReadyHead + position) % mMaxJobs] == inJob.mIndex)
+            {
+                outIndex = TakeReadyAt(int(position));
+                return true;
+            }
+    }
+    outIndex = TakeReadyAt(0); // The head
+    return true;
+}
+
 void JobSystem::Run(uint32_t inIndex)
 {
     JobSlot& slot = mSlots[inIndex];
@@ -287,11 +306,13 @@ void JobSystem::Wait(const JobHandle& inJob)
     const uint64_t run = tCurrentRun;
     if (run == 0)
     {
-        // Outside any job: help with whatever is queued
+        // Outside any job: the awaited job first, then whatever is queued. The head can be a long job that
+        // another part of the frame scheduled to run beside this one (the physics step's broad-phase update
+        // behind the helpers of its ParallelFor): run here, it no longer ran beside anything
         while (!IsDone(inJob))
         {
             uint32_t index;
-            if (TryPopReady(index))
+            if (TryPopAwaited(inJob, index))
             {
                 Run(index);
                 continue;

@@ -8,6 +8,7 @@
 #include <array>
 #include <bit>
 #include <chrono>
+#include <exception>
 #include <thread>
 #if defined(__SSE2__)
 #include <immintrin.h>
@@ -47,6 +48,71 @@ uint64_t MixBits(uint64_t inKey)
     return inKey;
 }
 
+/// A step's broad-phase update. With a job system of two or more threads and a broad phase whose pair search
+/// may run during its update (BroadPhase::CanFindPairsDuringUpdate), it runs as a job while the updating
+/// thread applies forces and finds pairs and contacts on the tree as it stands (queries are exact in any
+/// state of the tree, so the pairs are the same); otherwise at once, on this thread. The job is waited for by
+/// Finish, or by the destructor when the step leaves early (an exception): it must not outlive the step's
+/// frame. What the job throws is caught there (a job must not throw) and rethrown by Finish.
+class BroadPhaseUpdate
+{
+public:
+    BroadPhaseUpdate(BroadPhase& ioBroadPhase, jobs::JobSystem* ioJobs)
+        : mBroadPhase(ioBroadPhase),
+          mJobs(ioJobs != nullptr && ioJobs->GetNumThreads() > 1 && ioBroadPhase.CanFindPairsDuringUpdate()
+                    ? ioJobs
+                    : nullptr)
+    {
+        if (mJobs == nullptr)
+        {
+            Clock::time_point start = Clock::now();
+            mBroadPhase.Update();
+            mMilliseconds = MillisecondsSince(start);
+            return;
+        }
+        mJob = mJobs->Schedule("broad-phase update",
+                               [this]
+                               {
+                                   Clock::time_point start = Clock::now();
+                                   try
+                                   {
+                                       mBroadPhase.Update();
+                                   }
+                                   catch (...)
+                                   {
+                                       mError = std::current_exception();
+                                   }
+                                   mMilliseconds = MillisecondsSince(start);
+                               });
+    }
+    ~BroadPhaseUpdate()
+    {
+        if (mJobs != nullptr && !mFinished) mJobs->Wait(mJob);
+    }
+    BroadPhaseUpdate(const BroadPhaseUpdate&) = delete;
+    BroadPhaseUpdate& operator=(const BroadPhaseUpdate&) = delete;
+
+    /// Waits for the update (running it here if no other thread has started it); returns its duration in ms.
+    double Finish()
+    {
+        if (mJobs != nullptr && !mFinished)
+        {
+            mJobs->Wait(mJob);
+            mFinished = true;
+            if (mError) std::rethrow_exception(mError);
+        }
+        return mMilliseconds;
+    }
+
+private:
+    BroadPhase& mBroadPhase;
+    jobs::JobSystem* mJobs;     ///< Null when the update ran in the constructor
+    jobs::JobHandle mJob;       ///< The update job (mJobs only)
+    bool mFinished = false;     ///< Finish has waited
+    double mMilliseconds = 0.0; ///< Written by the job before it finishes, read after the wait
+    std::exception_ptr mError;  ///< The same
+};
+
 Vec3 ClampLength(const Vec3& inV, float inMax)
 {
     const float lengthSq = inV.squaredNorm();
@@ -70,32 +136,14 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
 {
     mJobs = ioJobs;
     // The step's parallel loops are separated by single-threaded stretches (merges, sorts, the coloring) that
-    // outlast the workers' spin: without this, each loop after one began with waking a worker
-    const jobs::JobSystem::StayAwake stayAwake(mJobs != nullptr && mJobs->GetNumThreads() > 1 ? mJobs
-                                                                                              : nullptr);
+    // outlast the workers' spin: without this, each loop after one began with waking a worker. Not with more
+    // threads than cores: spinning workers would then take the updating thread's core
+    const bool keepAwake = mJobs != nullptr && mJobs->GetNumThreads() > 1 &&
+                           mJobs->GetNumThreads() <= std::max(1u, std::thread::hardware_concurrency());
+    const jobs::JobSystem::StayAwake stayAwake(keepAwake ? mJobs : nullptr);
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
-    // The broad-phase rebuild (single-threaded) runs on another thread while this one applies forces and
-    // finds the pairs on the tree as it stands: queries are exact in any state of the tree, so the pairs are
-    // the same, and the rebuild no longer holds up the step (it was most of the time the second thread
-    // waited)
-    const bool overlapUpdate =
-        mJobs != nullptr && mJobs->GetNumThreads() > 1 && mBroadPhase.CanFindPairsDuringUpdate();
-    double updateMs = 0.0;
-    jobs::JobHandle update;
-    if (overlapUpdate)
-        update = mJobs->Schedule("broad-phase update",
-                                 [this, &updateMs]
-                                 {
-                                     Clock::time_point updateStart = Clock::now();
-                                     mBroadPhase.Update();
-                                     updateMs = MillisecondsSince(updateStart);
-                                 });
-    else
-    {
-        mBroadPhase.Update();
-        updateMs = MillisecondsSince(phase);
-    }
+    BroadPhaseUpdate update(mBroadPhase, mJobs);
 
     mContactCache.BeginStep();
     mConstraints.clear();
@@ -112,9 +160,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     CollideNewlyActive(0, inDeltaTime);
     // The rebuild is the step's: done before the step's moves reach the broad phase (UpdateBoundsAndSleep)
     // and before the next step's Update, which a rebuild still running would refuse
-    if (overlapUpdate) mJobs->Wait(update);
-    ioStatistics.mBroadPhaseUpdateMs +=
-        updateMs; // Its own time; with a job system it overlaps the next phase
+    ioStatistics.mBroadPhaseUpdateMs += update.Finish(); // Its own time: beside the narrow phase when a job
     ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
 
     BuildIslands();

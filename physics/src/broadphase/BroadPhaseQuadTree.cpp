@@ -211,7 +211,12 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
     {
         if (i + cTableAhead < inBodies.size())
             if (const uint32_t index = inBodies[i + cTableAhead].mID.GetIndex(); index < mMaxBodies)
-                __builtin_prefetch(&mBodies[index]);
+            {
+                // An entry may straddle two cache lines: its first and last bytes
+                const char* entry = reinterpret_cast<const char*>(&mBodies[index]);
+                __builtin_prefetch(entry);
+                __builtin_prefetch(entry + sizeof(QuadTreeBodyTable::Entry) - 1);
+            }
         if (i + cNodeAhead < inBodies.size())
             if (const BroadPhaseBody& ahead = inBodies[i + cNodeAhead]; mLayerSetup.IsValid(ahead.mLayer))
                 TreeOf(ahead.mLayer).PrefetchNodeOf(ahead.mID.GetIndex());

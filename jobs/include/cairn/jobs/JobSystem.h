@@ -30,12 +30,15 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <span>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace cairn::jobs
@@ -113,11 +116,12 @@ public:
 
     /// True once the job has finished (its effects are then visible to this thread).
     bool IsDone(const JobHandle& inJob) const;
-    /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs any
-    /// queued job. From inside a job it runs only jobs scheduled inside that job, the awaited job itself and
-    /// the jobs the awaited job depends on, through any number of prerequisites: an unrelated job run on this
-    /// stack could wait for the job below it and never return (TBB calls this isolation). It runs other jobs
-    /// only when every worker is stuck the same way and none of those is queued.
+    /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs the job
+    /// itself when it is near the front of the queue, else any queued job. From inside a job it runs only
+    /// jobs scheduled inside that job, the awaited job itself and the jobs the awaited job depends on,
+    /// through any number of prerequisites: an unrelated job run on this stack could wait for the job below
+    /// it and never return (TBB calls this isolation). It runs other jobs only when every worker is stuck the
+    /// same way and none of those is queued.
     void Wait(const JobHandle& inJob);
     void WaitAll(std::span<const JobHandle> inJobs);
     /// Returns true when no frame job is queued or running, running queued jobs meanwhile. From inside a job
@@ -145,12 +149,14 @@ public:
                 inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
             return;
         }
-        ChunkRegion regions[cMaxThreads];
+        // Only the parts' regions are made (all cMaxThreads would be 4 KB written on every call)
+        alignas(ChunkRegion) std::byte storage[sizeof(ChunkRegion) * cMaxThreads];
+        ChunkRegion* regions = reinterpret_cast<ChunkRegion*>(storage);
+        static_assert(std::is_trivially_destructible_v<ChunkRegion>, "the regions are never destroyed");
         for (uint32_t p = 0; p < parts; ++p)
-            // Relaxed: the helper jobs are scheduled below, and scheduling orders these stores before them
-            regions[p].mRange.store(ChunkRegion::Pack(chunks * p / parts, chunks * (p + 1) / parts),
-                                    std::memory_order_relaxed);
-        auto work = [&regions, &inBody, parts, grain, inCount](uint32_t inPart)
+            // Made before the helper jobs are scheduled: scheduling orders them before the helpers' claims
+            new (&regions[p]) ChunkRegion(ChunkRegion::Pack(chunks * p / parts, chunks * (p + 1) / parts));
+        auto work = [regions, &inBody, parts, grain, inCount](uint32_t inPart)
         {
             auto run = [&](uint64_t inChunk)
             {
@@ -213,7 +219,9 @@ private:
     /// cache line each: the parts' owners update theirs at once.
     struct alignas(64) ChunkRegion
     {
-        std::atomic<uint64_t> mRange{0}; ///< front in the low 32 bits, back in the high 32
+        explicit ChunkRegion(uint64_t inRange) : mRange(inRange) {}
+
+        std::atomic<uint64_t> mRange; ///< front in the low 32 bits, back in the high 32
 
         static uint64_t Pack(uint64_t inFront, uint64_t inBack) { return inBack << 32 | inFront; }
         bool TakeFront(uint64_t& outChunk) { return Take(outChunk, true); }
@@ -261,6 +269,12 @@ private:
     JobHandle Publish(uint32_t inIndex, const char* inName, std::span<const JobHandle> inPrerequisites);
     void Enqueue(uint32_t inIndex);
     bool TryPopReady(uint32_t& outIndex);
+    /// For a wait outside a job: takes inJob itself if it is among the first cAwaitedSearch queued jobs (it
+    /// runs what it waits for before other queued work), else the head; false when nothing is queued.
+    bool TryPopAwaited(const JobHandle& inJob, uint32_t& outIndex);
+    /// Queued jobs a wait outside a job looks through for its own: enough for a ParallelFor's helpers behind
+    /// a job scheduled before them, and a bounded cost for a wait on each of a thousand queued jobs.
+    static constexpr uint32_t cAwaitedSearch = 8;
     /// Index in the ready ring (from its head) of a job a wait inside job run inScope may run for inAwaited:
     /// one scheduled in inScope, the awaited job itself or a job it depends on (through any number of
     /// prerequisites), else any job when every worker is stuck in such a wait; -1 when none. mQueueMutex

@@ -58,9 +58,12 @@ struct StepStatistics
     uint32_t mNumWarmStartedPoints = 0; ///< Contact points that took over last step's impulses
     uint32_t mNumIslands = 0;
     uint32_t mLargestIsland = 0; ///< Bodies
+    /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
+    /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
+    /// to more than mTotalMs
     double mBroadPhaseUpdateMs = 0.0;
     double mFindPairsMs = 0.0;
-    double mNarrowPhaseMs = 0.0;
+    double mNarrowPhaseMs = 0.0; ///< Forces, pairs and the narrow phase, from the step's start (see above)
     double mIslandsMs = 0.0;
     double mSolveMs = 0.0;  ///< Velocity and position iterations plus integration
     double mFinishMs = 0.0; ///< Bounds update, broad-phase notify and sleeping

@@ -118,8 +118,9 @@ public:
     /// Validates every tree (single-threaded tests); false on the first violation or a count mismatch.
     bool Validate() const;
 
-    /// Step calls (Update, RebuildAll, FindCollidingPairs) refused because another one was running: two
-    /// threads stepping one world. Such a call returns without doing anything.
+    /// Step calls refused because another of the same kind was running (Update or RebuildAll during one of
+    /// them, FindCollidingPairs during another): two threads stepping one world. Such a call returns without
+    /// doing anything.
     uint64_t GetRefusedStepCalls() const
     {
         return mRefusedStepCalls.load(std::memory_order_relaxed); // Statistic
