@@ -420,22 +420,8 @@ void JobSystem::WorkerMain()
         SpinUntil([] { return false; }); // Returns early when a job is queued
         if (mNumReady.load(std::memory_order_relaxed) != 0) continue;
         std::unique_lock lock(mQueueMutex);
-        // While a StayAwake scope is open the wait returns at once and the worker spins again (stopping is
-        // still seen here). The count is read under the mutex and BeginStayAwake notifies under it: no lost
-        // wake-up
-        mWake.wait(lock,
-                   [&]
-                   {
-                       const bool wake =
-                           mReadyCount > 0 || mStopping || mStayAwake.load(std::memory_order_relaxed) != 0;
-                       if (!wake) mWorkerSleeps.fetch_add(1, std::memory_order_relaxed); // Statistic only
-                       return wake;
-                   });
-        if (mReadyCount == 0)
-        {
-            if (mStopping) return; // Nothing left
-            continue;              // Staying awake: spin again
-        }
+        mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
+        if (mReadyCount == 0) return; // Stopping, and nothing left
         index = mReady[mReadyHead];
         mReadyHead = (mReadyHead + 1) % mMaxJobs;
         --mReadyCount;
@@ -445,20 +431,6 @@ void JobSystem::WorkerMain()
     }
 }
 
-void JobSystem::BeginStayAwake()
-{
-    // Relaxed: the count is a hint to idle workers; the first scope wakes the sleepers under the mutex their
-    // wait checks it under
-    if (mStayAwake.fetch_add(1, std::memory_order_relaxed) != 0) return;
-    std::lock_guard lock(mQueueMutex);
-    mWake.notify_all();
-}
-
-void JobSystem::EndStayAwake()
-{
-    mStayAwake.fetch_sub(1, std::memory_order_relaxed); // Relaxed: see BeginStayAwake
-}
-
 JobSystem::Stats JobSystem::GetStats() const
 {
     Stats stats;
@@ -466,7 +438,6 @@ JobSystem::Stats JobSystem::GetStats() const
     stats.mJobsRun = mJobsRun.load(std::memory_order_relaxed);
     stats.mJobsRunInline = mJobsRunInline.load(std::memory_order_relaxed);
     stats.mDependentOverflow = mDependentOverflow.load(std::memory_order_relaxed);
-    stats.mWorkerSleeps = mWorkerSleeps.load(std::memory_order_relaxed);
     return stats;
 }
 

@@ -135,12 +135,6 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs)
 {
     mJobs = ioJobs;
-    // The step's parallel loops are separated by single-threaded stretches (merges, sorts, the coloring) that
-    // outlast the workers' spin: without this, each loop after one began with waking a worker. Not with more
-    // threads than cores: spinning workers would then take the updating thread's core
-    const bool keepAwake = mJobs != nullptr && mJobs->GetNumThreads() > 1 &&
-                           mJobs->GetNumThreads() <= std::max(1u, std::thread::hardware_concurrency());
-    const jobs::JobSystem::StayAwake stayAwake(keepAwake ? mJobs : nullptr);
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
     BroadPhaseUpdate update(mBroadPhase, mJobs);

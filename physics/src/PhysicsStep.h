@@ -7,8 +7,8 @@
 // With a job system, the parallel phases run on its threads (ParallelFor; the updating thread takes part):
 // velocities, pair finding (per active body), the narrow phase (per chunk of pairs), islands (largest first),
 // bounds and the broad-phase notify. The broad-phase update runs as a job of its own beside the velocities,
-// the pair finding and the narrow phase when the broad phase allows it (BroadPhaseUpdate in the .cpp), and
-// the workers spin between the parallel phases instead of sleeping (JobSystem::StayAwake). Each parallel task
+// the pair finding and the narrow phase when the broad phase allows it (BroadPhaseUpdate in the .cpp). Each
+// parallel task
 // writes only its own bodies or its own chunk's output; everything shared (the constraint list, the contact
 // cache, the active list, waking) is merged afterwards in pair order: the updating thread wakes bodies and
 // reserves each chunk's places in the constraint list and the contact cache, then the chunks are copied into

@@ -206,49 +206,6 @@ TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
     }
 }
 
-TEST(JobSystemStayAwakeTest, IdleWorkersDoNotSleepWhileAScopeIsOpen)
-{
-    JobSystem::Settings settings;
-    settings.mNumThreads = 2;
-    JobSystem jobs(settings);
-    // Polls inCondition for up to 5 s: the worker needs a core, which a loaded machine may give it late
-    auto eventually = [](auto inCondition)
-    {
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-        while (!inCondition() && std::chrono::steady_clock::now() < deadline)
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        return inCondition();
-    };
-    // Idle past the spin: the worker goes to sleep
-    ASSERT_TRUE(eventually([&] { return jobs.GetStats().mWorkerSleeps >= 1; }));
-    // Jobs that come far apart (each after more than the spin) run on the worker without it sleeping in
-    // between. Without the scope it sleeps after each. Polled, not waited for: a wait would run them here
-    auto runSpacedJobs = [&]
-    {
-        for (int i = 0; i < 5; ++i)
-        {
-            std::this_thread::sleep_for(std::chrono::milliseconds(2));
-            const JobHandle job = jobs.Schedule("spaced", [] {});
-            ASSERT_TRUE(eventually([&] { return jobs.IsDone(job); }));
-        }
-    };
-    {
-        const JobSystem::StayAwake awake(&jobs);
-        const JobSystem::StayAwake nested(&jobs);                  // Scopes nest
-        std::this_thread::sleep_for(std::chrono::milliseconds(2)); // The opening wakes the sleeping worker
-        const uint64_t sleepsInScope = jobs.GetStats().mWorkerSleeps;
-        runSpacedJobs();
-        EXPECT_EQ(jobs.GetStats().mWorkerSleeps, sleepsInScope) << "a worker slept while the scope was open";
-        std::atomic<int> ran{0};
-        jobs.ParallelFor(64, 1, [&](uint32_t, uint32_t) { ran.fetch_add(1); });
-        EXPECT_EQ(ran.load(), 64);
-    }
-    // Closed: the worker sleeps again, after each of the same jobs
-    const uint64_t sleepsAfterScope = jobs.GetStats().mWorkerSleeps;
-    runSpacedJobs();
-    EXPECT_TRUE(eventually([&] { return jobs.GetStats().mWorkerSleeps >= sleepsAfterScope + 5; }));
-}
-
 TEST_P(JobSystemThreads, JobsCanScheduleAndWaitForJobs)
 {
     JobSystem jobs(MakeSettings());

@@ -75,7 +75,6 @@ public:
         uint64_t mJobsRun = 0;           ///< Jobs run through the queue
         uint64_t mJobsRunInline = 0;     ///< Jobs run at once because every slot was in use
         uint64_t mDependentOverflow = 0; ///< Prerequisites waited for because cMaxDependents was reached
-        uint64_t mWorkerSleeps = 0; ///< Times an idle worker went to sleep (none while StayAwake is open)
     };
 
     JobSystem(); ///< Default settings
@@ -176,32 +175,6 @@ public:
         work(0);
         WaitAll({handles, parts - 1});
     }
-
-    /// While at least one is open, idle workers keep spinning (a CPU pause at a time) instead of going to
-    /// sleep after cSpinMicroseconds, and opening the first wakes the sleeping ones. For a frame phase whose
-    /// parallel loops are separated by single-threaded stretches longer than the spin (a physics step): each
-    /// loop after such a stretch otherwise began with tens of microseconds of waking a worker, alone on the
-    /// calling thread. The workers' cores stay busy while one is open: keep it to the phase. Any thread; may
-    /// nest and overlap (a count).
-    class StayAwake
-    {
-    public:
-        explicit StayAwake(JobSystem* ioJobs) : mJobs(ioJobs)
-        {
-            if (mJobs != nullptr) mJobs->BeginStayAwake();
-        }
-        ~StayAwake()
-        {
-            if (mJobs != nullptr) mJobs->EndStayAwake();
-        }
-        StayAwake(const StayAwake&) = delete;
-        StayAwake& operator=(const StayAwake&) = delete;
-
-    private:
-        JobSystem* mJobs;
-    };
-    void BeginStayAwake();
-    void EndStayAwake();
 
     /// Frame jobs scheduled and not yet finished.
     uint32_t GetNumJobsInFlight() const
@@ -305,7 +278,6 @@ private:
     uint32_t mReadyCount = 0;           ///< mQueueMutex
     bool mStopping = false;             ///< mQueueMutex
 
-    std::atomic<uint32_t> mStayAwake{0}; ///< Open StayAwake scopes (relaxed: a hint, see WorkerMain)
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     size_t mNumStuckWorkers = 0;          ///< mQueueMutex: workers in a wait inside a job with nothing to run
@@ -321,7 +293,6 @@ private:
     std::atomic<uint64_t> mJobsRun{0};
     std::atomic<uint64_t> mJobsRunInline{0};
     std::atomic<uint64_t> mDependentOverflow{0};
-    std::atomic<uint64_t> mWorkerSleeps{0};
 
     std::vector<std::thread> mWorkers;
 };
