@@ -247,6 +247,24 @@ bool JobSystem::TryPopAwaited(const JobHandle& inJob, uint32_t& outIndex)
     return true;
 }
 
+bool JobSystem::TryRunHere(const JobHandle& inJob)
+{
+    if (!inJob.IsValid()) return false;
+    uint32_t index = JobHandle::cInvalidIndex;
+    {
+        std::lock_guard lock(mQueueMutex);
+        // Still running means its slot holds it (a finished job's slot may already hold a new one)
+        if (IsDone(inJob)) return false;
+        const uint32_t searched = std::min(mReadyCount, cAwaitedSearch);
+        for (uint32_t position = 0; position < searched && index == JobHandle::cInvalidIndex; ++position)
+            if (mReady[(mReadyHead + position) % mMaxJobs] == inJob.mIndex)
+                index = TakeReadyAt(int(position));
+    }
+    if (index == JobHandle::cInvalidIndex) return false;
+    Run(index);
+    return true;
+}
+
 void JobSystem::Run(uint32_t inIndex)
 {
     JobSlot& slot = mSlots[inIndex];

@@ -30,7 +30,9 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
 {
     std::unique_ptr<jobs::JobSystem> jobSystem;
     if (GetParam() > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{GetParam()});
-    PhysicsSystem system;
+    PhysicsSettings settings;
+    settings.mUpdateBesideStepMinActiveBodies = 0; // The broad-phase rebuild beside the pairs, on any scene
+    PhysicsSystem system(settings, LayerSetup::CreateDefault());
     BodyInterface& bodies = system.GetBodyInterface();
     const BodyCreationSettings floor = test::StaticFloorSettings(50.0f);
     const BodyID floorID = bodies.CreateAndAddBody(floor, Activation::DontActivate).Value();

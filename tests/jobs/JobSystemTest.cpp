@@ -184,6 +184,38 @@ TEST(JobSystemParallelForTest, TheCallerTakesItsRegionFromTheFrontAndTheOthersFr
     EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2, 3, 7, 6, 5, 4}));
 }
 
+TEST(JobSystemTryRunHereTest, RunsAQueuedJobOnTheCallerAndNothingElse)
+{
+    // Two threads, the worker held by a job: a job scheduled now stays queued, and TryRunHere runs it here
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    std::atomic<bool> holding{false}, release{false};
+    const JobHandle holder = jobs.Schedule("holder",
+                                           [&]
+                                           {
+                                               holding.store(true);
+                                               while (!release.load())
+                                                   std::this_thread::yield();
+                                           });
+    while (!holding.load())
+        std::this_thread::yield();
+    std::thread::id ranOn;
+    int otherRuns = 0;
+    const JobHandle first = jobs.Schedule("first", [&] { ++otherRuns; });
+    const JobHandle job = jobs.Schedule("job", [&] { ranOn = std::this_thread::get_id(); });
+    EXPECT_FALSE(jobs.TryRunHere(holder)) << "a job another thread is running";
+    EXPECT_TRUE(jobs.TryRunHere(job)) << "second in the queue";
+    EXPECT_TRUE(jobs.IsDone(job));
+    EXPECT_EQ(ranOn, std::this_thread::get_id());
+    EXPECT_EQ(otherRuns, 0) << "only the job asked for runs";
+    EXPECT_FALSE(jobs.TryRunHere(job)) << "a finished job";
+    release.store(true);
+    jobs.Wait(holder);
+    jobs.Wait(first);
+    EXPECT_EQ(otherRuns, 1);
+}
+
 TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
 {
     // The first chunks are slow, so threads that finish their region take chunks from the back of the slow

@@ -32,7 +32,7 @@ bool BitIdentical(const BodyState& inL, const BodyState& inR)
 
 /// A pile of boxes and spheres falling onto a floor and a ramp, in several heaps (several islands, some
 /// falling asleep, some woken by late arrivals), stepped 600 times.
-std::vector<BodyState> RunPile(uint32_t inThreads)
+std::vector<BodyState> RunPile(uint32_t inThreads, bool inUpdateBesideStep = false)
 {
     std::unique_ptr<jobs::JobSystem> jobSystem;
     if (inThreads > 0)
@@ -41,7 +41,10 @@ std::vector<BodyState> RunPile(uint32_t inThreads)
         settings.mNumThreads = inThreads;
         jobSystem = std::make_unique<jobs::JobSystem>(settings);
     }
-    PhysicsSystem system;
+    PhysicsSettings physicsSettings;
+    // The broad-phase rebuild beside the pair search on this small scene too (by default from 1,024 bodies)
+    if (inUpdateBesideStep) physicsSettings.mUpdateBesideStepMinActiveBodies = 0;
+    PhysicsSystem system(physicsSettings);
     BodyInterface& bodies = system.GetBodyInterface();
     const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
@@ -115,6 +118,8 @@ TEST(StepDeterminismTest, ThreadCountDoesNotChangeTheResult)
     ExpectIdentical(reference, RunPile(1), "1 job thread vs no job system");
     ExpectIdentical(reference, RunPile(2), "2 threads vs no job system");
     ExpectIdentical(reference, RunPile(4), "4 threads vs no job system");
+    ExpectIdentical(reference, RunPile(2, true),
+                    "2 threads, broad-phase update beside the step, vs no job system");
 }
 
 } // namespace

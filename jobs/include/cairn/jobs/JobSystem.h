@@ -115,6 +115,12 @@ public:
 
     /// True once the job has finished (its effects are then visible to this thread).
     bool IsDone(const JobHandle& inJob) const;
+    /// Runs inJob on this thread now if it is still queued (no thread has started it; it must be among the
+    /// first few queued jobs, see cAwaitedSearch) and returns true; false when it has started, finished or is
+    /// further back. For a job scheduled to run beside the caller's own work when a worker is free at once,
+    /// and better run here than waited for when none is (a sleeping worker takes tens of microseconds to
+    /// wake). From inside a job only for a job that job scheduled.
+    bool TryRunHere(const JobHandle& inJob);
     /// Returns when the job has finished, running queued jobs meanwhile. From outside a job it runs the job
     /// itself when it is near the front of the queue, else any queued job. From inside a job it runs only
     /// jobs scheduled inside that job, the awaited job itself and the jobs the awaited job depends on,

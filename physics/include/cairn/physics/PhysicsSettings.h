@@ -40,6 +40,12 @@ struct PhysicsSettings
     /// enough that a contact point moves by at most a few millimetres on a metre-sized body
     float mPairCacheMaxDeltaPosition = 0.001f;
     float mPairCacheMaxDeltaAngle = 2.0f * cPi / 180.0f;
+    /// With a job system of two or more threads and a broad phase that allows it, a step with at least this
+    /// many active bodies rebuilds the broad phase on another thread while it finds its pairs and contacts.
+    /// Below, a small scene's rebuild is short and the step does it first, itself: running it beside cost
+    /// more than it saved (a worker woken for it, pair queries on the tree not yet rebuilt; the demo's 0.2 ms
+    /// physics frames were 15-25 % slower with it, the 1,240- and 2,000-body benchmarks 3-6 % faster)
+    uint32_t mUpdateBesideStepMinActiveBodies = 1024;
 };
 
 /// Ok, or an InvalidArgument error naming the first field out of its documented range (NaN, infinity, a
