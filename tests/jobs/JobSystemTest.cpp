@@ -151,6 +151,37 @@ TEST_P(JobSystemThreads, ParallelForVisitsEveryIndexOnce)
         }
 }
 
+/// Keeps the only worker of a 2-thread job system busy with a job until Release (or the end of the scope), so
+/// that what the test schedules meanwhile stays queued.
+class WorkerHeld
+{
+public:
+    explicit WorkerHeld(JobSystem& ioJobs) : mJobs(ioJobs)
+    {
+        mHolder = mJobs.Schedule("holder",
+                                 [this]
+                                 {
+                                     mHolding.store(true);
+                                     while (!mRelease.load())
+                                         std::this_thread::yield();
+                                 });
+        while (!mHolding.load())
+            std::this_thread::yield();
+    }
+    ~WorkerHeld() { Release(); }
+    void Release()
+    {
+        mRelease.store(true);
+        mJobs.Wait(mHolder);
+    }
+    const JobHandle& Holder() const { return mHolder; }
+
+private:
+    JobSystem& mJobs;
+    JobHandle mHolder;
+    std::atomic<bool> mHolding{false}, mRelease{false};
+};
+
 TEST(JobSystemParallelForTest, TheCallerTakesItsRegionFromTheFrontAndTheOthersFromTheBack)
 {
     // Two threads; the worker is held by a job, so the caller runs every chunk itself: its own region (the
@@ -159,16 +190,7 @@ TEST(JobSystemParallelForTest, TheCallerTakesItsRegionFromTheFrontAndTheOthersFr
     JobSystem::Settings settings;
     settings.mNumThreads = 2;
     JobSystem jobs(settings);
-    std::atomic<bool> holding{false}, release{false};
-    const JobHandle holder = jobs.Schedule("holder",
-                                           [&]
-                                           {
-                                               holding.store(true);
-                                               while (!release.load())
-                                                   std::this_thread::yield();
-                                           });
-    while (!holding.load())
-        std::this_thread::yield();
+    WorkerHeld held(jobs);
     std::vector<uint32_t> order;
     const std::thread::id caller = std::this_thread::get_id();
     bool allOnCaller = true;
@@ -178,8 +200,7 @@ TEST(JobSystemParallelForTest, TheCallerTakesItsRegionFromTheFrontAndTheOthersFr
                          allOnCaller = allOnCaller && std::this_thread::get_id() == caller;
                          order.push_back(inBegin / 10);
                      });
-    release.store(true);
-    jobs.Wait(holder);
+    held.Release();
     EXPECT_TRUE(allOnCaller);
     EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2, 3, 7, 6, 5, 4}));
 }
@@ -190,28 +211,18 @@ TEST(JobSystemTryRunHereTest, RunsAQueuedJobOnTheCallerAndNothingElse)
     JobSystem::Settings settings;
     settings.mNumThreads = 2;
     JobSystem jobs(settings);
-    std::atomic<bool> holding{false}, release{false};
-    const JobHandle holder = jobs.Schedule("holder",
-                                           [&]
-                                           {
-                                               holding.store(true);
-                                               while (!release.load())
-                                                   std::this_thread::yield();
-                                           });
-    while (!holding.load())
-        std::this_thread::yield();
+    WorkerHeld held(jobs);
     std::thread::id ranOn;
     int otherRuns = 0;
     const JobHandle first = jobs.Schedule("first", [&] { ++otherRuns; });
     const JobHandle job = jobs.Schedule("job", [&] { ranOn = std::this_thread::get_id(); });
-    EXPECT_FALSE(jobs.TryRunHere(holder)) << "a job another thread is running";
+    EXPECT_FALSE(jobs.TryRunHere(held.Holder())) << "a job another thread is running";
     EXPECT_TRUE(jobs.TryRunHere(job)) << "second in the queue";
     EXPECT_TRUE(jobs.IsDone(job));
     EXPECT_EQ(ranOn, std::this_thread::get_id());
     EXPECT_EQ(otherRuns, 0) << "only the job asked for runs";
     EXPECT_FALSE(jobs.TryRunHere(job)) << "a finished job";
-    release.store(true);
-    jobs.Wait(holder);
+    held.Release();
     jobs.Wait(first);
     EXPECT_EQ(otherRuns, 1);
 }
