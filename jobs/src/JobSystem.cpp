@@ -228,39 +228,34 @@ bool JobSystem::TryPopReady(uint32_t& outIndex)
     return true;
 }
 
+int JobSystem::FindQueuedNearFront(const JobHandle& inJob) const
+{
+    // Still running means its slot holds it (a finished job's slot may already hold a new one)
+    if (!inJob.IsValid() || IsDone(inJob)) return -1;
+    const uint32_t searched = std::min(mReadyCount, cAwaitedSearch);
+    for (uint32_t position = 0; position < searched; ++position)
+        if (mReady[(mReadyHead + position) % mMaxJobs] == inJob.mIndex) return int(position);
+    return -1;
+}
+
 bool JobSystem::TryPopAwaited(const JobHandle& inJob, uint32_t& outIndex)
 {
     std::lock_guard lock(mQueueMutex);
     if (mReadyCount == 0) return false;
-    // Still running means its slot holds it (a finished job's slot may already hold a new one)
-    if (inJob.IsValid() && !IsDone(inJob))
-    {
-        const uint32_t searched = std::min(mReadyCount, cAwaitedSearch);
-        for (uint32_t position = 0; position < searched; ++position)
-            if (mReady[(mReadyHead + position) % mMaxJobs] == inJob.mIndex)
-            {
-                outIndex = TakeReadyAt(int(position));
-                return true;
-            }
-    }
-    outIndex = TakeReadyAt(0); // The head
+    const int position = FindQueuedNearFront(inJob);
+    outIndex = TakeReadyAt(position >= 0 ? position : 0); // Else the head
     return true;
 }
 
 bool JobSystem::TryRunHere(const JobHandle& inJob)
 {
-    if (!inJob.IsValid()) return false;
-    uint32_t index = JobHandle::cInvalidIndex;
+    uint32_t index;
     {
         std::lock_guard lock(mQueueMutex);
-        // Still running means its slot holds it (a finished job's slot may already hold a new one)
-        if (IsDone(inJob)) return false;
-        const uint32_t searched = std::min(mReadyCount, cAwaitedSearch);
-        for (uint32_t position = 0; position < searched && index == JobHandle::cInvalidIndex; ++position)
-            if (mReady[(mReadyHead + position) % mMaxJobs] == inJob.mIndex)
-                index = TakeReadyAt(int(position));
+        const int position = FindQueuedNearFront(inJob);
+        if (position < 0) return false;
+        index = TakeReadyAt(position);
     }
-    if (index == JobHandle::cInvalidIndex) return false;
     Run(index);
     return true;
 }

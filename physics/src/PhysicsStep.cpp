@@ -96,8 +96,8 @@ public:
     BroadPhaseUpdate& operator=(const BroadPhaseUpdate&) = delete;
 
     /// Runs the update here if no other thread has started it yet: a worker that was awake took it within
-    /// microseconds of its scheduling; a sleeping one would take tens of them to wake, longer than the update
-    /// of a small scene (the demo's physics frames were 15 % slower waiting for it).
+    /// microseconds of its scheduling; a sleeping one takes tens of them to wake, and the update is better
+    /// run here than waited for.
     void RunHereUnlessStarted()
     {
         if (mJobs != nullptr && !mFinished && mJobs->TryRunHere(mJob))

@@ -148,8 +148,7 @@ public:
         const uint32_t parts = uint32_t(std::min<uint64_t>(chunks, GetNumThreads()));
         if (parts == 1)
         {
-            // One thread or one chunk: in order, no claims (the regions below cost a 4 KB array and an
-            // exchange per chunk)
+            // One thread or one chunk: in order, no claims (the regions below cost an exchange per chunk)
             for (uint64_t begin = 0; begin < inCount; begin += grain)
                 inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
             return;
@@ -251,6 +250,9 @@ private:
     /// For a wait outside a job: takes inJob itself if it is among the first cAwaitedSearch queued jobs (it
     /// runs what it waits for before other queued work), else the head; false when nothing is queued.
     bool TryPopAwaited(const JobHandle& inJob, uint32_t& outIndex);
+    /// Position (from the head) of inJob among the first cAwaitedSearch queued jobs; -1 when it is not there
+    /// (started, finished or further back). mQueueMutex held.
+    int FindQueuedNearFront(const JobHandle& inJob) const;
     /// Queued jobs a wait outside a job looks through for its own: enough for a ParallelFor's helpers behind
     /// a job scheduled before them, and a bounded cost for a wait on each of a thousand queued jobs.
     static constexpr uint32_t cAwaitedSearch = 8;
