@@ -11,6 +11,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchOptions.h"
 #include "common/FrameTimes.h"
+#include "common/MachineInfo.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -183,7 +184,8 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf("cairn-bench-step: build %s, %d repetitions\n", buildType, repetitions);
+    std::printf("cairn-bench-step: build %s, %d repetitions; %s\n", buildType, repetitions,
+                tools::DescribeMachine().c_str());
     auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
     {
         for (size_t t = 1; t < inMeans.size(); ++t)

@@ -7,12 +7,12 @@
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
+#include "common/MachineInfo.h"
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 using namespace cairn;
@@ -52,9 +52,8 @@ int main(int argc, char** argv)
     std::string commandLine = "cairn-demo";
     for (int i = 1; i < argc; ++i)
         commandLine += std::string(" ") + argv[i];
-    std::printf("cairn-demo: %d frames per mode, seed %llu, %d agents, %u hardware threads\n",
-                settings.mFrames, (unsigned long long)settings.mSeed, settings.mAgents,
-                std::thread::hardware_concurrency());
+    std::printf("cairn-demo: %d frames per mode, seed %llu, %d agents; %s\n", settings.mFrames,
+                (unsigned long long)settings.mSeed, settings.mAgents, tools::DescribeMachine().c_str());
 
     std::vector<DemoRunResult> runs;
     if (mode != "global-mutex") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTree, stdout));
