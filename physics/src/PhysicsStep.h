@@ -8,11 +8,10 @@
 // velocities, pair finding (per active body), the narrow phase (per chunk of pairs), islands (largest first),
 // bounds and the broad-phase notify. The broad-phase update runs as a job of its own beside the velocities,
 // the pair finding and the narrow phase when the broad phase allows it (BroadPhaseUpdate in the .cpp). Each
-// parallel task
-// writes only its own bodies or its own chunk's output; everything shared (the constraint list, the contact
-// cache, the active list, waking) is merged afterwards in pair order: the updating thread wakes bodies and
-// reserves each chunk's places in the constraint list and the contact cache, then the chunks are copied into
-// their places in parallel. Results do not depend on the number of threads or their timing.
+// parallel task writes only its own bodies or its own chunk's output; everything shared (the constraint list,
+// the contact cache, the active list, waking) is merged afterwards in pair order: the updating thread wakes
+// bodies and reserves each chunk's places in the constraint list and the contact cache, then the chunks are
+// copied into their places in parallel. Results do not depend on the number of threads or their timing.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSettings.h"
