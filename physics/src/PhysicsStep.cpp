@@ -535,8 +535,10 @@ void PhysicsStep::FindPairs(size_t inBegin)
     if (mPairChunks.size() < numChunks) mPairChunks.resize(numChunks);
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
         mPairChunks[chunk].mPairs.clear();
-    const ParallelRanges ranges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
+    // Named: a FunctionRef only refers to its callable, which must outlive it (a temporary lambda would not)
+    auto runRanges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
     { ParallelFor(inCount, cBodiesPerChunk, inRange); };
+    const ParallelRanges ranges = runRanges;
     mBroadPhase.FindCollidingPairs(
         sliceIDs, mLayers,
         [&](BodyID inActive, BodyID inOther)
