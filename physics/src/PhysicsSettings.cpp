@@ -51,6 +51,8 @@ Status ValidateSettings(const PhysicsSettings& inSettings)
         return Invalid("mPairCacheMaxDeltaPosition must be in [0, 1] m");
     if (!InRange(inSettings.mPairCacheMaxDeltaAngle, 0.0f, cPi))
         return Invalid("mPairCacheMaxDeltaAngle must be in [0, pi]");
+    if (!InRange(inSettings.mBroadPhaseCandidateMargin, 0.0f, 100.0f))
+        return Invalid("mBroadPhaseCandidateMargin must be in [0, 100] m");
     const SolverSettings& solver = inSettings.mSolver;
     // Iteration counts bound the step's work: a typo of 10000 would look like a hang
     if (solver.mVelocityIterations < 1 || solver.mVelocityIterations > 1000)

@@ -10,20 +10,24 @@ namespace cairn
 
 namespace
 {
-std::unique_ptr<BroadPhase> CreateBroadPhase(BroadPhaseType inType, uint32_t inMaxBodies,
-                                             const LayerSetup& inLayers)
+std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
 {
-    switch (inType)
+    auto quadTree = [&](BroadPhaseQuadTree::LockMode inMode)
+    {
+        auto broadPhase = std::make_unique<BroadPhaseQuadTree>(inSettings.mMaxBodies, inLayers, inMode);
+        broadPhase->SetCandidateCacheMargin(inSettings.mBroadPhaseCandidateMargin);
+        return broadPhase;
+    };
+    switch (inSettings.mBroadPhase)
     {
     case BroadPhaseType::BruteForce:
         return std::make_unique<BroadPhaseBruteForce>();
     case BroadPhaseType::SortAndSweep:
-        return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
+        return std::make_unique<BroadPhaseSortAndSweep>(inSettings.mMaxBodies, inLayers);
     case BroadPhaseType::QuadTree:
-        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, inLayers);
+        return quadTree(BroadPhaseQuadTree::LockMode::LockFree);
     case BroadPhaseType::QuadTreeGlobalMutex:
-        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, inLayers,
-                                                    BroadPhaseQuadTree::LockMode::GlobalMutex);
+        return quadTree(BroadPhaseQuadTree::LockMode::GlobalMutex);
     }
     return nullptr;
 }
@@ -47,7 +51,7 @@ PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup
       mSettings(mSetupStatus.IsOk() ? inSettings : PhysicsSettings{}),
       mLayers(mSetupStatus.IsOk() ? inLayers : LayerSetup::CreateDefault()),
       mBodies(std::make_unique<BodyManager>(mSettings.mMaxBodies, mSettings.mNumBodyMutexes)),
-      mBroadPhase(CreateBroadPhase(mSettings.mBroadPhase, mSettings.mMaxBodies, mLayers)),
+      mBroadPhase(CreateBroadPhase(mSettings, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
       mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase)),
       mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase))

@@ -8,6 +8,7 @@
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchOptions.h"
 #include "common/FrameTimes.h"
@@ -29,13 +30,18 @@ namespace
 struct RunResult
 {
     tools::TimingSummary mStep;
-    StepStatistics mPhaseSums;     ///< Phase times summed over all steps
-    double mHeightChecksum = 0.0;  ///< Sum of final y of the dynamic bodies
-    uint64_t mContactPoints = 0;   ///< Contact points summed over all steps
-    uint64_t mBodyPairs = 0;       ///< Broad-phase pairs summed over all steps
-    uint64_t mReusedBodyPairs = 0; ///< ... of which took last step's manifolds over
+    StepStatistics mPhaseSums;                           ///< Phase times summed over all steps
+    double mHeightChecksum = 0.0;                        ///< Sum of final y of the dynamic bodies
+    uint64_t mContactPoints = 0;                         ///< Contact points summed over all steps
+    uint64_t mBodyPairs = 0;                             ///< Broad-phase pairs summed over all steps
+    uint64_t mReusedBodyPairs = 0;                       ///< ... of which took last step's manifolds over
+    BroadPhaseQuadTree::CandidateCacheStats mCandidates; ///< How the pair search served static candidates
     int mSteps = 0;
 };
+
+/// The broad phase's margin for cached static candidates (--candidate-margin); the engine's default unless
+/// given.
+float gCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;
 
 BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, float inYaw,
                                  MotionType inMotion, float inFriction)
@@ -90,6 +96,8 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     result.mStep = tools::Summarize(stepMs);
     for (const BodyID& id : inDynamic)
         result.mHeightChecksum += ioSystem.GetBodyInterface().GetPosition(id).Value().y();
+    if (const auto* quadTree = dynamic_cast<const BroadPhaseQuadTree*>(&ioSystem.GetBroadPhase()))
+        result.mCandidates = quadTree->GetCandidateCacheStats();
     return result;
 }
 
@@ -100,6 +108,7 @@ PhysicsSettings BenchSettings(bool inAllowSleeping)
     settings.mSolver.mVelocityIterations = 10;
     settings.mSolver.mPositionIterations = 2;
     settings.mAllowSleeping = inAllowSleeping;
+    settings.mBroadPhaseCandidateMargin = gCandidateMargin;
     return settings;
 }
 
@@ -145,16 +154,24 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
     for (size_t i = 0; i < inRuns.size(); ++i)
     {
         const RunResult& run = inRuns[i];
-        std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
-                    "broadphase-update %.3f  "
-                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
-                    "contacts %llu  | pairs reused %.1f%%\n",
-                    inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
-                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
-                    run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
-                    run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
-                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints),
-                    100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)));
+        const uint64_t candidateQueries =
+            std::max<uint64_t>(run.mCandidates.mReused + run.mCandidates.mWalked + run.mCandidates.mRefilled +
+                                   run.mCandidates.mUncached,
+                               1);
+        std::printf(
+            "%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
+            "broadphase-update %.3f  "
+            "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
+            "contacts %llu  | pairs reused %.1f%%  | static candidates reused %.1f%% (%.1f%% walked, too "
+            "many)\n",
+            inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
+            run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
+            run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
+            run.mPhaseSums.mFinishMs / run.mSteps, run.mHeightChecksum,
+            static_cast<unsigned long long>(run.mContactPoints),
+            100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
+            100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
+            100.0 * double(run.mCandidates.mWalked) / double(candidateQueries));
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);
@@ -174,7 +191,15 @@ int main(int inArgc, char** inArgv)
 {
     tools::BenchOptions options;
     if (auto stop = tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-step: physics step figures",
-                                             {"step_pile2k", "step_pyramid"}, options, true))
+                                             {"step_pile2k", "step_pyramid"}, options, true,
+                                             [](CLI::App& ioApp)
+                                             {
+                                                 ioApp
+                                                     .add_option("--candidate-margin", gCandidateMargin,
+                                                                 "Broad-phase static candidate margin (m), 0 "
+                                                                 "turns the cache off")
+                                                     ->check(CLI::Range(0.0f, 100.0f));
+                                             }))
         return *stop;
     const int repetitions = options.mRepetitions;
     const std::string& only = options.mOnly;

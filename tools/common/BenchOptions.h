@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,9 +25,11 @@ struct BenchOptions
 /// stop with (0 after --help, 2 on a usage error, the message printed), or nothing to go on.
 inline std::optional<int> ParseBenchOptions(int inArgc, char** inArgv, const std::string& inDescription,
                                             const std::vector<std::string>& inBenchmarks,
-                                            BenchOptions& ioOptions, bool inTakesThreads = false)
+                                            BenchOptions& ioOptions, bool inTakesThreads = false,
+                                            const std::function<void(CLI::App&)>& inMoreOptions = {})
 {
     CLI::App app{inDescription};
+    if (inMoreOptions) inMoreOptions(app);
     app.add_option("--repetitions", ioOptions.mRepetitions, "Runs of each benchmark (medians are printed)")
         ->check(CLI::Range(1, 1000));
     app.add_option("--only", ioOptions.mOnly, "Run one benchmark")->check(CLI::IsMember(inBenchmarks));

@@ -33,6 +33,9 @@ int main(int argc, char** argv)
         ->check(CLI::Range(0, 64));
     app.add_option("--collision-steps", settings.mCollisionSteps, "Physics collision steps per frame")
         ->check(CLI::Range(1, 8));
+    app.add_option("--candidate-margin", settings.mCandidateMargin,
+                   "Broad-phase static candidate margin (m), 0 turns the cache off")
+        ->check(CLI::Range(0.0f, 100.0f));
     app.add_option("--game-objects", settings.mGameObjects, "Game objects updated by jobs each frame")
         ->check(CLI::Range(0, 20000));
     app.add_option("--mode", mode, "lock-free, global-mutex or both")

@@ -49,6 +49,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     PhysicsSettings physicsSettings;
     physicsSettings.mMaxBodies = 65536;
     physicsSettings.mBroadPhase = inMode;
+    physicsSettings.mBroadPhaseCandidateMargin = inSettings.mCandidateMargin;
     // The reference engine's "before": one read-write mutex around the broad phase and one for every body
     // (its "after": the lock-free trees and 32 body mutexes)
     if (inMode == BroadPhaseType::QuadTreeGlobalMutex) physicsSettings.mNumBodyMutexes = 1;

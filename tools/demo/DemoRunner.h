@@ -21,8 +21,10 @@ struct DemoSettings
     uint64_t mSeed = 1;
     int mFrames = 1200; ///< Per mode
     int mAgents = 8;
-    uint32_t mThreads = 0;         ///< Job system threads (0: all cores)
-    int mCollisionSteps = 1;       ///< Per 1/60 s frame
+    uint32_t mThreads = 0;   ///< Job system threads (0: all cores)
+    int mCollisionSteps = 1; ///< Per 1/60 s frame
+    /// PhysicsSettings::mBroadPhaseCandidateMargin (m; 0: the pair search walks the static tree every step)
+    float mCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;
     uint32_t mGameObjects = 256;   ///< Objects updated by jobs each frame
     uint32_t mGameObjectJobs = 8;  ///< K jobs per frame
     bool mRealTime = true;         ///< Wait for each 1/60 s tick (false: as fast as it goes)

@@ -1,5 +1,6 @@
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 
+#include "PairCandidateCache.h"
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <cassert>
@@ -56,7 +57,7 @@ private:
 
 BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers, LockMode inMode)
     : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
-      mBodies(mMaxBodies)
+      mBodies(mMaxBodies), mCandidateCache(std::make_unique<PairCandidateCache>())
 {
     // A full rebuild needs at most ~1.4 nodes per body (4-wide, at least one body per leaf slot group);
     // batches may not take the last 2 per body, so a rebuild always finds its nodes. Storage is backed on
@@ -145,6 +146,7 @@ void BroadPhaseQuadTree::AddBodiesFinalize(AddState inState)
         if (subTree.mChild == QuadTree::cInvalidChild) continue;
         mTrees[layer]->LinkSubTree(subTree);
         mBodyCount.fetch_add(subTree.mNumBodies, std::memory_order_relaxed); // Statistic
+        CountTreeChanges(1u << layer);
     }
 }
 
@@ -156,40 +158,50 @@ void BroadPhaseQuadTree::AddBodiesAbort(AddState inState)
         mTrees[layer]->FreeSubTree(batch->mSubTrees[layer]);
 }
 
-void BroadPhaseQuadTree::RemoveBody(BodyID inBody)
+void BroadPhaseQuadTree::CountTreeChanges(uint32_t inTrees)
 {
-    if (inBody.IsInvalid() || inBody.GetIndex() >= mMaxBodies) return;
+    for (; inTrees != 0; inTrees &= inTrees - 1)
+        // Release: a FindCollidingPairs that acquires the new count sees the change made before it
+        mTreeChanges[std::countr_zero(inTrees)].fetch_add(1, std::memory_order_release);
+}
+
+uint32_t BroadPhaseQuadTree::RemoveBody(BodyID inBody)
+{
+    if (inBody.IsInvalid() || inBody.GetIndex() >= mMaxBodies) return 0;
     // Relaxed: the caller serialises operations on this body, so its layer is stable
     const ObjectLayer layer = mBodies[inBody.GetIndex()].mLayer.load(std::memory_order_relaxed);
-    if (!mLayerSetup.IsValid(layer)) return;
-    if (TreeOf(layer).RemoveBody(inBody)) mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Statistic
+    if (!mLayerSetup.IsValid(layer) || !TreeOf(layer).RemoveBody(inBody)) return 0;
+    mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Statistic
+    return 1u << TreeIndexOf(layer);
 }
 
 void BroadPhaseQuadTree::RemoveBodies(std::span<const BodyID> inBodies)
 {
     auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    uint32_t changed = 0;
     for (BodyID id : inBodies)
-        RemoveBody(id);
+        changed |= RemoveBody(id);
+    CountTreeChanges(changed);
 }
 
-void BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
+uint32_t BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
 {
     const uint32_t index = inBody.mID.GetIndex();
     const bool ok = !inBody.mID.IsInvalid() && index < mMaxBodies && mLayerSetup.IsValid(inBody.mLayer) &&
                     IsValidBroadPhaseBounds(inBody.mBounds);
     assert(ok && "BroadPhaseQuadTree: invalid body id, object layer or bounds");
-    if (!ok) return;
+    if (!ok) return 0;
     // Relaxed: the caller serialises operations on this body
     const ObjectLayer oldLayer = mBodies[index].mLayer.load(std::memory_order_relaxed);
-    if (!mLayerSetup.IsValid(oldLayer)) return;
+    if (!mLayerSetup.IsValid(oldLayer)) return 0;
     QuadTree& oldTree = TreeOf(oldLayer);
-    if (!oldTree.Contains(inBody.mID)) return;
+    if (!oldTree.Contains(inBody.mID)) return 0;
     QuadTree& newTree = TreeOf(inBody.mLayer);
     if (&oldTree == &newTree)
     {
         if (oldLayer != inBody.mLayer) oldTree.SetBodyLayer(inBody.mID, inBody.mLayer);
         oldTree.MoveBody(inBody.mID, inBody.mBounds);
-        return;
+        return 1u << TreeIndexOf(oldLayer);
     }
     // Another broad-phase layer: the slow path, a remove and a one-body add
     oldTree.RemoveBody(inBody.mID);
@@ -198,6 +210,7 @@ void BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
         mBodyCount.fetch_sub(1, std::memory_order_relaxed); // Out of nodes: the body left the broad phase
     else
         newTree.LinkSubTree(subTree);
+    return 1u << TreeIndexOf(oldLayer) | 1u << TreeIndexOf(inBody.mLayer);
 }
 
 void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
@@ -207,6 +220,7 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
     // are fetched 8 bodies ahead and the nodes 4 ahead (from the entries fetched before), so that the misses
     // of a move overlap those of the next ones instead of following each other
     constexpr size_t cTableAhead = 8, cNodeAhead = 4;
+    uint32_t changed = 0;
     for (size_t i = 0; i < inBodies.size(); ++i)
     {
         if (i + cTableAhead < inBodies.size())
@@ -220,8 +234,9 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
         if (i + cNodeAhead < inBodies.size())
             if (const BroadPhaseBody& ahead = inBodies[i + cNodeAhead]; mLayerSetup.IsValid(ahead.mLayer))
                 TreeOf(ahead.mLayer).PrefetchNodeOf(ahead.mID.GetIndex());
-        MoveBody(inBodies[i]);
+        changed |= MoveBody(inBodies[i]);
     }
+    CountTreeChanges(changed);
 }
 
 void BroadPhaseQuadTree::Update()
@@ -308,6 +323,28 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
                 { return inTree.CastAABox(inBox, inDisplacement, inMask, maxFraction, inVisitor); });
 }
 
+uint32_t BroadPhaseQuadTree::PrepareCachedTrees(uint32_t inNumActive) const
+{
+    uint32_t cached = 0;
+    for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+    {
+        // Acquire: pairs with CountTreeChanges; a change whose count we see is in the walks that follow
+        const uint64_t changes = mTreeChanges[tree].load(std::memory_order_acquire);
+        if (changes == mSeenTreeChanges[tree]) cached |= 1u << tree;
+        mSeenTreeChanges[tree] = changes;
+    }
+    if (mCandidateCacheMargin <= 0.0f) cached = 0;
+    // A tree that changed drops out of the set for at least one call, so a set equal to the last one means
+    // none of its trees changed since this generation's entries were filled
+    if (cached != mCachedTrees)
+    {
+        ++mCandidateCacheGeneration;
+        mCachedTrees = cached;
+    }
+    if (cached != 0) mCandidateCache->Prepare(inNumActive);
+    return cached;
+}
+
 void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodies,
                                             const LayerSetup& inLayers, BodyPairVisitor inVisitor,
                                             const ParallelRanges* inParallel) const
@@ -323,11 +360,22 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
         return mLayerSetup.IsValid(layer) && TreeOf(layer).Contains(inID);
     };
     // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
+    bool listedTwice = false;
     for (BodyID id : inActiveBodies)
-        if (isPresent(id)) mBodies[id.GetIndex()].mActiveInStep = 1;
+        if (isPresent(id))
+        {
+            listedTwice |= mBodies[id.GetIndex()].mActiveInStep != 0;
+            mBodies[id.GetIndex()].mActiveInStep = 1;
+        }
+    // A body listed twice would have two threads write its cache entry: no cache then (a caller bug)
+    const uint32_t cachedTrees =
+        PrepareCachedTrees(uint32_t(inActiveBodies.size())) & (listedTwice ? 0u : ~0u);
+    const uint64_t generation = mCandidateCacheGeneration;
+    const float margin = mCandidateCacheMargin;
 
     auto findRange = [&](uint32_t inBegin, uint32_t inEnd)
     {
+        CandidateCacheStats stats;
         for (uint32_t position = inBegin; position < inEnd; ++position)
         {
             const BodyID id = inActiveBodies[position];
@@ -337,22 +385,84 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
                 mBodies[selfIndex].mLayer.load(std::memory_order_relaxed); // See above
             const AABB bounds = TreeOf(selfLayer).GetBodyBounds(id);
             const ObjectLayerMask collidesWith = inLayers.GetCollisionMask(selfLayer);
-            ForEachTree(collidesWith,
-                        [&](const QuadTree& inTree, ObjectLayerMask inMask)
-                        {
-                            inTree.CollideAABox(
-                                bounds, inMask,
-                                [&](BodyID inOther)
-                                {
-                                    const uint32_t otherIndex = inOther.GetIndex();
-                                    // Skip itself; of two active bodies the lower index reports
-                                    if (otherIndex != selfIndex &&
-                                        (mBodies[otherIndex].mActiveInStep == 0 || otherIndex > selfIndex))
-                                        inVisitor(id, inOther);
-                                });
-                            return true;
-                        });
+            auto report = [&](BodyID inOther)
+            {
+                const uint32_t otherIndex = inOther.GetIndex();
+                // Skip itself; of two active bodies the lower index reports
+                if (otherIndex != selfIndex &&
+                    (mBodies[otherIndex].mActiveInStep == 0 || otherIndex > selfIndex))
+                    inVisitor(id, inOther);
+            };
+            // The changing trees are walked; the others, if any, go through the cache below
+            uint32_t cachedOfBody = 0;
+            ForEachTreeIndexed(collidesWith,
+                               [&](uint32_t inTreeIndex, const QuadTree& inTree, ObjectLayerMask inMask)
+                               {
+                                   if ((cachedTrees >> inTreeIndex) & 1u)
+                                       cachedOfBody |= 1u << inTreeIndex;
+                                   else
+                                       inTree.CollideAABox(bounds, inMask, report);
+                               });
+            if (cachedOfBody == 0) continue;
+            auto walkCached = [&](const AABB& inBox, auto&& inVisit)
+            {
+                ForEachTreeIndexed(collidesWith,
+                                   [&](uint32_t inTreeIndex, const QuadTree& inTree, ObjectLayerMask inMask)
+                                   {
+                                       if ((cachedOfBody >> inTreeIndex) & 1u)
+                                           inTree.CollideAABoxWithBounds(inBox, inMask, inVisit);
+                                   });
+            };
+            auto reportOverlapping = [&](BodyID inOther, const AABB& inOtherBounds)
+            {
+                if (AABBsOverlap(inOtherBounds, bounds)) report(inOther);
+            };
+            PairCandidateCache::Entry* entry = mCandidateCache->FindOrClaim(selfIndex);
+            if (entry == nullptr)
+            {
+                walkCached(bounds, reportOverlapping);
+                ++stats.mUncached;
+                continue;
+            }
+            if (entry->mGeneration == generation && entry->mID == id &&
+                entry->mCollidesWith == collidesWith && entry->mGrownBounds.Contains(bounds))
+            {
+                if (entry->mNumCandidates <= PairCandidateCache::cMaxCandidates)
+                {
+                    for (uint32_t c = 0; c < entry->mNumCandidates; ++c)
+                        reportOverlapping(entry->mCandidates[c].mID, entry->mCandidates[c].mBounds);
+                    ++stats.mReused;
+                }
+                else
+                {
+                    walkCached(bounds, reportOverlapping);
+                    ++stats.mWalked;
+                }
+                continue;
+            }
+            // New, stale or left its box: walk with grown bounds and remember what is there
+            const AABB grown = bounds.Expanded(margin);
+            uint32_t count = 0;
+            walkCached(grown,
+                       [&](BodyID inOther, const AABB& inOtherBounds)
+                       {
+                           if (count < PairCandidateCache::cMaxCandidates)
+                               entry->mCandidates[count] = {inOther, inOtherBounds};
+                           ++count;
+                           reportOverlapping(inOther, inOtherBounds);
+                       });
+            entry->mID = id;
+            entry->mGeneration = generation;
+            entry->mCollidesWith = collidesWith;
+            entry->mGrownBounds = grown;
+            entry->mNumCandidates = std::min(count, PairCandidateCache::cMaxCandidates + 1);
+            ++stats.mRefilled;
         }
+        // Relaxed: statistics
+        mCandidateCacheReused.fetch_add(stats.mReused, std::memory_order_relaxed);
+        mCandidateCacheWalked.fetch_add(stats.mWalked, std::memory_order_relaxed);
+        mCandidateCacheRefilled.fetch_add(stats.mRefilled, std::memory_order_relaxed);
+        mCandidateCacheUncached.fetch_add(stats.mUncached, std::memory_order_relaxed);
     };
     // The trees are queried from several threads at once (queries are lock-free); the marks above are only
     // read
@@ -365,6 +475,21 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
         if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mBodies[id.GetIndex()].mActiveInStep = 0;
 }
 
+BroadPhaseQuadTree::CandidateCacheStats BroadPhaseQuadTree::GetCandidateCacheStats() const
+{
+    // Relaxed: statistics
+    return {mCandidateCacheReused.load(std::memory_order_relaxed),
+            mCandidateCacheWalked.load(std::memory_order_relaxed),
+            mCandidateCacheRefilled.load(std::memory_order_relaxed),
+            mCandidateCacheUncached.load(std::memory_order_relaxed)};
+}
+
+void BroadPhaseQuadTree::SetCandidateCacheMargin(float inMargin)
+{
+    // NaN or negative: off (a clear "no" rather than boxes that never contain anything)
+    mCandidateCacheMargin = inMargin > 0.0f && inMargin < cLargeFloat ? inMargin : 0.0f;
+}
+
 size_t BroadPhaseQuadTree::GetBodyCount() const
 {
     return size_t(std::max<int64_t>(0, mBodyCount.load(std::memory_order_relaxed))); // Statistic
@@ -375,6 +500,7 @@ BroadPhaseQuadTree::MemoryStats BroadPhaseQuadTree::GetMemoryStats() const
     MemoryStats stats;
     stats.mBodyTableBytes = mBodies.GetMemoryBytes();
     stats.mNodeSize = sizeof(QuadTree::Node);
+    stats.mCandidateCacheBytes = mCandidateCache->GetMemoryBytes(); // Between steps only, like the margin
     for (const std::unique_ptr<QuadTree>& tree : mTrees)
     {
         const QuadTree::MemoryStats treeStats = tree->GetMemoryStats();

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cassert>
 #include <cstddef>
+#include <type_traits>
 #include <utility>
 
 #if defined(__SSE2__)
@@ -638,8 +639,9 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, Leaf
     while (stack.Pop(nodeIndex))
     {
         const Node& node = GetNode(nodeIndex);
+        const quadtree::SlotBounds4 slots(node);
         // One branch-free 4-wide test for the node, then only the slots that passed
-        for (uint32_t hits = inTest4(quadtree::SlotBounds4(node), fractions); hits != 0; hits &= hits - 1)
+        for (uint32_t hits = inTest4(slots, fractions); hits != 0; hits &= hits - 1)
         {
             const int s = std::countr_zero(hits);
             // Acquire: pairs with the release exchange in LinkSubTree that published a sub-tree here
@@ -658,19 +660,27 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, Leaf
             const uint32_t index = child & ~cBodyFlag;
             const QuadTreeBodyTable::Entry& entry = mBodies[index];
             float fraction = fractions[s];
+            bool haveExact = false;
+            AABB exact;
             // Relaxed: MoveBody set the bit before the release of the growth we may have acquired above
             if ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u)
             {
                 // The slot may be wider than the body: test its exact bounds (the slot, which contains the
                 // old bounds, was already tested when a move is being written)
-                AABB exact;
-                if (QuadTreeBodyTable::LoadBounds(entry, exact) && !inTest(exact, fraction)) continue;
+                haveExact = QuadTreeBodyTable::LoadBounds(entry, exact);
+                if (haveExact && !inTest(exact, fraction)) continue;
             }
             // Relaxed: written before the sub-tree was published (acquired above); a concurrent re-add of
             // the index is reported with its old or new id, both allowed
             if (checkLayers && !IsInLayerMask(inMask, entry.mLayer.load(std::memory_order_relaxed))) continue;
             const BodyID id(index, mBodies.Sequence(index).load(std::memory_order_relaxed)); // As above
-            if (!inLeaf(id, fraction)) return false;
+            if constexpr (std::is_invocable_v<LeafVisit&, BodyID, float, const AABB&>)
+            {
+                // A slot that is not loose holds the body's exact bounds
+                if (!inLeaf(id, fraction, haveExact ? exact : slots.Slot(s))) return false;
+            }
+            else if (!inLeaf(id, fraction))
+                return false;
         }
     }
     return true;
@@ -686,6 +696,21 @@ void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisit
         [&](BodyID inID, float)
         {
             inVisitor(inID);
+            return true;
+        });
+}
+
+void QuadTree::CollideAABoxWithBounds(const AABB& inBox, ObjectLayerMask inMask,
+                                      FunctionRef<void(BodyID, const AABB&)> inVisitor) const
+{
+    Walk(
+        inMask,
+        [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
+        { return quadtree::OverlapMask(inSlots, inBox); },
+        [&](const AABB& inBody, float&) { return AABBsOverlap(inBody, inBox); },
+        [&](BodyID inID, float, const AABB& inBounds)
+        {
+            inVisitor(inID, inBounds);
             return true;
         });
 }

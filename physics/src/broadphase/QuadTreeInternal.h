@@ -90,6 +90,20 @@ struct SlotBounds4
     {
     }
 
+    /// One slot's bounds (a query hit's; rare next to the 4-wide tests, so the stores are fine).
+    AABB Slot(int inSlot) const
+    {
+        alignas(16) float rows[6][4];
+        _mm_store_ps(rows[0], mMinX);
+        _mm_store_ps(rows[1], mMinY);
+        _mm_store_ps(rows[2], mMinZ);
+        _mm_store_ps(rows[3], mMaxX);
+        _mm_store_ps(rows[4], mMaxY);
+        _mm_store_ps(rows[5], mMaxZ);
+        return AABB(Vec3(rows[0][inSlot], rows[1][inSlot], rows[2][inSlot]),
+                    Vec3(rows[3][inSlot], rows[4][inSlot], rows[5][inSlot]));
+    }
+
     /// The same bounds grown by inExtent on every side (swept boxes). Empty slots stay empty.
     SlotBounds4 Grown(const Vec3& inExtent) const
     {
@@ -107,11 +121,12 @@ private:
     static __m128 Load4(const std::atomic<float> (&inValues)[4])
     {
 #if defined(__x86_64__) && !defined(__SANITIZE_THREAD__)
-        // One aligned 16-byte load for the four slots. On x86 every load has acquire order (TSO) and an aligned
-        // 4-byte element is read whole, so this reads what four acquire loads would, without 4 loads and 3
-        // shuffles a row (the SIMD test was spending most of its time assembling its inputs); the fence keeps the
-        // compiler from moving later loads (the children) above it, as acquire would. ThreadSanitizer builds take
-        // the portable path below, so the protocol is still checked with real atomic loads.
+        // One aligned 16-byte load for the four slots. On x86 every load has acquire order (TSO) and an
+        // aligned 4-byte element is read whole, so this reads what four acquire loads would, without 4 loads
+        // and 3 shuffles a row (the SIMD test was spending most of its time assembling its inputs); the fence
+        // keeps the compiler from moving later loads (the children) above it, as acquire would.
+        // ThreadSanitizer builds take the portable path below, so the protocol is still checked with real
+        // atomic loads.
         static_assert(sizeof(std::atomic<float>) == sizeof(float) && std::atomic<float>::is_always_lock_free);
         const __m128 values = _mm_load_ps(reinterpret_cast<const float*>(&inValues[0]));
         std::atomic_signal_fence(std::memory_order_acquire);

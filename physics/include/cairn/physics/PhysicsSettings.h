@@ -46,6 +46,10 @@ struct PhysicsSettings
     /// more than it saved (a worker woken for it, pair queries on the tree not yet rebuilt; the demo's 0.2 ms
     /// physics frames were 15-25 % slower with it, the 1,240- and 2,000-body benchmarks 3-6 % faster)
     uint32_t mUpdateBesideStepMinActiveBodies = 1024;
+    /// Quad-tree broad phase: the pair search remembers the static bodies (those of trees that did not
+    /// change) within this margin (m) of each active body and reuses them while the body stays inside it; 0
+    /// turns it off. Larger keeps candidates longer but more of them (see BroadPhaseQuadTree)
+    float mBroadPhaseCandidateMargin = 0.25f;
 };
 
 /// Ok, or an InvalidArgument error naming the first field out of its documented range (NaN, infinity, a

@@ -16,6 +16,11 @@
 //    alone. A second Update (or RebuildAll) that overlaps a running one, or a second FindCollidingPairs that
 //    overlaps a running one (two threads stepping one world), is refused and counted (GetRefusedStepCalls),
 //    never run concurrently.
+// FindCollidingPairs keeps, per active body, the bodies of the trees that did not change since its last call
+// (the static layer) near the body's bounds grown by a margin (PairCandidateCache, physics/src/broadphase):
+// while the body stays inside that box and those trees stay unchanged, its pairs with them come from the
+// cache instead of a walk, the same pairs. Each tree counts the modification calls that finished on it
+// (mTreeChanges), and a tree whose count moved between two pair searches is walked in the second.
 // LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
 // and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
 // comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
@@ -35,6 +40,8 @@
 
 namespace cairn
 {
+
+class PairCandidateCache;
 
 class BroadPhaseQuadTree final : public BroadPhase
 {
@@ -66,7 +73,25 @@ public:
         uint32_t mNodesInUse = 0;    ///< Nodes allocated
         uint32_t mNodesRetired = 0;  ///< Of which waiting to be freed
         size_t mNodeSize = 0;        ///< Bytes per node
+        /// FindCollidingPairs' cache, sized by the active bodies (not the bodies), so not in the per-body
+        /// figures
+        size_t mCandidateCacheBytes = 0;
     };
+
+    /// How FindCollidingPairs served the active bodies' queries of unchanged trees, since construction.
+    struct CandidateCacheStats
+    {
+        uint64_t mReused = 0; ///< From the cache: no walk
+        uint64_t mWalked = 0; ///< Inside the grown box but with too many candidates to keep: walked
+        uint64_t mRefilled =
+            0; ///< Walked with grown bounds and remembered (first time, left the box, changes)
+        uint64_t mUncached = 0; ///< Walked because the cache table was full
+    };
+
+    /// Margin by which a body's bounds are grown for its cached candidates (the default, 0.25 m, keeps a
+    /// falling or sliding box's candidates for a few steps); 0 turns the cache off. Not during
+    /// FindCollidingPairs: set it between steps.
+    static constexpr float cDefaultCandidateCacheMargin = 0.25f;
 
     /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +
     /// 1,024 nodes per layer (the new and old trees of a fully changed layer fit twice over).
@@ -113,6 +138,9 @@ public:
     size_t GetBodyCount() const override;
 
     LockMode GetLockMode() const { return mMode; }
+    void SetCandidateCacheMargin(float inMargin);
+    float GetCandidateCacheMargin() const { return mCandidateCacheMargin; }
+    CandidateCacheStats GetCandidateCacheStats() const;
     const UpdateStats& GetLastUpdateStats() const { return mLastUpdate; }
     MemoryStats GetMemoryStats() const;
     /// Validates every tree (single-threaded tests); false on the first violation or a count mismatch.
@@ -143,9 +171,25 @@ private:
             if (const ObjectLayerMask mask = MaskForTree(tree, inMask); mask != 0)
                 if (!inQuery(*mTrees[tree], mask)) return;
     }
+    /// As ForEachTree, with the tree's index; the query returns nothing (visits every tree).
+    template <class Query> void ForEachTreeIndexed(ObjectLayerMask inMask, Query&& inQuery) const
+    {
+        for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
+            if (const ObjectLayerMask mask = MaskForTree(tree, inMask); mask != 0)
+                inQuery(tree, *mTrees[tree], mask);
+    }
     void UpdateImpl(bool inFull);
-    void RemoveBody(BodyID inBody);
-    void MoveBody(const BroadPhaseBody& inBody);
+    /// Index of the tree a body of object layer inLayer lives in.
+    uint32_t TreeIndexOf(ObjectLayer inLayer) const { return mLayerSetup.GetBroadPhaseLayer(inLayer); }
+    /// Counts a finished modification call on each tree of inTrees (a bit per tree).
+    void CountTreeChanges(uint32_t inTrees);
+    /// Remove and move of one body; return the trees they changed (a bit per tree).
+    uint32_t RemoveBody(BodyID inBody);
+    uint32_t MoveBody(const BroadPhaseBody& inBody);
+    /// Trees FindCollidingPairs may serve from the pair cache in this call (a bit per tree): those whose
+    /// change count is the one the last call saw. Starts a new cache generation when that set differs from
+    /// the last call's. FindCollidingPairs only.
+    uint32_t PrepareCachedTrees(uint32_t inNumActive) const;
 
     const uint32_t mMaxBodies;                     ///< Body indices are below this
     const LayerSetup mLayerSetup;                  ///< Copy of the constructor's setup; immutable
@@ -159,6 +203,20 @@ private:
     mutable std::atomic<bool> mUpdateActive{false};     ///< Update or RebuildAll is running (StepCallGuard)
     mutable std::atomic<bool> mPairsActive{false};      ///< FindCollidingPairs is running (StepCallGuard)
     mutable std::atomic<uint64_t> mRefusedStepCalls{0}; ///< Statistic
+    /// Per tree: modification calls (add, remove, move) finished on it. Incremented with release after the
+    /// change is in the tree, loaded with acquire by FindCollidingPairs: a count it sees implies it sees the
+    /// change; a change it missed moves the count for the next call.
+    std::array<std::atomic<uint64_t>, cMaxBroadPhaseLayers> mTreeChanges{};
+    // The pair cache's state: FindCollidingPairs only (one call at a time: StepCallGuard)
+    std::unique_ptr<PairCandidateCache> mCandidateCache;                   ///< See PairCandidateCache
+    mutable std::array<uint64_t, cMaxBroadPhaseLayers> mSeenTreeChanges{}; ///< Counts the last call saw
+    mutable uint32_t mCachedTrees = 0;                                     ///< Trees the generation covers
+    mutable uint64_t mCandidateCacheGeneration = 1; ///< Entries of another generation are stale
+    float mCandidateCacheMargin =
+        cDefaultCandidateCacheMargin; ///< Between steps only (SetCandidateCacheMargin)
+    /// CandidateCacheStats, summed per range (relaxed: statistics)
+    mutable std::atomic<uint64_t> mCandidateCacheReused{0}, mCandidateCacheWalked{0},
+        mCandidateCacheRefilled{0}, mCandidateCacheUncached{0};
 };
 
 } // namespace cairn

@@ -145,6 +145,10 @@ public:
 
     /// Bodies whose exact bounds overlap inBox. inMask: object layers to report.
     void CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const;
+    /// As CollideAABox, with each body's bounds as the query saw them: exact, or, while a move of the body is
+    /// being written, its slot's (which contain the old bounds).
+    void CollideAABoxWithBounds(const AABB& inBox, ObjectLayerMask inMask,
+                                FunctionRef<void(BodyID, const AABB&)> inVisitor) const;
     /// Bodies whose exact bounds are within inRadius of inCenter.
     void CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask,
                        BodyVisitor inVisitor) const;
@@ -237,7 +241,8 @@ private:
     void MarkChangedUp(uint32_t inNode);
     /// Depth-first walk under a read section. inTest4(SlotBounds4, Array4f& fractions) -> slot mask decides
     /// which slots to descend or report; inTest(exact AABB, float& fraction) -> bool re-tests a body whose
-    /// slot is loose; inLeaf(BodyID, fraction) -> bool returns false to stop. Returns false when stopped.
+    /// slot is loose; inLeaf(BodyID, fraction) -> bool returns false to stop (or inLeaf(BodyID, fraction,
+    /// bounds) to get the bounds tested too). Returns false when stopped.
     template <class Test4, class Test, class LeafVisit>
     bool Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const;
 

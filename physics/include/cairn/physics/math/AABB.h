@@ -48,6 +48,11 @@ struct AABB
     {
         return (mMin.array() <= inOther.mMax.array()).all() && (inOther.mMin.array() <= mMax.array()).all();
     }
+    /// Closed: a box contains itself.
+    bool Contains(const AABB& inOther) const
+    {
+        return (mMin.array() <= inOther.mMin.array()).all() && (inOther.mMax.array() <= mMax.array()).all();
+    }
     bool Contains(const Vec3& inPoint) const
     {
         return (mMin.array() <= inPoint.array()).all() && (inPoint.array() <= mMax.array()).all();
