@@ -323,7 +323,7 @@ TEST(BroadPhaseCandidateCacheTest, AFullTableWalksTheRestExactly)
     // 512 entries in a table of 1,024 (not cleared: half full), then 512 other bodies: a quarter of the
     // table is kept free, so 256 of them find no entry
     worlds.ExpectSamePairs(first, "the first half, entries filled");
-    worlds.ExpectSamePairs(second, "the second half", 2);
+    worlds.ExpectSamePairs(second, "the second half"); // One thread: two may claim a few over the limit
     EXPECT_EQ(worlds.Tested().GetCandidateCacheStats().mUncached, 256u);
     // The next call finds the table over half full and clears it; the one after needs a larger table: every
     // body gets an entry in both
