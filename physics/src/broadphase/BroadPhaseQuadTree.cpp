@@ -67,6 +67,7 @@ BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& i
     for (uint32_t layer = 0; layer < mLayerSetup.GetNumBroadPhaseLayers(); ++layer)
     {
         mTrees.push_back(std::make_unique<QuadTree>(mBodies, uint8_t(layer), maxNodes, rebuildReserve));
+        mTrees.back()->SetMovedSlotMargin(cMovedSlotMargin);
         mObjectLayersOfTree[layer] = mLayerSetup.GetObjectLayersIn(BroadPhaseLayer(layer));
     }
 }

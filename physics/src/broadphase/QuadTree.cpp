@@ -551,6 +551,11 @@ void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
     const uint8_t looseBit = uint8_t(1u << slot);
     if ((node.mLoose.load(std::memory_order_relaxed) & looseBit) == 0)
         node.mLoose.fetch_or(looseBit, std::memory_order_relaxed);
+    // Inside its slot (grown by the last rebuild when the body had moved): nothing above changes. Only this
+    // body's serialised operations grow its slot, and each of them returned after growing every ancestor,
+    // so the ancestors contain the slot already. Writing nothing keeps the nodes' cache lines shared, and
+    // the node unchanged for the rebuild
+    if (LoadSlot(node, slot).Contains(inBounds)) return;
     GrowSlot(node, slot, inBounds);
     MarkChanged(node);
     // Always walk to the root (no early out when a parent already contains the box): another mover may have

@@ -296,7 +296,7 @@ struct BuildItem
 struct Relocation
 {
     uint32_t mBody, mOldLocation, mNewLocation;
-    AABB mBuiltBounds; ///< What phase 1 read and the new slot holds
+    AABB mBuiltBounds; ///< What the new slot holds: the exact bounds phase 1 read, grown if it had moved
 };
 
 /// A kept node and its parent in the new tree.

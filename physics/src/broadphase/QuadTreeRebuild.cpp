@@ -95,6 +95,11 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 AABB bounds;
                 if (!QuadTreeBodyTable::LoadBounds(mBodies[child & ~cBodyFlag], bounds))
                     bounds = LoadSlot(node, s); // Being moved: the commit sets the exact bounds
+                // A body that moved since the last rebuild (its slot is loose) gets a slot grown by the
+                // margin: while it stays inside, its moves write nothing to the tree (see MoveBody). Relaxed:
+                // the bit is only read here to choose; the commit handles moves made meanwhile
+                else if (mMovedSlotMargin > 0.0f && ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u))
+                    bounds = bounds.Expanded(mMovedSlotMargin);
                 items.push_back({child, bounds, nodeIndex << 2 | uint32_t(s)});
                 continue;
             }
@@ -124,16 +129,27 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     relocations.clear();
     reparents.clear();
     newNodes.clear();
-    const SubTree built =
-        BuildNodes(items, 0, newNodes,
-                   [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
-                   {
-                       if ((inItem.mChild & cBodyFlag) != 0)
-                           relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
-                                                  inNode << 2 | uint32_t(inSlot), inItem.mBounds});
-                       else
-                           reparents.push_back({inItem.mChild, inNode});
-                   });
+    const SubTree built = BuildNodes(
+        items, 0, newNodes,
+        [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
+        {
+            if ((inItem.mChild & cBodyFlag) != 0)
+            {
+                // The exact bounds again (the entry is still cached from phase 1): a slot grown
+                // by the margin is loose, so queries test the exact bounds. A move being written
+                // counts as loose too; the commit sees it
+                AABB exact;
+                const bool readable =
+                    QuadTreeBodyTable::LoadBounds(mBodies[inItem.mChild & ~cBodyFlag], exact);
+                if (!readable || exact.mMin != inItem.mBounds.mMin || exact.mMax != inItem.mBounds.mMax)
+                    // Relaxed: the node is private until the commit publishes it
+                    GetNode(inNode).mLoose.fetch_or(uint8_t(1u << inSlot), std::memory_order_relaxed);
+                relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
+                                       inNode << 2 | uint32_t(inSlot), inItem.mBounds});
+            }
+            else
+                reparents.push_back({inItem.mChild, inNode});
+        });
     auto freeNew = [&](const std::vector<uint32_t>& inNodes)
     {
         for (uint32_t node : inNodes)
@@ -197,12 +213,23 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             {
                 AABB exact;
                 QuadTreeBodyTable::LoadBounds(entry, exact); // No writer can be inside: always consistent
-                // Moved during the build: its slot and the private ancestors take the current bounds (the
-                // common case, unchanged, costs no atomic operation: the commit is what modifiers wait for)
-                if (exact.mMin != relocation.mBuiltBounds.mMin || exact.mMax != relocation.mBuiltBounds.mMax)
+                // Not what the slot was built from (grown, or moved during the build): the slot is loose, and
+                // if the body left it, it and the private ancestors grow to the current bounds (the common
+                // case costs no atomic write: the commit is what modifiers wait for)
+                const AABB& built = relocation.mBuiltBounds;
+                if (exact.mMin != built.mMin || exact.mMax != built.mMax)
                 {
-                    InitSlot(GetNode(newNode), newSlot, cBodyFlag | relocation.mBody, exact);
-                    PropagateUp(newNode, exact);
+                    // Relaxed: the node is private until the swap below (release) publishes it; the bit is
+                    // mostly set already (by the build, for a grown slot)
+                    Node& node = GetNode(newNode);
+                    const uint8_t looseBit = uint8_t(1u << newSlot);
+                    if ((node.mLoose.load(std::memory_order_relaxed) & looseBit) == 0)
+                        node.mLoose.fetch_or(looseBit, std::memory_order_relaxed);
+                    if (!built.Contains(exact))
+                    {
+                        GrowSlot(node, newSlot, exact);
+                        PropagateUp(newNode, exact);
+                    }
                 }
                 // Release: a modifier that acquires the location sees the new node's contents
                 entry.mLocation.store(relocation.mNewLocation, std::memory_order_release);

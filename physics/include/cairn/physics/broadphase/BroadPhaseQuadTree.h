@@ -92,6 +92,9 @@ public:
     /// falling or sliding box's candidates for a few steps); 0 turns the cache off. Not during
     /// FindCollidingPairs: set it between steps.
     static constexpr float cDefaultCandidateCacheMargin = 0.25f;
+    /// Slot margin of the bodies that moved since a tree's last rebuild (QuadTree::SetMovedSlotMargin): a
+    /// resting body's jitter stays inside, so its moves write no node.
+    static constexpr float cMovedSlotMargin = 0.05f;
 
     /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +
     /// 1,024 nodes per layer (the new and old trees of a fully changed layer fit twice over).

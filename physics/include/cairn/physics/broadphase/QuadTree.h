@@ -138,6 +138,14 @@ public:
     /// Sets the object layer of a linked body (same broad-phase layer).
     void SetBodyLayer(BodyID inBody, ObjectLayer inLayer);
 
+    /// Margin (m) by which a rebuild grows the slot of a body that moved since the previous rebuild (0: exact
+    /// slots). A body then moves inside its slot for a while without writing to any node (no cache line taken
+    /// from the other cores, no node marked changed for the next rebuild); queries test its exact bounds.
+    /// Update thread, or before the tree is shared.
+    void SetMovedSlotMargin(float inMargin)
+    {
+        mMovedSlotMargin = inMargin > 0.0f && inMargin < cLargeFloat ? inMargin : 0.0f;
+    }
     /// Rebuilds the changed parts (everything when inFull) into a new tree and swaps it in. Update thread.
     RebuildStats Rebuild(bool inFull);
     /// Advances the reclaimer and frees retired nodes that no query can reach any more. Update thread.
@@ -279,6 +287,7 @@ private:
     std::unique_ptr<quadtree::RebuildScratch> mRebuildScratch; ///< Update thread only: reused arrays
     std::vector<uint32_t> mRebuildMark;                        ///< Update thread only: node -> rebuild stamp
     uint32_t mRebuildStamp = 0;                                ///< Update thread only
+    float mMovedSlotMargin = 0.0f;                             ///< Update thread only (SetMovedSlotMargin)
 };
 
 } // namespace cairn
