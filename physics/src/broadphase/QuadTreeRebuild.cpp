@@ -129,27 +129,16 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     relocations.clear();
     reparents.clear();
     newNodes.clear();
-    const SubTree built = BuildNodes(
-        items, 0, newNodes,
-        [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
-        {
-            if ((inItem.mChild & cBodyFlag) != 0)
-            {
-                // The exact bounds again (the entry is still cached from phase 1): a slot grown
-                // by the margin is loose, so queries test the exact bounds. A move being written
-                // counts as loose too; the commit sees it
-                AABB exact;
-                const bool readable =
-                    QuadTreeBodyTable::LoadBounds(mBodies[inItem.mChild & ~cBodyFlag], exact);
-                if (!readable || exact.mMin != inItem.mBounds.mMin || exact.mMax != inItem.mBounds.mMax)
-                    // Relaxed: the node is private until the commit publishes it
-                    GetNode(inNode).mLoose.fetch_or(uint8_t(1u << inSlot), std::memory_order_relaxed);
-                relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
-                                       inNode << 2 | uint32_t(inSlot), inItem.mBounds});
-            }
-            else
-                reparents.push_back({inItem.mChild, inNode});
-        });
+    const SubTree built =
+        BuildNodes(items, 0, newNodes,
+                   [&](const BuildItem& inItem, uint32_t inNode, int inSlot)
+                   {
+                       if ((inItem.mChild & cBodyFlag) != 0)
+                           relocations.push_back({inItem.mChild & ~cBodyFlag, inItem.mOldLocation,
+                                                  inNode << 2 | uint32_t(inSlot), inItem.mBounds});
+                       else
+                           reparents.push_back({inItem.mChild, inNode});
+                   });
     auto freeNew = [&](const std::vector<uint32_t>& inNodes)
     {
         for (uint32_t node : inNodes)
@@ -213,14 +202,14 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             {
                 AABB exact;
                 QuadTreeBodyTable::LoadBounds(entry, exact); // No writer can be inside: always consistent
-                // Not what the slot was built from (grown, or moved during the build): the slot is loose, and
-                // if the body left it, it and the private ancestors grow to the current bounds (the common
-                // case costs no atomic write: the commit is what modifiers wait for)
+                // Not the slot's bounds (grown by the margin, read while a move was being written, or moved
+                // during the build): the slot is loose, so queries test the exact bounds, and if the body
+                // left it, it and the private ancestors grow to the current bounds (an exact slot, the common
+                // case without a margin, costs no atomic write: the commit is what modifiers wait for)
                 const AABB& built = relocation.mBuiltBounds;
                 if (exact.mMin != built.mMin || exact.mMax != built.mMax)
                 {
-                    // Relaxed: the node is private until the swap below (release) publishes it; the bit is
-                    // mostly set already (by the build, for a grown slot)
+                    // Relaxed: the node is private until the swap below (release) publishes it
                     Node& node = GetNode(newNode);
                     const uint8_t looseBit = uint8_t(1u << newSlot);
                     if ((node.mLoose.load(std::memory_order_relaxed) & looseBit) == 0)
