@@ -52,6 +52,10 @@ TEST(BroadPhaseCandidateCacheChangesTest, StaticsAddedOrRemovedBeforeASearchAreS
         boxes.push_back({BodyID(500 + i, 1), Box(center + Vec3(0, 0.2f, 0), 0.2f), Layers::cMoving});
         active.push_back(boxes.back().mID);
     }
+    // Far away statics, so that the static tree is large enough to be served from the cache
+    for (uint32_t i = 0; i < BroadPhaseQuadTree::cMinCachedTreeBodies; ++i)
+        tiles.push_back(
+            {BodyID(2000 + i, 1), Box(Vec3(500.0f + float(i), 0.0f, 500.0f), 0.4f), Layers::cStatic});
     broadPhase.AddBodiesFinalize(broadPhase.AddBodiesPrepare(tiles));
     broadPhase.AddBodiesFinalize(broadPhase.AddBodiesPrepare(boxes));
     broadPhase.Update();

@@ -331,7 +331,8 @@ uint32_t BroadPhaseQuadTree::PrepareCachedTrees(uint32_t inNumActive) const
     {
         // Acquire: pairs with CountTreeChanges; a change whose count we see is in the walks that follow
         const uint64_t changes = mTreeChanges[tree].load(std::memory_order_acquire);
-        if (changes == mSeenTreeChanges[tree]) cached |= 1u << tree;
+        if (changes == mSeenTreeChanges[tree] && mTrees[tree]->GetNumBodies() >= cMinCachedTreeBodies)
+            cached |= 1u << tree;
         mSeenTreeChanges[tree] = changes;
     }
     if (mCandidateCacheMargin <= 0.0f) cached = 0;

@@ -103,7 +103,8 @@ AABB Box(const Vec3& inCenter, float inHalfExtent)
     return AABB::FromCenterExtent(inCenter, Vec3::Constant(inHalfExtent));
 }
 
-/// A floor of static tiles (1 m apart, 0.9 m wide) and boxes resting on it, each over a different tile.
+/// A floor of static tiles (1 m apart, 0.9 m wide) and boxes resting on it, each over a different tile, and
+/// far away enough statics for the static tree to be served from the cache (cMinCachedTreeBodies).
 struct RestingScene
 {
     std::vector<BroadPhaseBody> mStatics, mMoving;
@@ -116,6 +117,9 @@ struct RestingScene
             for (uint32_t z = 0; z < inSide; ++z)
                 mStatics.push_back(
                     {BodyID(index++, 1), Box(Vec3(float(x), -0.45f, float(z)), 0.45f), Layers::cStatic});
+        for (uint32_t i = 0; i < BroadPhaseQuadTree::cMinCachedTreeBodies; ++i)
+            mStatics.push_back(
+                {BodyID(index++, 1), Box(Vec3(1000.0f + float(i), 0.0f, 0.0f), 0.4f), Layers::cStatic});
         for (uint32_t x = 0; x < inSide; x += inEvery)
             for (uint32_t z = 0; z < inSide; z += inEvery)
             {
@@ -175,6 +179,20 @@ TEST(BroadPhaseCandidateCacheTest, RestingBodiesReuseTheirCandidatesWithTheSameP
         else
             EXPECT_EQ(Queries(stats), 0u) << "margin 0 turns the cache off";
     }
+}
+
+TEST(BroadPhaseCandidateCacheTest, SmallTreesAreAlwaysWalked)
+{
+    // The resting scene without its far statics: 900 tiles, under cMinCachedTreeBodies
+    Worlds worlds;
+    RestingScene scene(30, 3);
+    scene.mStatics.resize(30 * 30);
+    static_assert(30 * 30 < BroadPhaseQuadTree::cMinCachedTreeBodies);
+    worlds.Add(scene.mStatics);
+    worlds.Add(scene.mMoving);
+    for (int call = 0; call < 4; ++call)
+        EXPECT_EQ(worlds.ExpectSamePairs(scene.mActive, "a small static tree"), scene.mActive.size());
+    EXPECT_EQ(Queries(worlds.Tested().GetCandidateCacheStats()), 0u);
 }
 
 TEST(BroadPhaseCandidateCacheTest, BodiesLeavingTheirGrownBoxAreWalkedAgain)

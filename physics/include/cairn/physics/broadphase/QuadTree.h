@@ -170,6 +170,11 @@ public:
     bool CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
                    float& ioMaxFraction, RayBodyVisitor inVisitor) const;
 
+    /// Bodies linked (a snapshot: others may be adding and removing).
+    uint32_t GetNumBodies() const
+    {
+        return mNumBodies.load(std::memory_order_relaxed); // Relaxed: a size hint, see mNumBodies
+    }
     /// True when the body (exact id) is in a built or linked sub-tree of this tree.
     bool Contains(BodyID inBody) const;
     /// Starts fetching the cache lines of the node that holds body index inIndex, if it is in this tree: a
