@@ -29,7 +29,7 @@ PairCandidateCache::Entry* PairCandidateCache::FindOrClaim(uint32_t inIndex)
 {
     if (mCapacity == 0 || inIndex == cEmptyKey) return nullptr;
     const uint32_t mask = mCapacity - 1;
-    uint32_t slot = (inIndex * 2654435761u) >> mHashShift; // Fibonacci hashing: neighbouring indices spread
+    uint32_t slot = HomeSlot(inIndex);
     for (uint32_t probe = 0; probe < mCapacity; ++probe, slot = (slot + 1) & mask)
     {
         Entry& entry = mEntries[slot];

@@ -61,6 +61,15 @@ public:
     /// The entry of body index inIndex, claimed (with a fresh, invalid payload) if it has none; nullptr when
     /// the table is too full (the body's trees are then walked). Any range thread, for its own bodies.
     Entry* FindOrClaim(uint32_t inIndex);
+    /// Starts fetching the first cache lines of body index inIndex's likely entry (a hint; reads nothing).
+    void Prefetch(uint32_t inIndex) const
+    {
+        if (mCapacity == 0) return;
+        const char* entry = reinterpret_cast<const char*>(&mEntries[HomeSlot(inIndex)]);
+        __builtin_prefetch(entry);
+        __builtin_prefetch(entry + 64);
+        __builtin_prefetch(entry + 128);
+    }
     /// Bytes held (the table). Any thread.
     size_t GetMemoryBytes() const
     {
@@ -68,6 +77,9 @@ public:
     }
 
 private:
+    /// Where inIndex's probe starts. Fibonacci hashing: neighbouring indices spread over the table
+    uint32_t HomeSlot(uint32_t inIndex) const { return (inIndex * 2654435761u) >> mHashShift; }
+
     std::unique_ptr<Entry[]> mEntries;
     uint32_t mCapacity = 0;        ///< A power of two, or 0 before the first Prepare
     uint32_t mHashShift = 32;      ///< 32 - log2(mCapacity): the hash's top bits index the table
