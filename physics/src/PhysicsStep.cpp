@@ -190,6 +190,8 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
     ioStatistics.mNumContactPoints += mNumContactPoints;
     ioStatistics.mNumIslands += numIslands;
+    ioStatistics.mNumColoredIslands += mNumColoredIslands;
+    ioStatistics.mNumColoringsReused += mNumColoringsReused;
     ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
 
     UpdateBoundsAndSleep(inDeltaTime);
@@ -791,6 +793,11 @@ void PhysicsStep::OrderConstraints()
     for (uint32_t island = 0; island < numIslands; ++island) // In number order: ties stay so
         mIslandOrder[mIslandSizeStart[largest - mIslands.GetBodies(island).size()]++] = island;
     mIslandFirstColor.assign(numIslands, UINT32_MAX);
+    // This step's colorings go to the other set of records; the previous step's stay for reuse
+    mCurrentColorings = 1 - mCurrentColorings;
+    mNumColorings[mCurrentColorings] = 0;
+    mNumColoredIslands = 0;
+    mNumColoringsReused = 0;
     mColorStart.clear();
     mColorFirstBatch.clear();
     mNumWideBatches = 0;
@@ -845,41 +852,40 @@ void PhysicsStep::OrderConstraints()
 void PhysicsStep::ColorIsland(uint32_t inIsland)
 {
     const uint32_t begin = mConstraintStart[inIsland], end = mConstraintStart[inIsland + 1];
-    mBodyColors.resize(mBodies.GetActiveBodiesForStep().size(), 0);
-    mColorItems.resize(end - begin);
-    uint32_t count[cSerialColor + 1] = {};
-    // Greedy, in the hashed solve order: each constraint takes the lowest color that neither of its dynamic
-    // bodies has yet (static and kinematic bodies are only read by the solver, so they may repeat in a color)
-    for (uint32_t i = begin; i < end; ++i)
+    const uint32_t size = end - begin;
+    ++mNumColoredIslands;
+    // This step's record; the previous step's of the same size is the candidate for reuse
+    std::vector<ColoringRecord>& records = mColorings[mCurrentColorings];
+    if (records.size() <= mNumColorings[mCurrentColorings]) records.emplace_back();
+    ColoringRecord& record = records[mNumColorings[mCurrentColorings]++];
+    ColoringRecord* previous = nullptr;
+    if (mSettings.mSolver.mReuseColorings)
+        for (uint32_t r = 0; r < mNumColorings[1 - mCurrentColorings]; ++r)
+            if (ColoringRecord& candidate = mColorings[1 - mCurrentColorings][r];
+                candidate.mBodyPairs.size() == size)
+                previous = &candidate;
+    // The coloring is a function of the constraints' bodies in solve order alone
+    record.mBodyPairs.resize(size);
+    bool same = previous != nullptr;
+    for (uint32_t i = 0; i < size; ++i)
     {
-        const ConstraintInfo& info = mConstraintInfo[mOrderItems[i].mConstraint];
-        const uint32_t indexA = info.mBodyA, indexB = info.mBodyB;
-        const bool dynamicA = indexA != UINT32_MAX, dynamicB = indexB != UINT32_MAX;
-        const uint64_t taken = (dynamicA ? mBodyColors[indexA] : 0) | (dynamicB ? mBodyColors[indexB] : 0);
-        const uint32_t color = taken == ~uint64_t(0) ? cSerialColor : uint32_t(std::countr_zero(~taken));
-        if (color != cSerialColor)
-        {
-            if (dynamicA) mBodyColors[indexA] |= uint64_t(1) << color;
-            if (dynamicB) mBodyColors[indexB] |= uint64_t(1) << color;
-        }
-        // Within a color the order changes nothing (no two constraints share a dynamic body): by lowest
-        // dynamic body, so that one contiguous part per thread gives each thread the same region of the
-        // island in every color, and a body's velocities stay in one core's cache
-        mColorItems[i - begin] = {uint64_t(color) << 32 | std::min(indexA, indexB), i - begin};
-        ++count[color];
+        const ConstraintInfo& info = mConstraintInfo[mOrderItems[begin + i].mConstraint];
+        record.mBodyPairs[i] = uint64_t(info.mBodyA) << 32 | info.mBodyB;
+        same = same && record.mBodyPairs[i] == previous->mBodyPairs[i];
     }
-    for (uint32_t activeIndex : mIslands.GetBodies(inIsland))
-        mBodyColors[activeIndex] = 0;
-    // Keys computed once: the sort does not chase the constraints' body pointers. The items are in position
-    // order, so a stable sort by key gives the (key, position) order. Radix: a key has few significant bytes
-    // (the color and an active index), and the digit passes that are the same for all items are skipped
-    static_assert(cSerialColor < 256, "the color must fit the key's 40 bits");
-    RadixSort(
-        std::span<ColorItem>(mColorItems), mColorItemsScratch,
-        [](const ColorItem& inItem) { return inItem.mKey; }, 40);
-    mColorScratch.resize(end - begin);
-    for (uint32_t i = 0; i < end - begin; ++i)
-        mColorScratch[i] = mIslandConstraints[begin + mColorItems[i].mPosition];
+    if (same)
+    {
+        std::swap(record.mOrder, previous->mOrder); // The previous step's records are not read again
+        record.mCount = previous->mCount;
+        previous->mBodyPairs.clear(); // Nor matched twice
+        ++mNumColoringsReused;
+    }
+    else
+        ComputeColoring(record);
+    const std::array<uint32_t, cSerialColor + 1>& count = record.mCount;
+    mColorScratch.resize(size);
+    for (uint32_t i = 0; i < size; ++i)
+        mColorScratch[i] = mIslandConstraints[begin + record.mOrder[i]];
     std::copy(mColorScratch.begin(), mColorScratch.end(), mIslandConstraints.begin() + begin);
 
     mIslandFirstColor[inIsland] = uint32_t(mColorStart.size());
@@ -898,6 +904,48 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
     mColorStart.push_back(end);
     mColorIsSerial.push_back(0); // The end marker
     mColorFirstBatch.push_back(mNumWideBatches);
+}
+
+void PhysicsStep::ComputeColoring(ColoringRecord& ioRecord)
+{
+    const uint32_t size = uint32_t(ioRecord.mBodyPairs.size());
+    mBodyColors.resize(mBodies.GetActiveBodiesForStep().size(), 0);
+    mColorItems.resize(size);
+    std::array<uint32_t, cSerialColor + 1>& count = ioRecord.mCount;
+    count.fill(0);
+    // Greedy, in the hashed solve order: each constraint takes the lowest color that neither of its dynamic
+    // bodies has yet (static and kinematic bodies are only read by the solver, so they may repeat in a color)
+    for (uint32_t i = 0; i < size; ++i)
+    {
+        const uint32_t indexA = uint32_t(ioRecord.mBodyPairs[i] >> 32),
+                       indexB = uint32_t(ioRecord.mBodyPairs[i]);
+        const bool dynamicA = indexA != UINT32_MAX, dynamicB = indexB != UINT32_MAX;
+        const uint64_t taken = (dynamicA ? mBodyColors[indexA] : 0) | (dynamicB ? mBodyColors[indexB] : 0);
+        const uint32_t color = taken == ~uint64_t(0) ? cSerialColor : uint32_t(std::countr_zero(~taken));
+        if (color != cSerialColor)
+        {
+            if (dynamicA) mBodyColors[indexA] |= uint64_t(1) << color;
+            if (dynamicB) mBodyColors[indexB] |= uint64_t(1) << color;
+        }
+        // Within a color the order changes nothing (no two constraints share a dynamic body): by lowest
+        // dynamic body, so that one contiguous part per thread gives each thread the same region of the
+        // island in every color, and a body's velocities stay in one core's cache
+        mColorItems[i] = {uint64_t(color) << 32 | std::min(indexA, indexB), i};
+        ++count[color];
+    }
+    for (const uint64_t pair : ioRecord.mBodyPairs)
+        for (const uint32_t activeIndex : {uint32_t(pair >> 32), uint32_t(pair)})
+            if (activeIndex != UINT32_MAX) mBodyColors[activeIndex] = 0;
+    // Keys computed once: the sort does not chase the constraints' body pointers. The items are in position
+    // order, so a stable sort by key gives the (key, position) order. Radix: a key has few significant bytes
+    // (the color and an active index), and the digit passes that are the same for all items are skipped
+    static_assert(cSerialColor < 256, "the color must fit the key's 40 bits");
+    RadixSort(
+        std::span<ColorItem>(mColorItems), mColorItemsScratch,
+        [](const ColorItem& inItem) { return inItem.mKey; }, 40);
+    ioRecord.mOrder.resize(size);
+    for (uint32_t i = 0; i < size; ++i)
+        ioRecord.mOrder[i] = mColorItems[i].mPosition;
 }
 
 void PhysicsStep::SolveColoredIsland(uint32_t inIsland, float inDeltaTime, bool inAlone)

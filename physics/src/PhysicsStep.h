@@ -24,6 +24,7 @@
 #include "solver/WideContactSolver.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -238,6 +239,9 @@ private:
     void FinishIsland(uint32_t inIsland, float inDeltaTime);
     /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
     void ColorIsland(uint32_t inIsland);
+    struct ColoringRecord;
+    /// The greedy coloring of ioRecord.mBodyPairs: fills its order and counts.
+    void ComputeColoring(ColoringRecord& ioRecord);
     /// Solves a colored island with every thread: each color's constraints in parallel, the colors in turn;
     /// or, inAlone, on this thread only (the same results: within a color the order changes nothing).
     void SolveColoredIsland(uint32_t inIsland, float inDeltaTime, bool inAlone);
@@ -359,8 +363,23 @@ private:
     std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
     std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
-    std::vector<ContactConstraint*> mConstraints;  ///< This step's contacts, in the narrow phase's chunks
-    uint32_t mNumChunksUsed = 0;                   ///< Narrow-phase chunks used by this step's rounds
+    /// A coloring, kept for the next step: a resting pile's largest island has the same constraints between
+    /// the same bodies in most steps, and its coloring (greedy, then a sort) is serial work
+    struct ColoringRecord
+    {
+        std::vector<uint64_t> mBodyPairs; ///< Per constraint in solve order: active index A << 32 | B
+        std::vector<uint32_t> mOrder;     ///< Island positions in color order
+        std::array<uint32_t, cSerialColor + 1> mCount{}; ///< Constraints per color
+    };
+    /// The records of this step [0, mNumColorings[mCurrentColorings]) and of the previous one (the other
+    /// index); kept allocated. Physics step thread (OrderConstraints)
+    std::array<std::vector<ColoringRecord>, 2> mColorings;
+    std::array<uint32_t, 2> mNumColorings{};
+    uint32_t mCurrentColorings = 0;
+    uint32_t mNumColoredIslands = 0;              ///< This step's (statistics)
+    uint32_t mNumColoringsReused = 0;             ///< This step's (statistics)
+    std::vector<ContactConstraint*> mConstraints; ///< This step's contacts, in the narrow phase's chunks
+    uint32_t mNumChunksUsed = 0;                  ///< Narrow-phase chunks used by this step's rounds
     struct alignas(64) StageCounters
     {
         std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread

@@ -36,6 +36,8 @@ struct RunResult
     uint64_t mBodyPairs = 0;                             ///< Broad-phase pairs summed over all steps
     uint64_t mReusedBodyPairs = 0;                       ///< ... of which took last step's manifolds over
     BroadPhaseQuadTree::CandidateCacheStats mCandidates; ///< How the pair search served static candidates
+    uint64_t mColoredIslands = 0;                        ///< Islands colored, summed over all steps
+    uint64_t mReusedColorings = 0;                       ///< ... of which took the previous step's coloring
     int mSteps = 0;
 };
 
@@ -92,6 +94,8 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mContactPoints += stats.mNumContactPoints;
         result.mBodyPairs += stats.mNumBodyPairs;
         result.mReusedBodyPairs += stats.mNumReusedBodyPairs;
+        result.mColoredIslands += stats.mNumColoredIslands;
+        result.mReusedColorings += stats.mNumColoringsReused;
     }
     result.mStep = tools::Summarize(stepMs);
     for (const BodyID& id : inDynamic)
@@ -163,7 +167,7 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             "broadphase-update %.3f  "
             "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
             "contacts %llu  | pairs reused %.1f%%  | static candidates reused %.1f%% (%.1f%% walked, too "
-            "many)\n",
+            "many)  | colorings reused %llu of %llu\n",
             inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
             run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
             run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
@@ -171,7 +175,9 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             static_cast<unsigned long long>(run.mContactPoints),
             100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
             100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
-            100.0 * double(run.mCandidates.mWalked) / double(candidateQueries));
+            100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
+            static_cast<unsigned long long>(run.mReusedColorings),
+            static_cast<unsigned long long>(run.mColoredIslands));
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

@@ -1,10 +1,12 @@
 // The wide solver (four manifolds per SSE register, for colored islands) does the scalar solver's arithmetic
-// in the same order: the same scene gives the same body states either way, step after step.
+// in the same order: the same scene gives the same body states either way, step after step. The same for an
+// island's coloring taken over from the previous step (SolverSettings::mReuseColorings) and one made anew.
 
 #include "SimulationFixture.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <vector>
 
 namespace cairn::test
@@ -19,11 +21,12 @@ struct PyramidRun
 };
 
 /// A world without sleeping, with the wide solver on or off, and a static 80 m x 80 m floor at y = 0.
-PyramidRun MakeWorldWithFloor(bool inWide)
+PyramidRun MakeWorldWithFloor(bool inWide, bool inReuseColorings = true)
 {
     PhysicsSettings settings;
     settings.mAllowSleeping = false;
     settings.mSolver.mWideColoredIslands = inWide;
+    settings.mSolver.mReuseColorings = inReuseColorings;
     PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
     const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)run.mSystem->GetBodyInterface().CreateAndAddBody(floor, Activation::DontActivate);
@@ -31,9 +34,9 @@ PyramidRun MakeWorldWithFloor(bool inWide)
 }
 
 /// A pyramid of boxes, offset layer on layer, on a floor: one island large enough to be colored.
-PyramidRun MakePyramid(bool inWide)
+PyramidRun MakePyramid(bool inWide, bool inReuseColorings = true)
 {
-    PyramidRun run = MakeWorldWithFloor(inWide);
+    PyramidRun run = MakeWorldWithFloor(inWide, inReuseColorings);
     BodyInterface& bodies = run.mSystem->GetBodyInterface();
     const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     constexpr int cLayers = 6;
@@ -99,6 +102,64 @@ TEST(WideSolverTest, SameStatesAsTheScalarSolverOnTwoThreads)
     jobs::JobSystem jobSystem(settings);
     PyramidRun scalar = MakePyramid(false), wide = MakePyramid(true);
     StepBoth(scalar, wide, &jobSystem, 100);
+}
+
+TEST(WideSolverTest, AColoringTakenOverGivesTheSameStatesAsANewOne)
+{
+    jobs::JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    jobs::JobSystem jobSystem(settings);
+    PyramidRun fresh = MakePyramid(true, false), reused = MakePyramid(true, true);
+    StepBoth(fresh, reused, &jobSystem, 150);
+    StepBoth(fresh, reused, nullptr, 50);
+    // Once settled, the pyramid's contacts are the same from step to step: its coloring is taken over
+    uint32_t colored = 0, takenOver = 0;
+    for (int step = 0; step < 20; ++step)
+    {
+        for (PyramidRun* run : {&fresh, &reused})
+            ASSERT_TRUE(run->mSystem->Update(1.0f / 60.0f).IsOk());
+        colored += reused.mSystem->GetLastStepStatistics().mNumColoredIslands;
+        takenOver += reused.mSystem->GetLastStepStatistics().mNumColoringsReused;
+        EXPECT_EQ(fresh.mSystem->GetLastStepStatistics().mNumColoringsReused, 0u);
+    }
+    EXPECT_EQ(colored, 20u);
+    EXPECT_GE(takenOver, 15u);
+    StepBoth(fresh, reused, nullptr, 1); // Still the same states after those steps
+}
+
+TEST(WideSolverTest, ColoringsOfAPileFallingOverEachOtherAreTakenOverOnlyWhenTheSame)
+{
+    // Boxes dropped onto each other, turned: the pile's contacts change from step to step while their number
+    // often stays the same, so a coloring taken over on its size alone would solve other constraints together
+    auto makePile = [](bool inReuse)
+    {
+        PyramidRun run = MakeWorldWithFloor(true, inReuse);
+        BodyInterface& bodies = run.mSystem->GetBodyInterface();
+        const ShapeRef box = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+        for (int i = 0; i < 150; ++i)
+        {
+            BodyCreationSettings settings;
+            settings.mShape = box;
+            settings.mPosition =
+                Vec3(float(i % 5) * 1.02f, 0.5f + 1.2f * float(i / 25), float((i / 5) % 5) * 1.02f);
+            settings.mRotation =
+                Quat(Eigen::AngleAxisf(0.4f * float(i % 7), Vec3(0.3f, 1.0f, 0.2f).normalized()));
+            settings.mMotionType = MotionType::Dynamic;
+            settings.mObjectLayer = Layers::cMoving;
+            run.mBoxes.push_back(bodies.CreateAndAddBody(settings, Activation::Activate).Value());
+        }
+        return run;
+    };
+    PyramidRun fresh = makePile(false), reused = makePile(true);
+    uint32_t colored = 0, takenOver = 0;
+    for (int step = 0; step < 120; ++step)
+    {
+        StepBoth(fresh, reused, nullptr, 1);
+        colored += reused.mSystem->GetLastStepStatistics().mNumColoredIslands;
+        takenOver += reused.mSystem->GetLastStepStatistics().mNumColoringsReused;
+    }
+    EXPECT_GT(colored, 60u) << "the pile must be colored for the test to mean anything";
+    std::printf("[ figure   ] %u of %u colorings taken over\n", takenOver, colored);
 }
 
 /// Small islands: single boxes, stacks of two and three, and tilted boxes on a floor (one to four

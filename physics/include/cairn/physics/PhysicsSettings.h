@@ -67,7 +67,9 @@ struct StepStatistics
     uint32_t mNumContactPoints = 0;
     uint32_t mNumWarmStartedPoints = 0; ///< Contact points that took over last step's impulses
     uint32_t mNumIslands = 0;
-    uint32_t mLargestIsland = 0; ///< Bodies
+    uint32_t mLargestIsland = 0;      ///< Bodies
+    uint32_t mNumColoredIslands = 0;  ///< Islands colored for the parallel or wide solver
+    uint32_t mNumColoringsReused = 0; ///< ... of which took the previous step's coloring (mReuseColorings)
     /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
     /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
     /// to more than mTotalMs

@@ -16,6 +16,10 @@ struct SolverSettings
     /// Velocity iterations of large (colored) islands four manifolds at a time with SSE, where available.
     /// Same results bit for bit as the scalar solver (false), which is kept for comparison
     bool mWideColoredIslands = true;
+    /// An island whose constraints join the same bodies in the same solve order as an island colored in the
+    /// previous step takes that coloring over (the coloring depends on nothing else: same results bit for
+    /// bit); false colors every island anew, for comparison
+    bool mReuseColorings = true;
 };
 
 } // namespace cairn
