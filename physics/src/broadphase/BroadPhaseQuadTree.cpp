@@ -447,8 +447,18 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
                 }
                 continue;
             }
-            // New, stale or left its box: walk with grown bounds and remember what is there
-            const AABB grown = bounds.Expanded(margin);
+            // New, stale or left its box: walk with grown bounds and remember what is there. A body that left
+            // its box is moving: the box also reaches as far ahead as it moved since the box was made (at
+            // most 4 margins: a teleported body must not get a box so large that it holds too many candidates
+            // for as long as it stays inside). pile2k: 58 -> 77 % of the static queries served
+            AABB grown = bounds.Expanded(margin);
+            if (entry->mGeneration == generation && entry->mID == id)
+            {
+                const float reach = 4.0f * margin;
+                const Vec3 ahead =
+                    (bounds.Center() - entry->mGrownBounds.Center()).cwiseMax(-reach).cwiseMin(reach);
+                grown.Encapsulate(AABB(grown.mMin + ahead, grown.mMax + ahead));
+            }
             uint32_t count = 0;
             walkCached(grown,
                        [&](BodyID inOther, const AABB& inOtherBounds)

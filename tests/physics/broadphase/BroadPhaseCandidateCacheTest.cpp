@@ -201,7 +201,8 @@ TEST(BroadPhaseCandidateCacheTest, BodiesLeavingTheirGrownBoxAreWalkedAgain)
     RestingScene scene(30, 3);
     worlds.Add(scene.mStatics);
     worlds.Add(scene.mMoving);
-    // Every box slides 0.1 m a call along x over the tiles: out of its 0.25 m grown box every third call
+    // Every box slides 0.1 m a call along x over the tiles: out of its 0.25 m grown box after the third call,
+    // then out of boxes that also reach as far ahead as it moved (at most 1 m) every few calls
     for (int call = 0; call < 60; ++call)
     {
         for (BroadPhaseBody& body : scene.mMoving)
@@ -211,8 +212,8 @@ TEST(BroadPhaseCandidateCacheTest, BodiesLeavingTheirGrownBoxAreWalkedAgain)
         worlds.ExpectSamePairs(scene.mActive, "sliding", call % 2 == 0 ? 1 : 2);
     }
     const BroadPhaseQuadTree::CandidateCacheStats stats = worlds.Tested().GetCandidateCacheStats();
-    EXPECT_GT(stats.mRefilled, 15 * scene.mActive.size());
-    EXPECT_GT(stats.mReused, 30 * scene.mActive.size());
+    EXPECT_GT(stats.mRefilled, 4 * scene.mActive.size());
+    EXPECT_GT(stats.mReused, 40 * scene.mActive.size());
 }
 
 TEST(BroadPhaseCandidateCacheTest, ChangesToStaticBodiesAreSeenAtTheNextCall)
