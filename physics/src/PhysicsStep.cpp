@@ -190,7 +190,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mNumManifolds += uint32_t(mConstraints.size());
     ioStatistics.mNumContactPoints += mNumContactPoints;
     ioStatistics.mNumIslands += numIslands;
-    ioStatistics.mNumColoredIslands += mNumColoredIslands;
+    ioStatistics.mNumColoredIslands += mNumColorings[mCurrentColorings]; // A record per colored island
     ioStatistics.mNumColoringsReused += mNumColoringsReused;
     ioStatistics.mLargestIsland = std::max(ioStatistics.mLargestIsland, largestIsland);
 
@@ -796,7 +796,6 @@ void PhysicsStep::OrderConstraints()
     // This step's colorings go to the other set of records; the previous step's stay for reuse
     mCurrentColorings = 1 - mCurrentColorings;
     mNumColorings[mCurrentColorings] = 0;
-    mNumColoredIslands = 0;
     mNumColoringsReused = 0;
     mColorStart.clear();
     mColorFirstBatch.clear();
@@ -853,7 +852,6 @@ void PhysicsStep::ColorIsland(uint32_t inIsland)
 {
     const uint32_t begin = mConstraintStart[inIsland], end = mConstraintStart[inIsland + 1];
     const uint32_t size = end - begin;
-    ++mNumColoredIslands;
     // This step's record; the previous step's of the same size is the candidate for reuse
     std::vector<ColoringRecord>& records = mColorings[mCurrentColorings];
     if (records.size() <= mNumColorings[mCurrentColorings]) records.emplace_back();

@@ -376,8 +376,7 @@ private:
     std::array<std::vector<ColoringRecord>, 2> mColorings;
     std::array<uint32_t, 2> mNumColorings{};
     uint32_t mCurrentColorings = 0;
-    uint32_t mNumColoredIslands = 0;              ///< This step's (statistics)
-    uint32_t mNumColoringsReused = 0;             ///< This step's (statistics)
+    uint32_t mNumColoringsReused = 0;             ///< This step's (statistics; colored islands: its records)
     std::vector<ContactConstraint*> mConstraints; ///< This step's contacts, in the narrow phase's chunks
     uint32_t mNumChunksUsed = 0;                  ///< Narrow-phase chunks used by this step's rounds
     struct alignas(64) StageCounters

@@ -814,11 +814,6 @@ QuadTree::MemoryStats QuadTree::GetMemoryStats() const
 
 int64_t QuadTree::Validate() const
 {
-    auto BoxContains = [](const AABB& inOuter, const AABB& inInner)
-    {
-        return (inOuter.mMin.array() <= inInner.mMin.array()).all() &&
-               (inInner.mMax.array() <= inOuter.mMax.array()).all();
-    };
     // Single-threaded (tests): relaxed loads throughout
     int64_t bodies = 0;
     NodeStack stack;
@@ -841,8 +836,7 @@ int64_t QuadTree::Validate() const
                     (nodeIndex << 2 | uint32_t(s)))
                     return -1;
                 AABB exact;
-                if (!QuadTreeBodyTable::LoadBounds(mBodies[index], exact) || !BoxContains(slot, exact))
-                    return -1;
+                if (!QuadTreeBodyTable::LoadBounds(mBodies[index], exact) || !slot.Contains(exact)) return -1;
                 ++bodies;
                 continue;
             }
@@ -852,7 +846,7 @@ int64_t QuadTree::Validate() const
             {
                 const AABB childSlot = LoadSlot(childNode, c);
                 if (childNode.mChild[c].load(std::memory_order_relaxed) != cInvalidChild &&
-                    !IsEmptyBox(childSlot) && !BoxContains(slot, childSlot))
+                    !IsEmptyBox(childSlot) && !slot.Contains(childSlot))
                     return -1;
             }
             stack.Push(child);

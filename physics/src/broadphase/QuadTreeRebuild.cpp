@@ -209,11 +209,10 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 const AABB& built = relocation.mBuiltBounds;
                 if (exact.mMin != built.mMin || exact.mMax != built.mMax)
                 {
-                    // Relaxed: the node is private until the swap below (release) publishes it
+                    // Relaxed: the node is private until the swap below (release) publishes it, so no other
+                    // core holds its line (MoveBody's read before the write is for published nodes)
                     Node& node = GetNode(newNode);
-                    const uint8_t looseBit = uint8_t(1u << newSlot);
-                    if ((node.mLoose.load(std::memory_order_relaxed) & looseBit) == 0)
-                        node.mLoose.fetch_or(looseBit, std::memory_order_relaxed);
+                    node.mLoose.fetch_or(uint8_t(1u << newSlot), std::memory_order_relaxed);
                     if (!built.Contains(exact))
                     {
                         GrowSlot(node, newSlot, exact);
