@@ -68,6 +68,7 @@ BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& i
     {
         mTrees.push_back(std::make_unique<QuadTree>(mBodies, uint8_t(layer), maxNodes, rebuildReserve));
         mTrees.back()->SetMovedSlotMargin(cMovedSlotMargin);
+        mTrees.back()->SetMovedSlotReach(cMovedSlotReach);
         mObjectLayersOfTree[layer] = mLayerSetup.GetObjectLayersIn(BroadPhaseLayer(layer));
     }
 }

@@ -53,6 +53,37 @@ AABB UnionOfSlots(const QuadTree::Node& inNode)
 
 } // namespace
 
+AABB QuadTree::MovedSlot(const AABB& inBounds, const AABB& inOldSlot, uint8_t inStretchedSides,
+                         uint8_t& outStretchedSides) const
+{
+    AABB slot = inBounds.Expanded(mMovedSlotMargin);
+    outStretchedSides = 0;
+    if (mMovedSlotReach == 0.0f) return slot;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+        const uint8_t minSide = uint8_t(1u << (2 * axis)), maxSide = uint8_t(2u << (2 * axis));
+        // Room left above the body means it moved towards min, and the other way round. An empty slot (the
+        // body removed meanwhile) leaves no room on either side: its min is +large and its max -large
+        const float leftAbove = (inStretchedSides & maxSide) != 0
+                                    ? 0.0f
+                                    : inOldSlot.mMax[axis] - inBounds.mMax[axis] - mMovedSlotMargin;
+        const float leftBelow = (inStretchedSides & minSide) != 0
+                                    ? 0.0f
+                                    : inBounds.mMin[axis] - inOldSlot.mMin[axis] - mMovedSlotMargin;
+        if (leftAbove > 0.0f)
+        {
+            slot.mMin[axis] -= std::min(mMovedSlotReach * leftAbove, cMaxMovedSlotReach);
+            outStretchedSides |= minSide;
+        }
+        if (leftBelow > 0.0f)
+        {
+            slot.mMax[axis] += std::min(mMovedSlotReach * leftBelow, cMaxMovedSlotReach);
+            outStretchedSides |= maxSide;
+        }
+    }
+    return slot;
+}
+
 QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
 {
     RebuildStats stats;
@@ -93,13 +124,17 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             if ((child & cBodyFlag) != 0)
             {
                 AABB bounds;
-                if (!QuadTreeBodyTable::LoadBounds(mBodies[child & ~cBodyFlag], bounds))
+                QuadTreeBodyTable::Entry& entry = mBodies[child & ~cBodyFlag];
+                const uint8_t stretchedSides = entry.mSlotReachSides;
+                entry.mSlotReachSides = 0;
+                if (!QuadTreeBodyTable::LoadBounds(entry, bounds))
                     bounds = LoadSlot(node, s); // Being moved: the commit sets the exact bounds
                 // A body that moved since the last rebuild (its slot is loose) gets a slot grown by the
-                // margin: while it stays inside, its moves write nothing to the tree (see MoveBody). Relaxed:
-                // the bit is only read here to choose; the commit handles moves made meanwhile
+                // margin, and stretched ahead of its motion: while it stays inside, its moves write nothing
+                // to the tree (see MoveBody). Relaxed: the bit is only read here to choose; the commit
+                // handles moves made meanwhile
                 else if (mMovedSlotMargin > 0.0f && ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u))
-                    bounds = bounds.Expanded(mMovedSlotMargin);
+                    bounds = MovedSlot(bounds, LoadSlot(node, s), stretchedSides, entry.mSlotReachSides);
                 items.push_back({child, bounds, nodeIndex << 2 | uint32_t(s)});
                 continue;
             }

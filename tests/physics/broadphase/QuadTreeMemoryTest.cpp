@@ -43,9 +43,10 @@ TEST(QuadTreeMemoryTest, AnUpdatesOldNodesAreFreedByTheNextUpdate)
     uint32_t firstRetired = 0;
     for (int frame = 0; frame < 5; ++frame)
     {
+        // Back and forth: a steady move would stay inside the slots a rebuild stretches ahead of it
+        const Vec3 delta = (frame % 2 == 0 ? 1.0f : -1.0f) * Vec3(0.3f, 0.0f, -0.2f);
         for (BroadPhaseBody& body : moving)
-            body.mBounds =
-                AABB(body.mBounds.mMin + Vec3(0.3f, 0.0f, -0.2f), body.mBounds.mMax + Vec3(0.3f, 0, -0.2f));
+            body.mBounds = AABB(body.mBounds.mMin + delta, body.mBounds.mMax + delta);
         broadPhase.NotifyBodiesAABBChanged(moving);
         broadPhase.Update();
         const uint32_t retired = broadPhase.GetMemoryStats().mNodesRetired;

@@ -1,6 +1,7 @@
-// A rebuild grows the slots of the bodies that had moved by a margin (BroadPhaseQuadTree::cMovedSlotMargin):
-// their next small moves write no node, so the tree is unchanged and the next update rebuilds nothing.
-// Queries must still report exactly the bodies whose own bounds match, not their grown slots.
+// A rebuild grows the slots of the bodies that had moved by a margin (BroadPhaseQuadTree::cMovedSlotMargin)
+// and stretches them ahead of their motion (cMovedSlotReach): their next small moves, and the next few steps
+// of a steady fall, write no node, so the tree is unchanged and the next update rebuilds nothing. Queries
+// must still report exactly the bodies whose own bounds match, not their grown slots.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
@@ -28,23 +29,32 @@ AABB Shifted(const AABB& inBox, const Vec3& inDelta)
     return AABB(inBox.mMin + inDelta, inBox.mMax + inDelta);
 }
 
+/// inCount bodies of 0.8 m in a 60 m x 60 m field, added to both broad phases; the tested one updated.
+std::vector<BroadPhaseBody> AddField(uint32_t inCount, test::TestRandom& ioRandom,
+                                     BroadPhaseQuadTree& ioTested, BroadPhaseBruteForce& ioReference)
+{
+    std::vector<BroadPhaseBody> bodies;
+    for (uint32_t i = 0; i < inCount; ++i)
+    {
+        const Vec3 centre(ioRandom.Uniform(0.0f, 60.0f), ioRandom.Uniform(0.0f, 4.0f),
+                          ioRandom.Uniform(0.0f, 60.0f));
+        bodies.push_back(
+            {BodyID(i, 1), AABB::FromCenterExtent(centre, Vec3::Constant(0.4f)), Layers::cMoving});
+    }
+    for (BroadPhase* broadPhase :
+         {static_cast<BroadPhase*>(&ioTested), static_cast<BroadPhase*>(&ioReference)})
+        broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
+    ioTested.Update();
+    return bodies;
+}
+
 TEST(QuadTreeMovedSlotTest, SmallMovesAfterARebuildChangeNoNodeAndQueriesStayExact)
 {
     static_assert(BroadPhaseQuadTree::cMovedSlotMargin >= 0.02f, "the jiggles below must fit in the margin");
     test::TestRandom random(3);
-    std::vector<BroadPhaseBody> moving;
-    for (uint32_t i = 0; i < 2000; ++i)
-    {
-        const Vec3 centre(random.Uniform(0.0f, 60.0f), random.Uniform(0.0f, 4.0f),
-                          random.Uniform(0.0f, 60.0f));
-        moving.push_back(
-            {BodyID(i, 1), AABB::FromCenterExtent(centre, Vec3::Constant(0.4f)), Layers::cMoving});
-    }
     BroadPhaseQuadTree tested(2000, LayerSetup::CreateDefault());
     BroadPhaseBruteForce reference;
-    for (BroadPhase* broadPhase : {static_cast<BroadPhase*>(&tested), static_cast<BroadPhase*>(&reference)})
-        broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(moving));
-    tested.Update();
+    std::vector<BroadPhaseBody> moving = AddField(2000, random, tested, reference);
     auto moveAll = [&](float inStep)
     {
         for (BroadPhaseBody& body : moving)
@@ -84,6 +94,74 @@ TEST(QuadTreeMovedSlotTest, SmallMovesAfterARebuildChangeNoNodeAndQueriesStayExa
     tested.Update();
     EXPECT_GT(tested.GetLastUpdateStats().mLayersRebuilt, 0u);
     expectExactQueries("after the second rebuild");
+    EXPECT_TRUE(tested.Validate());
+}
+
+/// Moves every body by inDelta in both broad phases and checks queries around some of them.
+void MoveAllAndCheck(std::vector<BroadPhaseBody>& ioBodies, const Vec3& inDelta, BroadPhaseQuadTree& ioTested,
+                     BroadPhaseBruteForce& ioReference)
+{
+    for (BroadPhaseBody& body : ioBodies)
+        body.mBounds = Shifted(body.mBounds, inDelta);
+    ioTested.NotifyBodiesAABBChanged(ioBodies);
+    ioReference.NotifyBodiesAABBChanged(ioBodies);
+    for (size_t i = 0; i < ioBodies.size(); i += 13)
+        for (const float grow : {-0.1f, 0.0f, 0.2f})
+        {
+            const AABB box = ioBodies[i].mBounds.Expanded(grow);
+            ASSERT_EQ(BoxQuery(ioTested, box), BoxQuery(ioReference, box)) << "body " << i;
+        }
+}
+
+TEST(QuadTreeMovedSlotTest, SteadyFallIsRebuiltIntoSlotsStretchedAheadAndQueriesStayExact)
+{
+    static_assert(BroadPhaseQuadTree::cMovedSlotReach >= 2.0f, "the count below assumes slots reach 2 moves");
+    BroadPhaseQuadTree tested(1000, LayerSetup::CreateDefault());
+    BroadPhaseBruteForce reference;
+    test::TestRandom random(5);
+    std::vector<BroadPhaseBody> bodies = AddField(1000, random, tested, reference);
+    // 10 cm a frame straight down: each rebuild stretches the slots below by twice the fall since the last
+    // one, so the falls between rebuilds lengthen (1, 2, 4, ... frames) until the 1 m cap. Exact slots would
+    // rebuild every frame; the margin alone (5 cm) too
+    constexpr int cFrames = 30;
+    int rebuilds = 0;
+    for (int frame = 0; frame < cFrames; ++frame)
+    {
+        MoveAllAndCheck(bodies, Vec3(0.0f, -0.1f, 0.0f), tested, reference);
+        tested.Update();
+        rebuilds += tested.GetLastUpdateStats().mLayersRebuilt > 0 ? 1 : 0;
+        ASSERT_TRUE(tested.Validate()) << "frame " << frame;
+    }
+    EXPECT_GE(rebuilds, 3) << "the falling bodies left their slots now and then";
+    EXPECT_LE(rebuilds, cFrames / 3) << "the slots reached ahead of the fall";
+}
+
+TEST(QuadTreeMovedSlotTest, BodiesThatStopGiveBackTheStretchAtTheNextRebuilds)
+{
+    BroadPhaseQuadTree tested(1000, LayerSetup::CreateDefault());
+    BroadPhaseBruteForce reference;
+    test::TestRandom random(5);
+    std::vector<BroadPhaseBody> bodies = AddField(1000, random, tested, reference);
+    MoveAllAndCheck(bodies, Vec3(0.0f, -0.3f, 0.0f), tested, reference);
+    tested.Update(); // The slots stretch 0.5 m below (twice the 0.25 m past the margin)
+    // At rest, as an awake body is: notified every frame with the same bounds (its slot stays loose). Each
+    // full rebuild must see no move, not take the stretch the body did not use for room left behind (that
+    // would stretch the slot the other way, and back, up to the cap)
+    for (int rebuild = 0; rebuild < 3; ++rebuild)
+    {
+        MoveAllAndCheck(bodies, Vec3::Zero(), tested, reference);
+        tested.RebuildAll();
+    }
+    // Back to the margin on every side: a 10 cm move either way leaves the slots
+    for (const float dy : {0.1f, -0.1f})
+    {
+        MoveAllAndCheck(bodies, Vec3::Zero(), tested, reference);
+        tested.RebuildAll();
+        MoveAllAndCheck(bodies, Vec3(0.0f, dy, 0.0f), tested, reference);
+        tested.Update();
+        EXPECT_GT(tested.GetLastUpdateStats().mLayersRebuilt, 0u) << "a move of " << dy << " m stayed inside";
+        MoveAllAndCheck(bodies, Vec3(0.0f, -dy, 0.0f), tested, reference); // Back where they rested
+    }
     EXPECT_TRUE(tested.Validate());
 }
 

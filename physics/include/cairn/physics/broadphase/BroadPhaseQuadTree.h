@@ -99,6 +99,9 @@ public:
     /// Slot margin of the bodies that moved since a tree's last rebuild (QuadTree::SetMovedSlotMargin): a
     /// resting body's jitter stays inside, so its moves write no node.
     static constexpr float cMovedSlotMargin = 0.05f;
+    /// Stretch of a moved body's slot ahead of its motion, in moves since the last rebuild
+    /// (QuadTree::SetMovedSlotReach): a falling box then writes a node every third step, not every step.
+    static constexpr float cMovedSlotReach = 2.0f;
 
     /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +
     /// 1,024 nodes per layer (the new and old trees of a fully changed layer fit twice over).

@@ -146,6 +146,17 @@ public:
     {
         mMovedSlotMargin = inMargin > 0.0f && inMargin < cLargeFloat ? inMargin : 0.0f;
     }
+    /// Longest stretch of a moved body's slot ahead of its motion (see SetMovedSlotReach).
+    static constexpr float cMaxMovedSlotReach = 1.0f;
+    /// How far ahead a rebuild stretches the slot of a body that moved since the previous rebuild, in
+    /// multiples of that move (on each axis, past the margin, at most cMaxMovedSlotReach; 0: no stretch). A
+    /// falling or sliding body then crosses its slot in that many steps without writing a node: no ancestor
+    /// grown up to the root on every step (cache lines taken from the other core) and no path for the next
+    /// rebuild. Needs a margin (SetMovedSlotMargin). Update thread, or before the tree is shared.
+    void SetMovedSlotReach(float inMoves)
+    {
+        mMovedSlotReach = inMoves > 0.0f && inMoves < cLargeFloat ? inMoves : 0.0f;
+    }
     /// Rebuilds the changed parts (everything when inFull) into a new tree and swaps it in. Update thread.
     RebuildStats Rebuild(bool inFull);
     /// Advances the reclaimer and frees retired nodes that no query can reach any more. Update thread.
@@ -237,6 +248,13 @@ private:
     static void GrowSlot(Node& ioNode, int inSlot, const AABB& inBounds);
     /// Empties a slot (bounds and child).
     static void ClearSlot(Node& ioNode, int inSlot);
+    /// The slot a rebuild gives a body that moved (see SetMovedSlotReach): inBounds grown by the margin and,
+    /// on each axis, stretched ahead by the room the body left behind in inOldSlot. That room is only on a
+    /// side the last rebuild did not stretch (inStretchedSides, the body table's mSlotReachSides): a stretch
+    /// the body has not used is not a move, else an idle body's slot would grow at every rebuild.
+    /// outStretchedSides: the sides stretched now.
+    AABB MovedSlot(const AABB& inBounds, const AABB& inOldSlot, uint8_t inStretchedSides,
+                   uint8_t& outStretchedSides) const;
     /// Slot bounds as read now (each float atomically).
     static AABB LoadSlot(const Node& inNode, int inSlot)
     {
@@ -293,6 +311,7 @@ private:
     std::vector<uint32_t> mRebuildMark;                        ///< Update thread only: node -> rebuild stamp
     uint32_t mRebuildStamp = 0;                                ///< Update thread only
     float mMovedSlotMargin = 0.0f;                             ///< Update thread only (SetMovedSlotMargin)
+    float mMovedSlotReach = 0.0f;                              ///< Update thread only (SetMovedSlotReach)
 };
 
 } // namespace cairn

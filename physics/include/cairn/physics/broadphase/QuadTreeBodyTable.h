@@ -40,6 +40,12 @@ public:
         /// 1 while BroadPhaseQuadTree::FindCollidingPairs runs and the body is active. Plain: only the
         /// physics step touches it, one call at a time; it fills padding, so it costs no memory.
         mutable uint8_t mActiveInStep = 0;
+        /// Sides of the body's slot that the last rebuild stretched ahead of its motion (bit 2a: the min side
+        /// of axis a, bit 2a + 1: the max side), so that the next rebuild tells that stretch from the room
+        /// the body left behind. Plain: only rebuilds read and write it, one at a time
+        /// (BroadPhaseQuadTree::Update rebuilds its trees in turn); a stale value (a body removed and another
+        /// added at its index) only makes one slot reach less far. It fills padding, so it costs no memory.
+        uint8_t mSlotReachSides = 0;
     };
 
     explicit QuadTreeBodyTable(uint32_t inMaxBodies)
