@@ -62,9 +62,11 @@ void CellTriangle(const HeightFieldShape& inField, uint32_t inX, uint32_t inZ, i
         outV[i] = SamplePosition(inField, inX + cHalfCorners[inHalf][i][0], inZ + cHalfCorners[inHalf][i][1]);
 }
 
+/// A cell half's normal, not normalised (IsEdgeActive takes any length): never zero, its y is the cell size
+/// squared; finite, the heights are bounded (Create).
 Vec3 FaceNormal(const Vec3 inV[3])
 {
-    return ShapeHelpers::SafeNormalized((inV[1] - inV[0]).cross(inV[2] - inV[0]), Vec3::UnitY());
+    return (inV[1] - inV[0]).cross(inV[2] - inV[0]);
 }
 
 /// Edge flags of a cell half, computed from its neighbours on demand (no per-cell storage to keep in sync).

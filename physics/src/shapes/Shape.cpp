@@ -96,7 +96,13 @@ Vec3 TriangleNormalFacing(const Vec3& inV0, const Vec3& inV1, const Vec3& inV2, 
 bool IsEdgeActive(const Vec3& inNormal, const Vec3& inEdgePoint, const Vec3& inNeighbourNormal,
                   const Vec3& inNeighbourApex, float inCosThreshold)
 {
-    if (inNormal.dot(inNeighbourNormal) > inCosThreshold) return false;
+    // The cosine from normals of any length: the height field tests its triangles' edges on every visit, and
+    // normalising the four normals each took most of a terrain query's time. In double: the squared
+    // lengths of a large triangle's normal (its doubled area) overflow a float
+    const Eigen::Vector3d normal = inNormal.cast<double>(), neighbour = inNeighbourNormal.cast<double>();
+    if (normal.dot(neighbour) >
+        double(inCosThreshold) * std::sqrt(normal.squaredNorm() * neighbour.squaredNorm()))
+        return false;
     // A neighbour rising in front of this triangle's plane makes a concave joint: nothing can touch its
     // edge from outside without touching one of the two faces first
     const bool concave = inNormal.dot(inNeighbourApex - inEdgePoint) > 0.0f;

@@ -202,6 +202,21 @@ TEST(HeightFieldShapeTest, VisitTrianglesSupersetAndHoles)
     }
 }
 
+/// Active edges of inField's triangles lying along x = inX: 2 of them in the fields below.
+int ActiveEdgesAlongX(const HeightFieldShape& inField, float inX)
+{
+    int activeCount = 0, count = 0;
+    for (const Triangle& t : AllTriangles(inField))
+        for (int e = 0; e < 3; ++e)
+            if (t.mV[e].x() == inX && t.mV[(e + 1) % 3].x() == inX)
+            {
+                ++count;
+                activeCount += (t.mActiveEdges & (1u << e)) != 0 ? 1 : 0;
+            }
+    EXPECT_EQ(count, 2);
+    return activeCount;
+}
+
 TEST(HeightFieldShapeTest, InternalEdges)
 {
     // Flat 2 x 2 cells: the edges on the border are active, every other edge is inactive
@@ -222,25 +237,12 @@ TEST(HeightFieldShapeTest, InternalEdges)
     EXPECT_EQ(active, 8);
 
     // A 90-degree convex ridge along z at x = 1 keeps its edge active; the mirrored valley (concave) does not
-    auto ridgeEdgeActive = [](const HeightFieldShape& inField)
-    {
-        int activeCount = 0, count = 0;
-        for (const Triangle& t : AllTriangles(inField))
-            for (int e = 0; e < 3; ++e)
-                if (t.mV[e].x() == 1.0f && t.mV[(e + 1) % 3].x() == 1.0f)
-                {
-                    ++count;
-                    activeCount += (t.mActiveEdges & (1u << e)) != 0 ? 1 : 0;
-                }
-        EXPECT_EQ(count, 2);
-        return activeCount;
-    };
     const auto ridge = MakeField(3, 2, 1.0f, {0, 1, 0, 0, 1, 0});
     ASSERT_NE(ridge, nullptr);
-    EXPECT_EQ(ridgeEdgeActive(*ridge), 2);
+    EXPECT_EQ(ActiveEdgesAlongX(*ridge, 1.0f), 2);
     const auto valley = MakeField(3, 2, 1.0f, {1, 0, 1, 1, 0, 1});
     ASSERT_NE(valley, nullptr);
-    EXPECT_EQ(ridgeEdgeActive(*valley), 0);
+    EXPECT_EQ(ActiveEdgesAlongX(*valley, 1.0f), 0);
 
     // Next to a hole the edge has no neighbour: active
     const float h = HeightFieldShape::cHole;
@@ -254,4 +256,21 @@ TEST(HeightFieldShapeTest, InternalEdges)
             {
                 EXPECT_NE(t.mActiveEdges & (1u << e), 0);
             }
+}
+
+TEST(HeightFieldShapeTest, InternalEdgesAtTheWorldsScale)
+{
+    // Cells of 200 km with heights of 200 km: the triangles' normals (edge cross products, not normalised)
+    // have squared lengths whose product overflows a float. The flat joint must still be internal, the ridge
+    // active and the valley internal
+    constexpr float cell = 2.0e5f;
+    const auto flat = MakeField(3, 2, cell, std::vector<float>(6, cell));
+    ASSERT_NE(flat, nullptr);
+    EXPECT_EQ(ActiveEdgesAlongX(*flat, cell), 0);
+    const auto ridge = MakeField(3, 2, cell, {0, cell, 0, 0, cell, 0});
+    ASSERT_NE(ridge, nullptr);
+    EXPECT_EQ(ActiveEdgesAlongX(*ridge, cell), 2);
+    const auto valley = MakeField(3, 2, cell, {cell, 0, cell, cell, 0, cell});
+    ASSERT_NE(valley, nullptr);
+    EXPECT_EQ(ActiveEdgesAlongX(*valley, cell), 0);
 }

@@ -169,9 +169,10 @@ float RayTriangleFraction(const RayCast& inRay, const Vec3& inV0, const Vec3& in
 /// Unit normal of a triangle facing against the ray direction (for two-sided hits).
 Vec3 TriangleNormalFacing(const Vec3& inV0, const Vec3& inV1, const Vec3& inV2, const Vec3& inRayDirection);
 
-/// True when an edge shared by a triangle (unit normal inNormal, inEdgePoint on the edge) and one neighbour
-/// (unit normal inNeighbourNormal, inNeighbourApex = its vertex not on the edge) must stay active: the joint
-/// is convex and not flat (normals' dot <= inCosThreshold). Flat and concave joints are internal (inactive).
+/// True when an edge shared by a triangle (normal inNormal, inEdgePoint on the edge) and one neighbour
+/// (normal inNeighbourNormal, inNeighbourApex = its vertex not on the edge) must stay active: the joint is
+/// convex and not flat (the normals' cosine <= inCosThreshold). Flat and concave joints are internal
+/// (inactive). The normals may have any finite, non-zero length (an edge cross product will do).
 bool IsEdgeActive(const Vec3& inNormal, const Vec3& inEdgePoint, const Vec3& inNeighbourNormal,
                   const Vec3& inNeighbourApex, float inCosThreshold);
 
