@@ -433,7 +433,10 @@ void JobSystem::WorkerMain()
         SpinUntil([] { return false; }); // Returns early when a job is queued
         if (mNumReady.load(std::memory_order_relaxed) != 0) continue;
         std::unique_lock lock(mQueueMutex);
+        // Relaxed: read only as a hint (GetNumWorkersAsleep)
+        mNumWorkersAsleep.fetch_add(1, std::memory_order_relaxed);
         mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
+        mNumWorkersAsleep.fetch_sub(1, std::memory_order_relaxed);
         if (mReadyCount == 0) return; // Stopping, and nothing left
         index = mReady[mReadyHead];
         mReadyHead = (mReadyHead + 1) % mMaxJobs;

@@ -213,7 +213,7 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
                          WideContactSolver::cPaddingBlocks * (mColorStart.size() + mNumIslandGroups));
     const uint32_t groupPaddingFirst =
         mPaddingBlocksFirst + WideContactSolver::cPaddingBlocks * uint32_t(mColorStart.size());
-    ParallelFor(numActive, 512,
+    ParallelFor(numActive, 512, 7, // ns a body (pile2k, as the estimates below)
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
@@ -243,7 +243,12 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
             mCopyRanges.back().second = begin;
         }
     }
+    uint32_t numCopied = 0;
+    for (const auto& [begin, end] : mCopyRanges)
+        numCopied += end - begin;
+    constexpr uint32_t cCopyNanoseconds = 110; // A constraint's copy and binding (pile2k)
     ParallelFor(uint32_t(mCopyRanges.size()), 1,
+                mCopyRanges.empty() ? 0 : cCopyNanoseconds * numCopied / uint32_t(mCopyRanges.size()),
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t range = inBegin; range < inEnd; ++range)
@@ -274,29 +279,36 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     // Islands share no dynamic body and no constraint. The colored islands with a quarter of the step first,
     // one at a time with every thread on each; then the others at once, the largest first so that the longest
     // starts early and the small ones fill in around it (colored ones among them by one thread each)
+    uint32_t numItemConstraints = uint32_t(mConstraints.size());
     for (uint32_t island : mColoredIslands)
+    {
         SolveColoredIsland(island, inDeltaTime, false);
-    ParallelFor(uint32_t(mSolveItems.size()), 1,
-                [&](uint32_t inBegin, uint32_t inEnd)
-                {
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                    {
-                        const SolveItem& item = mSolveItems[i];
-                        const uint32_t island = mSolvedIslands[item.mFirst];
-                        if (item.mGroup == UINT32_MAX && mIslandFirstColor[island] != UINT32_MAX)
-                            SolveColoredIsland(island, inDeltaTime, true);
-                        else if (item.mGroup == UINT32_MAX)
-                            SolveIsland(island, inDeltaTime);
-                        else
-                            SolveIslandGroup(
-                                std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
-                                groupPaddingFirst + WideContactSolver::cPaddingBlocks * item.mGroup,
-                                inDeltaTime);
-                    }
-                });
+        numItemConstraints -= mConstraintStart[island + 1] - mConstraintStart[island];
+    }
+    // A constraint's iterations, integration and position passes in an island or a group (pile2k)
+    constexpr uint32_t cSolveNanoseconds = 500;
+    ParallelFor(
+        uint32_t(mSolveItems.size()), 1,
+        mSolveItems.empty() ? 0 : cSolveNanoseconds * numItemConstraints / uint32_t(mSolveItems.size()),
+        [&](uint32_t inBegin, uint32_t inEnd)
+        {
+            for (uint32_t i = inBegin; i < inEnd; ++i)
+            {
+                const SolveItem& item = mSolveItems[i];
+                const uint32_t island = mSolvedIslands[item.mFirst];
+                if (item.mGroup == UINT32_MAX && mIslandFirstColor[island] != UINT32_MAX)
+                    SolveColoredIsland(island, inDeltaTime, true);
+                else if (item.mGroup == UINT32_MAX)
+                    SolveIsland(island, inDeltaTime);
+                else
+                    SolveIslandGroup(
+                        std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
+                        groupPaddingFirst + WideContactSolver::cPaddingBlocks * item.mGroup, inDeltaTime);
+            }
+        });
     // A body with nothing to solve keeps the velocity its forces gave it. One chunk per island made the
     // threads fight over the chunk cursor when thousands of bodies fall freely
-    ParallelFor(uint32_t(mUnconstrainedBodies.size()), 256,
+    ParallelFor(uint32_t(mUnconstrainedBodies.size()), 256, 15, // An integration
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)
@@ -413,7 +425,7 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         const size_t end = active.size();
         const std::span<const uint32_t> slice(active.data() + begin, end - begin);
         mInverseInertia.resize(end);
-        ParallelFor(uint32_t(slice.size()), 256,
+        ParallelFor(uint32_t(slice.size()), 256, 30, // A body's forces and world inertia
                     [&](uint32_t inB, uint32_t inE)
                     { ApplyForces(slice.subspan(inB, inE - inB), inDeltaTime); });
         FindPairs(begin);
@@ -427,7 +439,8 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         const uint32_t firstChunk = mNumChunksUsed;
         mNumChunksUsed += numChunks;
         if (mNarrowPhaseChunks.size() < mNumChunksUsed) mNarrowPhaseChunks.resize(mNumChunksUsed);
-        ParallelFor(numChunks, 1,
+        constexpr uint32_t cPairNanoseconds = 425; // pile2k's boxes; a box on a height field takes more
+        ParallelFor(numChunks, 1, cPairsPerChunk * cPairNanoseconds,
                     [&](uint32_t inB, uint32_t inE)
                     {
                         for (uint32_t chunk = inB; chunk < inE; ++chunk)
@@ -474,7 +487,7 @@ void PhysicsStep::CollideNewlyActive(size_t inBegin, float inDeltaTime)
         const size_t firstConstraint = mConstraints.size();
         mConstraints.resize(firstConstraint + numManifolds);
         mConstraintInfo.resize(firstConstraint + numManifolds);
-        ParallelFor(numChunks, 4,
+        ParallelFor(numChunks, 4, 1'200, // A chunk's copies
                     [&](uint32_t inB, uint32_t inE)
                     {
                         for (uint32_t chunk = inB; chunk < inE; ++chunk)
@@ -539,7 +552,7 @@ void PhysicsStep::FindPairs(size_t inBegin)
         mPairChunks[chunk].mPairs.clear();
     // Named: a FunctionRef only refers to its callable, which must outlive it (a temporary lambda would not)
     auto runRanges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
-    { ParallelFor(inCount, cBodiesPerChunk, inRange); };
+    { ParallelFor(inCount, cBodiesPerChunk, 300, inRange); }; // A body's walks of the trees
     const ParallelRanges ranges = runRanges;
     mBroadPhase.FindCollidingPairs(
         sliceIDs, mLayers,
@@ -1214,7 +1227,7 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
 {
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     mMovedBodies.resize(active.size());
-    ParallelFor(uint32_t(active.size()), 256,
+    ParallelFor(uint32_t(active.size()), 256, 90, // A body's bounds and broad-phase move
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t i = inBegin; i < inEnd; ++i)

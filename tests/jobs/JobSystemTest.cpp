@@ -227,6 +227,26 @@ TEST(JobSystemTryRunHereTest, RunsAQueuedJobOnTheCallerAndNothingElse)
     EXPECT_EQ(otherRuns, 1);
 }
 
+TEST(JobSystemSleepTest, WorkersWithoutWorkAreCountedAsleepAndABusyOneIsNot)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    JobSystem jobs(settings);
+    // Idle workers spin about cSpinMicroseconds, then sleep: polled, for a loaded test machine
+    auto waitFor = [&](uint32_t inAsleep)
+    {
+        for (int i = 0; i < 2000 && jobs.GetNumWorkersAsleep() != inAsleep; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        return jobs.GetNumWorkersAsleep();
+    };
+    EXPECT_EQ(waitFor(2), 2u) << "both workers sleep with nothing to do";
+    {
+        WorkerHeld held(jobs); // One worker runs a job until released
+        EXPECT_EQ(waitFor(1), 1u) << "the other one sleeps";
+    }
+    EXPECT_EQ(waitFor(2), 2u) << "the released worker sleeps again";
+}
+
 TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
 {
     // The first chunks are slow, so threads that finish their region take chunks from the back of the slow

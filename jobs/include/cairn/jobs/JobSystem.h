@@ -86,6 +86,14 @@ public:
 
     /// Threads that run frame jobs: the workers plus the one that waits.
     uint32_t GetNumThreads() const { return uint32_t(mWorkers.size()) + 1; }
+    /// Workers asleep for want of work (a worker spins about cSpinMicroseconds before it sleeps). A hint for
+    /// a caller deciding whether a small loop is worth handing out: a sleeping worker takes tens of
+    /// microseconds to wake, a spinning one a few.
+    uint32_t GetNumWorkersAsleep() const
+    {
+        return mNumWorkersAsleep.load(
+            std::memory_order_relaxed); // Relaxed: a hint, stale by the time it is read
+    }
 
     /// Queues inFunction to run once every job of inPrerequisites has finished. inName must outlive the job
     /// (a string literal).
@@ -288,7 +296,9 @@ private:
 
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
-    size_t mNumStuckWorkers = 0;          ///< mQueueMutex: workers in a wait inside a job with nothing to run
+    std::atomic<uint32_t> mNumWorkersAsleep{
+        0};                      ///< Workers asleep in WorkerMain's wait (changed under mQueueMutex)
+    size_t mNumStuckWorkers = 0; ///< mQueueMutex: workers in a wait inside a job with nothing to run
     /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
     /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex
     mutable std::vector<uint32_t> mSearchMarks;
