@@ -436,6 +436,7 @@ void JobSystem::WorkerMain()
         // Relaxed: read only as a hint (GetNumWorkersAsleep)
         mNumWorkersAsleep.fetch_add(1, std::memory_order_relaxed);
         mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
+        // Relaxed: as above
         mNumWorkersAsleep.fetch_sub(1, std::memory_order_relaxed);
         if (mReadyCount == 0) return; // Stopping, and nothing left
         index = mReady[mReadyHead];

@@ -248,7 +248,7 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
         numCopied += end - begin;
     constexpr uint32_t cCopyNanoseconds = 110; // A constraint's copy and binding (pile2k)
     ParallelFor(uint32_t(mCopyRanges.size()), 1,
-                mCopyRanges.empty() ? 0 : cCopyNanoseconds * numCopied / uint32_t(mCopyRanges.size()),
+                PerItem(uint64_t(cCopyNanoseconds) * numCopied, mCopyRanges.size()),
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
                     for (uint32_t range = inBegin; range < inEnd; ++range)
@@ -287,25 +287,25 @@ void PhysicsStep::SolveIslands(float inDeltaTime)
     }
     // A constraint's iterations, integration and position passes in an island or a group (pile2k)
     constexpr uint32_t cSolveNanoseconds = 500;
-    ParallelFor(
-        uint32_t(mSolveItems.size()), 1,
-        mSolveItems.empty() ? 0 : cSolveNanoseconds * numItemConstraints / uint32_t(mSolveItems.size()),
-        [&](uint32_t inBegin, uint32_t inEnd)
-        {
-            for (uint32_t i = inBegin; i < inEnd; ++i)
-            {
-                const SolveItem& item = mSolveItems[i];
-                const uint32_t island = mSolvedIslands[item.mFirst];
-                if (item.mGroup == UINT32_MAX && mIslandFirstColor[island] != UINT32_MAX)
-                    SolveColoredIsland(island, inDeltaTime, true);
-                else if (item.mGroup == UINT32_MAX)
-                    SolveIsland(island, inDeltaTime);
-                else
-                    SolveIslandGroup(
-                        std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
-                        groupPaddingFirst + WideContactSolver::cPaddingBlocks * item.mGroup, inDeltaTime);
-            }
-        });
+    ParallelFor(uint32_t(mSolveItems.size()), 1,
+                PerItem(uint64_t(cSolveNanoseconds) * numItemConstraints, mSolveItems.size()),
+                [&](uint32_t inBegin, uint32_t inEnd)
+                {
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                    {
+                        const SolveItem& item = mSolveItems[i];
+                        const uint32_t island = mSolvedIslands[item.mFirst];
+                        if (item.mGroup == UINT32_MAX && mIslandFirstColor[island] != UINT32_MAX)
+                            SolveColoredIsland(island, inDeltaTime, true);
+                        else if (item.mGroup == UINT32_MAX)
+                            SolveIsland(island, inDeltaTime);
+                        else
+                            SolveIslandGroup(
+                                std::span<const uint32_t>(mSolvedIslands.data() + item.mFirst, item.mCount),
+                                groupPaddingFirst + WideContactSolver::cPaddingBlocks * item.mGroup,
+                                inDeltaTime);
+                    }
+                });
     // A body with nothing to solve keeps the velocity its forces gave it. One chunk per island made the
     // threads fight over the chunk cursor when thousands of bodies fall freely
     ParallelFor(uint32_t(mUnconstrainedBodies.size()), 256, 15, // An integration

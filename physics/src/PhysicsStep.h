@@ -91,6 +91,11 @@ private:
     /// 0.09 ms of its 0.4 ms in its two parallel loops' hand-offs. An awake worker (back-to-back loops, as in
     /// the step benchmarks) costs a few microseconds: any loop of more than one chunk is handed out then.
     static constexpr uint32_t cMinWakingNanoseconds = 50'000;
+    /// inTotal spread over inItems (0 for none), saturated: a step of millions of constraints must not wrap.
+    static uint32_t PerItem(uint64_t inTotal, size_t inItems)
+    {
+        return inItems == 0 ? 0 : uint32_t(std::min<uint64_t>(inTotal / inItems, UINT32_MAX));
+    }
     /// inBody(begin, end) over [0, inCount) in chunks of inGrain: on the job system's threads, unless a
     /// worker sleeps and the items' estimated cost (inItemNanoseconds each, measured on pile2k on one
     /// thread) is under cMinWakingNanoseconds; else here.

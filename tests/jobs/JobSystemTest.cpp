@@ -151,7 +151,7 @@ TEST_P(JobSystemThreads, ParallelForVisitsEveryIndexOnce)
         }
 }
 
-/// Keeps the only worker of a 2-thread job system busy with a job until Release (or the end of the scope), so
+/// Keeps a worker busy with a job until Release (or the end of the scope): with 2 threads the only one, so
 /// that what the test schedules meanwhile stays queued.
 class WorkerHeld
 {

@@ -3,8 +3,9 @@
 // A rebuild has two phases:
 //  1. Build, with no lock, concurrently with queries, moves, removes and links: walk the live tree from the
 //     root, descending only into Changed nodes (all of them for a full rebuild). An unchanged node is kept
-//     whole, as one object; a body of a changed node becomes one object with its exact bounds. The objects
-//     are built into new private nodes with the same midpoint split as a batch add.
+//     whole, as one object; a body of a changed node becomes one object with its exact bounds (grown by the
+//     margin and stretched ahead of its motion if it moved: MovedSlot). The objects are built into new
+//     private nodes with the same midpoint split as a batch add.
 //  2. Commit, under the exclusive side of the modification lock (so no move, remove or link runs), in
 //  O(bodies
 //     relocated + nodes kept):
@@ -63,19 +64,22 @@ AABB QuadTree::MovedSlot(const AABB& inBounds, const AABB& inOldSlot, uint8_t in
     {
         const uint8_t minSide = uint8_t(1u << (2 * axis)), maxSide = uint8_t(2u << (2 * axis));
         // Room left above the body means it moved towards min, and the other way round. An empty slot (the
-        // body removed meanwhile) leaves no room on either side: its min is +large and its max -large
+        // body removed meanwhile) leaves no room on either side: its min is +large and its max -large. Room
+        // under a quarter of the margin is taken for rounding (bounds + margin - bounds is not the margin
+        // far from the origin), not for a move
         const float leftAbove = (inStretchedSides & maxSide) != 0
                                     ? 0.0f
                                     : inOldSlot.mMax[axis] - inBounds.mMax[axis] - mMovedSlotMargin;
         const float leftBelow = (inStretchedSides & minSide) != 0
                                     ? 0.0f
                                     : inBounds.mMin[axis] - inOldSlot.mMin[axis] - mMovedSlotMargin;
-        if (leftAbove > 0.0f)
+        const float minRoom = 0.25f * mMovedSlotMargin;
+        if (leftAbove > minRoom)
         {
             slot.mMin[axis] -= std::min(mMovedSlotReach * leftAbove, cMaxMovedSlotReach);
             outStretchedSides |= minSide;
         }
-        if (leftBelow > 0.0f)
+        if (leftBelow > minRoom)
         {
             slot.mMax[axis] += std::min(mMovedSlotReach * leftBelow, cMaxMovedSlotReach);
             outStretchedSides |= maxSide;
@@ -125,8 +129,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
             {
                 AABB bounds;
                 QuadTreeBodyTable::Entry& entry = mBodies[child & ~cBodyFlag];
-                const uint8_t stretchedSides = entry.mSlotReachSides;
-                entry.mSlotReachSides = 0;
+                uint8_t stretchedSides = 0;
                 if (!QuadTreeBodyTable::LoadBounds(entry, bounds))
                     bounds = LoadSlot(node, s); // Being moved: the commit sets the exact bounds
                 // A body that moved since the last rebuild (its slot is loose) gets a slot grown by the
@@ -134,7 +137,12 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
                 // to the tree (see MoveBody). Relaxed: the bit is only read here to choose; the commit
                 // handles moves made meanwhile
                 else if (mMovedSlotMargin > 0.0f && ((node.mLoose.load(std::memory_order_relaxed) >> s) & 1u))
-                    bounds = MovedSlot(bounds, LoadSlot(node, s), stretchedSides, entry.mSlotReachSides);
+                    bounds = MovedSlot(bounds, LoadSlot(node, s), entry.mSlotReachSides, stretchedSides);
+                // Written here, not by the commit: a rebuild that gives up later (out of nodes) leaves flags
+                // that describe slots it did not make, which only makes the next stretch shorter or wrongly
+                // sided (speed, never containment: the commit checks every slot). Only when they change: the
+                // update runs beside the pair search, which reads these entries
+                if (entry.mSlotReachSides != stretchedSides) entry.mSlotReachSides = stretchedSides;
                 items.push_back({child, bounds, nodeIndex << 2 | uint32_t(s)});
                 continue;
             }

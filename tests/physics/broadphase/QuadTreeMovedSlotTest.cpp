@@ -121,8 +121,8 @@ TEST(QuadTreeMovedSlotTest, SteadyFallIsRebuiltIntoSlotsStretchedAheadAndQueries
     test::TestRandom random(5);
     std::vector<BroadPhaseBody> bodies = AddField(1000, random, tested, reference);
     // 10 cm a frame straight down: each rebuild stretches the slots below by twice the fall since the last
-    // one, so the falls between rebuilds lengthen (1, 2, 4, ... frames) until the 1 m cap. Exact slots would
-    // rebuild every frame; the margin alone (5 cm) too
+    // one past the margin, so the falls between rebuilds lengthen (2, 5, then 11 frames at the 1 m cap).
+    // Exact slots would rebuild every frame; the margin alone (5 cm) too
     constexpr int cFrames = 30;
     int rebuilds = 0;
     for (int frame = 0; frame < cFrames; ++frame)

@@ -100,7 +100,8 @@ public:
     /// resting body's jitter stays inside, so its moves write no node.
     static constexpr float cMovedSlotMargin = 0.05f;
     /// Stretch of a moved body's slot ahead of its motion, in moves since the last rebuild
-    /// (QuadTree::SetMovedSlotReach): a falling box then writes a node every third step, not every step.
+    /// (QuadTree::SetMovedSlotReach): a box falling 10 cm a step then leaves its slot after 2, 5, then 11
+    /// steps (the 1 m cap), not after every one.
     static constexpr float cMovedSlotReach = 2.0f;
 
     /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +

@@ -11,7 +11,8 @@
 //  - LinkSubTree, RemoveBody, MoveBody: any thread, concurrently with each other and with queries. They take
 //    this tree's StripedSharedMutex shared (their own stripe: no contention between them) only to keep out of
 //    the rebuild's short commit. The caller serialises operations on one body.
-//  - Rebuild and CollectGarbage: one thread at a time (the physics update), concurrently with the rest. A
+//  - Rebuild and CollectGarbage: one thread at a time (the physics update) across all the trees that share a
+//    QuadTreeBodyTable (its mSlotReachSides is the rebuilds' own), concurrently with the rest. A
 //    rebuild builds the new tree off the live one with no lock, then commits (relocates the bodies it moved,
 //    re-parents kept nodes, links what was linked meanwhile, swaps the root) under the exclusive side of the
 //    modification lock: modifiers may wait for that commit (measured by the broad-phase benchmark), queries
@@ -152,7 +153,9 @@ public:
     /// multiples of that move (on each axis, past the margin, at most cMaxMovedSlotReach; 0: no stretch). A
     /// falling or sliding body then crosses its slot in that many steps without writing a node: no ancestor
     /// grown up to the root on every step (cache lines taken from the other core) and no path for the next
-    /// rebuild. Needs a margin (SetMovedSlotMargin). Update thread, or before the tree is shared.
+    /// rebuild. Needs a margin (SetMovedSlotMargin). A body that stops inside a stretched slot keeps it until
+    /// a rebuild visits its node again (its moves no longer change the tree): queries then test its exact
+    /// bounds for a little longer. Update thread, or before the tree is shared.
     void SetMovedSlotReach(float inMoves)
     {
         mMovedSlotReach = inMoves > 0.0f && inMoves < cLargeFloat ? inMoves : 0.0f;

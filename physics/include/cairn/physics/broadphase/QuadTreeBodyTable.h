@@ -6,13 +6,13 @@
 // rebuild); queries test the exact bounds here when a slot is marked loose, so they report exactly the
 // bodies whose current AABB matches.
 //
-// Threads: every field is atomic. A body's entry is written by whoever adds, moves or removes it (the caller
-// serialises operations on one body) and by the rebuild commit (under the tree's exclusive modification
-// lock); it is read by queries on any thread.
-// Exact bounds use a sequence lock that readers never wait on (fence-free, see StoreBounds): a writer makes
-// the version odd, writes the six floats, makes it even; a reader that sees an odd or changed version falls
-// back to the slot bounds, which contain the body's old bounds (a move in progress may be reported with its
-// old state, as allowed).
+// Threads: every field is atomic but two plain bytes, each of one writer (see them). A body's entry is
+// written by whoever adds, moves or removes it (the caller serialises operations on one body) and by the
+// rebuild commit (under the tree's exclusive modification lock); it is read by queries on any thread. Exact
+// bounds use a sequence lock that readers never wait on (fence-free, see StoreBounds): a writer makes the
+// version odd, writes the six floats, makes it even; a reader that sees an odd or changed version falls back
+// to the slot bounds, which contain the body's old bounds (a move in progress may be reported with its old
+// state, as allowed).
 
 #include "cairn/physics/math/AABB.h"
 
