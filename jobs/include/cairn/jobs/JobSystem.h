@@ -91,8 +91,8 @@ public:
     /// microseconds to wake, a spinning one a few.
     uint32_t GetNumWorkersAsleep() const
     {
-        return mNumWorkersAsleep.load(
-            std::memory_order_relaxed); // Relaxed: a hint, stale by the time it is read
+        // Relaxed: a hint, stale by the time it is read
+        return mNumWorkersAsleep.load(std::memory_order_relaxed);
     }
 
     /// Queues inFunction to run once every job of inPrerequisites has finished. inName must outlive the job
@@ -296,8 +296,8 @@ private:
 
     std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
-    std::atomic<uint32_t> mNumWorkersAsleep{
-        0};                      ///< Workers asleep in WorkerMain's wait (changed under mQueueMutex)
+    /// Workers asleep in WorkerMain's wait (changed under mQueueMutex)
+    std::atomic<uint32_t> mNumWorkersAsleep{0};
     size_t mNumStuckWorkers = 0; ///< mQueueMutex: workers in a wait inside a job with nothing to run
     /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
     /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex

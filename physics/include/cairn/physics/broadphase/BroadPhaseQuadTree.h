@@ -83,8 +83,8 @@ public:
     {
         uint64_t mReused = 0; ///< From the cache: no walk
         uint64_t mWalked = 0; ///< Inside the grown box but with too many candidates to keep: walked
-        uint64_t mRefilled =
-            0; ///< Walked with grown bounds and remembered (first time, left the box, changes)
+        /// Walked with grown bounds and remembered (first time, left the box, changes)
+        uint64_t mRefilled = 0;
         uint64_t mUncached = 0; ///< Walked because the cache table was full
     };
 
