@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
+#include <type_traits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -47,8 +48,31 @@ template <class Done> bool JobSystem::SpinUntil(const Done& inDone) const
         if (inDone()) return true;
         // Relaxed: a hint to stop spinning; the queue itself is read under its mutex
         if (mNumReady.load(std::memory_order_relaxed) != 0) return false;
-        if ((i & 63) == 63 && std::chrono::steady_clock::now() > deadline) return false;
+        if ((i & 63) == 63)
+        {
+            const auto now = std::chrono::steady_clock::now();
+            // Relaxed: a deadline only, it orders no data
+            if (now > deadline &&
+                now.time_since_epoch().count() > mSpinExtendedUntil.load(std::memory_order_relaxed))
+                return false;
+        }
         CpuRelax();
+    }
+}
+
+void JobSystem::ExtendSpin(uint64_t inNanoseconds)
+{
+    using Nanoseconds = std::chrono::duration<int64_t, std::nano>;
+    static_assert(std::is_same_v<std::chrono::steady_clock::duration, Nanoseconds>,
+                  "mSpinExtendedUntil holds steady_clock ticks as nanoseconds");
+    const int64_t until = std::chrono::steady_clock::now().time_since_epoch().count() +
+                          int64_t(std::min(inNanoseconds, cMaxSpinExtensionNanoseconds)) +
+                          int64_t(cSpinMicroseconds) * 1000;
+    // Relaxed: a deadline only; the later of two concurrent extensions wins
+    int64_t current = mSpinExtendedUntil.load(std::memory_order_relaxed);
+    while (current < until &&
+           !mSpinExtendedUntil.compare_exchange_weak(current, until, std::memory_order_relaxed))
+    {
     }
 }
 

@@ -111,6 +111,14 @@ private:
                 inBody(begin, std::min(inCount, begin + inGrain));
     }
 
+    /// Before a serial stretch of about inNanoseconds that a parallel loop follows: the workers spinning idle
+    /// spin through it (JobSystem::ExtendSpin) instead of falling asleep halfway, so that the loop does not
+    /// begin with tens of microseconds of waking one.
+    void KeepWorkersSpinningFor(uint64_t inNanoseconds) const
+    {
+        if (mJobs != nullptr && mJobs->GetNumThreads() > 1) mJobs->ExtendSpin(inNanoseconds);
+    }
+
     /// Runs inNumStages stages in order, every thread of the job system on each: stage s has inPartsOf(s)
     /// parts (1 to the thread count) and inRunPart(s, part, parts) does one. A stage starts only when every
     /// part of the one before has finished: the threads wait on a counter, not on a job per part (a colored

@@ -247,6 +247,51 @@ TEST(JobSystemSleepTest, WorkersWithoutWorkAreCountedAsleepAndABusyOneIsNot)
     EXPECT_EQ(waitFor(2), 2u) << "the released worker sleeps again";
 }
 
+TEST(JobSystemSleepTest, AnExtendedSpinKeepsAnIdleWorkerAwakeUntilItEnds)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    auto waitFor = [&](uint32_t inAsleep)
+    {
+        for (int i = 0; i < 2000 && jobs.GetNumWorkersAsleep() != inAsleep; ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        return jobs.GetNumWorkersAsleep();
+    };
+    ASSERT_EQ(waitFor(1), 1u) << "the worker sleeps with nothing to do";
+    using Clock = std::chrono::steady_clock;
+    // A job on the worker extends the spin as its last act, so the worker runs out of work right after
+    std::atomic<bool> running{false}, release{false};
+    std::atomic<Clock::rep> extendedAt{0};
+    const JobHandle job = jobs.Schedule("extends the spin",
+                                        [&]
+                                        {
+                                            running.store(true);
+                                            while (!release.load())
+                                                std::this_thread::yield();
+                                            // Before the call: the extension runs from a later time
+                                            extendedAt.store(Clock::now().time_since_epoch().count());
+                                            jobs.ExtendSpin(JobSystem::cMaxSpinExtensionNanoseconds);
+                                        });
+    while (!running.load())
+        std::this_thread::yield();
+    EXPECT_EQ(jobs.GetNumWorkersAsleep(), 0u);
+    release.store(true);
+    // Polled without pause. The worker is seen asleep after it went to sleep, never before, so the time
+    // measured is never shorter than its spin, however loaded the machine: a shorter one proves that it
+    // slept early (without the extension it sleeps about cSpinMicroseconds after the job)
+    const Clock::time_point released = Clock::now();
+    while (jobs.GetNumWorkersAsleep() == 0 && Clock::now() - released < std::chrono::seconds(5))
+    {
+    }
+    const Clock::time_point seenAsleep = Clock::now();
+    EXPECT_EQ(jobs.GetNumWorkersAsleep(), 1u) << "the worker sleeps once the extension is over";
+    const Clock::time_point extended{Clock::duration(extendedAt.load())};
+    EXPECT_GE(seenAsleep - extended, std::chrono::nanoseconds(JobSystem::cMaxSpinExtensionNanoseconds))
+        << "the idle worker spins through the extension before it sleeps";
+    jobs.Wait(job);
+}
+
 TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)
 {
     // The first chunks are slow, so threads that finish their region take chunks from the back of the slow

@@ -95,6 +95,13 @@ public:
         return mNumWorkersAsleep.load(std::memory_order_relaxed);
     }
 
+    /// Threads spinning idle (workers out of work, waits) spin on as if they had run out of work
+    /// inNanoseconds from now (at most cMaxSpinExtensionNanoseconds) instead of going to sleep
+    /// cSpinMicroseconds after they did; threads asleep stay asleep. For a serial stretch of about that
+    /// length that a parallel loop follows, so that the loop does not begin by waking a worker. Any thread.
+    void ExtendSpin(uint64_t inNanoseconds);
+    static constexpr uint64_t cMaxSpinExtensionNanoseconds = 1'000'000;
+
     /// Queues inFunction to run once every job of inPrerequisites has finished. inName must outlive the job
     /// (a string literal).
     template <class Function>
@@ -298,6 +305,8 @@ private:
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     /// Workers asleep in WorkerMain's wait (changed under mQueueMutex)
     std::atomic<uint32_t> mNumWorkersAsleep{0};
+    /// ExtendSpin's deadline: steady_clock nanoseconds since its epoch. Any thread; read by spinners
+    std::atomic<int64_t> mSpinExtendedUntil{0};
     size_t mNumStuckWorkers = 0; ///< mQueueMutex: workers in a wait inside a job with nothing to run
     /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
     /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex
