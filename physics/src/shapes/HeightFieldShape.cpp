@@ -30,7 +30,7 @@ struct EdgeNeighbour
 
 constexpr EdgeNeighbour cNeighbours[2][3] = {
     {{-1, 0, 1, 0}, {0, 1, 1, 1}, {0, 0, 1, 2}},
-    {{0, 0, 0, 1}, {1, 0, 0, 2}, {0, -1, 0, 1}},
+    {{0, 0, 0, 1}, {1, 0, 0, 2}, {0, -1, 0, 0}},
 };
 
 /// Sample offsets (dx, dz) of the 3 vertices of each half, in counter-clockwise order seen from +Y.

@@ -1,10 +1,16 @@
 #include "cairn/physics/shapes/HeightFieldShape.h"
 
+#include "cairn/physics/shapes/TriangleMeshShape.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <gtest/gtest.h>
 #include <limits>
 #include <map>
 #include <random>
 #include <set>
+#include <tuple>
 
 using namespace cairn;
 
@@ -273,4 +279,63 @@ TEST(HeightFieldShapeTest, InternalEdgesAtTheWorldsScale)
     const auto valley = MakeField(3, 2, cell, {cell, 0, cell, cell, 0, cell});
     ASSERT_NE(valley, nullptr);
     EXPECT_EQ(ActiveEdgesAlongX(*valley, cell), 0);
+}
+
+TEST(HeightFieldShapeTest, EdgeFlagsEqualThoseOfTheSameTrianglesAsAMesh)
+{
+    // The field works its flags out per cell from the grid at creation; a mesh of the same triangles finds
+    // its neighbours by shared vertices: two ways to the same answer, holes and borders included
+    std::mt19937 rng(17);
+    for (int trial = 0; trial < 4; ++trial)
+    {
+        const float cell = 0.7f;
+        const auto field = RandomField(rng, 12, 9, cell);
+        ASSERT_NE(field, nullptr);
+        const std::vector<Triangle> fieldTriangles = AllTriangles(*field);
+        ASSERT_GT(fieldTriangles.size(), 50u);
+        std::vector<Vec3> vertices;
+        std::map<std::pair<long, long>, uint32_t> vertexOfSample;
+        auto vertexOf = [&](const Vec3& inV)
+        {
+            const std::pair<long, long> sample{std::lround(inV.x() / cell), std::lround(inV.z() / cell)};
+            auto [it, added] = vertexOfSample.try_emplace(sample, uint32_t(vertices.size()));
+            if (added) vertices.push_back(inV);
+            return it->second;
+        };
+        std::vector<std::array<uint32_t, 3>> indices;
+        for (const Triangle& t : fieldTriangles)
+            indices.push_back({vertexOf(t.mV[0]), vertexOf(t.mV[1]), vertexOf(t.mV[2])});
+        auto mesh = TriangleMeshShape::Create(vertices, indices);
+        ASSERT_TRUE(mesh.IsOk()) << mesh.GetError().mMessage;
+
+        // Each edge of each triangle, named by its vertices: whether it is active
+        using EdgeKey = std::tuple<uint32_t, uint32_t, uint32_t, uint32_t, uint32_t>;
+        auto edgeFlags = [&](const std::vector<Triangle>& inTriangles)
+        {
+            std::map<EdgeKey, bool> flags;
+            for (const Triangle& t : inTriangles)
+            {
+                std::array<uint32_t, 3> corners{vertexOf(t.mV[0]), vertexOf(t.mV[1]), vertexOf(t.mV[2])};
+                std::array<uint32_t, 3> sorted = corners;
+                std::sort(sorted.begin(), sorted.end());
+                for (int e = 0; e < 3; ++e)
+                    flags[{sorted[0], sorted[1], sorted[2], corners[e], corners[(e + 1) % 3]}] =
+                        (t.mActiveEdges & (1u << e)) != 0;
+            }
+            return flags;
+        };
+        const std::map<EdgeKey, bool> fromField = edgeFlags(fieldTriangles);
+        const std::map<EdgeKey, bool> fromMesh = edgeFlags(AllTriangles(*mesh.Value()));
+        ASSERT_EQ(fromField.size(), fromMesh.size());
+        int active = 0;
+        for (const auto& [edge, isActive] : fromField)
+        {
+            const auto it = fromMesh.find(edge);
+            ASSERT_NE(it, fromMesh.end());
+            EXPECT_EQ(isActive, it->second) << "trial " << trial;
+            active += isActive ? 1 : 0;
+        }
+        EXPECT_GT(active, 0) << "borders and holes are active";
+        EXPECT_LT(active, int(fromField.size())) << "the concave joints of a random terrain are internal";
+    }
 }
