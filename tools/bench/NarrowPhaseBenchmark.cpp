@@ -7,11 +7,13 @@
 #include "cairn/physics/narrowphase/CollideSphereBox.h"
 #include "cairn/physics/narrowphase/CollideSphereSphere.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 
 #include <array>
 #include <benchmark/benchmark.h>
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -120,10 +122,64 @@ void BM_BoxOnMesh(benchmark::State& ioState)
     }
     ioState.counters["manifolds_per_call"] = double(manifolds) / double(ioState.iterations());
 }
+
+/// The demo's terrain tile: 65 x 65 samples 1 m apart, rolling hills a few metres high.
+std::vector<float> TerrainHeights()
+{
+    std::vector<float> heights;
+    for (uint32_t z = 0; z < 65; ++z)
+        for (uint32_t x = 0; x < 65; ++x)
+            heights.push_back(2.0f * std::sin(0.21f * float(x)) * std::cos(0.17f * float(z)) +
+                              0.3f * std::sin(1.3f * float(x + 2 * z)));
+    return heights;
+}
+
+/// Creating that tile's height field (its edge flags are worked out here, once).
+void BM_HeightFieldCreate(benchmark::State& ioState)
+{
+    const std::vector<float> heights = TerrainHeights();
+    for (auto _ : ioState)
+    {
+        auto field = HeightFieldShape::Create(65, 65, 1.0f, heights);
+        benchmark::DoNotOptimize(field);
+    }
+}
+
+/// A box sunk 5 cm into that terrain at random places and headings: CollideShapes against the cells under it.
+void BM_BoxOnHeightField(benchmark::State& ioState)
+{
+    const std::vector<float> heights = TerrainHeights();
+    const auto field = HeightFieldShape::Create(65, 65, 1.0f, heights).Value();
+    const auto box = BoxShape::Create(Vec3(0.4f, 0.4f, 0.4f)).Value();
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> place(2.0f, 62.0f), heading(0.0f, 6.28f);
+    std::vector<Transform> poses;
+    for (int i = 0; i < 1000; ++i)
+    {
+        const float x = place(random), z = place(random);
+        // The height under the box's centre: a ray down the field
+        RayHit hit;
+        hit.mFraction = 1.0f;
+        const RayCast down{Vec3(x, 50.0f, z), Vec3(0.0f, -100.0f, 0.0f)};
+        const float y = field->CastRay(down, hit) ? 50.0f - 100.0f * hit.mFraction : 0.0f;
+        poses.push_back({Vec3(x, y + 0.35f, z), Quat(Eigen::AngleAxisf(heading(random), Vec3::UnitY()))});
+    }
+    size_t next = 0;
+    int64_t manifolds = 0;
+    for (auto _ : ioState)
+    {
+        manifolds += CollideShapes(*box, poses[next], *field, Transform::Identity(), {},
+                                   [](const ContactManifold&) {});
+        next = (next + 1) % poses.size();
+    }
+    ioState.counters["manifolds_per_call"] = double(manifolds) / double(ioState.iterations());
+}
 } // namespace
 
 BENCHMARK(BM_BoxBox);
 BENCHMARK(BM_SphereBox);
 BENCHMARK(BM_SphereSphere);
 BENCHMARK(BM_BoxOnMesh);
+BENCHMARK(BM_HeightFieldCreate);
+BENCHMARK(BM_BoxOnHeightField);
 BENCHMARK_MAIN();
