@@ -227,18 +227,24 @@ TEST(JobSystemTryRunHereTest, RunsAQueuedJobOnTheCallerAndNothingElse)
     EXPECT_EQ(otherRuns, 1);
 }
 
+namespace
+{
+/// The workers asleep once inAsleep of them are (or after 2 s). Idle workers spin about cSpinMicroseconds,
+/// then sleep: polled, for a loaded test machine.
+uint32_t WaitForWorkersAsleep(const JobSystem& inJobs, uint32_t inAsleep)
+{
+    for (int i = 0; i < 2000 && inJobs.GetNumWorkersAsleep() != inAsleep; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return inJobs.GetNumWorkersAsleep();
+}
+} // namespace
+
 TEST(JobSystemSleepTest, WorkersWithoutWorkAreCountedAsleepAndABusyOneIsNot)
 {
     JobSystem::Settings settings;
     settings.mNumThreads = 3;
     JobSystem jobs(settings);
-    // Idle workers spin about cSpinMicroseconds, then sleep: polled, for a loaded test machine
-    auto waitFor = [&](uint32_t inAsleep)
-    {
-        for (int i = 0; i < 2000 && jobs.GetNumWorkersAsleep() != inAsleep; ++i)
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        return jobs.GetNumWorkersAsleep();
-    };
+    auto waitFor = [&](uint32_t inAsleep) { return WaitForWorkersAsleep(jobs, inAsleep); };
     EXPECT_EQ(waitFor(2), 2u) << "both workers sleep with nothing to do";
     {
         WorkerHeld held(jobs); // One worker runs a job until released
@@ -252,13 +258,7 @@ TEST(JobSystemSleepTest, AnExtendedSpinKeepsAnIdleWorkerAwakeUntilItEnds)
     JobSystem::Settings settings;
     settings.mNumThreads = 2;
     JobSystem jobs(settings);
-    auto waitFor = [&](uint32_t inAsleep)
-    {
-        for (int i = 0; i < 2000 && jobs.GetNumWorkersAsleep() != inAsleep; ++i)
-            std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        return jobs.GetNumWorkersAsleep();
-    };
-    ASSERT_EQ(waitFor(1), 1u) << "the worker sleeps with nothing to do";
+    ASSERT_EQ(WaitForWorkersAsleep(jobs, 1), 1u) << "the worker sleeps with nothing to do";
     using Clock = std::chrono::steady_clock;
     // A job on the worker extends the spin as its last act, so the worker runs out of work right after
     std::atomic<bool> running{false}, release{false};
