@@ -2,11 +2,13 @@
 // (so tiles stream in and out several times): no body lost or duplicated by streaming, every navmesh tile the
 // agents asked for built, no agent path through a wall, nothing reported wrong.
 
+#include "DemoReport.h"
 #include "DemoRunner.h"
 
 #include <cstdio>
 #include <gtest/gtest.h>
 #include <string>
+#include <vector>
 
 namespace cairn::demo
 {
@@ -41,6 +43,7 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(inRun.mTilesStreamedIn, 13u) << inRun.mModeName;
     EXPECT_GT(inRun.mTilesStreamedOut, 0u) << inRun.mModeName;
     EXPECT_EQ(inRun.mPhysicsMs.size(), 240u);
+    EXPECT_EQ(inRun.mSteps.size(), 240u);
     EXPECT_GT(inRun.mQueries, 0u);
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
     const std::string paths =
@@ -61,6 +64,29 @@ TEST(DemoTest, LockFreeModeKeepsItsInvariants)
 TEST(DemoTest, GlobalMutexModeKeepsItsInvariants)
 {
     ExpectInvariants(RunDemo(SmallDemo(), BroadPhaseType::QuadTreeGlobalMutex, nullptr));
+}
+
+TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
+{
+    DemoRunResult run;
+    run.mModeName = "lock-free";
+    run.mFrameMs = {2.5, 3.0};
+    run.mPhysicsMs = {0.25, 0.5};
+    run.mMainThreadStreamMs = {0.01, 0.02};
+    run.mSteps = {{0.03, 0.1, 0.002, 0.05, 0.004, 26, 40, 66}, {0.3, 0.12, 0.003, 0.06, 0.005, 27, 41, 70}};
+    DemoRunResult odd = run;
+    odd.mModeName = "a, \"b\"";
+    odd.mSteps.pop_back(); // A series one frame short: its rows end there
+    const std::string csv = FramesCsv({run, odd});
+    std::vector<std::string> lines;
+    for (size_t begin = 0, end; (end = csv.find('\n', begin)) != std::string::npos; begin = end + 1)
+        lines.push_back(csv.substr(begin, end - begin));
+    ASSERT_EQ(lines.size(), 4u) << csv;
+    EXPECT_EQ(lines[0], "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
+                        "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points");
+    EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66");
+    EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70");
+    EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 
 } // namespace

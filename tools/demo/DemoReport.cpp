@@ -845,8 +845,19 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
         text += "## Comparison\n\n" + TableMarkdown(BuildComparison(lockFree, global)) + "\n";
     }
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
-    text += "![Navmesh tile latency in frames](tile_latency.svg)\n";
+    text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
+    text += "Every frame's figures, with the physics step's phases: [frames.csv](frames.csv).\n";
     return text;
+}
+
+/// A CSV field: the mode names are plain words, but a comma or quote in one must not shift the columns.
+std::string CsvField(const std::string& inText)
+{
+    if (inText.find_first_of(",\"\n") == std::string::npos) return inText;
+    std::string quoted = "\"";
+    for (char c : inText)
+        quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
 }
 
 /// Removes the temporary files it holds when the report is abandoned half-way, however that happens.
@@ -865,6 +876,28 @@ struct TemporaryFiles
 };
 
 } // namespace
+
+std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
+{
+    std::string csv = "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
+                      "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points\n";
+    for (const DemoRunResult& run : inRuns)
+    {
+        const std::string mode = CsvField(run.mModeName);
+        // The series are filled frame by frame together; a shorter one ends the rows instead of reading past
+        const size_t frames = std::min(
+            {run.mFrameMs.size(), run.mPhysicsMs.size(), run.mMainThreadStreamMs.size(), run.mSteps.size()});
+        for (size_t i = 0; i < frames; ++i)
+        {
+            const FrameStep& step = run.mSteps[i];
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u\n", mode.c_str(), i,
+                          run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
+                          step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
+                          step.mFinishMs, step.mActiveBodies, step.mBodyPairs, step.mContactPoints);
+        }
+    }
+    return csv;
+}
 
 bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& inRuns,
                  const std::string& inCommandLine, std::string& outError)
@@ -901,6 +934,7 @@ bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& 
             (inRuns.empty() ? std::string() : " (" + ModeName(inRuns[0], "run 1") + ")");
         const std::vector<std::pair<std::string, std::string>> files = {
             {"report.md", ReportMarkdown(inRuns, inCommandLine)},
+            {"frames.csv", FramesCsv(inRuns)},
             {"frame_times.svg", SvgLineChart("Physics ms per frame", "ms", frameSeries)},
             {"tile_latency.svg",
              SvgHistogram(latencyTitle, "frames",

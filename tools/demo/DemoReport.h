@@ -30,9 +30,13 @@ std::string SvgLineChart(const std::string& inTitle, const std::string& inYLabel
 std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel,
                          const std::vector<uint32_t>& inValues);
 
-/// Writes report.md, frame_times.svg and tile_latency.svg to inFolder (created if missing). With two runs the
-/// one whose mode name contains "global" is compared against the other. On failure returns false with the
-/// path and reason in outError, and removes the files it had started; never throws.
+/// Per-frame figures of every run, one row per frame: mode, frame, the main thread's frame, its physics step
+/// and streaming work (ms), the step's phases (ms) and its active bodies, pairs and contact points.
+std::string FramesCsv(const std::vector<DemoRunResult>& inRuns);
+
+/// Writes report.md, frames.csv, frame_times.svg and tile_latency.svg to inFolder (created if missing). With
+/// two runs the one whose mode name contains "global" is compared against the other. On failure returns false
+/// with the path and reason in outError, and removes the files it had started; never throws.
 bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& inRuns,
                  const std::string& inCommandLine, std::string& outError);
 
