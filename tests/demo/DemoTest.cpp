@@ -73,7 +73,22 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mFrameMs = {2.5, 3.0};
     run.mPhysicsMs = {0.25, 0.5};
     run.mMainThreadStreamMs = {0.01, 0.02};
-    run.mSteps = {{0.03, 0.1, 0.002, 0.05, 0.004, 26, 40, 66}, {0.3, 0.12, 0.003, 0.06, 0.005, 27, 41, 70}};
+    auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
+                   uint32_t inActive, uint32_t inPairs, uint32_t inPoints)
+    {
+        StepStatistics s;
+        s.mBroadPhaseUpdateMs = inBroadPhase;
+        s.mNarrowPhaseMs = inNarrow;
+        s.mIslandsMs = inIslands;
+        s.mSolveMs = inSolve;
+        s.mFinishMs = inFinish;
+        s.mNumActiveBodies = inActive;
+        s.mNumBodyPairs = inPairs;
+        s.mNumContactPoints = inPoints;
+        return s;
+    };
+    run.mSteps = {step(0.03, 0.1, 0.002, 0.05, 0.004, 26, 40, 66),
+                  step(0.3, 0.12, 0.003, 0.06, 0.005, 27, 41, 70)};
     DemoRunResult odd = run;
     odd.mModeName = "a, \"b\"";
     odd.mSteps.pop_back(); // A series one frame short: its rows end there

@@ -889,11 +889,11 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
             {run.mFrameMs.size(), run.mPhysicsMs.size(), run.mMainThreadStreamMs.size(), run.mSteps.size()});
         for (size_t i = 0; i < frames; ++i)
         {
-            const FrameStep& step = run.mSteps[i];
+            const StepStatistics& step = run.mSteps[i];
             csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u\n", mode.c_str(), i,
                           run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
-                          step.mFinishMs, step.mActiveBodies, step.mBodyPairs, step.mContactPoints);
+                          step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints);
         }
     }
     return csv;

@@ -3,6 +3,8 @@
 // What one run of the demo measured: plain data, filled by DemoRunner on the main thread after the run, read
 // by DemoReport to print the summary and write the Markdown report.
 
+#include "cairn/physics/PhysicsSettings.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,20 +33,6 @@ struct PhaseTimes
     double mFinishMs = 0.0;
 };
 
-/// One frame's physics step: its phases (summed over the frame's collision steps) and how much there was to
-/// do.
-struct FrameStep
-{
-    double mBroadPhaseUpdateMs = 0.0; ///< Runs beside the narrow phase on 2+ threads: overlaps it
-    double mNarrowPhaseMs = 0.0;      ///< Forces, pairs and the narrow phase
-    double mIslandsMs = 0.0;
-    double mSolveMs = 0.0;
-    double mFinishMs = 0.0;
-    uint32_t mActiveBodies = 0;
-    uint32_t mBodyPairs = 0;
-    uint32_t mContactPoints = 0;
-};
-
 struct DemoRunResult
 {
     std::string mModeName; ///< "lock-free" or "global mutex"
@@ -54,7 +42,9 @@ struct DemoRunResult
     std::vector<double>
         mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
     PhaseTimes mPhases;
-    std::vector<FrameStep> mSteps; ///< Per frame, for frames.csv: where a slow frame's time went
+    /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics), for frames.csv: where a slow
+    /// frame's time went
+    std::vector<StepStatistics> mSteps;
     /// Game-object query jobs: mean microseconds per query, per job-system thread (index = thread slot)
     std::vector<double> mQueryMicrosPerThread;
     uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs

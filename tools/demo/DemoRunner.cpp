@@ -121,9 +121,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         result.mPhases.mIslandsMs += step.mIslandsMs;
         result.mPhases.mSolveMs += step.mSolveMs;
         result.mPhases.mFinishMs += step.mFinishMs;
-        result.mSteps.push_back({step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs,
-                                 step.mSolveMs, step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs,
-                                 step.mNumContactPoints});
+        result.mSteps.push_back(step);
 
         gameObjects->Update(frameJobs, inSettings.mGameObjectJobs, player, dt);
         agents->Update(dt, player);
