@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cassert>
 #include <chrono>
-#include <type_traits>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -62,14 +61,16 @@ template <class Done> bool JobSystem::SpinUntil(const Done& inDone) const
 
 void JobSystem::ExtendSpin(uint64_t inNanoseconds)
 {
-    using Nanoseconds = std::chrono::duration<int64_t, std::nano>;
-    static_assert(std::is_same_v<std::chrono::steady_clock::duration, Nanoseconds>,
-                  "mSpinExtendedUntil holds steady_clock ticks as nanoseconds");
-    const int64_t until = std::chrono::steady_clock::now().time_since_epoch().count() +
-                          int64_t(std::min(inNanoseconds, cMaxSpinExtensionNanoseconds)) +
-                          int64_t(cSpinMicroseconds) * 1000;
+    if (mMoreThreadsThanCores) return;
+    using Clock = std::chrono::steady_clock;
+    const Clock::rep until =
+        (Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::nanoseconds(std::min(inNanoseconds, cMaxSpinExtensionNanoseconds)) +
+                            std::chrono::microseconds(cSpinMicroseconds)))
+            .time_since_epoch()
+            .count();
     // Relaxed: a deadline only; the later of two concurrent extensions wins
-    int64_t current = mSpinExtendedUntil.load(std::memory_order_relaxed);
+    Clock::rep current = mSpinExtendedUntil.load(std::memory_order_relaxed);
     while (current < until &&
            !mSpinExtendedUntil.compare_exchange_weak(current, until, std::memory_order_relaxed))
     {
@@ -89,6 +90,7 @@ JobSystem::JobSystem(const Settings& inSettings)
     uint32_t numThreads = inSettings.mNumThreads;
     if (numThreads == 0) numThreads = std::max(1u, std::thread::hardware_concurrency());
     numThreads = std::min(numThreads, cMaxThreads);
+    mMoreThreadsThanCores = numThreads > std::max(1u, std::thread::hardware_concurrency());
     mWorkers.reserve(numThreads - 1);
     for (uint32_t i = 1; i < numThreads; ++i)
         mWorkers.emplace_back([this] { WorkerMain(); });
@@ -97,6 +99,8 @@ JobSystem::JobSystem(const Settings& inSettings)
 JobSystem::~JobSystem()
 {
     (void)WaitIdle(); // The owner destroys it outside any of its jobs
+    // Relaxed: a deadline only; spinning workers then leave within cSpinMicroseconds, not an extension later
+    mSpinExtendedUntil.store(0, std::memory_order_relaxed);
     {
         std::lock_guard lock(mQueueMutex);
         mStopping = true;

@@ -113,10 +113,13 @@ private:
 
     /// Before a serial stretch of about inNanoseconds that a parallel loop follows: the workers spinning idle
     /// spin through it (JobSystem::ExtendSpin) instead of falling asleep halfway, so that the loop does not
-    /// begin with tens of microseconds of waking one.
+    /// begin with tens of microseconds of waking one. A stretch under half the spin is left alone (a small
+    /// step's): a worker that spins now most likely still spins at its end, and no extension is paid for.
     void KeepWorkersSpinningFor(uint64_t inNanoseconds) const
     {
-        if (mJobs != nullptr && mJobs->GetNumThreads() > 1) mJobs->ExtendSpin(inNanoseconds);
+        if (mJobs != nullptr && mJobs->GetNumThreads() > 1 &&
+            inNanoseconds >= uint64_t(jobs::JobSystem::cSpinMicroseconds) * 500)
+            mJobs->ExtendSpin(inNanoseconds);
     }
 
     /// Runs inNumStages stages in order, every thread of the job system on each: stage s has inPartsOf(s)

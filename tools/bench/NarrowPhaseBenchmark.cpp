@@ -145,7 +145,8 @@ void BM_HeightFieldCreate(benchmark::State& ioState)
     }
 }
 
-/// A box sunk 5 cm into that terrain at random places and headings: CollideShapes against the cells under it.
+/// A box sunk 5 cm at its centre into that terrain (its corners deeper on a slope), at random places and
+/// headings: CollideShapes against the cells under it.
 void BM_BoxOnHeightField(benchmark::State& ioState)
 {
     const std::vector<float> heights = TerrainHeights();

@@ -853,7 +853,7 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
 /// A CSV field: the mode names are plain words, but a comma or quote in one must not shift the columns.
 std::string CsvField(const std::string& inText)
 {
-    if (inText.find_first_of(",\"\n") == std::string::npos) return inText;
+    if (inText.find_first_of(",\"\r\n") == std::string::npos) return inText;
     std::string quoted = "\"";
     for (char c : inText)
         quoted += c == '"' ? std::string("\"\"") : std::string(1, c);

@@ -2,6 +2,7 @@
 
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 
+#include <cassert>
 #include <string>
 
 namespace cairn
@@ -110,7 +111,8 @@ void VisitCell(const HeightFieldShape& inField, uint32_t inX, uint32_t inZ, cons
             continue;
         if (inWithEdges)
             triangle.mActiveEdges = uint8_t(inField.GetCellActiveEdges(inX, inZ) >> (3 * half) & 7u);
-        triangle.mSubShape = (inX + inZ * (inField.GetSampleCountX() - 1)) * 2 + uint32_t(half);
+        triangle.mSubShape =
+            uint32_t((inX + size_t(inZ) * (inField.GetSampleCountX() - 1)) * 2 + size_t(half));
         inVisitor(triangle);
     }
 }
@@ -197,6 +199,10 @@ Result<std::shared_ptr<const HeightFieldShape>> HeightFieldShape::Create(uint32_
         return MakeError(ErrorCode::DegenerateShape, "HeightFieldShape: needs at least 2 x 2 samples, got " +
                                                          std::to_string(inSampleCountX) + " x " +
                                                          std::to_string(inSampleCountZ));
+    if (uint64_t(inSampleCountX - 1) * uint64_t(inSampleCountZ - 1) > cMaxCells)
+        return MakeError(ErrorCode::InvalidArgument, "HeightFieldShape: " + std::to_string(inSampleCountX) +
+                                                         " x " + std::to_string(inSampleCountZ) +
+                                                         " samples are more than 2^31 cells");
     if (uint64_t(inSampleCountX) * uint64_t(inSampleCountZ) != uint64_t(inHeights.size()))
         return MakeError(ErrorCode::InvalidArgument, "HeightFieldShape: " + std::to_string(inSampleCountX) +
                                                          " x " + std::to_string(inSampleCountZ) +
@@ -228,6 +234,8 @@ HeightFieldShape::HeightFieldShape(uint32_t inSampleCountX, uint32_t inSampleCou
     : Shape(ShapeType::HeightField), mSampleCountX(inSampleCountX), mSampleCountZ(inSampleCountZ),
       mCellSize(inCellSize), mHeights(std::move(inHeights))
 {
+    assert(mSampleCountX >= 2 && mSampleCountZ >= 2 &&
+           mHeights.size() == size_t(mSampleCountX) * mSampleCountZ);
     // Bounds over solid cells only, so that borders made of holes do not inflate them; each solid cell's edge
     // flags (about 85 ns a cell), which a visit used to work out for each triangle it passed
     mCellActiveEdges.assign(size_t(mSampleCountX - 1) * (mSampleCountZ - 1), 0);

@@ -96,8 +96,8 @@ Vec3 TriangleNormalFacing(const Vec3& inV0, const Vec3& inV1, const Vec3& inV2, 
 bool IsEdgeActive(const Vec3& inNormal, const Vec3& inEdgePoint, const Vec3& inNeighbourNormal,
                   const Vec3& inNeighbourApex, float inCosThreshold)
 {
-    // The cosine from normals of any length: the height field tests its triangles' edges on every visit, and
-    // normalising the four normals each took most of a terrain query's time. In double: the squared
+    // The cosine from normals of any length: the height field works out a flag per cell edge at creation,
+    // from raw cross products, and normalising them would be most of that work. In double: the squared
     // lengths of a large triangle's normal (its doubled area) overflow a float
     const Eigen::Vector3d normal = inNormal.cast<double>(), neighbour = inNeighbourNormal.cast<double>();
     if (normal.dot(neighbour) >

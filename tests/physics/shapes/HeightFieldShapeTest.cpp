@@ -55,6 +55,12 @@ TEST(HeightFieldShapeTest, RejectsBadInput)
     // Counts whose product overflows 32 bits must not wrap around to the span's size
     EXPECT_EQ(HeightFieldShape::Create(65536, 65536, 1.0f, four).GetError().mCode,
               ErrorCode::InvalidArgument);
+    // Over 2^31 cells their triangles' sub-shape ids would not fit 32 bits: refused by the count alone
+    const auto tooMany = HeightFieldShape::Create(65537, 32770, 1.0f, four);
+    ASSERT_FALSE(tooMany.IsOk());
+    EXPECT_EQ(tooMany.GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_NE(tooMany.GetError().mMessage.find("2^31 cells"), std::string::npos)
+        << tooMany.GetError().mMessage;
     EXPECT_EQ(HeightFieldShape::Create(2, 2, 0.0f, four).GetError().mCode, ErrorCode::DegenerateShape);
     EXPECT_EQ(HeightFieldShape::Create(2, 2, -1.0f, four).GetError().mCode, ErrorCode::DegenerateShape);
     EXPECT_EQ(HeightFieldShape::Create(2, 2, 1e-30f, four).GetError().mCode, ErrorCode::DegenerateShape)

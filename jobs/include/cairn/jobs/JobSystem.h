@@ -98,7 +98,9 @@ public:
     /// Threads spinning idle (workers out of work, waits) spin on as if they had run out of work
     /// inNanoseconds from now (at most cMaxSpinExtensionNanoseconds) instead of going to sleep
     /// cSpinMicroseconds after they did; threads asleep stay asleep. For a serial stretch of about that
-    /// length that a parallel loop follows, so that the loop does not begin by waking a worker. Any thread.
+    /// length that a parallel loop follows, so that the loop does not begin by waking a worker. Does nothing
+    /// when the job system has more threads than the machine has cores: a spinning worker would then take the
+    /// core of the thread doing the serial work. Any thread.
     void ExtendSpin(uint64_t inNanoseconds);
     static constexpr uint64_t cMaxSpinExtensionNanoseconds = 1'000'000;
 
@@ -305,9 +307,10 @@ private:
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     /// Workers asleep in WorkerMain's wait (changed under mQueueMutex)
     std::atomic<uint32_t> mNumWorkersAsleep{0};
-    /// ExtendSpin's deadline: steady_clock nanoseconds since its epoch. Any thread; read by spinners
-    std::atomic<int64_t> mSpinExtendedUntil{0};
-    size_t mNumStuckWorkers = 0; ///< mQueueMutex: workers in a wait inside a job with nothing to run
+    /// ExtendSpin's deadline: steady_clock ticks since its epoch. Any thread; read by spinners
+    std::atomic<std::chrono::steady_clock::rep> mSpinExtendedUntil{0};
+    bool mMoreThreadsThanCores = false; ///< Set by the constructor: ExtendSpin does nothing
+    size_t mNumStuckWorkers = 0;        ///< mQueueMutex: workers in a wait inside a job with nothing to run
     /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
     /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex
     mutable std::vector<uint32_t> mSearchMarks;
