@@ -23,4 +23,24 @@ SampleSummary Summarize(std::vector<double> inSamples)
     return {timing.mMean, timing.mP50, timing.mP99, timing.mMax, count};
 }
 
+PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
+{
+    PhaseTimes means;
+    for (const StepStatistics& step : inSteps)
+    {
+        means.mBroadPhaseUpdateMs += step.mBroadPhaseUpdateMs;
+        means.mNarrowPhaseMs += step.mNarrowPhaseMs;
+        means.mIslandsMs += step.mIslandsMs;
+        means.mSolveMs += step.mSolveMs;
+        means.mFinishMs += step.mFinishMs;
+    }
+    const double frames = double(std::max<size_t>(1, inSteps.size()));
+    means.mBroadPhaseUpdateMs /= frames;
+    means.mNarrowPhaseMs /= frames;
+    means.mIslandsMs /= frames;
+    means.mSolveMs /= frames;
+    means.mFinishMs /= frames;
+    return means;
+}
+
 } // namespace cairn::demo

@@ -33,6 +33,9 @@ struct PhaseTimes
     double mFinishMs = 0.0;
 };
 
+/// The step phases' means per frame over inSteps (zeros for none).
+PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps);
+
 struct DemoRunResult
 {
     std::string mModeName; ///< "lock-free" or "global mutex"
@@ -41,9 +44,8 @@ struct DemoRunResult
     std::vector<double> mPhysicsMs; ///< Per frame: PhysicsSystem::Update wall time
     std::vector<double>
         mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
-    PhaseTimes mPhases;
-    /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics), for frames.csv: where a slow
-    /// frame's time went
+    /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics): the phase means of the
+    /// summary (MeanPhases) and frames.csv, where a slow frame's time went
     std::vector<StepStatistics> mSteps;
     /// Game-object query jobs: mean microseconds per query, per job-system thread (index = thread slot)
     std::vector<double> mQueryMicrosPerThread;

@@ -115,13 +115,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
             result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
         result.mPhysicsMs.push_back(MillisecondsSince(physicsStart));
-        const StepStatistics& step = physics.GetLastStepStatistics();
-        result.mPhases.mBroadPhaseUpdateMs += step.mBroadPhaseUpdateMs;
-        result.mPhases.mNarrowPhaseMs += step.mNarrowPhaseMs;
-        result.mPhases.mIslandsMs += step.mIslandsMs;
-        result.mPhases.mSolveMs += step.mSolveMs;
-        result.mPhases.mFinishMs += step.mFinishMs;
-        result.mSteps.push_back(step);
+        result.mSteps.push_back(physics.GetLastStepStatistics());
 
         gameObjects->Update(frameJobs, inSettings.mGameObjectJobs, player, dt);
         agents->Update(dt, player);
@@ -183,12 +177,6 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mDynamicBodiesPeak = streaming.mDynamicPeak;
     for (const std::string& error : streaming.mErrors)
         result.mErrors.push_back("streaming: " + error);
-    const double frames = std::max(1, inSettings.mFrames);
-    result.mPhases.mBroadPhaseUpdateMs /= frames;
-    result.mPhases.mNarrowPhaseMs /= frames;
-    result.mPhases.mIslandsMs /= frames;
-    result.mPhases.mSolveMs /= frames;
-    result.mPhases.mFinishMs /= frames;
 
     // Tear down in dependency order: agents (invokers), the scheduler (its jobs read the world), then the
     // streamer, whose unload checks every body it made once more
