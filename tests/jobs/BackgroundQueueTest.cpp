@@ -112,13 +112,15 @@ TEST(BackgroundQueueTest, ARunningTaskGivesWayToAHigherOneBetweenChunks)
                             });
     while (low->GetChunksRun() < 3)
         std::this_thread::sleep_for(1ms);
-    urgentSubmitted.store(true, std::memory_order_release);
     auto urgent = queue.Submit("urgent", 10,
                                [&](BackgroundTaskContext&)
                                {
                                    urgentDone.store(true, std::memory_order_release);
                                    return BackgroundStep::Done;
                                });
+    // Once it is queued, not before: set before, a low chunk could see the flag, end, and start another
+    // before the urgent task was queued at all (a second count on a loaded machine, not a missed preemption)
+    urgentSubmitted.store(true, std::memory_order_release);
     ASSERT_TRUE(urgent->Wait(10s));
     ASSERT_TRUE(low->Wait(10s));
     EXPECT_TRUE(lowSawUrgentDone.load());
