@@ -1076,6 +1076,34 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
         return std::span<ContactConstraint* const>(mIslandConstraints.data() + inBatch.mFirst,
                                                    inBatch.mCount);
     };
+    // The batches of a color (they share no dynamic body) are solved in one contiguous part per thread, as
+    // in SolveColoredIsland (8 batches are the 32 constraints a part needs). Packed and stored by the thread
+    // whose part they are: a batch is 2 KB, and one packed on the other core (a loop over all the batches
+    // in chunks gave half of them to it) crossed between the cores twice a step
+    auto batchesOf = [&](uint32_t inColor)
+    {
+        return std::span<WideContactBatch>(mWideBatches.data() + mColorFirstBatch[inColor],
+                                           mWideBatches.data() + mColorFirstBatch[inColor + 1]);
+    };
+    auto partsOfColor = [&](uint32_t inColor) { return PartsFor(uint32_t(batchesOf(inColor).size()), 8); };
+    auto forEachPartOfThreads = [&](const auto& inRunBatches)
+    {
+        const uint32_t threads = inAlone || mJobs == nullptr ? 1 : mJobs->GetNumThreads();
+        if (threads == 1)
+        {
+            inRunBatches(std::span<WideContactBatch>(mWideBatches.data() + islandFirstBatch, numBatches));
+            return;
+        }
+        mJobs->ParallelFor(threads, 1,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           {
+                               for (uint32_t part = inBegin; part < inEnd; ++part)
+                                   for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
+                                       if (const uint32_t parts = partsOfColor(color); part < parts)
+                                           inRunBatches(PartOf(batchesOf(color), part, parts));
+                           });
+    };
+
     // The constraints are where the narrow phase made them (not copied: see SolveIslands), scattered over its
     // chunks: each batch's are fetched a batch ahead, and bound and given position constraints as they are
     // packed, while their cache lines are at hand. The range that found no color is prepared here
@@ -1084,38 +1112,30 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
         if (mColorIsSerial[color] != 0)
             for (uint32_t i = mColorStart[color]; i < mColorStart[color + 1]; ++i)
                 PrepareForSolve(i, numActive);
-    ParallelForUnlessAlone(inAlone, numBatches, 64,
-                           [&](uint32_t inBegin, uint32_t inEnd)
-                           {
-                               for (uint32_t i = islandFirstBatch + inBegin; i < islandFirstBatch + inEnd;
-                                    ++i)
-                               {
-                                   if (i + 1 < islandFirstBatch + inEnd)
-                                       for (ContactConstraint* next : constraintsOf(mWideBatches[i + 1]))
-                                           PrefetchConstraint(next);
-                                   WideContactBatch& batch = mWideBatches[i];
-                                   for (uint32_t lane = 0; lane < batch.mCount; ++lane)
-                                       PrepareForSolve(batch.mFirst + lane, numActive);
-                                   WideContactSolver::Pack(constraintsOf(batch), solverBodies, batch);
-                               }
-                           });
+    forEachPartOfThreads(
+        [&](std::span<WideContactBatch> inBatches)
+        {
+            for (size_t i = 0; i < inBatches.size(); ++i)
+            {
+                if (i + 1 < inBatches.size())
+                    for (ContactConstraint* next : constraintsOf(inBatches[i + 1]))
+                        PrefetchConstraint(next);
+                WideContactBatch& batch = inBatches[i];
+                for (uint32_t lane = 0; lane < batch.mCount; ++lane)
+                    PrepareForSolve(batch.mFirst + lane, numActive);
+                WideContactSolver::Pack(constraintsOf(batch), solverBodies, batch);
+            }
+        });
 
     // The warm start, then the iterations: each a pass over the colors in turn, each color a stage. The
-    // serial range by the scalar solver in one part; the batches of a color (they share no dynamic body) in
-    // one contiguous part per thread, as in SolveColoredIsland (8 batches are the 32 constraints a part
-    // needs)
+    // serial range by the scalar solver in one part; the batches of a color in their parts
     const uint32_t numColors = inLastColor - inFirstColor + 1;
-    auto batchesOf = [&](uint32_t inColor)
-    {
-        return std::span<WideContactBatch>(mWideBatches.data() + mColorFirstBatch[inColor],
-                                           mWideBatches.data() + mColorFirstBatch[inColor + 1]);
-    };
     RunStages(
         inAlone, (1 + uint32_t(mSettings.mSolver.mVelocityIterations)) * numColors,
         [&](uint32_t inStage)
         {
             const uint32_t color = inFirstColor + inStage % numColors;
-            return mColorIsSerial[color] != 0 ? 1u : PartsFor(uint32_t(batchesOf(color).size()), 8);
+            return mColorIsSerial[color] != 0 ? 1u : partsOfColor(color);
         },
         [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
         {
@@ -1137,15 +1157,14 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                 WideContactSolver::SolveVelocities(part, solverBodies, pass - 1);
         });
 
-    ParallelForUnlessAlone(
-        inAlone, numBatches, 64,
-        [&](uint32_t inBegin, uint32_t inEnd)
+    forEachPartOfThreads(
+        [&](std::span<WideContactBatch> inBatches)
         {
-            for (uint32_t i = islandFirstBatch + inBegin; i < islandFirstBatch + inEnd; ++i)
+            for (WideContactBatch& batch : inBatches)
                 if (inStoreImpulses)
-                    WideContactSolver::StoreImpulses(mWideBatches[i], mContactCache);
+                    WideContactSolver::StoreImpulses(batch, mContactCache);
                 else
-                    WideContactSolver::Unpack(mWideBatches[i], constraintsOf(mWideBatches[i]));
+                    WideContactSolver::Unpack(batch, constraintsOf(batch));
         });
     if (inStoreImpulses)
         for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
