@@ -380,9 +380,17 @@ private:
         uint64_t mOrderKey;
         uint32_t mCacheIndex; ///< Tie-break (unique)
         uint32_t mConstraint; ///< Index into mConstraints and mConstraintInfo
+        bool operator==(const OrderItem&) const = default;
     };
-    /// Per entry of mIslandConstraints once sorted (until ColorIsland reorders a colored island's entries)
+    /// Per entry of mIslandConstraints once sorted (until ColorIsland reorders a colored island's entries);
+    /// kept for the next step, whose sort input may be the same (OrderConstraints)
     std::vector<OrderItem> mOrderItems;
+    /// The sort's input: each island's items in constraint order (BuildIslands); and the input that
+    /// mOrderItems holds sorted, with its islands' starts
+    std::vector<OrderItem> mUnsortedOrderItems;
+    std::vector<OrderItem> mSortedOrderItemsInput;
+    std::vector<uint32_t> mSortedOrderItemsStarts;
+    bool mSolveOrderReused = false;       ///< This step's (statistics)
     std::vector<OrderItem> mOrderScratch; ///< Scratch: the radix sort's second buffer
     struct ColorItem
     {

@@ -38,6 +38,7 @@ struct RunResult
     BroadPhaseQuadTree::CandidateCacheStats mCandidates; ///< How the pair search served static candidates
     uint64_t mColoredIslands = 0;                        ///< Islands colored, summed over all steps
     uint64_t mReusedColorings = 0;                       ///< ... of which took the previous step's coloring
+    uint64_t mReusedSolveOrders = 0;                     ///< Steps that took the previous step's solve order
     int mSteps = 0;
 };
 
@@ -96,6 +97,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mReusedBodyPairs += stats.mNumReusedBodyPairs;
         result.mColoredIslands += stats.mNumColoredIslands;
         result.mReusedColorings += stats.mNumColoringsReused;
+        result.mReusedSolveOrders += stats.mNumSolveOrdersReused;
     }
     result.mStep = tools::Summarize(stepMs);
     for (const BodyID& id : inDynamic)
@@ -167,7 +169,7 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             "broadphase-update %.3f  "
             "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
             "contacts %llu  | pairs reused %.1f%%  | static candidates reused %.1f%% (%.1f%% walked, too "
-            "many)  | colorings reused %llu of %llu\n",
+            "many)  | colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
             inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
             run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
             run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
@@ -177,7 +179,8 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
             100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
             static_cast<unsigned long long>(run.mReusedColorings),
-            static_cast<unsigned long long>(run.mColoredIslands));
+            static_cast<unsigned long long>(run.mColoredIslands),
+            static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

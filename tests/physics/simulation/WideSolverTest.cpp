@@ -1,6 +1,7 @@
 // The wide solver (four manifolds per SSE register, for colored islands) does the scalar solver's arithmetic
 // in the same order: the same scene gives the same body states either way, step after step. The same for an
-// island's coloring taken over from the previous step (SolverSettings::mReuseColorings) and one made anew.
+// island's coloring and solve order taken over from the previous step (SolverSettings::mReuseColorings) and
+// ones made anew.
 
 #include "SimulationFixture.h"
 #include "common/StaticFloor.h"
@@ -112,18 +113,22 @@ TEST(WideSolverTest, AColoringTakenOverGivesTheSameStatesAsANewOne)
     PyramidRun fresh = MakePyramid(true, false), reused = MakePyramid(true, true);
     StepBoth(fresh, reused, &jobSystem, 150);
     StepBoth(fresh, reused, nullptr, 50);
-    // Once settled, the pyramid's contacts are the same from step to step: its coloring is taken over
-    uint32_t colored = 0, takenOver = 0;
+    // Once settled, the pyramid's contacts are the same from step to step: its coloring and its solve order
+    // are taken over
+    uint32_t colored = 0, takenOver = 0, ordersTakenOver = 0;
     for (int step = 0; step < 20; ++step)
     {
         for (PyramidRun* run : {&fresh, &reused})
             ASSERT_TRUE(run->mSystem->Update(1.0f / 60.0f).IsOk());
         colored += reused.mSystem->GetLastStepStatistics().mNumColoredIslands;
         takenOver += reused.mSystem->GetLastStepStatistics().mNumColoringsReused;
+        ordersTakenOver += reused.mSystem->GetLastStepStatistics().mNumSolveOrdersReused;
         EXPECT_EQ(fresh.mSystem->GetLastStepStatistics().mNumColoringsReused, 0u);
+        EXPECT_EQ(fresh.mSystem->GetLastStepStatistics().mNumSolveOrdersReused, 0u);
     }
     EXPECT_EQ(colored, 20u);
     EXPECT_GE(takenOver, 15u);
+    EXPECT_GE(ordersTakenOver, 15u);
     StepBoth(fresh, reused, nullptr, 1); // Still the same states after those steps
 }
 
@@ -151,15 +156,18 @@ TEST(WideSolverTest, ColoringsOfAPileFallingOverEachOtherAreTakenOverOnlyWhenThe
         return run;
     };
     PyramidRun fresh = makePile(false), reused = makePile(true);
-    uint32_t colored = 0, takenOver = 0;
+    uint32_t colored = 0, takenOver = 0, ordersTakenOver = 0;
     for (int step = 0; step < 120; ++step)
     {
         StepBoth(fresh, reused, nullptr, 1);
         colored += reused.mSystem->GetLastStepStatistics().mNumColoredIslands;
         takenOver += reused.mSystem->GetLastStepStatistics().mNumColoringsReused;
+        ordersTakenOver += reused.mSystem->GetLastStepStatistics().mNumSolveOrdersReused;
     }
     EXPECT_GT(colored, 60u) << "the pile must be colored for the test to mean anything";
-    std::printf("[ figure   ] %u of %u colorings taken over\n", takenOver, colored);
+    EXPECT_LT(ordersTakenOver, 120u) << "the pile's contacts must change for the test to mean anything";
+    std::printf("[ figure   ] %u of %u colorings taken over, solve orders in %u of 120 steps\n", takenOver,
+                colored, ordersTakenOver);
 }
 
 /// Small islands: single boxes, stacks of two and three, and tilted boxes on a floor (one to four

@@ -18,7 +18,8 @@ struct SolverSettings
     bool mWideColoredIslands = true;
     /// An island whose constraints join the same bodies in the same solve order as an island colored in the
     /// previous step takes that coloring over (the coloring depends on nothing else: same results bit for
-    /// bit); false colors every island anew, for comparison
+    /// bit); likewise a step whose constraints come with the same keys in the same order as the previous
+    /// step's takes its solve order over. False colors every island and sorts every step anew, for comparison
     bool mReuseColorings = true;
 };
 
