@@ -951,10 +951,28 @@ void PhysicsStep::ComputeColoring(ColoringRecord& ioRecord)
     mColorItems.resize(size);
     std::array<uint32_t, cSerialColor + 1>& count = ioRecord.mCount;
     count.fill(0);
-    // Greedy, in the hashed solve order: each constraint takes the lowest color that neither of its dynamic
-    // bodies has yet (static and kinematic bodies are only read by the solver, so they may repeat in a color)
+    // Greedy, body by body: the constraints in the order of their lowest dynamic body, then their other one
+    // (a static or kinematic side counts as numActive, after every dynamic body), then solve order. Each
+    // takes the lowest color that neither of its dynamic bodies has yet (static and kinematic bodies are only
+    // read by the solver, so they may repeat in a color). A body's constraints then take the colors its
+    // neighbours left free: a pyramid's 8,400 constraints in 16 colors of 340-610, where the hashed solve
+    // order took 20, down to colors of 15 and of 1 constraint (each a stage of its own in every pass)
+    const uint32_t numActive = uint32_t(mBodyColors.size());
+    const int indexBits = std::max(1, int(std::bit_width(numActive)));
+    mColorVisit.resize(size);
     for (uint32_t i = 0; i < size; ++i)
     {
+        const uint32_t indexA = uint32_t(ioRecord.mBodyPairs[i] >> 32),
+                       indexB = uint32_t(ioRecord.mBodyPairs[i]);
+        const uint32_t low = std::min(indexA, indexB), high = std::max(indexA, indexB);
+        mColorVisit[i] = {uint64_t(low) << indexBits | (high == UINT32_MAX ? numActive : high), i};
+    }
+    RadixSort(
+        std::span<ColorItem>(mColorVisit), mColorItemsScratch,
+        [](const ColorItem& inItem) { return inItem.mKey; }, 2 * indexBits);
+    for (const ColorItem& visit : mColorVisit)
+    {
+        const uint32_t i = visit.mPosition;
         const uint32_t indexA = uint32_t(ioRecord.mBodyPairs[i] >> 32),
                        indexB = uint32_t(ioRecord.mBodyPairs[i]);
         const bool dynamicA = indexA != UINT32_MAX, dynamicB = indexB != UINT32_MAX;

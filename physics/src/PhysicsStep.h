@@ -394,10 +394,11 @@ private:
     std::vector<OrderItem> mOrderScratch; ///< Scratch: the radix sort's second buffer
     struct ColorItem
     {
-        uint64_t mKey;      ///< color << 32 | lowest dynamic active index
+        uint64_t mKey;      ///< color << 32 | lowest dynamic active index (the visit order: both bodies)
         uint32_t mPosition; ///< In the island's hashed order
     };
     std::vector<ColorItem> mColorItems;            ///< Scratch per constraint of the island being colored
+    std::vector<ColorItem> mColorVisit;            ///< Scratch: the coloring's visit order (bodies, position)
     std::vector<ColorItem> mColorItemsScratch;     ///< Scratch: the radix sort's second buffer
     std::vector<ContactConstraint*> mColorScratch; ///< Scratch: the island's constraints reordered
     /// A coloring, kept for the next step: a resting pile's largest island has the same constraints between
