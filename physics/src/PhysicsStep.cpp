@@ -785,7 +785,8 @@ void PhysicsStep::OrderConstraints()
     };
     // A resting pile or pyramid finds the same contacts in the same order step after step: the same sort
     // input, whose sorted order mOrderItems still holds (a compare, where a pyramid's sort took 60 us)
-    mSolveOrderReused = mSettings.mSolver.mReuseColorings && mUnsortedOrderItems == mSortedOrderItemsInput &&
+    mSolveOrderReused = mSettings.mSolver.mReuseColorings && !mUnsortedOrderItems.empty() &&
+                        mUnsortedOrderItems == mSortedOrderItemsInput &&
                         mConstraintStart == mSortedOrderItemsStarts;
     if (!mSolveOrderReused)
     {
@@ -1106,9 +1107,11 @@ void PhysicsStep::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstCo
                                                    inBatch.mCount);
     };
     // The batches of a color (they share no dynamic body) are solved in one contiguous part per thread, as
-    // in SolveColoredIsland (8 batches are the 32 constraints a part needs). Packed and stored by the thread
-    // whose part they are: a batch is 2 KB, and one packed on the other core (a loop over all the batches
-    // in chunks gave half of them to it) crossed between the cores twice a step
+    // in SolveColoredIsland (8 batches are the 32 constraints a part needs). Packed and stored in the same
+    // parts, part p by the thread that runs the loop's part p, which is normally the one that runs the
+    // stages' part p too (each thread takes its own part first): a batch is 2 KB, and one packed on the other
+    // core (a loop over all the batches in chunks gave half of them to it) crossed between the cores twice a
+    // step
     auto batchesOf = [&](uint32_t inColor)
     {
         return std::span<WideContactBatch>(mWideBatches.data() + mColorFirstBatch[inColor],

@@ -70,8 +70,8 @@ struct StepStatistics
     uint32_t mLargestIsland = 0;      ///< Bodies
     uint32_t mNumColoredIslands = 0;  ///< Islands colored for the parallel or wide solver
     uint32_t mNumColoringsReused = 0; ///< ... of which took the previous step's coloring (mReuseColorings)
-    /// Collision steps whose constraints came with the same keys in the same order as in the one before, so
-    /// that its solve order was taken over instead of sorted (mReuseColorings)
+    /// Collision steps whose constraints (at least one) came with the same keys in the same order as in the
+    /// one before, so that its solve order was taken over instead of sorted (mReuseColorings)
     uint32_t mNumSolveOrdersReused = 0;
     /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
     /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
