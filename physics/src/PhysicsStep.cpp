@@ -793,23 +793,21 @@ void PhysicsStep::OrderConstraints()
         mOrderItems = mUnsortedOrderItems;
         std::swap(mUnsortedOrderItems, mSortedOrderItemsInput);
         mSortedOrderItemsStarts = mConstraintStart;
-    }
-    for (uint32_t island = 0; island < numIslands && !mSolveOrderReused; ++island)
-    {
-        const std::span<OrderItem> items(mOrderItems.data() + mConstraintStart[island],
-                                         mOrderItems.data() + mConstraintStart[island + 1]);
-        // A large island (a pile or a pyramid: thousands of constraints) by radix on the key's high half,
-        // which took a third of the time of std::sort there; items whose high halves are equal (rare) are
-        // then put in the comparison's order, so the result is that of sorting by the whole key and cache
-        // index
-        if (items.size() < cRadixSortMinItems)
+        for (uint32_t island = 0; island < numIslands; ++island)
         {
-            std::sort(items.begin(), items.end(), byKeyThenCacheIndex);
-            continue;
+            const std::span<OrderItem> items(mOrderItems.data() + mConstraintStart[island],
+                                             mOrderItems.data() + mConstraintStart[island + 1]);
+            // A large island (a pile or a pyramid: thousands of constraints) by radix on the key's high half,
+            // which took a third of the time of std::sort there; items whose high halves are equal (rare) are
+            // then put in the comparison's order, so the result is that of sorting by the whole key and cache
+            // index
+            if (items.size() < cRadixSortMinItems)
+                std::sort(items.begin(), items.end(), byKeyThenCacheIndex);
+            else
+                RadixSortByHighHalf(
+                    items, mOrderScratch, [](const OrderItem& inItem) { return inItem.mOrderKey; },
+                    byKeyThenCacheIndex);
         }
-        RadixSortByHighHalf(
-            items, mOrderScratch, [](const OrderItem& inItem) { return inItem.mOrderKey; },
-            byKeyThenCacheIndex);
     }
     mIslandConstraints.resize(mOrderItems.size());
     for (size_t i = 0; i < mOrderItems.size(); ++i)
