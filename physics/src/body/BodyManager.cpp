@@ -1,5 +1,7 @@
 #include "cairn/physics/body/BodyManager.h"
 
+#include "cairn/physics/LockWaits.h"
+
 #include <algorithm>
 #include <bit>
 #include <cassert>
@@ -76,7 +78,7 @@ BodyManager::~BodyManager() = default;
 
 uint32_t BodyManager::GetNumBodies() const
 {
-    std::lock_guard lock(mFreeListMutex);
+    const auto lock = LockedCountingWait(mFreeListMutex);
     return mNumBodies;
 }
 
@@ -89,7 +91,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 
     uint32_t index;
     {
-        std::lock_guard lock(mFreeListMutex);
+        const auto lock = LockedCountingWait(mFreeListMutex);
         if (mFreeList.empty())
             return MakeError(ErrorCode::OutOfCapacity,
                              "body manager is full (" + std::to_string(mMaxBodies) + " bodies)");
@@ -98,8 +100,8 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
         ++mNumBodies;
     }
 
-    std::unique_lock lock(GetMutexForBody(index));
-    std::unique_lock staticLock(GetStaticMutexForBody(index));
+    const auto lock = LockedCountingWait(GetMutexForBody(index));
+    const auto staticLock = LockedCountingWait(GetStaticMutexForBody(index));
     Body& body = mBodies[index];
     const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
@@ -115,8 +117,8 @@ Status BodyManager::DestroyBody(const BodyID& inID)
     if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)
         return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
     {
-        std::unique_lock lock(GetMutexForBody(inID.GetIndex()));
-        std::unique_lock staticLock(GetStaticMutexForBody(inID.GetIndex()));
+        const auto lock = LockedCountingWait(GetMutexForBody(inID.GetIndex()));
+        const auto staticLock = LockedCountingWait(GetStaticMutexForBody(inID.GetIndex()));
         Body* body = TryGetBody(inID);
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
         if (body->mInWorld || body->mAddPending)
@@ -127,7 +129,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);
         mSlotInUse[inID.GetIndex()] = false;
     }
-    std::lock_guard lock(mFreeListMutex);
+    const auto lock = LockedCountingWait(mFreeListMutex);
     mFreeList.push_back(inID.GetIndex());
     --mNumBodies;
     return Status::Ok();
@@ -153,7 +155,7 @@ void BodyManager::ActivateBody(Body& ioBody)
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
     if (!IsInsideStep())
     {
-        lock.lock();
+        LockCountingWait(lock);
         // Woken from outside: the bodies it slept with may rest on it; the next step wakes them (it holds
         // every lock, so it can walk the island's ring safely)
         ioBody.mWakeIsland = true;
@@ -167,7 +169,7 @@ void BodyManager::DeactivateBody(Body& ioBody)
 {
     if (!ioBody.IsActive()) return;
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
-    if (!IsInsideStep()) lock.lock();
+    if (!IsInsideStep()) LockCountingWait(lock);
     // Swap-remove: the last body takes this body's place in the list
     const uint32_t slot = ioBody.GetActiveIndex();
     const uint32_t last = mActiveBodies.back();
@@ -225,7 +227,7 @@ void BodyManager::LockAllBodies() const
 {
     assert(!tInsideStep);
     for (uint32_t m = 0; m <= mMutexMask; ++m) // In index order: see the lock order above
-        mBodyMutexes[m].mMutex.lock();
+        LockCountingWait(mBodyMutexes[m].mMutex);
     tInsideStep = true;
 }
 

@@ -6,7 +6,9 @@
 // Taking one inside a step callback (where the step already holds every body mutex), or while this thread
 // already holds one (two locks held in any order can deadlock against the step, which takes all of them),
 // would risk a deadlock: it is refused instead (GetBody() returns nullptr, WasWrongThread() is true).
+// A lock that has to wait adds its wait to the thread's LockWaits total.
 
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/body/BodyManager.h"
 
 #include <chrono>
@@ -31,12 +33,12 @@ public:
         mMutex = &inManager.GetMutexForBody(inID.GetIndex());
         if constexpr (Write)
         {
-            mMutex->lock();
+            LockCountingWait(*mMutex);
             mStaticMutex = &inManager.GetStaticMutexForBody(inID.GetIndex());
-            mStaticMutex->lock();
+            LockCountingWait(*mStaticMutex);
         }
         else
-            mMutex->lock_shared();
+            LockSharedCountingWait(*mMutex);
         BodyManager::NoteBodyLockHeld(+1);
         mBody = inManager.TryGetBody(inID);
     }
@@ -128,10 +130,9 @@ public:
             // Contended (a writer outside the step): time the real wait, not the thread's scheduling
             const auto start = std::chrono::steady_clock::now();
             mMutex->lock_shared();
-            if (ioWaitMs != nullptr)
-                *ioWaitMs =
-                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                        .count();
+            const auto wait = std::chrono::steady_clock::now() - start;
+            AddThisThreadLockWait(wait);
+            if (ioWaitMs != nullptr) *ioWaitMs = std::chrono::duration<double, std::milli>(wait).count();
         }
         BodyManager::NoteBodyLockHeld(+1);
         const Body* body = inManager.TryGetBody(inID);

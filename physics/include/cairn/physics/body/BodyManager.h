@@ -18,6 +18,7 @@
 //    body mutex; the step never writes a static body. So a thread holding only the static mutex (shared) may
 //    read a static body while the step runs: StaticBodyLockRead, with which background navmesh jobs read
 //    level geometry without waiting for a whole step.
+//  - Every one of these mutexes that has to wait adds its wait to the thread's LockWaits total.
 
 #include "cairn/physics/body/Body.h"
 #include "cairn/physics/body/BodyChangeListener.h"

@@ -9,11 +9,13 @@
 // rebuilds, and 32 more held at once would exceed ThreadSanitizer's lock-tracking limit (64 per thread).
 // Waiting: a shared locker that finds the flag raised, and the exclusive locker waiting for stripes to empty,
 // yield the CPU in a loop; both waits last at most one commit or one modification (microseconds).
-// Threads: any. Not recursive. Exclusive lockers are serialised by mWriterMutex.
+// Threads: any. Not recursive. Exclusive lockers are serialised by mWriterMutex. Both waits are added to the
+// waiting thread's LockWaits total.
 // Memory orders: the shared side's increment and flag check and the exclusive side's flag raise and count
 // check are seq_cst (a store-load pattern in each thread that acquire/release does not order); the unlocks
 // are release and pair with the acquire of the next locker's loads.
 
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/broadphase/ThreadStripe.h"
 
 #include <atomic>
@@ -39,6 +41,7 @@ public:
             if (!mWriter.load(std::memory_order_seq_cst)) return stripe;
             // A commit is running or waiting: step aside so that it can finish, then retry
             count.fetch_sub(1, std::memory_order_release); // Release: nothing was touched, but keep it paired
+            ScopedLockWait wait;
             while (mWriter.load(std::memory_order_acquire)) // Acquire: pairs with the release in unlock()
                 std::this_thread::yield();
         }
@@ -53,11 +56,15 @@ public:
     /// Exclusive lock: raises the flag, then waits until no shared holder is left.
     void lock()
     {
-        mWriterMutex.lock();
+        LockCountingWait(mWriterMutex);
         mWriter.store(true, std::memory_order_seq_cst); // seq_cst: see the header comment
         for (const Stripe& stripe : mStripes)
-            while (stripe.mCount.load(std::memory_order_seq_cst) != 0) // seq_cst: see the header comment
-                std::this_thread::yield();
+            if (stripe.mCount.load(std::memory_order_seq_cst) != 0) // seq_cst: see the header comment
+            {
+                ScopedLockWait wait;
+                while (stripe.mCount.load(std::memory_order_seq_cst) != 0) // As above
+                    std::this_thread::yield();
+            }
     }
 
     void unlock()

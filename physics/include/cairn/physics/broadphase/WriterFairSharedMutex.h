@@ -9,7 +9,10 @@
 // (lock, unlock) before taking the shared lock. Once a writer waits, new readers queue behind it; readers
 // already inside finish, the writer gets in. Readers pay one uncontended mutex lock/unlock. Threads: any. Not
 // recursive: a thread holding it (shared or exclusive) must not lock it again. Satisfies SharedLockable, so
-// std::unique_lock and std::shared_lock work with it.
+// std::unique_lock and std::shared_lock work with it. A lock that has to wait adds its wait to the thread's
+// LockWaits total.
+
+#include "cairn/physics/LockWaits.h"
 
 #include <mutex>
 #include <shared_mutex>
@@ -23,8 +26,18 @@ public:
     /// Exclusive lock: blocks new readers while waiting.
     void lock()
     {
+        if (try_lock()) return;
+        ScopedLockWait wait;
         std::lock_guard turnstile(mTurnstile);
         mMutex.lock();
+    }
+    /// Exclusive lock if it is free and no writer waits for it.
+    bool try_lock()
+    {
+        if (!mTurnstile.try_lock()) return false;
+        const bool locked = mMutex.try_lock();
+        mTurnstile.unlock();
+        return locked;
     }
     /// Releases the exclusive lock.
     void unlock() { mMutex.unlock(); }
@@ -32,10 +45,19 @@ public:
     /// Shared lock: waits behind any writer that is already waiting.
     void lock_shared()
     {
+        if (try_lock_shared()) return;
+        ScopedLockWait wait;
         {
             std::lock_guard turnstile(mTurnstile);
         }
         mMutex.lock_shared();
+    }
+    /// Shared lock if no writer holds it or waits for it.
+    bool try_lock_shared()
+    {
+        if (!mTurnstile.try_lock()) return false; // A writer waits (or another reader is passing through)
+        mTurnstile.unlock();
+        return mMutex.try_lock_shared();
     }
     /// Releases a shared lock.
     void unlock_shared() { mMutex.unlock_shared(); }
