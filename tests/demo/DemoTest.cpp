@@ -44,6 +44,8 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(inRun.mTilesStreamedOut, 0u) << inRun.mModeName;
     EXPECT_EQ(inRun.mPhysicsMs.size(), 240u);
     EXPECT_EQ(inRun.mSteps.size(), 240u);
+    EXPECT_EQ(inRun.mGameObjectLockWaitUs.size(), 240u);
+    EXPECT_EQ(inRun.mLockWaitMicrosPerThreadFrame.size(), inRun.mQueryMicrosPerThread.size());
     EXPECT_GT(inRun.mQueries, 0u);
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
     const std::string paths =
@@ -73,6 +75,7 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mFrameMs = {2.5, 3.0};
     run.mPhysicsMs = {0.25, 0.5};
     run.mMainThreadStreamMs = {0.01, 0.02};
+    run.mGameObjectLockWaitUs = {0.0, 12.5};
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
                    uint32_t inActive, uint32_t inPairs, uint32_t inPoints)
     {
@@ -98,10 +101,45 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
         lines.push_back(csv.substr(begin, end - begin));
     ASSERT_EQ(lines.size(), 4u) << csv;
     EXPECT_EQ(lines[0], "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
-                        "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points");
-    EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66");
-    EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70");
+                        "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,"
+                        "game_object_lock_wait_us");
+    EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.00");
+    EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,12.50");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
+}
+
+/// What PrintComparison writes for the two runs.
+std::string ComparisonText(const DemoRunResult& inLockFree, const DemoRunResult& inGlobal)
+{
+    std::FILE* file = std::tmpfile();
+    if (file == nullptr) return "";
+    PrintComparison(file, inLockFree, inGlobal);
+    std::rewind(file);
+    std::string text;
+    for (int c; (c = std::fgetc(file)) != EOF;)
+        text += char(c);
+    std::fclose(file);
+    return text;
+}
+
+TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
+{
+    DemoRunResult lockFree, global;
+    lockFree.mModeName = "lock-free";
+    global.mModeName = "global mutex";
+    lockFree.mLockWaitMicrosPerThreadFrame = {0.5, 1.5};
+    global.mLockWaitMicrosPerThreadFrame = {20.0, 10.0};
+    const std::string text = ComparisonText(lockFree, global);
+    const size_t row = text.find("lock waits µs/frame per thread");
+    ASSERT_NE(row, std::string::npos) << text;
+    const std::string line = text.substr(row, text.find('\n', row) - row);
+    EXPECT_NE(line.find("1.00"), std::string::npos) << line;
+    EXPECT_NE(line.find("15.00"), std::string::npos) << line;
+    EXPECT_NE(line.find("15.00x"), std::string::npos) << line;
+
+    lockFree.mLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    const std::string none = ComparisonText(lockFree, global);
+    EXPECT_NE(none.find("no waits lock-free"), std::string::npos) << none;
 }
 
 } // namespace

@@ -88,6 +88,23 @@ std::string Ratio(double inNumerator, double inDenominator)
     return Format("%.2fx", inNumerator / inDenominator);
 }
 
+/// A ratio of two waits, where the lock-free side may be exactly 0.
+std::string WaitRatio(double inNumerator, double inDenominator)
+{
+    if (std::isfinite(inNumerator) && inNumerator > 0.0 && inDenominator == 0.0) return "no waits lock-free";
+    return Ratio(inNumerator, inDenominator);
+}
+
+/// The mean of a series, NaN when empty.
+double MeanOf(const std::vector<double>& inValues)
+{
+    if (inValues.empty()) return std::nan("");
+    double sum = 0.0;
+    for (double value : inValues)
+        sum += value;
+    return sum / double(inValues.size());
+}
+
 /// Display width in columns, counting UTF-8 code points (the reports use "µ").
 size_t TextWidth(const std::string& inText)
 {
@@ -254,6 +271,10 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     for (size_t i = 0; i < inRun.mQueryMicrosPerThread.size(); ++i)
         perThread += (i == 0 ? "" : ", ") + Micros(inRun.mQueryMicrosPerThread[i]);
     if (perThread.empty()) perThread = "n/a";
+    std::string waitsPerThread;
+    for (size_t i = 0; i < inRun.mLockWaitMicrosPerThreadFrame.size(); ++i)
+        waitsPerThread += (i == 0 ? "" : ", ") + Micros(inRun.mLockWaitMicrosPerThreadFrame[i]);
+    if (waitsPerThread.empty()) waitsPerThread = "n/a";
 
     auto ofQueries = [&](uint64_t inCount)
     {
@@ -285,7 +306,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     sections.push_back({"game-object queries",
                         {{"queries", Count(inRun.mQueries)},
                          {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
-                         {"µs/query per thread", perThread}}});
+                         {"µs/query per thread", perThread},
+                         {"lock waits µs/frame per thread", waitsPerThread}}});
     sections.push_back({"streaming",
                         {{"tiles in", Count(inRun.mTilesStreamedIn)},
                          {"tiles out", Count(inRun.mTilesStreamedOut)},
@@ -407,6 +429,10 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
         table.mRows.push_back({Format("query µs/query thread %zu", i), Micros(lockFreeValue),
                                Micros(globalValue), Ratio(globalValue, lockFreeValue)});
     }
+    const double lockFreeWaits = MeanOf(inLockFree.mLockWaitMicrosPerThreadFrame);
+    const double globalWaits = MeanOf(inGlobal.mLockWaitMicrosPerThreadFrame);
+    table.mRows.push_back({"lock waits µs/frame per thread", Micros(lockFreeWaits), Micros(globalWaits),
+                           WaitRatio(globalWaits, lockFreeWaits)});
     return table;
 }
 
@@ -844,6 +870,11 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
         const DemoRunResult& lockFree = firstIsGlobal ? inRuns[1] : inRuns[0];
         const DemoRunResult& global = firstIsGlobal ? inRuns[0] : inRuns[1];
         text += "## Comparison\n\n" + TableMarkdown(BuildComparison(lockFree, global)) + "\n";
+        text +=
+            "A query's cost is mostly its narrow phase, the same in both modes. The lock waits are the time "
+            "the game-object jobs (queries and moves) spent blocked on the engine's locks, per thread and "
+            "frame, which is where the two modes differ (the reference engine's slide gave its broad phase "
+            "500 µs a thread with one read-write mutex, 10 µs with 32).\n\n";
     }
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
@@ -881,20 +912,23 @@ struct TemporaryFiles
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
 {
     std::string csv = "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
-                      "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points\n";
+                      "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,"
+                      "game_object_lock_wait_us\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
         // The series are filled frame by frame together; a shorter one ends the rows instead of reading past
-        const size_t frames = std::min(
-            {run.mFrameMs.size(), run.mPhysicsMs.size(), run.mMainThreadStreamMs.size(), run.mSteps.size()});
+        const size_t frames =
+            std::min({run.mFrameMs.size(), run.mPhysicsMs.size(), run.mMainThreadStreamMs.size(),
+                      run.mSteps.size(), run.mGameObjectLockWaitUs.size()});
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u\n", mode.c_str(), i,
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.2f\n", mode.c_str(), i,
                           run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
-                          step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints);
+                          step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
+                          run.mGameObjectLockWaitUs[i]);
         }
     }
     return csv;

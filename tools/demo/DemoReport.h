@@ -17,7 +17,8 @@ namespace cairn::demo
 /// Compact human summary of one run (one locking mode) written to inOut.
 void PrintSummary(std::FILE* inOut, const DemoRunResult& inRun);
 
-/// Side-by-side table of the two modes with the global/lock-free ratios (the query-cost target is >= 10x).
+/// Side-by-side table of the two modes with the global/lock-free ratios (the query-cost target is >= 10x),
+/// ending with the game-object jobs' lock waits per thread and frame.
 void PrintComparison(std::FILE* inOut, const DemoRunResult& inLockFree, const DemoRunResult& inGlobal);
 
 /// Self-contained 800x300 SVG plotting each (name, samples) series against its sample index. Non-finite
@@ -31,7 +32,8 @@ std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel
                          const std::vector<uint32_t>& inValues);
 
 /// Per-frame figures of every run, one row per frame: mode, frame, the main thread's frame, its physics step
-/// and streaming work (ms), the step's phases (ms) and its active bodies, pairs and contact points.
+/// and streaming work (ms), the step's phases (ms), its active bodies, pairs and contact points, and the
+/// game-object jobs' lock waits (µs, all threads).
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns);
 
 /// Writes report.md, frames.csv, frame_times.svg and tile_latency.svg to inFolder (created if missing). With

@@ -51,6 +51,10 @@ struct DemoRunResult
     std::vector<double> mQueryMicrosPerThread;
     uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs
     double mQueryMicrosMean = 0.0; ///< Over all queries
+    /// Game-object jobs: microseconds per frame each thread spent waiting for the engine's locks (LockWaits),
+    /// in the order of mQueryMicrosPerThread
+    std::vector<double> mLockWaitMicrosPerThreadFrame;
+    std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the game-object jobs' lock waits, all threads
     /// Streaming, measured on the loading thread per world tile
     std::vector<double> mStreamInMs;         ///< Create + prepare + finalize of one tile's bodies
     std::vector<double> mStreamLinkMs;       ///< The finalize (broad-phase link) alone

@@ -117,7 +117,10 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         result.mPhysicsMs.push_back(MillisecondsSince(physicsStart));
         result.mSteps.push_back(physics.GetLastStepStatistics());
 
+        const uint64_t waitedBefore = gameObjects->GetLockWaitNanosTotal();
         gameObjects->Update(frameJobs, inSettings.mGameObjectJobs, player, dt);
+        result.mGameObjectLockWaitUs.push_back(double(gameObjects->GetLockWaitNanosTotal() - waitedBefore) /
+                                               1000.0);
         agents->Update(dt, player);
         scheduler->Update();
         result.mFrameMs.push_back(MillisecondsSince(frameStart));
@@ -167,6 +170,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");
     result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();
     result.mQueryMicrosPerThread = gameObjects->GetQueryMicrosPerThread();
+    result.mLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame();
     const TileStreamer::Stats streaming = streamer->GetStats();
     result.mStreamInMs = streaming.mStreamInMs;
     result.mStreamLinkMs = streaming.mStreamLinkMs;

@@ -1,6 +1,7 @@
 #include "GameObjects.h"
 
 #include "WorldGenerator.h"
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/shapes/BoxShape.h"
 
 #include <chrono>
@@ -97,17 +98,21 @@ void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& i
     mTime += inDeltaTime * 0.5f;
     const uint32_t count = uint32_t(mObjects.size());
     if (count == 0) return;
+    ++mFrames;
     const uint32_t grain = std::max(1u, (count + inJobs - 1) / std::max(1u, inJobs));
     ioJobs.ParallelFor(count, grain,
                        [&](uint32_t inBegin, uint32_t inEnd)
                        {
                            uint64_t nanos = 0, queries = 0;
+                           const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
                            for (uint32_t i = inBegin; i < inEnd; ++i)
                                UpdateObject(mObjects[i], inPlayer, nanos, queries);
+                           const uint64_t waited = GetThisThreadLockWaitNanoseconds() - waitedBefore;
                            ThreadSlot& slot = mSlots[ThreadSlotIndex()];
                            // Relaxed: totals read after the jobs are waited for (the wait orders them)
                            slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
                            slot.mQueries.fetch_add(queries, std::memory_order_relaxed);
+                           slot.mLockWaitNanos.fetch_add(waited, std::memory_order_relaxed);
                        });
 }
 
@@ -130,6 +135,24 @@ std::vector<double> GameObjects::GetQueryMicrosPerThread() const
                                 double(queries));
     }
     return perThread;
+}
+
+std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame() const
+{
+    std::vector<double> perThread;
+    for (const ThreadSlot& slot : mSlots)
+        if (slot.mQueries.load(std::memory_order_relaxed) > 0) // The threads of GetQueryMicrosPerThread
+            perThread.push_back(double(slot.mLockWaitNanos.load(std::memory_order_relaxed)) / 1000.0 /
+                                double(std::max<uint64_t>(1, mFrames)));
+    return perThread;
+}
+
+uint64_t GameObjects::GetLockWaitNanosTotal() const
+{
+    uint64_t total = 0;
+    for (const ThreadSlot& slot : mSlots)
+        total += slot.mLockWaitNanos.load(std::memory_order_relaxed);
+    return total;
 }
 
 double GameObjects::GetQueryMicrosMean() const

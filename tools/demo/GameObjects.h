@@ -5,7 +5,8 @@
 // object probes the ground (a ray cast down), checks its line of sight to the player (a ray cast), looks for
 // bodies around it (a sphere query), then moves its body (a broad-phase write). These queries and moves from
 // several threads at once are the load under which the lock-free broad phase and the global-mutex mode are
-// compared.
+// compared: the time each thread's jobs spend in queries, and the time they spend blocked on the engine's
+// locks (LockWaits, read around each job).
 //
 // Threads: Update on the main thread, which runs the jobs and waits for them; each object is touched by one
 // job only. The per-thread query figures are atomics added once per job.
@@ -42,6 +43,11 @@ public:
     /// came).
     std::vector<double> GetQueryMicrosPerThread() const;
     double GetQueryMicrosMean() const;
+    /// Microseconds per frame that each thread's game-object jobs spent waiting for the engine's locks
+    /// (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
+    std::vector<double> GetLockWaitMicrosPerThreadFrame() const;
+    /// Nanoseconds all game-object jobs have waited for the engine's locks so far (take differences).
+    uint64_t GetLockWaitNanosTotal() const;
 
 private:
     struct Object
@@ -56,6 +62,7 @@ private:
     {
         std::atomic<uint64_t> mNanos{0};
         std::atomic<uint64_t> mQueries{0};
+        std::atomic<uint64_t> mLockWaitNanos{0};
     };
 
     void UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);
@@ -65,6 +72,7 @@ private:
     const WorldGenerator& mGenerator;
     std::vector<Object> mObjects;
     float mTime = 0.0f;
+    uint64_t mFrames = 0; ///< Updates with objects (main thread)
     std::array<ThreadSlot, cMaxThreadSlots> mSlots;
     std::atomic<uint64_t> mQueryErrors{0}; ///< Any job thread; relaxed: a count read after the frame's jobs
 };
