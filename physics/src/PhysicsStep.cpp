@@ -1,5 +1,6 @@
 #include "PhysicsStep.h"
 
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/math/RadixSort.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/solver/SequentialImpulseSolver.h"
@@ -69,7 +70,9 @@ public:
         if (mJobs == nullptr)
         {
             Clock::time_point start = Clock::now();
+            const uint64_t waited = GetThisThreadLockWaitNanoseconds();
             mBroadPhase.Update();
+            mLockWaitNanoseconds = GetThisThreadLockWaitNanoseconds() - waited;
             mMilliseconds = MillisecondsSince(start);
             return;
         }
@@ -77,6 +80,7 @@ public:
                                [this]
                                {
                                    Clock::time_point start = Clock::now();
+                                   const uint64_t waited = GetThisThreadLockWaitNanoseconds();
                                    try
                                    {
                                        mBroadPhase.Update();
@@ -85,6 +89,7 @@ public:
                                    {
                                        mError = std::current_exception();
                                    }
+                                   mLockWaitNanoseconds = GetThisThreadLockWaitNanoseconds() - waited;
                                    mMilliseconds = MillisecondsSince(start);
                                });
     }
@@ -117,14 +122,18 @@ public:
         }
         return mMilliseconds;
     }
+    /// How long the update waited for locks (its rebuild commit; the global-mutex broad phase's mutex). After
+    /// Finish.
+    uint64_t GetLockWaitNanoseconds() const { return mLockWaitNanoseconds; }
 
 private:
     BroadPhase& mBroadPhase;
-    jobs::JobSystem* mJobs;     ///< Null when the update ran in the constructor
-    jobs::JobHandle mJob;       ///< The update job (mJobs only)
-    bool mFinished = false;     ///< Finish has waited
-    double mMilliseconds = 0.0; ///< Written by the job before it finishes, read after the wait
-    std::exception_ptr mError;  ///< The same
+    jobs::JobSystem* mJobs;            ///< Null when the update ran in the constructor
+    jobs::JobHandle mJob;              ///< The update job (mJobs only)
+    bool mFinished = false;            ///< Finish has waited
+    double mMilliseconds = 0.0;        ///< Written by the job before it finishes, read after the wait
+    uint64_t mLockWaitNanoseconds = 0; ///< The same
+    std::exception_ptr mError;         ///< The same
 };
 
 Vec3 ClampLength(const Vec3& inV, float inMax)
@@ -172,6 +181,8 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     // The rebuild is the step's: done before the step's moves reach the broad phase (UpdateBoundsAndSleep)
     // and before the next step's Update, which a rebuild still running would refuse
     ioStatistics.mBroadPhaseUpdateMs += update.Finish(); // Its own time: beside the narrow phase when a job
+    mLockWaitNanoseconds.fetch_add(update.GetLockWaitNanoseconds(),
+                                   std::memory_order_relaxed); // See the member
     ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
 
     // Island finalization and the constraints' ordering are serial (about 18 ns a constraint in a pyramid),
@@ -202,6 +213,8 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mFinishMs += MillisecondsSince(phase);
     ioStatistics.mNumActiveBodies = uint32_t(mBodies.GetActiveBodiesForStep().size());
     ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    // Relaxed: every job that added to it was waited for
+    ioStatistics.mLockWaitMs += double(mLockWaitNanoseconds.exchange(0, std::memory_order_relaxed)) / 1.0e6;
 }
 
 void PhysicsStep::SolveIslands(float inDeltaTime)
@@ -558,6 +571,7 @@ void PhysicsStep::FindPairs(size_t inBegin)
     auto runRanges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
     { ParallelFor(inCount, cBodiesPerChunk, 300, inRange); }; // A body's walks of the trees
     const ParallelRanges ranges = runRanges;
+    const uint64_t waitedBeforePairs = GetThisThreadLockWaitNanoseconds(); // The global-mutex mode's lock
     mBroadPhase.FindCollidingPairs(
         sliceIDs, mLayers,
         [&](BodyID inActive, BodyID inOther)
@@ -575,6 +589,8 @@ void PhysicsStep::FindPairs(size_t inBegin)
                  std::max(inActive.GetIndex(), inOther.GetIndex())});
         },
         &ranges);
+    mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waitedBeforePairs,
+                                   std::memory_order_relaxed); // See the member
     // The gathering and the sort are serial (6 ns a pair in a pyramid), the narrow phase's loop follows
     size_t numPairs = 0;
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
@@ -1315,8 +1331,11 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                         body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
                     }
                     // Any thread may move bodies in the broad phase (each body here is in one range only)
+                    const uint64_t waited = GetThisThreadLockWaitNanoseconds();
                     mBroadPhase.NotifyBodiesAABBChanged(
                         std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
+                    mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
+                                                   std::memory_order_relaxed); // See the member
                 });
 
     // An island sleeps as a whole when every body in it has been slow long enough

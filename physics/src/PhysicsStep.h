@@ -442,8 +442,11 @@ private:
 #endif
     uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
     std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
-    std::vector<uint32_t> mSleepingIslands;   ///< Scratch
-    uint32_t mNumBodyPairs = 0;               ///< Counters of the running step
+    /// This step's waits for locks (LockWaits), added by whichever of its threads waited. Relaxed: a sum,
+    /// read by the stepping thread after it waited for every job that adds to it
+    std::atomic<uint64_t> mLockWaitNanoseconds{0};
+    std::vector<uint32_t> mSleepingIslands; ///< Scratch
+    uint32_t mNumBodyPairs = 0;             ///< Counters of the running step
     uint32_t mNumWarmStartedPoints = 0;
     uint32_t mNumReusedPairs = 0;
     float mPairCacheCosHalfMaxAngle =

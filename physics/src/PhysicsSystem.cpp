@@ -1,6 +1,7 @@
 #include "cairn/physics/PhysicsSystem.h"
 
 #include "PhysicsStep.h"
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
@@ -91,8 +92,10 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     if (mUpdating.exchange(true, std::memory_order_acquire))
         return MakeError(ErrorCode::WrongThread, "Update is already running on another thread");
 
+    const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
     mBodies->LockAllBodies();
     mLastStatistics = {};
+    mLastStatistics.mLockWaitMs = double(GetThisThreadLockWaitNanoseconds() - waitedBefore) / 1.0e6;
     const float stepTime = inDeltaTime / float(inCollisionSteps);
     for (int step = 0; step < inCollisionSteps; ++step)
         mStep->Run(stepTime, mLastStatistics, ioJobs);

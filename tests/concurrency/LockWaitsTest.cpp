@@ -4,10 +4,12 @@
 
 #include "cairn/physics/LockWaits.h"
 
+#include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/StripedSharedMutex.h"
 #include "cairn/physics/broadphase/WriterFairSharedMutex.h"
+#include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
 #include <atomic>
@@ -191,6 +193,33 @@ TEST(LockWaitsTest, StripedMutexCountsBothSides)
                       mutex.unlock();
                   }),
               cMinWaitNs);
+}
+
+TEST(LockWaitsTest, StepStatisticsCountTheUpdatesWaits)
+{
+    PhysicsSystem system;
+    BodyCreationSettings box;
+    box.mShape = BoxShape::Create(Vec3(0.4f, 0.4f, 0.4f)).Value();
+    const BodyID body = system.GetBodyInterface().CreateAndAddBody(box, Activation::Activate).Value();
+    ASSERT_TRUE(system.Update(1.0f / 60.0f));
+    EXPECT_EQ(system.GetLastStepStatistics().mLockWaitMs, 0.0); // Nobody else holds a lock
+
+    // Another thread holds the body's lock when the update starts: the update waits for it at its start
+    std::atomic<bool> held{false};
+    std::thread holder(
+        [&]
+        {
+            BodyLockWrite lock(system.GetBodyManager(), body);
+            EXPECT_NE(lock.GetBody(), nullptr);
+            held.store(true, std::memory_order_release); // Release: a signal only
+            std::this_thread::sleep_for(cHold);
+        });
+    while (!held.load(std::memory_order_acquire)) // Acquire: pairs with the store above
+        std::this_thread::yield();
+    EXPECT_TRUE(system.Update(1.0f / 60.0f)); // Not ASSERT: the holder must be joined
+    holder.join();
+    // Most of cHold, less what it took this thread to get to the lock
+    EXPECT_GE(system.GetLastStepStatistics().mLockWaitMs, 10.0);
 }
 
 } // namespace

@@ -83,6 +83,10 @@ struct StepStatistics
     double mSolveMs = 0.0;  ///< Velocity and position iterations plus integration
     double mFinishMs = 0.0; ///< Bounds update, broad-phase notify and sleeping
     double mTotalMs = 0.0;
+    /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
+    /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex
+    /// (in the pair search and the bounds notify too). A slow step with no wait here lost its time elsewhere
+    double mLockWaitMs = 0.0;
 };
 
 } // namespace cairn
