@@ -77,7 +77,7 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mMainThreadStreamMs = {0.01, 0.02};
     run.mGameObjectLockWaitUs = {0.0, 12.5};
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
-                   uint32_t inActive, uint32_t inPairs, uint32_t inPoints)
+                   uint32_t inActive, uint32_t inPairs, uint32_t inPoints, double inLockWait)
     {
         StepStatistics s;
         s.mBroadPhaseUpdateMs = inBroadPhase;
@@ -88,10 +88,11 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
         s.mNumActiveBodies = inActive;
         s.mNumBodyPairs = inPairs;
         s.mNumContactPoints = inPoints;
+        s.mLockWaitMs = inLockWait;
         return s;
     };
-    run.mSteps = {step(0.03, 0.1, 0.002, 0.05, 0.004, 26, 40, 66),
-                  step(0.3, 0.12, 0.003, 0.06, 0.005, 27, 41, 70)};
+    run.mSteps = {step(0.03, 0.1, 0.002, 0.05, 0.004, 26, 40, 66, 0.0),
+                  step(0.3, 0.12, 0.003, 0.06, 0.005, 27, 41, 70, 0.25)};
     DemoRunResult odd = run;
     odd.mModeName = "a, \"b\"";
     odd.mSteps.pop_back(); // A series one frame short: its rows end there
@@ -100,12 +101,29 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     for (size_t begin = 0, end; (end = csv.find('\n', begin)) != std::string::npos; begin = end + 1)
         lines.push_back(csv.substr(begin, end - begin));
     ASSERT_EQ(lines.size(), 4u) << csv;
-    EXPECT_EQ(lines[0], "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
-                        "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,"
-                        "game_object_lock_wait_us");
-    EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.00");
-    EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,12.50");
+    EXPECT_EQ(lines[0],
+              "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
+              "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
+              "game_object_lock_wait_us");
+    EXPECT_EQ(lines[1],
+              "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00");
+    EXPECT_EQ(lines[2],
+              "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
+}
+
+TEST(DemoResultTest, MeanPhasesAveragesThePhasesAndKeepsTheLargestLockWait)
+{
+    StepStatistics first, second;
+    first.mSolveMs = 0.1;
+    first.mLockWaitMs = 0.0;
+    second.mSolveMs = 0.3;
+    second.mLockWaitMs = 0.5;
+    const PhaseTimes means = MeanPhases({first, second});
+    EXPECT_DOUBLE_EQ(means.mSolveMs, 0.2);
+    EXPECT_DOUBLE_EQ(means.mLockWaitMs, 0.25);
+    EXPECT_DOUBLE_EQ(means.mLockWaitMaxMs, 0.5);
+    EXPECT_EQ(MeanPhases({}).mLockWaitMaxMs, 0.0);
 }
 
 /// What PrintComparison writes for the two runs.

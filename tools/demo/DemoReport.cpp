@@ -302,7 +302,9 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"narrow phase + pairs", Ms(phases.mNarrowPhaseMs)},
                          {"islands", Ms(phases.mIslandsMs)},
                          {"solve", Ms(phases.mSolveMs)},
-                         {"finish", Ms(phases.mFinishMs)}}});
+                         {"finish", Ms(phases.mFinishMs)},
+                         {"lock waits", Ms(phases.mLockWaitMs)},
+                         {"lock waits max", Ms(phases.mLockWaitMaxMs)}}});
     sections.push_back({"game-object queries",
                         {{"queries", Count(inRun.mQueries)},
                          {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
@@ -911,9 +913,10 @@ struct TemporaryFiles
 
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
 {
-    std::string csv = "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
-                      "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,"
-                      "game_object_lock_wait_us\n";
+    std::string csv =
+        "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
+        "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
+        "game_object_lock_wait_us\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
@@ -924,11 +927,11 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.2f\n", mode.c_str(), i,
-                          run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f\n", mode.c_str(),
+                          i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
                           step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
-                          run.mGameObjectLockWaitUs[i]);
+                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i]);
         }
     }
     return csv;

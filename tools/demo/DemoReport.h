@@ -32,8 +32,8 @@ std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel
                          const std::vector<uint32_t>& inValues);
 
 /// Per-frame figures of every run, one row per frame: mode, frame, the main thread's frame, its physics step
-/// and streaming work (ms), the step's phases (ms), its active bodies, pairs and contact points, and the
-/// game-object jobs' lock waits (µs, all threads).
+/// and streaming work (ms), the step's phases (ms), its active bodies, pairs, contact points and lock waits
+/// (ms), and the game-object jobs' lock waits (µs, all threads).
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns);
 
 /// Writes report.md, frames.csv, frame_times.svg and tile_latency.svg to inFolder (created if missing). With

@@ -33,6 +33,8 @@ PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
         means.mIslandsMs += step.mIslandsMs;
         means.mSolveMs += step.mSolveMs;
         means.mFinishMs += step.mFinishMs;
+        means.mLockWaitMs += step.mLockWaitMs;
+        means.mLockWaitMaxMs = std::max(means.mLockWaitMaxMs, step.mLockWaitMs);
     }
     const double frames = double(std::max<size_t>(1, inSteps.size()));
     means.mBroadPhaseUpdateMs /= frames;
@@ -40,6 +42,7 @@ PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
     means.mIslandsMs /= frames;
     means.mSolveMs /= frames;
     means.mFinishMs /= frames;
+    means.mLockWaitMs /= frames;
     return means;
 }
 

@@ -31,9 +31,11 @@ struct PhaseTimes
     double mIslandsMs = 0.0;
     double mSolveMs = 0.0;
     double mFinishMs = 0.0;
+    double mLockWaitMs = 0.0;    ///< The step's threads blocked on locks (not a phase: inside the others)
+    double mLockWaitMaxMs = 0.0; ///< The largest of one frame
 };
 
-/// The step phases' means per frame over inSteps (zeros for none).
+/// The step phases' means per frame over inSteps (zeros for none), and the largest lock wait.
 PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps);
 
 struct DemoRunResult
