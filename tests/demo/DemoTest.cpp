@@ -126,18 +126,38 @@ TEST(DemoResultTest, MeanPhasesAveragesThePhasesAndKeepsTheLargestLockWait)
     EXPECT_EQ(MeanPhases({}).mLockWaitMaxMs, 0.0);
 }
 
-/// What PrintComparison writes for the two runs.
-std::string ComparisonText(const DemoRunResult& inLockFree, const DemoRunResult& inGlobal)
+/// What inPrint writes to a file.
+template <class Print> std::string Printed(const Print& inPrint)
 {
     std::FILE* file = std::tmpfile();
     if (file == nullptr) return "";
-    PrintComparison(file, inLockFree, inGlobal);
+    inPrint(file);
     std::rewind(file);
     std::string text;
     for (int c; (c = std::fgetc(file)) != EOF;)
         text += char(c);
     std::fclose(file);
     return text;
+}
+
+TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
+{
+    DemoRunResult run;
+    run.mModeName = "lock-free";
+    run.mPhysicsMs.assign(200, 1.0);
+    run.mPhysicsMs.back() = 2.0; // max 2x the average: the spike target holds
+    run.mMainThreadStreamMs.assign(200, 0.1);
+    std::string text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("(target <= 3x: met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("(target <= 0.5 ms: met)"), std::string::npos) << text;
+
+    run.mPhysicsMs[0] = 10.0; // A spike of about 9.9x the average
+    run.mMainThreadStreamMs[7] = 0.75;
+    text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("(target <= 3x: NOT met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("(target <= 0.5 ms: NOT met)"), std::string::npos) << text;
+    // p99 is at most 2.0 ms on an average of 1.055 ms, whichever sample the percentile picks
+    EXPECT_NE(text.find("(target <= 2x: met)"), std::string::npos) << text;
 }
 
 TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
@@ -147,7 +167,7 @@ TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
     global.mModeName = "global mutex";
     lockFree.mLockWaitMicrosPerThreadFrame = {0.5, 1.5};
     global.mLockWaitMicrosPerThreadFrame = {20.0, 10.0};
-    const std::string text = ComparisonText(lockFree, global);
+    const std::string text = Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); });
     const size_t row = text.find("lock waits µs/frame per thread");
     ASSERT_NE(row, std::string::npos) << text;
     const std::string line = text.substr(row, text.find('\n', row) - row);
@@ -156,7 +176,7 @@ TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
     EXPECT_NE(line.find("15.00x"), std::string::npos) << line;
 
     lockFree.mLockWaitMicrosPerThreadFrame = {0.0, 0.0};
-    const std::string none = ComparisonText(lockFree, global);
+    const std::string none = Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); });
     EXPECT_NE(none.find("no waits lock-free"), std::string::npos) << none;
 }
 

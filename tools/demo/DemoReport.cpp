@@ -22,7 +22,10 @@ namespace
 
 namespace fs = std::filesystem;
 
-constexpr double cQueryTargetRatio = 10.0; ///< The lock-free query path must be this much cheaper
+constexpr double cQueryTargetRatio = 10.0;        ///< The lock-free query path must be this much cheaper
+constexpr double cP99TargetRatio = 2.0;           ///< A physics frame's p99 at most this times its average
+constexpr double cSpikeTargetRatio = 3.0;         ///< No physics frame over this times the average
+constexpr double cMainThreadStreamTargetMs = 0.5; ///< Streaming work on the main thread per frame, at most
 constexpr size_t cMaxHistogramBuckets = 40;
 constexpr int cSummaryTitleWidth = 22; ///< Column of the first metric in the console summary
 
@@ -86,6 +89,13 @@ std::string Ratio(double inNumerator, double inDenominator)
 {
     if (!(inDenominator > 0.0) || !std::isfinite(inNumerator) || !std::isfinite(inDenominator)) return "n/a";
     return Format("%.2fx", inNumerator / inDenominator);
+}
+
+/// " (target <= 2x: met)": inValue against the bound inBound (smaller is better).
+std::string AtMost(double inValue, double inBound, const char* inUnit)
+{
+    if (!std::isfinite(inValue)) return "";
+    return Format(" (target <= %g%s: %s)", inBound, inUnit, inValue <= inBound ? "met" : "NOT met");
 }
 
 /// A ratio of two waits, where the lock-free side may be exactly 0.
@@ -289,8 +299,10 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"p50", Ms(physics, physics.mP50)},
                          {"p99", Ms(physics, physics.mP99)},
                          {"max spike", Ms(physics, physics.mMax)},
-                         {"p99/avg", Ratio(physics.mP99, physics.mMean)},
-                         {"max/avg", Ratio(physics.mMax, physics.mMean)}}});
+                         {"p99/avg", Ratio(physics.mP99, physics.mMean) +
+                                         AtMost(physics.mP99 / physics.mMean, cP99TargetRatio, "x")},
+                         {"max/avg", Ratio(physics.mMax, physics.mMean) +
+                                         AtMost(physics.mMax / physics.mMean, cSpikeTargetRatio, "x")}}});
     sections.push_back({"frame ms",
                         {{"avg", Ms(frame, frame.mMean)},
                          {"p50", Ms(frame, frame.mP50)},
@@ -317,7 +329,11 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"tile in ms max", Ms(streamIn, streamIn.mMax)},
                          {"link ms p50", Ms(link, link.mP50)},
                          {"link ms max", Ms(link, link.mMax)},
-                         {"main-thread ms/frame max", Ms(mainThreadStream, mainThreadStream.mMax)}}});
+                         {"main-thread ms/frame max",
+                          Ms(mainThreadStream, mainThreadStream.mMax) +
+                              (mainThreadStream.mCount == 0
+                                   ? std::string()
+                                   : AtMost(mainThreadStream.mMax, cMainThreadStreamTargetMs, " ms"))}}});
     sections.push_back(
         {"bodies peak",
          {{"static", Count(inRun.mStaticBodiesPeak)}, {"dynamic", Count(inRun.mDynamicBodiesPeak)}}});
