@@ -150,6 +150,12 @@ TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
     std::string text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
     EXPECT_NE(text.find("(target <= 3x: met)"), std::string::npos) << text;
     EXPECT_NE(text.find("(target <= 0.5 ms: met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("tile out ms p50 n/a"), std::string::npos) << text; // No tile streamed out
+
+    run.mStreamOutMs = {1.25, 0.5, 3.0};
+    text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("tile out ms p50 1.250"), std::string::npos) << text;
+    EXPECT_NE(text.find("tile out ms max 3.000"), std::string::npos) << text;
 
     run.mPhysicsMs[0] = 10.0; // A spike of about 9.9x the average
     run.mMainThreadStreamMs[7] = 0.75;

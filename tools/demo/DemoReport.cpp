@@ -271,6 +271,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     const SampleSummary frame = Summarize(inRun.mFrameMs);
     const SampleSummary streamIn = Summarize(inRun.mStreamInMs);
     const SampleSummary link = Summarize(inRun.mStreamLinkMs);
+    const SampleSummary streamOut = Summarize(inRun.mStreamOutMs);
     const SampleSummary mainThreadStream = Summarize(inRun.mMainThreadStreamMs);
     const SampleSummary latency = SummarizeFrames(inRun.mNavTileLatencyFrames);
 
@@ -329,6 +330,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"tile in ms max", Ms(streamIn, streamIn.mMax)},
                          {"link ms p50", Ms(link, link.mP50)},
                          {"link ms max", Ms(link, link.mMax)},
+                         {"tile out ms p50", Ms(streamOut, streamOut.mP50)},
+                         {"tile out ms max", Ms(streamOut, streamOut.mMax)},
                          {"main-thread ms/frame max",
                           Ms(mainThreadStream, mainThreadStream.mMax) +
                               (mainThreadStream.mCount == 0
