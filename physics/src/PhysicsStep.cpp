@@ -158,6 +158,7 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobSystem* ioJobs)
 {
     mJobs = ioJobs;
+    mLockWaitNanoseconds.store(0, std::memory_order_relaxed); // Relaxed: no job of this step runs yet
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
     BroadPhaseUpdate update(mBroadPhase, mJobs,
@@ -214,7 +215,7 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mNumActiveBodies = uint32_t(mBodies.GetActiveBodiesForStep().size());
     ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     // Relaxed: every job that added to it was waited for
-    ioStatistics.mLockWaitMs += double(mLockWaitNanoseconds.exchange(0, std::memory_order_relaxed)) / 1.0e6;
+    ioStatistics.mLockWaitMs += double(mLockWaitNanoseconds.load(std::memory_order_relaxed)) / 1.0e6;
 }
 
 void PhysicsStep::SolveIslands(float inDeltaTime)
@@ -571,7 +572,11 @@ void PhysicsStep::FindPairs(size_t inBegin)
     auto runRanges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange)
     { ParallelFor(inCount, cBodiesPerChunk, 300, inRange); }; // A body's walks of the trees
     const ParallelRanges ranges = runRanges;
-    const uint64_t waitedBeforePairs = GetThisThreadLockWaitNanoseconds(); // The global-mutex mode's lock
+    // A broad phase that cannot search during its update locks here (the global mutex). One that can takes no
+    // lock, but this thread may run the queued update job inside the search (a helping wait), whose waits the
+    // update counts itself: not counted here, or they would count twice
+    const bool pairsMayWait = !mBroadPhase.CanFindPairsDuringUpdate();
+    const uint64_t waitedBeforePairs = GetThisThreadLockWaitNanoseconds();
     mBroadPhase.FindCollidingPairs(
         sliceIDs, mLayers,
         [&](BodyID inActive, BodyID inOther)
@@ -589,8 +594,9 @@ void PhysicsStep::FindPairs(size_t inBegin)
                  std::max(inActive.GetIndex(), inOther.GetIndex())});
         },
         &ranges);
-    mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waitedBeforePairs,
-                                   std::memory_order_relaxed); // See the member
+    if (pairsMayWait)
+        mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waitedBeforePairs,
+                                       std::memory_order_relaxed); // See the member
     // The gathering and the sort are serial (6 ns a pair in a pyramid), the narrow phase's loop follows
     size_t numPairs = 0;
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)

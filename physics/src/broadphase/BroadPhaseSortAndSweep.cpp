@@ -1,5 +1,6 @@
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <algorithm>
@@ -410,7 +411,7 @@ void BroadPhaseSortAndSweep::AddBodiesFinalize(AddState inState)
 {
     SortAndSweepAddBatch* batch = static_cast<SortAndSweepAddBatch*>(inState);
     {
-        std::unique_lock lock(mMutex);
+        const auto lock = LockedCountingWait(mMutex);
         for (const BroadPhaseBody& body : batch->mBodies)
             InsertBody(body);
     }
@@ -469,7 +470,7 @@ uint32_t BroadPhaseSortAndSweep::FindLocation(BodyID inID) const
 
 void BroadPhaseSortAndSweep::RemoveBodies(std::span<const BodyID> inBodies)
 {
-    std::unique_lock lock(mMutex);
+    const auto lock = LockedCountingWait(mMutex);
     for (BodyID id : inBodies)
         if (const uint32_t location = FindLocation(id); location != cNotPresent)
             RemoveAt(location & ((1u << cLayerBits) - 1), location >> cLayerBits);
@@ -477,7 +478,7 @@ void BroadPhaseSortAndSweep::RemoveBodies(std::span<const BodyID> inBodies)
 
 void BroadPhaseSortAndSweep::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
 {
-    std::unique_lock lock(mMutex);
+    const auto lock = LockedCountingWait(mMutex);
     for (const BroadPhaseBody& body : inBodies)
     {
         const uint32_t location = FindLocation(body.mID);
@@ -514,7 +515,7 @@ void BroadPhaseSortAndSweep::NotifyBodiesAABBChanged(std::span<const BroadPhaseB
 
 void BroadPhaseSortAndSweep::Update()
 {
-    std::unique_lock lock(mMutex);
+    const auto lock = LockedCountingWait(mMutex);
     for (Layer& layer : mLayers)
         if (!layer.mDirty.empty() || layer.mNumDead != 0) Rebuild(layer);
 }
@@ -593,7 +594,7 @@ template <class Test>
 void BroadPhaseSortAndSweep::VisitOverlapping(const Window& inWindow, ObjectLayerMask inMask, Test&& inTest,
                                               BodyVisitor inVisitor) const
 {
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
     Query(inWindow, inMask, inTest,
           [&](BodyID inID)
           {
@@ -642,7 +643,7 @@ void BroadPhaseSortAndSweep::CastRay(const RayCast& inRay, const BroadPhaseQuery
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     float maxFraction = 1.0f;
     float fraction = 0.0f;
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
     Query(
         window, inFilter.mObjectLayers,
         [&](const AABB& inBounds)
@@ -672,7 +673,7 @@ void BroadPhaseSortAndSweep::CastAABox(const AABB& inBox, const Vec3& inDisplace
                         std::max(sweep.mCenter.z(), end.z()) + halfExtent.z()};
     float maxFraction = 1.0f;
     float fraction = 0.0f;
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
     Query(
         window, inFilter.mObjectLayers,
         [&](const AABB& inBounds)
@@ -691,7 +692,7 @@ void BroadPhaseSortAndSweep::FindCollidingPairs(std::span<const BodyID> inActive
                                                 const LayerSetup& inLayers, BodyPairVisitor inVisitor,
                                                 const ParallelRanges* /*inParallel: runs serially*/) const
 {
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
 
     // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
     for (BodyID id : inActiveBodies)
@@ -725,13 +726,13 @@ void BroadPhaseSortAndSweep::FindCollidingPairs(std::span<const BodyID> inActive
 
 size_t BroadPhaseSortAndSweep::GetBodyCount() const
 {
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
     return mBodyCount;
 }
 
 bool BroadPhaseSortAndSweep::Validate() const
 {
-    std::shared_lock lock(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex);
     size_t count = 0;
     for (uint32_t layerIndex = 0; layerIndex < mLayers.size(); ++layerIndex)
     {

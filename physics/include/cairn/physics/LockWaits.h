@@ -10,13 +10,15 @@
 // atomic operations of free locks, not work done while holding one.
 // Counted: the body shard and static mutexes (BodyLock, StaticBodyLockRead, LockAllBodies, body creation and
 // destruction), the body manager's free-list and active-list mutexes, the global-mutex broad phase's
-// WriterFairSharedMutex and the quad tree's StripedSharedMutex. The lock-free queries' epoch read sections
-// never wait, so they have nothing to count.
+// WriterFairSharedMutex (a reader that finds a writer waiting, or another reader passing its turnstile,
+// counts too), the quad tree's StripedSharedMutex, and the comparison broad phases' mutexes (brute force,
+// sort and sweep). The lock-free queries' epoch read sections never wait, so they have nothing to count.
 // Threads: one counter per thread (thread_local), written and read by its own thread only.
 
 #include <chrono>
 #include <cstdint>
 #include <mutex>
+#include <shared_mutex>
 
 namespace cairn
 {
@@ -75,6 +77,14 @@ template <class SharedMutex> void LockSharedCountingWait(SharedMutex& ioMutex)
     if (ioMutex.try_lock_shared()) return;
     ScopedLockWait wait;
     ioMutex.lock_shared();
+}
+
+/// A std::shared_lock on ioMutex, taken by LockSharedCountingWait.
+template <class SharedMutex>
+[[nodiscard]] std::shared_lock<SharedMutex> SharedLockedCountingWait(SharedMutex& ioMutex)
+{
+    LockSharedCountingWait(ioMutex);
+    return std::shared_lock<SharedMutex>(ioMutex, std::adopt_lock);
 }
 
 } // namespace cairn
