@@ -32,7 +32,8 @@ constexpr auto cHold = 30ms; ///< How long a holder keeps its lock once the wait
 /// A waiter's counted wait and the window in which it could have waited (its lock call to the release).
 struct CountedWait
 {
-    uint64_t mCounted = 0;
+    uint64_t mCounted = 0;   ///< Of the kind of lock it waited for
+    uint64_t mOtherKind = 0; ///< Of the other kind: none
     int64_t mWindowNs = 0;
 };
 
@@ -40,13 +41,15 @@ struct CountedWait
 void ExpectMostOfWindow(const CountedWait& inWait)
 {
     EXPECT_GT(inWait.mWindowNs, 0); // The waiter came before the release: it had to wait
+    EXPECT_EQ(inWait.mOtherKind, 0u);
     EXPECT_GE(2 * int64_t(inWait.mCounted), inWait.mWindowNs)
         << "counted " << inWait.mCounted << " ns of a " << inWait.mWindowNs << " ns window";
 }
 
 /// Runs inWaiter on a second thread while this thread holds a lock (inHold takes it and returns a release
-/// callable). The holder lets go cHold after the waiter says it is about to lock.
-template <class Hold, class Waiter> CountedWait WaitBehindHolder(Hold&& inHold, Waiter&& inWaiter)
+/// callable) of inKind. The holder lets go cHold after the waiter says it is about to lock.
+template <class Hold, class Waiter>
+CountedWait WaitBehindHolder(LockKind inKind, Hold&& inHold, Waiter&& inWaiter)
 {
     std::atomic<bool> aboutToLock{false};
     CountedWait result;
@@ -55,11 +58,14 @@ template <class Hold, class Waiter> CountedWait WaitBehindHolder(Hold&& inHold, 
     std::thread waiter(
         [&]
         {
-            const uint64_t before = GetThisThreadLockWaitNanoseconds();
+            const LockKind other = inKind == LockKind::Body ? LockKind::BroadPhase : LockKind::Body;
+            const uint64_t before = GetThisThreadLockWaitNanoseconds(inKind);
+            const uint64_t otherBefore = GetThisThreadLockWaitNanoseconds(other);
             lockCall = Clock::now();
             aboutToLock.store(true, std::memory_order_release); // Release: publishes lockCall
             inWaiter();
-            result.mCounted = GetThisThreadLockWaitNanoseconds() - before;
+            result.mCounted = GetThisThreadLockWaitNanoseconds(inKind) - before;
+            result.mOtherKind = GetThisThreadLockWaitNanoseconds(other) - otherBefore;
         });
     while (!aboutToLock.load(std::memory_order_acquire)) // Acquire: pairs with the store above
         std::this_thread::yield();
@@ -119,6 +125,7 @@ TEST(LockWaitsTest, ReaderCountsItsWaitForABodyWriter)
     const BodyID body = MakeBody(manager);
     const uint64_t holderBefore = GetThisThreadLockWaitNanoseconds();
     const CountedWait waited = WaitBehindHolder(
+        LockKind::Body,
         [&]
         {
             auto lock = std::make_shared<BodyLockWrite>(manager, body);
@@ -143,6 +150,7 @@ TEST(LockWaitsTest, WriterCountsItsWaitForAStaticReader)
     settings.mMotionType = MotionType::Static;
     const BodyID body = manager.CreateBody(settings).Value();
     const CountedWait waited = WaitBehindHolder(
+        LockKind::Body,
         [&]
         {
             auto lock = std::make_shared<StaticBodyLockRead>(manager, body);
@@ -162,6 +170,7 @@ TEST(LockWaitsTest, WriterFairMutexCountsBothSides)
     WriterFairSharedMutex mutex;
     // A writer behind a reader
     ExpectMostOfWindow(WaitBehindHolder(
+        LockKind::BroadPhase,
         [&]
         {
             mutex.lock_shared();
@@ -174,6 +183,7 @@ TEST(LockWaitsTest, WriterFairMutexCountsBothSides)
         }));
     // A reader behind a writer
     ExpectMostOfWindow(WaitBehindHolder(
+        LockKind::BroadPhase,
         [&]
         {
             mutex.lock();
@@ -191,6 +201,7 @@ TEST(LockWaitsTest, StripedMutexCountsBothSides)
     StripedSharedMutex mutex;
     // A modifier (shared) behind a rebuild commit (exclusive)
     ExpectMostOfWindow(WaitBehindHolder(
+        LockKind::BroadPhase,
         [&]
         {
             mutex.lock();
@@ -199,6 +210,7 @@ TEST(LockWaitsTest, StripedMutexCountsBothSides)
         [&] { StripedSharedMutex::SharedLock shared(mutex); }));
     // A commit behind a modifier
     ExpectMostOfWindow(WaitBehindHolder(
+        LockKind::BroadPhase,
         [&]
         {
             const uint32_t stripe = mutex.LockShared();

@@ -181,9 +181,23 @@ TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
     EXPECT_NE(line.find(" 15.00 "), std::string::npos) << line; // Global mean
     EXPECT_NE(line.find(" 7.50x"), std::string::npos) << line;  // Their ratio
 
-    lockFree.mLockWaitMicrosPerThreadFrame = {0.0, 0.0};
-    const std::string none = Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); });
-    EXPECT_NE(none.find("no waits lock-free"), std::string::npos) << none;
+    // Split by kind: the broad phase's locks never made the lock-free mode wait, the body locks did
+    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    global.mBroadPhaseLockWaitMicrosPerThreadFrame = {8.0, 10.0};
+    lockFree.mBodyLockWaitMicrosPerThreadFrame = {1.0, 3.0};
+    global.mBodyLockWaitMicrosPerThreadFrame = {12.0, 0.0};
+    const std::string split = Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); });
+    auto lineOf = [&](const std::string& inName)
+    {
+        const size_t at = split.find(inName);
+        return at == std::string::npos ? std::string() : split.substr(at, split.find('\n', at) - at);
+    };
+    const std::string broadPhase = lineOf("of which broad-phase locks");
+    EXPECT_NE(broadPhase.find(" 9.00 "), std::string::npos) << split;
+    EXPECT_NE(broadPhase.find("no waits lock-free"), std::string::npos) << split;
+    const std::string bodies = lineOf("of which body locks");
+    EXPECT_NE(bodies.find(" 6.00 "), std::string::npos) << split;
+    EXPECT_NE(bodies.find(" 3.00x"), std::string::npos) << split;
 }
 
 } // namespace

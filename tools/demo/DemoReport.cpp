@@ -318,11 +318,14 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"finish", Ms(phases.mFinishMs)},
                          {"lock waits", Ms(phases.mLockWaitMs)},
                          {"lock waits max", Ms(phases.mLockWaitMaxMs)}}});
-    sections.push_back({"game-object queries",
-                        {{"queries", Count(inRun.mQueries)},
-                         {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
-                         {"µs/query per thread", perThread},
-                         {"lock waits µs/frame per thread", waitsPerThread}}});
+    sections.push_back(
+        {"game-object queries",
+         {{"queries", Count(inRun.mQueries)},
+          {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
+          {"µs/query per thread", perThread},
+          {"lock waits µs/frame per thread", waitsPerThread},
+          {"broad-phase / body locks", Micros(MeanOf(inRun.mBroadPhaseLockWaitMicrosPerThreadFrame)) + " / " +
+                                           Micros(MeanOf(inRun.mBodyLockWaitMicrosPerThreadFrame))}}});
     sections.push_back({"streaming",
                         {{"tiles in", Count(inRun.mTilesStreamedIn)},
                          {"tiles out", Count(inRun.mTilesStreamedOut)},
@@ -454,6 +457,14 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
     const double globalWaits = MeanOf(inGlobal.mLockWaitMicrosPerThreadFrame);
     table.mRows.push_back({"lock waits µs/frame per thread", Micros(lockFreeWaits), Micros(globalWaits),
                            WaitRatio(globalWaits, lockFreeWaits)});
+    auto kindRow = [&](const char* inName, const std::vector<double> DemoRunResult::*inSeries)
+    {
+        const double lockFree = MeanOf(inLockFree.*inSeries);
+        const double global = MeanOf(inGlobal.*inSeries);
+        table.mRows.push_back({inName, Micros(lockFree), Micros(global), WaitRatio(global, lockFree)});
+    };
+    kindRow("  of which broad-phase locks", &DemoRunResult::mBroadPhaseLockWaitMicrosPerThreadFrame);
+    kindRow("  of which body locks", &DemoRunResult::mBodyLockWaitMicrosPerThreadFrame);
     return table;
 }
 

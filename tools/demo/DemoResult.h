@@ -56,6 +56,8 @@ struct DemoRunResult
     /// Game-object jobs: microseconds per frame each thread spent waiting for the engine's locks (LockWaits),
     /// in the order of mQueryMicrosPerThread
     std::vector<double> mLockWaitMicrosPerThreadFrame;
+    std::vector<double> mBroadPhaseLockWaitMicrosPerThreadFrame; ///< The same, the broad phase's locks only
+    std::vector<double> mBodyLockWaitMicrosPerThreadFrame;       ///< The same, the body locks only
     std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the game-object jobs' lock waits, all threads
     /// Streaming, measured on the loading thread per world tile
     std::vector<double> mStreamInMs;         ///< Create + prepare + finalize of one tile's bodies

@@ -171,6 +171,9 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();
     result.mQueryMicrosPerThread = gameObjects->GetQueryMicrosPerThread();
     result.mLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame();
+    result.mBroadPhaseLockWaitMicrosPerThreadFrame =
+        gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::BroadPhase);
+    result.mBodyLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::Body);
     const TileStreamer::Stats streaming = streamer->GetStats();
     result.mStreamInMs = streaming.mStreamInMs;
     result.mStreamLinkMs = streaming.mStreamLinkMs;

@@ -104,15 +104,21 @@ void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& i
                        [&](uint32_t inBegin, uint32_t inEnd)
                        {
                            uint64_t nanos = 0, queries = 0;
-                           const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
+                           const uint64_t broadPhaseBefore =
+                               GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase);
+                           const uint64_t bodiesBefore = GetThisThreadLockWaitNanoseconds(LockKind::Body);
                            for (uint32_t i = inBegin; i < inEnd; ++i)
                                UpdateObject(mObjects[i], inPlayer, nanos, queries);
-                           const uint64_t waited = GetThisThreadLockWaitNanoseconds() - waitedBefore;
+                           const uint64_t broadPhaseWaited =
+                               GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase) - broadPhaseBefore;
+                           const uint64_t bodiesWaited =
+                               GetThisThreadLockWaitNanoseconds(LockKind::Body) - bodiesBefore;
                            ThreadSlot& slot = mSlots[ThreadSlotIndex()];
                            // Relaxed: totals read after the jobs are waited for (the wait orders them)
                            slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
                            slot.mQueries.fetch_add(queries, std::memory_order_relaxed);
-                           slot.mLockWaitNanos.fetch_add(waited, std::memory_order_relaxed);
+                           slot.mBroadPhaseWaitNanos.fetch_add(broadPhaseWaited, std::memory_order_relaxed);
+                           slot.mBodyWaitNanos.fetch_add(bodiesWaited, std::memory_order_relaxed);
                        });
 }
 
@@ -137,12 +143,20 @@ std::vector<double> GameObjects::GetQueryMicrosPerThread() const
     return perThread;
 }
 
-std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame() const
+uint64_t GameObjects::ThreadSlot::WaitNanos(std::optional<LockKind> inKind) const
+{
+    const uint64_t broadPhase = mBroadPhaseWaitNanos.load(std::memory_order_relaxed);
+    const uint64_t bodies = mBodyWaitNanos.load(std::memory_order_relaxed);
+    if (!inKind) return broadPhase + bodies;
+    return *inKind == LockKind::BroadPhase ? broadPhase : bodies;
+}
+
+std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame(std::optional<LockKind> inKind) const
 {
     std::vector<double> perThread;
     for (const ThreadSlot& slot : mSlots)
         if (slot.mQueries.load(std::memory_order_relaxed) > 0) // The threads of GetQueryMicrosPerThread
-            perThread.push_back(double(slot.mLockWaitNanos.load(std::memory_order_relaxed)) / 1000.0 /
+            perThread.push_back(double(slot.WaitNanos(inKind)) / 1000.0 /
                                 double(std::max<uint64_t>(1, mFrames)));
     return perThread;
 }
@@ -151,7 +165,7 @@ uint64_t GameObjects::GetLockWaitNanosTotal() const
 {
     uint64_t total = 0;
     for (const ThreadSlot& slot : mSlots)
-        total += slot.mLockWaitNanos.load(std::memory_order_relaxed);
+        total += slot.WaitNanos(std::nullopt);
     return total;
 }
 

@@ -12,10 +12,12 @@
 // job only. The per-thread query figures are atomics added once per job.
 
 #include "cairn/jobs/JobSystem.h"
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
 
 #include <array>
 #include <atomic>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -43,9 +45,9 @@ public:
     /// came).
     std::vector<double> GetQueryMicrosPerThread() const;
     double GetQueryMicrosMean() const;
-    /// Microseconds per frame that each thread's game-object jobs spent waiting for the engine's locks
-    /// (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
-    std::vector<double> GetLockWaitMicrosPerThreadFrame() const;
+    /// Microseconds per frame that each thread's game-object jobs spent waiting for the engine's locks of
+    /// inKind, or of every kind (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
+    std::vector<double> GetLockWaitMicrosPerThreadFrame(std::optional<LockKind> inKind = std::nullopt) const;
     /// Nanoseconds all game-object jobs have waited for the engine's locks so far (take differences).
     uint64_t GetLockWaitNanosTotal() const;
 
@@ -62,7 +64,10 @@ private:
     {
         std::atomic<uint64_t> mNanos{0};
         std::atomic<uint64_t> mQueries{0};
-        std::atomic<uint64_t> mLockWaitNanos{0};
+        std::atomic<uint64_t> mBroadPhaseWaitNanos{0};
+        std::atomic<uint64_t> mBodyWaitNanos{0};
+
+        uint64_t WaitNanos(std::optional<LockKind> inKind) const; ///< Of inKind, or of both
     };
 
     void UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);

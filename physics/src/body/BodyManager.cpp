@@ -78,7 +78,7 @@ BodyManager::~BodyManager() = default;
 
 uint32_t BodyManager::GetNumBodies() const
 {
-    const auto lock = LockedCountingWait(mFreeListMutex);
+    const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
     return mNumBodies;
 }
 
@@ -91,7 +91,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 
     uint32_t index;
     {
-        const auto lock = LockedCountingWait(mFreeListMutex);
+        const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
         if (mFreeList.empty())
             return MakeError(ErrorCode::OutOfCapacity,
                              "body manager is full (" + std::to_string(mMaxBodies) + " bodies)");
@@ -100,8 +100,8 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
         ++mNumBodies;
     }
 
-    const auto lock = LockedCountingWait(GetMutexForBody(index));
-    const auto staticLock = LockedCountingWait(GetStaticMutexForBody(index));
+    const auto lock = LockedCountingWait(GetMutexForBody(index), LockKind::Body);
+    const auto staticLock = LockedCountingWait(GetStaticMutexForBody(index), LockKind::Body);
     Body& body = mBodies[index];
     const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
@@ -117,8 +117,8 @@ Status BodyManager::DestroyBody(const BodyID& inID)
     if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)
         return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
     {
-        const auto lock = LockedCountingWait(GetMutexForBody(inID.GetIndex()));
-        const auto staticLock = LockedCountingWait(GetStaticMutexForBody(inID.GetIndex()));
+        const auto lock = LockedCountingWait(GetMutexForBody(inID.GetIndex()), LockKind::Body);
+        const auto staticLock = LockedCountingWait(GetStaticMutexForBody(inID.GetIndex()), LockKind::Body);
         Body* body = TryGetBody(inID);
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
         if (body->mInWorld || body->mAddPending)
@@ -129,7 +129,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);
         mSlotInUse[inID.GetIndex()] = false;
     }
-    const auto lock = LockedCountingWait(mFreeListMutex);
+    const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
     mFreeList.push_back(inID.GetIndex());
     --mNumBodies;
     return Status::Ok();
@@ -155,7 +155,7 @@ void BodyManager::ActivateBody(Body& ioBody)
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
     if (!IsInsideStep())
     {
-        LockCountingWait(lock);
+        LockCountingWait(lock, LockKind::Body);
         // Woken from outside: the bodies it slept with may rest on it; the next step wakes them (it holds
         // every lock, so it can walk the island's ring safely)
         ioBody.mWakeIsland = true;
@@ -169,7 +169,7 @@ void BodyManager::DeactivateBody(Body& ioBody)
 {
     if (!ioBody.IsActive()) return;
     std::unique_lock<std::mutex> lock(mActiveListMutex, std::defer_lock);
-    if (!IsInsideStep()) LockCountingWait(lock);
+    if (!IsInsideStep()) LockCountingWait(lock, LockKind::Body);
     // Swap-remove: the last body takes this body's place in the list
     const uint32_t slot = ioBody.GetActiveIndex();
     const uint32_t last = mActiveBodies.back();
@@ -227,7 +227,7 @@ void BodyManager::LockAllBodies() const
 {
     assert(!tInsideStep);
     for (uint32_t m = 0; m <= mMutexMask; ++m) // In index order: see the lock order above
-        LockCountingWait(mBodyMutexes[m].mMutex);
+        LockCountingWait(mBodyMutexes[m].mMutex, LockKind::Body);
     tInsideStep = true;
 }
 

@@ -38,7 +38,7 @@ void BroadPhaseBruteForce::AddBodiesFinalize(AddState inState)
 {
     BruteForceAddBatch* batch = static_cast<BruteForceAddBatch*>(inState);
     {
-        const auto lock = LockedCountingWait(mMutex);
+        const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
         for (const BroadPhaseBody& body : batch->mBodies)
         {
             if (!IsAcceptable(body)) continue;
@@ -69,7 +69,7 @@ uint32_t BroadPhaseBruteForce::FindPosition(BodyID inID) const
 
 void BroadPhaseBruteForce::RemoveBodies(std::span<const BodyID> inBodies)
 {
-    const auto lock = LockedCountingWait(mMutex);
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
     for (BodyID id : inBodies)
     {
         const uint32_t position = FindPosition(id);
@@ -84,7 +84,7 @@ void BroadPhaseBruteForce::RemoveBodies(std::span<const BodyID> inBodies)
 
 void BroadPhaseBruteForce::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
 {
-    const auto lock = LockedCountingWait(mMutex);
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : inBodies)
     {
         const uint32_t position = FindPosition(body.mID);
@@ -96,7 +96,7 @@ void BroadPhaseBruteForce::NotifyBodiesAABBChanged(std::span<const BroadPhaseBod
 void BroadPhaseBruteForce::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
                                         BodyVisitor inVisitor) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : mBodies)
         if (IsInLayerMask(inFilter.mObjectLayers, body.mLayer) && body.mBounds.Overlaps(inBox))
             inVisitor(body.mID);
@@ -105,7 +105,7 @@ void BroadPhaseBruteForce::CollideAABox(const AABB& inBox, const BroadPhaseQuery
 void BroadPhaseBruteForce::CollideSphere(const Vec3& inCenter, float inRadius,
                                          const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : mBodies)
         if (IsInLayerMask(inFilter.mObjectLayers, body.mLayer) &&
             SphereOverlapsAABB(inCenter, inRadius, body.mBounds))
@@ -115,7 +115,7 @@ void BroadPhaseBruteForce::CollideSphere(const Vec3& inCenter, float inRadius,
 void BroadPhaseBruteForce::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
                                         BodyVisitor inVisitor) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : mBodies)
         if (IsInLayerMask(inFilter.mObjectLayers, body.mLayer) && body.mBounds.Contains(inPoint))
             inVisitor(body.mID);
@@ -126,7 +126,7 @@ void BroadPhaseBruteForce::CastRay(const RayCast& inRay, const BroadPhaseQueryFi
 {
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     float maxFraction = 1.0f;
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : mBodies)
     {
         if (!IsInLayerMask(inFilter.mObjectLayers, body.mLayer)) continue;
@@ -144,7 +144,7 @@ void BroadPhaseBruteForce::CastAABox(const AABB& inBox, const Vec3& inDisplaceme
 {
     const SweptAABox sweep(inBox, inDisplacement);
     float maxFraction = 1.0f;
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : mBodies)
     {
         if (!IsInLayerMask(inFilter.mObjectLayers, body.mLayer)) continue;
@@ -159,7 +159,7 @@ void BroadPhaseBruteForce::FindCollidingPairs(std::span<const BodyID> inActiveBo
                                               const LayerSetup& inLayers, BodyPairVisitor inVisitor,
                                               const ParallelRanges* /*inParallel: runs serially*/) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
 
     // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
     mActiveScratch.assign(mBodies.size(), 0);
@@ -186,7 +186,7 @@ void BroadPhaseBruteForce::FindCollidingPairs(std::span<const BodyID> inActiveBo
 
 size_t BroadPhaseBruteForce::GetBodyCount() const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     return mBodies.size();
 }
 

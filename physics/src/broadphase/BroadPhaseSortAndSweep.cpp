@@ -411,7 +411,7 @@ void BroadPhaseSortAndSweep::AddBodiesFinalize(AddState inState)
 {
     SortAndSweepAddBatch* batch = static_cast<SortAndSweepAddBatch*>(inState);
     {
-        const auto lock = LockedCountingWait(mMutex);
+        const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
         for (const BroadPhaseBody& body : batch->mBodies)
             InsertBody(body);
     }
@@ -470,7 +470,7 @@ uint32_t BroadPhaseSortAndSweep::FindLocation(BodyID inID) const
 
 void BroadPhaseSortAndSweep::RemoveBodies(std::span<const BodyID> inBodies)
 {
-    const auto lock = LockedCountingWait(mMutex);
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
     for (BodyID id : inBodies)
         if (const uint32_t location = FindLocation(id); location != cNotPresent)
             RemoveAt(location & ((1u << cLayerBits) - 1), location >> cLayerBits);
@@ -478,7 +478,7 @@ void BroadPhaseSortAndSweep::RemoveBodies(std::span<const BodyID> inBodies)
 
 void BroadPhaseSortAndSweep::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
 {
-    const auto lock = LockedCountingWait(mMutex);
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
     for (const BroadPhaseBody& body : inBodies)
     {
         const uint32_t location = FindLocation(body.mID);
@@ -515,7 +515,7 @@ void BroadPhaseSortAndSweep::NotifyBodiesAABBChanged(std::span<const BroadPhaseB
 
 void BroadPhaseSortAndSweep::Update()
 {
-    const auto lock = LockedCountingWait(mMutex);
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
     for (Layer& layer : mLayers)
         if (!layer.mDirty.empty() || layer.mNumDead != 0) Rebuild(layer);
 }
@@ -594,7 +594,7 @@ template <class Test>
 void BroadPhaseSortAndSweep::VisitOverlapping(const Window& inWindow, ObjectLayerMask inMask, Test&& inTest,
                                               BodyVisitor inVisitor) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     Query(inWindow, inMask, inTest,
           [&](BodyID inID)
           {
@@ -643,7 +643,7 @@ void BroadPhaseSortAndSweep::CastRay(const RayCast& inRay, const BroadPhaseQuery
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     float maxFraction = 1.0f;
     float fraction = 0.0f;
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     Query(
         window, inFilter.mObjectLayers,
         [&](const AABB& inBounds)
@@ -673,7 +673,7 @@ void BroadPhaseSortAndSweep::CastAABox(const AABB& inBox, const Vec3& inDisplace
                         std::max(sweep.mCenter.z(), end.z()) + halfExtent.z()};
     float maxFraction = 1.0f;
     float fraction = 0.0f;
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     Query(
         window, inFilter.mObjectLayers,
         [&](const AABB& inBounds)
@@ -692,7 +692,7 @@ void BroadPhaseSortAndSweep::FindCollidingPairs(std::span<const BodyID> inActive
                                                 const LayerSetup& inLayers, BodyPairVisitor inVisitor,
                                                 const ParallelRanges* /*inParallel: runs serially*/) const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
 
     // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
     for (BodyID id : inActiveBodies)
@@ -726,13 +726,13 @@ void BroadPhaseSortAndSweep::FindCollidingPairs(std::span<const BodyID> inActive
 
 size_t BroadPhaseSortAndSweep::GetBodyCount() const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     return mBodyCount;
 }
 
 bool BroadPhaseSortAndSweep::Validate() const
 {
-    const auto lock = SharedLockedCountingWait(mMutex);
+    const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
     size_t count = 0;
     for (uint32_t layerIndex = 0; layerIndex < mLayers.size(); ++layerIndex)
     {

@@ -13,9 +13,13 @@
 // WriterFairSharedMutex (a reader that finds a writer waiting, or another reader passing its turnstile,
 // counts too), the quad tree's StripedSharedMutex, and the comparison broad phases' mutexes (brute force,
 // sort and sweep). The lock-free queries' epoch read sections never wait, so they have nothing to count.
-// Threads: one counter per thread (thread_local), written and read by its own thread only.
+// Two kinds are kept apart, because the reference's before and after differ in both: the broad phase's locks
+// (the global mutex, the trees' modification lock, the comparison broad phases' mutexes) and the body locks
+// (shard, static, free-list and active-list mutexes).
+// Threads: counters per thread (thread_local), written and read by their own thread only.
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <mutex>
 #include <shared_mutex>
@@ -23,22 +27,37 @@
 namespace cairn
 {
 
+/// Which of the engine's locks a wait was for.
+enum class LockKind : uint8_t
+{
+    BroadPhase, ///< The global-mutex broad phase's mutex, the trees' modification lock, the comparison ones'
+    Body,       ///< Body shard and static mutexes, the body manager's list mutexes
+};
+
 namespace lock_waits_detail
 {
-inline thread_local uint64_t tWaitNanoseconds = 0;
+inline thread_local uint64_t tWaitNanoseconds[2] = {0, 0}; ///< Indexed by LockKind
 } // namespace lock_waits_detail
 
-/// Nanoseconds this thread has spent waiting for the engine's locks since it started; take differences.
-inline uint64_t GetThisThreadLockWaitNanoseconds()
+/// Nanoseconds this thread has spent waiting for the engine's locks of inKind since it started; take
+/// differences.
+inline uint64_t GetThisThreadLockWaitNanoseconds(LockKind inKind)
 {
-    return lock_waits_detail::tWaitNanoseconds;
+    return lock_waits_detail::tWaitNanoseconds[size_t(inKind)];
 }
 
-/// Adds a wait timed elsewhere to this thread's total.
-inline void AddThisThreadLockWait(std::chrono::steady_clock::duration inWait)
+/// The same for every kind.
+inline uint64_t GetThisThreadLockWaitNanoseconds()
+{
+    return GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase) +
+           GetThisThreadLockWaitNanoseconds(LockKind::Body);
+}
+
+/// Adds a wait timed elsewhere to this thread's total of inKind.
+inline void AddThisThreadLockWait(LockKind inKind, std::chrono::steady_clock::duration inWait)
 {
     if (inWait.count() > 0)
-        lock_waits_detail::tWaitNanoseconds +=
+        lock_waits_detail::tWaitNanoseconds[size_t(inKind)] +=
             uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(inWait).count());
 }
 
@@ -46,44 +65,46 @@ inline void AddThisThreadLockWait(std::chrono::steady_clock::duration inWait)
 class ScopedLockWait
 {
 public:
-    ScopedLockWait() : mStart(std::chrono::steady_clock::now()) {}
-    ~ScopedLockWait() { AddThisThreadLockWait(std::chrono::steady_clock::now() - mStart); }
+    explicit ScopedLockWait(LockKind inKind) : mKind(inKind), mStart(std::chrono::steady_clock::now()) {}
+    ~ScopedLockWait() { AddThisThreadLockWait(mKind, std::chrono::steady_clock::now() - mStart); }
     ScopedLockWait(const ScopedLockWait&) = delete;
     ScopedLockWait& operator=(const ScopedLockWait&) = delete;
 
 private:
+    LockKind mKind;
     std::chrono::steady_clock::time_point mStart;
 };
 
 /// ioLockable.lock(), timed into this thread's total only when try_lock() fails. Works with mutexes and
 /// with std::unique_lock.
-template <class Lockable> void LockCountingWait(Lockable& ioLockable)
+template <class Lockable> void LockCountingWait(Lockable& ioLockable, LockKind inKind)
 {
     if (ioLockable.try_lock()) return;
-    ScopedLockWait wait;
+    ScopedLockWait wait(inKind);
     ioLockable.lock();
 }
 
 /// A std::unique_lock on ioMutex, taken by LockCountingWait.
-template <class Mutex> [[nodiscard]] std::unique_lock<Mutex> LockedCountingWait(Mutex& ioMutex)
+template <class Mutex>
+[[nodiscard]] std::unique_lock<Mutex> LockedCountingWait(Mutex& ioMutex, LockKind inKind)
 {
-    LockCountingWait(ioMutex);
+    LockCountingWait(ioMutex, inKind);
     return std::unique_lock<Mutex>(ioMutex, std::adopt_lock);
 }
 
 /// ioMutex.lock_shared(), timed only when try_lock_shared() fails.
-template <class SharedMutex> void LockSharedCountingWait(SharedMutex& ioMutex)
+template <class SharedMutex> void LockSharedCountingWait(SharedMutex& ioMutex, LockKind inKind)
 {
     if (ioMutex.try_lock_shared()) return;
-    ScopedLockWait wait;
+    ScopedLockWait wait(inKind);
     ioMutex.lock_shared();
 }
 
 /// A std::shared_lock on ioMutex, taken by LockSharedCountingWait.
 template <class SharedMutex>
-[[nodiscard]] std::shared_lock<SharedMutex> SharedLockedCountingWait(SharedMutex& ioMutex)
+[[nodiscard]] std::shared_lock<SharedMutex> SharedLockedCountingWait(SharedMutex& ioMutex, LockKind inKind)
 {
-    LockSharedCountingWait(ioMutex);
+    LockSharedCountingWait(ioMutex, inKind);
     return std::shared_lock<SharedMutex>(ioMutex, std::adopt_lock);
 }
 

@@ -33,12 +33,12 @@ public:
         mMutex = &inManager.GetMutexForBody(inID.GetIndex());
         if constexpr (Write)
         {
-            LockCountingWait(*mMutex);
+            LockCountingWait(*mMutex, LockKind::Body);
             mStaticMutex = &inManager.GetStaticMutexForBody(inID.GetIndex());
-            LockCountingWait(*mStaticMutex);
+            LockCountingWait(*mStaticMutex, LockKind::Body);
         }
         else
-            LockSharedCountingWait(*mMutex);
+            LockSharedCountingWait(*mMutex, LockKind::Body);
         BodyManager::NoteBodyLockHeld(+1);
         mBody = inManager.TryGetBody(inID);
     }
@@ -131,7 +131,7 @@ public:
             const auto start = std::chrono::steady_clock::now();
             mMutex->lock_shared();
             const auto wait = std::chrono::steady_clock::now() - start;
-            AddThisThreadLockWait(wait);
+            AddThisThreadLockWait(LockKind::Body, wait);
             if (ioWaitMs != nullptr) *ioWaitMs = std::chrono::duration<double, std::milli>(wait).count();
         }
         BodyManager::NoteBodyLockHeld(+1);

@@ -41,7 +41,7 @@ public:
             if (!mWriter.load(std::memory_order_seq_cst)) return stripe;
             // A commit is running or waiting: step aside so that it can finish, then retry
             count.fetch_sub(1, std::memory_order_release); // Release: nothing was touched, but keep it paired
-            ScopedLockWait wait;
+            ScopedLockWait wait(LockKind::BroadPhase);
             while (mWriter.load(std::memory_order_acquire)) // Acquire: pairs with the release in unlock()
                 std::this_thread::yield();
         }
@@ -56,12 +56,12 @@ public:
     /// Exclusive lock: raises the flag, then waits until no shared holder is left.
     void lock()
     {
-        LockCountingWait(mWriterMutex);
+        LockCountingWait(mWriterMutex, LockKind::BroadPhase);
         mWriter.store(true, std::memory_order_seq_cst); // seq_cst: see the header comment
         for (const Stripe& stripe : mStripes)
             if (stripe.mCount.load(std::memory_order_seq_cst) != 0) // seq_cst: see the header comment
             {
-                ScopedLockWait wait;
+                ScopedLockWait wait(LockKind::BroadPhase);
                 while (stripe.mCount.load(std::memory_order_seq_cst) != 0) // As above
                     std::this_thread::yield();
             }

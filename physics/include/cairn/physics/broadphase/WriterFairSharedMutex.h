@@ -27,7 +27,7 @@ public:
     void lock()
     {
         if (try_lock()) return;
-        ScopedLockWait wait;
+        ScopedLockWait wait(LockKind::BroadPhase);
         std::lock_guard turnstile(mTurnstile);
         mMutex.lock();
     }
@@ -46,7 +46,7 @@ public:
     void lock_shared()
     {
         if (try_lock_shared()) return;
-        ScopedLockWait wait;
+        ScopedLockWait wait(LockKind::BroadPhase);
         {
             std::lock_guard turnstile(mTurnstile);
         }
