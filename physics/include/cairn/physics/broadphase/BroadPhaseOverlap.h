@@ -42,11 +42,14 @@ inline bool AABBContains(const AABB& inBox, const Vec3& inPoint)
            (inBox.mMin.z() <= inPoint.z()) & (inPoint.z() <= inBox.mMax.z());
 }
 
-/// Closed-interval sphere-box test: the point of the box closest to the centre is within inRadius.
+/// Closed-interval sphere-box test: the point of the box closest to the centre is within inRadius. The
+/// squared distance is summed as (x + y) + z, the order of the quad tree's 4-wide node test, which decides a
+/// tight slot alone: Eigen's squaredNorm sums in another order, and a body on the sphere's surface came out 1
+/// ulp apart.
 inline bool SphereOverlapsAABB(const Vec3& inCenter, float inRadius, const AABB& inBox)
 {
-    const Vec3 closest = inCenter.cwiseMax(inBox.mMin).cwiseMin(inBox.mMax);
-    return (inCenter - closest).squaredNorm() <= inRadius * inRadius;
+    const Vec3 d = inCenter - inCenter.cwiseMax(inBox.mMin).cwiseMin(inBox.mMax);
+    return (d.x() * d.x() + d.y() * d.y()) + d.z() * d.z() <= inRadius * inRadius;
 }
 
 /// Precomputed swept-box cast: the box centre is ray-cast against each body box grown by the box half extents
