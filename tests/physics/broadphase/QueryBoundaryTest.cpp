@@ -1,0 +1,103 @@
+// Queries that just touch a box: the quad tree's 4-wide node tests decide a tight slot by themselves, and
+// must round exactly as the scalar tests of the other broad phases do, or the two disagree about bodies on
+// the sphere's surface (found by QuadTreePropertyTest: a squared distance summed in another order was 1 ulp
+// over the squared radius in one and equal to it in the other).
+
+#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
+#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+
+#include <cmath>
+#include <gtest/gtest.h>
+#include <random>
+#include <utility>
+#include <vector>
+
+namespace cairn
+{
+namespace
+{
+
+TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnSpheresThatJustTouch)
+{
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> coordinate(-20.0f, 20.0f), size(0.1f, 3.0f);
+    int touching = 0; // Cases where the radius lands on the squared distance (within an ulp or two)
+    for (int trial = 0; trial < 4000; ++trial)
+    {
+        const Vec3 min(coordinate(random), coordinate(random), coordinate(random));
+        const AABB box(min, min + Vec3(size(random), size(random), size(random)));
+        const Vec3 center(coordinate(random), coordinate(random), coordinate(random));
+        const Vec3 closest = center.cwiseMax(box.mMin).cwiseMin(box.mMax);
+        const float distance = (center - closest).norm();
+        if (distance == 0.0f) continue;
+
+        BroadPhaseBruteForce bruteForce;
+        BroadPhaseQuadTree quadTree(16, LayerSetup::CreateDefault());
+        const BroadPhaseBody body{BodyID(3, 1), box, Layers::cStatic};
+        bruteForce.AddBodiesFinalize(bruteForce.AddBodiesPrepare({&body, 1}));
+        quadTree.AddBodiesFinalize(quadTree.AddBodiesPrepare({&body, 1}));
+        // Radii around the distance, a few ulps either way
+        float radius = distance;
+        for (int step = 0; step < 3; ++step)
+            radius = std::nextafter(radius, 0.0f);
+        for (int step = 0; step < 7; ++step, radius = std::nextafter(radius, 100.0f))
+        {
+            int bruteForceHits = 0, quadTreeHits = 0;
+            bruteForce.CollideSphere(center, radius, {}, [&](BodyID) { ++bruteForceHits; });
+            quadTree.CollideSphere(center, radius, {}, [&](BodyID) { ++quadTreeHits; });
+            ASSERT_EQ(bruteForceHits, quadTreeHits)
+                << "trial " << trial << ", radius " << radius << " against a distance of " << distance;
+            touching += bruteForceHits == 1 && !SphereOverlapsAABB(center, std::nextafter(radius, 0.0f), box);
+        }
+    }
+    EXPECT_GT(touching, 1000); // The radii did straddle the surface
+}
+
+TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnRaysThatGrazeABox)
+{
+    // The same for the ray's 4-wide slab test: rays aimed at a box's corners and edge points, where the entry
+    // and exit fractions meet
+    std::mt19937 random(11);
+    std::uniform_real_distribution<float> coordinate(-20.0f, 20.0f), size(0.1f, 3.0f), unit(0.0f, 1.0f);
+    int hits = 0;
+    for (int trial = 0; trial < 4000; ++trial)
+    {
+        const Vec3 min(coordinate(random), coordinate(random), coordinate(random));
+        const AABB box(min, min + Vec3(size(random), size(random), size(random)));
+        BroadPhaseBruteForce bruteForce;
+        BroadPhaseQuadTree quadTree(16, LayerSetup::CreateDefault());
+        const BroadPhaseBody body{BodyID(3, 1), box, Layers::cStatic};
+        bruteForce.AddBodiesFinalize(bruteForce.AddBodiesPrepare({&body, 1}));
+        quadTree.AddBodiesFinalize(quadTree.AddBodiesPrepare({&body, 1}));
+        // A corner, or a point on an edge, of the box
+        Vec3 target((random() & 1) ? box.mMax.x() : box.mMin.x(),
+                    (random() & 1) ? box.mMax.y() : box.mMin.y(),
+                    (random() & 1) ? box.mMax.z() : box.mMin.z());
+        const int edgeAxis = int(random() % 4);
+        if (edgeAxis < 3)
+            target[edgeAxis] = box.mMin[edgeAxis] + unit(random) * (box.mMax - box.mMin)[edgeAxis];
+        const Vec3 origin(coordinate(random), coordinate(random), coordinate(random));
+        const float reach = 0.5f + 1.5f * unit(random); // Short of, or past, the target
+        const RayCast ray{origin, reach * (target - origin)};
+        std::vector<std::pair<BodyID, float>> bruteForceHits, quadTreeHits;
+        bruteForce.CastRay(ray, {},
+                           [&](BodyID inID, float inFraction)
+                           {
+                               bruteForceHits.emplace_back(inID, inFraction);
+                               return 1.0f;
+                           });
+        quadTree.CastRay(ray, {},
+                         [&](BodyID inID, float inFraction)
+                         {
+                             quadTreeHits.emplace_back(inID, inFraction);
+                             return 1.0f;
+                         });
+        ASSERT_EQ(bruteForceHits, quadTreeHits) << "trial " << trial;
+        hits += int(bruteForceHits.size());
+    }
+    EXPECT_GT(hits, 1000); // Many of the rays reach their corner or edge
+}
+
+} // namespace
+} // namespace cairn
