@@ -73,6 +73,15 @@ std::string Micros(double inValue)
     return Fixed(inValue, 2);
 }
 
+/// "1.25, 2.50" (per thread), or "n/a" for none.
+std::string MicrosList(const std::vector<double>& inValues)
+{
+    std::string text;
+    for (size_t i = 0; i < inValues.size(); ++i)
+        text += (i == 0 ? "" : ", ") + Micros(inValues[i]);
+    return text.empty() ? "n/a" : text;
+}
+
 /// A statistic of a series that was never sampled shows "n/a": a 0 would read as "free".
 std::string Ms(const SampleSummary& inSummary, double inValue)
 {
@@ -278,15 +287,6 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     auto frames = [&](double inValue)
     { return latency.mCount == 0 ? std::string("n/a") : Fixed(inValue, 0); };
 
-    std::string perThread;
-    for (size_t i = 0; i < inRun.mQueryMicrosPerThread.size(); ++i)
-        perThread += (i == 0 ? "" : ", ") + Micros(inRun.mQueryMicrosPerThread[i]);
-    if (perThread.empty()) perThread = "n/a";
-    std::string waitsPerThread;
-    for (size_t i = 0; i < inRun.mLockWaitMicrosPerThreadFrame.size(); ++i)
-        waitsPerThread += (i == 0 ? "" : ", ") + Micros(inRun.mLockWaitMicrosPerThreadFrame[i]);
-    if (waitsPerThread.empty()) waitsPerThread = "n/a";
-
     auto ofQueries = [&](uint64_t inCount)
     {
         const double percent =
@@ -322,8 +322,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
         {"game-object queries",
          {{"queries", Count(inRun.mQueries)},
           {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
-          {"µs/query per thread", perThread},
-          {"lock waits µs/frame per thread", waitsPerThread},
+          {"µs/query per thread", MicrosList(inRun.mQueryMicrosPerThread)},
+          {"lock waits µs/frame per thread", MicrosList(LockWaitMicrosPerThreadFrame(inRun))},
           {"broad-phase / body locks", Micros(MeanOf(inRun.mBroadPhaseLockWaitMicrosPerThreadFrame)) + " / " +
                                            Micros(MeanOf(inRun.mBodyLockWaitMicrosPerThreadFrame))}}});
     sections.push_back({"streaming",
@@ -453,8 +453,8 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
         table.mRows.push_back({Format("query µs/query thread %zu", i), Micros(lockFreeValue),
                                Micros(globalValue), Ratio(globalValue, lockFreeValue)});
     }
-    const double lockFreeWaits = MeanOf(inLockFree.mLockWaitMicrosPerThreadFrame);
-    const double globalWaits = MeanOf(inGlobal.mLockWaitMicrosPerThreadFrame);
+    const double lockFreeWaits = MeanOf(LockWaitMicrosPerThreadFrame(inLockFree));
+    const double globalWaits = MeanOf(LockWaitMicrosPerThreadFrame(inGlobal));
     table.mRows.push_back({"lock waits µs/frame per thread", Micros(lockFreeWaits), Micros(globalWaits),
                            WaitRatio(globalWaits, lockFreeWaits)});
     auto kindRow = [&](const char* inName, const std::vector<double> DemoRunResult::*inSeries)

@@ -46,4 +46,13 @@ PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
     return means;
 }
 
+std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun)
+{
+    std::vector<double> total = inRun.mBroadPhaseLockWaitMicrosPerThreadFrame;
+    total.resize(std::max(total.size(), inRun.mBodyLockWaitMicrosPerThreadFrame.size()), 0.0);
+    for (size_t i = 0; i < inRun.mBodyLockWaitMicrosPerThreadFrame.size(); ++i)
+        total[i] += inRun.mBodyLockWaitMicrosPerThreadFrame[i];
+    return total;
+}
+
 } // namespace cairn::demo

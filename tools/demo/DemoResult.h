@@ -53,11 +53,10 @@ struct DemoRunResult
     std::vector<double> mQueryMicrosPerThread;
     uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs
     double mQueryMicrosMean = 0.0; ///< Over all queries
-    /// Game-object jobs: microseconds per frame each thread spent waiting for the engine's locks (LockWaits),
-    /// in the order of mQueryMicrosPerThread
-    std::vector<double> mLockWaitMicrosPerThreadFrame;
-    std::vector<double> mBroadPhaseLockWaitMicrosPerThreadFrame; ///< The same, the broad phase's locks only
-    std::vector<double> mBodyLockWaitMicrosPerThreadFrame;       ///< The same, the body locks only
+    /// Game-object jobs: microseconds per frame each thread spent waiting for the broad phase's locks
+    /// (LockWaits), in the order of mQueryMicrosPerThread
+    std::vector<double> mBroadPhaseLockWaitMicrosPerThreadFrame;
+    std::vector<double> mBodyLockWaitMicrosPerThreadFrame; ///< The same for the body locks
     std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the game-object jobs' lock waits, all threads
     /// Streaming, measured on the loading thread per world tile
     std::vector<double> mStreamInMs;         ///< Create + prepare + finalize of one tile's bodies
@@ -85,5 +84,8 @@ struct DemoRunResult
     std::vector<std::string> mErrors; ///< Anything that went wrong, one line each
     std::string mNavMeshObj;          ///< The navmesh at the end of the run, as Wavefront OBJ text
 };
+
+/// The game-object jobs' lock waits of every kind, per thread (the sum of the per-kind series).
+std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun);
 
 } // namespace cairn::demo

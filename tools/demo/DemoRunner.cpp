@@ -170,7 +170,6 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");
     result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();
     result.mQueryMicrosPerThread = gameObjects->GetQueryMicrosPerThread();
-    result.mLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame();
     result.mBroadPhaseLockWaitMicrosPerThreadFrame =
         gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::BroadPhase);
     result.mBodyLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::Body);

@@ -104,21 +104,19 @@ void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& i
                        [&](uint32_t inBegin, uint32_t inEnd)
                        {
                            uint64_t nanos = 0, queries = 0;
-                           const uint64_t broadPhaseBefore =
-                               GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase);
-                           const uint64_t bodiesBefore = GetThisThreadLockWaitNanoseconds(LockKind::Body);
+                           uint64_t waitedBefore[cNumLockKinds];
+                           for (size_t kind = 0; kind < cNumLockKinds; ++kind)
+                               waitedBefore[kind] = GetThisThreadLockWaitNanoseconds(LockKind(kind));
                            for (uint32_t i = inBegin; i < inEnd; ++i)
                                UpdateObject(mObjects[i], inPlayer, nanos, queries);
-                           const uint64_t broadPhaseWaited =
-                               GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase) - broadPhaseBefore;
-                           const uint64_t bodiesWaited =
-                               GetThisThreadLockWaitNanoseconds(LockKind::Body) - bodiesBefore;
                            ThreadSlot& slot = mSlots[ThreadSlotIndex()];
                            // Relaxed: totals read after the jobs are waited for (the wait orders them)
                            slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
                            slot.mQueries.fetch_add(queries, std::memory_order_relaxed);
-                           slot.mBroadPhaseWaitNanos.fetch_add(broadPhaseWaited, std::memory_order_relaxed);
-                           slot.mBodyWaitNanos.fetch_add(bodiesWaited, std::memory_order_relaxed);
+                           for (size_t kind = 0; kind < cNumLockKinds; ++kind)
+                               slot.mWaitNanos[kind].fetch_add(
+                                   GetThisThreadLockWaitNanoseconds(LockKind(kind)) - waitedBefore[kind],
+                                   std::memory_order_relaxed);
                        });
 }
 
@@ -143,21 +141,13 @@ std::vector<double> GameObjects::GetQueryMicrosPerThread() const
     return perThread;
 }
 
-uint64_t GameObjects::ThreadSlot::WaitNanos(std::optional<LockKind> inKind) const
-{
-    const uint64_t broadPhase = mBroadPhaseWaitNanos.load(std::memory_order_relaxed);
-    const uint64_t bodies = mBodyWaitNanos.load(std::memory_order_relaxed);
-    if (!inKind) return broadPhase + bodies;
-    return *inKind == LockKind::BroadPhase ? broadPhase : bodies;
-}
-
-std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame(std::optional<LockKind> inKind) const
+std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame(LockKind inKind) const
 {
     std::vector<double> perThread;
     for (const ThreadSlot& slot : mSlots)
         if (slot.mQueries.load(std::memory_order_relaxed) > 0) // The threads of GetQueryMicrosPerThread
-            perThread.push_back(double(slot.WaitNanos(inKind)) / 1000.0 /
-                                double(std::max<uint64_t>(1, mFrames)));
+            perThread.push_back(double(slot.mWaitNanos[size_t(inKind)].load(std::memory_order_relaxed)) /
+                                1000.0 / double(std::max<uint64_t>(1, mFrames)));
     return perThread;
 }
 
@@ -165,7 +155,8 @@ uint64_t GameObjects::GetLockWaitNanosTotal() const
 {
     uint64_t total = 0;
     for (const ThreadSlot& slot : mSlots)
-        total += slot.WaitNanos(std::nullopt);
+        for (const std::atomic<uint64_t>& waited : slot.mWaitNanos)
+            total += waited.load(std::memory_order_relaxed);
     return total;
 }
 

@@ -17,7 +17,6 @@
 
 #include <array>
 #include <atomic>
-#include <optional>
 #include <random>
 #include <vector>
 
@@ -46,8 +45,8 @@ public:
     std::vector<double> GetQueryMicrosPerThread() const;
     double GetQueryMicrosMean() const;
     /// Microseconds per frame that each thread's game-object jobs spent waiting for the engine's locks of
-    /// inKind, or of every kind (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
-    std::vector<double> GetLockWaitMicrosPerThreadFrame(std::optional<LockKind> inKind = std::nullopt) const;
+    /// inKind (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
+    std::vector<double> GetLockWaitMicrosPerThreadFrame(LockKind inKind) const;
     /// Nanoseconds all game-object jobs have waited for the engine's locks so far (take differences).
     uint64_t GetLockWaitNanosTotal() const;
 
@@ -64,10 +63,7 @@ private:
     {
         std::atomic<uint64_t> mNanos{0};
         std::atomic<uint64_t> mQueries{0};
-        std::atomic<uint64_t> mBroadPhaseWaitNanos{0};
-        std::atomic<uint64_t> mBodyWaitNanos{0};
-
-        uint64_t WaitNanos(std::optional<LockKind> inKind) const; ///< Of inKind, or of both
+        std::array<std::atomic<uint64_t>, cNumLockKinds> mWaitNanos{}; ///< Indexed by LockKind
     };
 
     void UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);

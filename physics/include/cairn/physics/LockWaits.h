@@ -33,10 +33,11 @@ enum class LockKind : uint8_t
     BroadPhase, ///< The global-mutex broad phase's mutex, the trees' modification lock, the comparison ones'
     Body,       ///< Body shard and static mutexes, the body manager's list mutexes
 };
+inline constexpr size_t cNumLockKinds = 2;
 
 namespace lock_waits_detail
 {
-inline thread_local uint64_t tWaitNanoseconds[2] = {0, 0}; ///< Indexed by LockKind
+inline thread_local uint64_t tWaitNanoseconds[cNumLockKinds] = {}; ///< Indexed by LockKind
 } // namespace lock_waits_detail
 
 /// Nanoseconds this thread has spent waiting for the engine's locks of inKind since it started; take
@@ -49,8 +50,10 @@ inline uint64_t GetThisThreadLockWaitNanoseconds(LockKind inKind)
 /// The same for every kind.
 inline uint64_t GetThisThreadLockWaitNanoseconds()
 {
-    return GetThisThreadLockWaitNanoseconds(LockKind::BroadPhase) +
-           GetThisThreadLockWaitNanoseconds(LockKind::Body);
+    uint64_t total = 0;
+    for (size_t kind = 0; kind < cNumLockKinds; ++kind)
+        total += GetThisThreadLockWaitNanoseconds(LockKind(kind));
+    return total;
 }
 
 /// Adds a wait timed elsewhere to this thread's total of inKind.
