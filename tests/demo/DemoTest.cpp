@@ -5,6 +5,7 @@
 #include "DemoReport.h"
 #include "DemoRunner.h"
 
+#include <cmath>
 #include <cstdio>
 #include <gtest/gtest.h>
 #include <string>
@@ -45,6 +46,13 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_EQ(inRun.mPhysicsMs.size(), 240u);
     EXPECT_EQ(inRun.mSteps.size(), 240u);
     EXPECT_EQ(inRun.mGameObjectLockWaitUs.size(), 240u);
+    ASSERT_EQ(inRun.mPhysicsHostTakenMs.size(), 240u);
+    for (size_t i = 0; i < 240; ++i) // Unknown, or a part of the frame's physics time
+    {
+        const double host = inRun.mPhysicsHostTakenMs[i];
+        EXPECT_TRUE(std::isnan(host) || (host >= 0.0 && host <= inRun.mPhysicsMs[i]))
+            << "frame " << i << ": " << host << " of " << inRun.mPhysicsMs[i] << " ms";
+    }
     EXPECT_FALSE(LockWaitMicrosPerThreadFrame(inRun).empty());
     EXPECT_GT(inRun.mQueries, 0u);
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
@@ -76,6 +84,7 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mPhysicsMs = {0.25, 0.5};
     run.mMainThreadStreamMs = {0.01, 0.02};
     run.mGameObjectLockWaitUs = {0.0, 12.5};
+    run.mPhysicsHostTakenMs = {std::nan(""), 0.125}; // Unknown in the first frame
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
                    uint32_t inActive, uint32_t inPairs, uint32_t inPoints, double inLockWait)
     {
@@ -104,11 +113,12 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     EXPECT_EQ(lines[0],
               "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
               "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-              "game_object_lock_wait_us");
+              "game_object_lock_wait_us,physics_host_taken_ms");
     EXPECT_EQ(lines[1],
-              "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00");
-    EXPECT_EQ(lines[2],
-              "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50");
+              "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00,");
+    EXPECT_EQ(
+        lines[2],
+        "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50,0.1250");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 
@@ -124,6 +134,32 @@ TEST(DemoResultTest, MeanPhasesAveragesThePhasesAndKeepsTheLargestLockWait)
     EXPECT_DOUBLE_EQ(means.mLockWaitMs, 0.25);
     EXPECT_DOUBLE_EQ(means.mLockWaitMaxMs, 0.5);
     EXPECT_EQ(MeanPhases({}).mLockWaitMaxMs, 0.0);
+}
+
+TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
+{
+    DemoRunResult run;
+    run.mPhysicsMs.assign(100, 1.0);
+    run.mPhysicsHostTakenMs.assign(100, 0.0);
+    run.mPhysicsMs.push_back(5.0); // Within 3x the average without the host's 2.5 ms
+    run.mPhysicsHostTakenMs.push_back(2.5);
+    run.mPhysicsMs.push_back(4.5); // Unknown share: not the host's
+    run.mPhysicsHostTakenMs.push_back(std::nan(""));
+    run.mPhysicsMs.push_back(4.0); // The host's 0.5 ms leaves it over 3x
+    run.mPhysicsHostTakenMs.push_back(0.5);
+    const SpikeAttribution spikes = AttributeSpikes(run, 3.0); // Bound 3 * 113.5 / 103 = 3.31 ms
+    EXPECT_EQ(spikes.mSpikes, 3u);
+    EXPECT_EQ(spikes.mSpikesByHost, 1u);
+    EXPECT_DOUBLE_EQ(spikes.mHostTakenMinMs, 2.5);
+    EXPECT_DOUBLE_EQ(spikes.mHostTakenMaxMs, 2.5);
+    EXPECT_DOUBLE_EQ(spikes.mMaxLessHostMs, 4.5);
+
+    run.mPhysicsHostTakenMs.clear(); // Not measured at all: nothing is the host's
+    const SpikeAttribution unmeasured = AttributeSpikes(run, 3.0);
+    EXPECT_EQ(unmeasured.mSpikes, 3u);
+    EXPECT_EQ(unmeasured.mSpikesByHost, 0u);
+    EXPECT_DOUBLE_EQ(unmeasured.mMaxLessHostMs, 5.0);
+    EXPECT_EQ(AttributeSpikes(DemoRunResult{}, 3.0).mSpikes, 0u);
 }
 
 /// What inPrint writes to a file.
@@ -161,6 +197,14 @@ TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
     run.mMainThreadStreamMs[7] = 0.75;
     text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
     EXPECT_NE(text.find("(target <= 3x: NOT met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("frames over 3x avg 1  of which the host's none"), std::string::npos) << text;
+    run.mPhysicsHostTakenMs.assign(200, 0.0);
+    run.mPhysicsHostTakenMs[0] = 8.5; // The host took most of the spike
+    text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("of which the host's 1 (it took the updating thread's core for 8.500-8.500 ms)"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("max/avg less the host's time 1.90x"), std::string::npos) << text; // 2.0 / 1.055
     EXPECT_NE(text.find("(target <= 0.5 ms: NOT met)"), std::string::npos) << text;
     // p99 is at most 2.0 ms on an average of 1.055 ms, whichever sample the percentile picks
     EXPECT_NE(text.find("(target <= 2x: met)"), std::string::npos) << text;

@@ -304,6 +304,17 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                                          AtMost(physics.mP99 / physics.mMean, cP99TargetRatio, "x")},
                          {"max/avg", Ratio(physics.mMax, physics.mMean) +
                                          AtMost(physics.mMax / physics.mMean, cSpikeTargetRatio, "x")}}});
+    const SpikeAttribution spikes = AttributeSpikes(inRun, cSpikeTargetRatio);
+    sections.push_back({"physics spikes",
+                        {{Format("frames over %gx avg", cSpikeTargetRatio), Count(spikes.mSpikes)},
+                         {"of which the host's",
+                          spikes.mSpikes == 0 ? std::string("n/a")
+                          : spikes.mSpikesByHost == 0
+                              ? std::string("none")
+                              : Count(spikes.mSpikesByHost) + " (it took the updating thread's core for " +
+                                    Ms(spikes.mHostTakenMinMs) + "-" + Ms(spikes.mHostTakenMaxMs) + " ms)"},
+                         {"max/avg less the host's time", Ratio(spikes.mMaxLessHostMs, physics.mMean)},
+                         {"guest steal ms", Fixed(inRun.mGuestStealMs, 0)}}});
     sections.push_back({"frame ms",
                         {{"avg", Ms(frame, frame.mMean)},
                          {"p50", Ms(frame, frame.mP50)},
@@ -911,6 +922,14 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "and 32 body mutexes (the talk's slide: 500 against 10 µs a thread); the two rows below the lock "
             "waits split them between the broad phase's locks and the body locks.\n\n";
     }
+    if (!inRuns.empty())
+        text +=
+            "A physics spike is a frame over " + Format("%g", cSpikeTargetRatio) +
+            "x its run's average. The host's share of one is the time the updating thread was off its core "
+            "while the guest never switched it out (its CPU clock stood still while the wall clock ran): "
+            "the hypervisor had taken its vCPU. Only the updating thread is watched, so a job thread that "
+            "lost its core while the updating thread waited for it is not counted. Guest steal is the "
+            "same kind of time from all vCPUs over the run, as the guest counts it (10 ms ticks).\n\n";
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
     text += "Every frame's figures, with the physics step's phases: [frames.csv](frames.csv).\n";
@@ -949,7 +968,7 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
     std::string csv =
         "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
         "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-        "game_object_lock_wait_us\n";
+        "game_object_lock_wait_us,physics_host_taken_ms\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
@@ -960,11 +979,15 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f\n", mode.c_str(),
-                          i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
+            // Empty where the host's share can not be told (the updating thread was switched out)
+            const double host =
+                i < run.mPhysicsHostTakenMs.size() ? run.mPhysicsHostTakenMs[i] : std::nan("");
+            const std::string hostField = std::isfinite(host) ? Format("%.4f", host) : std::string();
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s\n",
+                          mode.c_str(), i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
                           step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
-                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i]);
+                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i], hostField.c_str());
         }
     }
     return csv;

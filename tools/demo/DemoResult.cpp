@@ -46,6 +46,35 @@ PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
     return means;
 }
 
+SpikeAttribution AttributeSpikes(const DemoRunResult& inRun, double inRatio)
+{
+    SpikeAttribution attribution;
+    const SampleSummary physics = Summarize(inRun.mPhysicsMs);
+    if (physics.mCount == 0) return attribution;
+    const double bound = inRatio * physics.mMean;
+    for (size_t i = 0; i < inRun.mPhysicsMs.size(); ++i)
+    {
+        const double wall = inRun.mPhysicsMs[i];
+        if (!std::isfinite(wall)) continue;
+        // An unknown share (the thread was switched out) is not the host's
+        const double host =
+            i < inRun.mPhysicsHostTakenMs.size() && std::isfinite(inRun.mPhysicsHostTakenMs[i])
+                ? std::clamp(inRun.mPhysicsHostTakenMs[i], 0.0, wall)
+                : 0.0;
+        attribution.mMaxLessHostMs = std::isnan(attribution.mMaxLessHostMs)
+                                         ? wall - host
+                                         : std::max(attribution.mMaxLessHostMs, wall - host);
+        if (wall <= bound) continue;
+        ++attribution.mSpikes;
+        if (wall - host > bound) continue;
+        ++attribution.mSpikesByHost;
+        attribution.mHostTakenMinMs =
+            std::fmin(attribution.mHostTakenMinMs, host); // fmin skips the NaN start
+        attribution.mHostTakenMaxMs = std::fmax(attribution.mHostTakenMaxMs, host);
+    }
+    return attribution;
+}
+
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun)
 {
     std::vector<double> total = inRun.mBroadPhaseLockWaitMicrosPerThreadFrame;

@@ -5,6 +5,7 @@
 
 #include "cairn/physics/PhysicsSettings.h"
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -44,6 +45,13 @@ struct DemoRunResult
     int mFrames = 0;
     uint32_t mThreads = 0;          ///< Job system threads
     std::vector<double> mPhysicsMs; ///< Per frame: PhysicsSystem::Update wall time
+    /// Per frame: of mPhysicsMs, the time the updating thread was off its core while the guest never switched
+    /// it out, so the host had taken its vCPU (tools::HostTakenMs); NaN when the thread was switched out (it
+    /// blocked, or the guest preempted it): then it can not be told. Only the updating thread is watched: a
+    /// job thread that loses its core while the updating thread spins for it shows up in neither.
+    std::vector<double> mPhysicsHostTakenMs;
+    double mGuestStealMs =
+        0.0; ///< Over the frames, from all vCPUs, as the guest counts it; NaN if it does not
     std::vector<double>
         mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
     /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics): the phase means of the
@@ -84,6 +92,20 @@ struct DemoRunResult
     std::vector<std::string> mErrors; ///< Anything that went wrong, one line each
     std::string mNavMeshObj;          ///< The navmesh at the end of the run, as Wavefront OBJ text
 };
+
+/// The physics frames over a bound (a multiple of their mean), and how many of them the host's taking the
+/// updating thread's vCPU accounts for (mPhysicsHostTakenMs).
+struct SpikeAttribution
+{
+    size_t mSpikes = 0;       ///< Frames over the bound
+    size_t mSpikesByHost = 0; ///< Of those, the frames that are within it once the host's time is left out
+    double mHostTakenMinMs = NAN; ///< The host's time in those frames: the least
+    double mHostTakenMaxMs = NAN; ///< ... and the most
+    double mMaxLessHostMs = NAN;  ///< The slowest frame once the host's time is left out of every frame
+};
+
+/// Frames of inRun.mPhysicsMs over inRatio times their mean: how many, and which the host accounts for.
+SpikeAttribution AttributeSpikes(const DemoRunResult& inRun, double inRatio);
 
 /// The game-object jobs' lock waits of every kind, per thread (the sum of the per-kind series).
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun);

@@ -11,6 +11,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "common/FrameTimes.h"
+#include "common/ThreadCpuClock.h"
 
 #include <chrono>
 #include <thread>
@@ -21,7 +22,10 @@ namespace cairn::demo
 namespace
 {
 using Clock = std::chrono::steady_clock;
+using tools::HostTakenMs;
 using tools::MillisecondsSince;
+using tools::SampleThisThreadCpu;
+using tools::ThreadCpuSample;
 
 /// Runs frames of physics and the navmesh sync point (no measuring) until inDone or inMaxSeconds.
 template <class Done>
@@ -99,6 +103,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
     const float dt = 1.0f / 60.0f;
     const Clock::time_point begin = Clock::now();
+    const double stealBefore = tools::GuestStealMs();
     for (int frame = 0; frame < inSettings.mFrames; ++frame)
     {
         const Clock::time_point frameStart = Clock::now();
@@ -111,10 +116,14 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
 
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
 
+        const ThreadCpuSample cpuBefore = SampleThisThreadCpu();
         const Clock::time_point physicsStart = Clock::now();
         if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
             result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
-        result.mPhysicsMs.push_back(MillisecondsSince(physicsStart));
+        const double physicsMs = MillisecondsSince(physicsStart);
+        const ThreadCpuSample cpuAfter = SampleThisThreadCpu();
+        result.mPhysicsMs.push_back(physicsMs);
+        result.mPhysicsHostTakenMs.push_back(HostTakenMs(cpuBefore, cpuAfter, physicsMs));
         result.mSteps.push_back(physics.GetLastStepStatistics());
 
         const uint64_t waitedBefore = gameObjects->GetLockWaitNanosTotal();
@@ -140,6 +149,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
             std::this_thread::sleep_until(begin + std::chrono::microseconds(int64_t(16667.0 * (frame + 1))));
     }
     if (inProgress != nullptr) std::fprintf(inProgress, "\n");
+    result.mGuestStealMs = tools::GuestStealMs() - stealBefore; // NaN where the guest does not count it
     result.mFrames = inSettings.mFrames;
     projectiles.RemoveAll(); // Before the streamer counts the world's bodies
 
