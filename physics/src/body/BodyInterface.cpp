@@ -106,6 +106,14 @@ void BodyInterface::WakeBodiesIn(const AABB& inBounds)
     mBroadPhase.CollideAABox(inBounds, {}, [&](BodyID inBody) { found.push_back(inBody); });
     for (const BodyID& id : found)
     {
+        {
+            // Only dynamic bodies wake. Tell them from the rest under the shard's static mutex, which no
+            // reader of bodies takes, instead of write-locking the shard of each static neighbour: a tile's
+            // stream-out removes hundreds of bodies, each beside the terrain and other props, and every write
+            // lock there made the game's queries of that shard wait (for long when the remover lost its core)
+            const StaticBodyLockRead probe(mBodies, id);
+            if (!probe.WasNotStatic() || probe.GetNotStaticMotionType() != MotionType::Dynamic) continue;
+        }
         BodyLockWrite lock(mBodies, id);
         if (Body* body = lock.GetBody(); body != nullptr && body->IsDynamic() && body->mInWorld)
             mBodies.ActivateBody(*body);

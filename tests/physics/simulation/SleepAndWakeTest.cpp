@@ -1,4 +1,9 @@
 #include "SimulationFixture.h"
+#include "cairn/physics/body/BodyLock.h"
+
+#include <atomic>
+#include <chrono>
+#include <thread>
 
 namespace cairn::test
 {
@@ -51,6 +56,43 @@ TEST_F(SleepAndWakeTest, RemovingTheSupportWakesTheBodyOnIt)
     EXPECT_TRUE(IsActive(box));
     Step(30);
     EXPECT_LT(Position(box).y(), 0.5f) << "the box should be falling";
+}
+
+TEST_F(SleepAndWakeTest, RemovingABodyDoesNotWriteLockItsStaticNeighbours)
+{
+    // A static neighbour held for read by another thread (a query, a navmesh job) must not hold up a removal
+    // beside it: static bodies never wake, so the removal has no reason to take their shard for writing
+    const BodyID neighbour = AddStatic(Box(Vec3(2, 0.5f, 2)), Vec3(0, 0, 0));
+    const BodyID removed = AddStatic(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 1.0f, 0));
+    const BodyID resting = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 2.0f, 0)));
+    Step(120);
+    ASSERT_FALSE(IsActive(resting));
+    const BodyManager& manager = System().GetBodyManager();
+    // The neighbour's shard is not one the removal needs: the removed body's, or the resting body's to wake
+    // it
+    ASSERT_NE(&manager.GetMutexForBody(neighbour.GetIndex()), &manager.GetMutexForBody(removed.GetIndex()));
+    ASSERT_NE(&manager.GetMutexForBody(neighbour.GetIndex()), &manager.GetMutexForBody(resting.GetIndex()));
+
+    std::atomic<bool> held{false}, release{false}; // Seq_cst: a test's handshake, not a hot path
+    std::thread reader(
+        [&]
+        {
+            BodyLockRead lock(manager, neighbour);
+            held = true;
+            const auto giveUp = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+            while (!release && std::chrono::steady_clock::now() < giveUp)
+                std::this_thread::yield();
+        });
+    while (!held)
+        std::this_thread::yield();
+    const auto start = std::chrono::steady_clock::now();
+    const Status status = Bodies().RemoveBody(removed);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const bool readerStillHeld = !release.exchange(true);
+    reader.join();
+    ASSERT_TRUE(status.IsOk());
+    EXPECT_TRUE(readerStillHeld && seconds < 4.0) << "the removal waited " << seconds << " s for the reader";
+    EXPECT_TRUE(IsActive(resting)) << "the dynamic body on the removed one still wakes";
 }
 
 TEST_F(SleepAndWakeTest, AWokenIslandWhoseOtherMemberWasDestroyedAndItsSlotReusedStillSteps)
