@@ -47,11 +47,15 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_EQ(inRun.mSteps.size(), 240u);
     EXPECT_EQ(inRun.mGameObjectLockWaitUs.size(), 240u);
     ASSERT_EQ(inRun.mPhysicsHostTakenMs.size(), 240u);
-    for (size_t i = 0; i < 240; ++i) // Unknown, or a part of the frame's physics time
+    ASSERT_EQ(inRun.mMainThreadStreamHostTakenMs.size(), 240u);
+    for (size_t i = 0; i < 240; ++i) // Unknown, or a part of the frame's time
     {
         const double host = inRun.mPhysicsHostTakenMs[i];
         EXPECT_TRUE(std::isnan(host) || (host >= 0.0 && host <= inRun.mPhysicsMs[i]))
             << "frame " << i << ": " << host << " of " << inRun.mPhysicsMs[i] << " ms";
+        const double streaming = inRun.mMainThreadStreamHostTakenMs[i];
+        EXPECT_TRUE(std::isnan(streaming) || (streaming >= 0.0 && streaming <= inRun.mMainThreadStreamMs[i]))
+            << "frame " << i << ": " << streaming << " of " << inRun.mMainThreadStreamMs[i] << " ms";
     }
     EXPECT_FALSE(LockWaitMicrosPerThreadFrame(inRun).empty());
     EXPECT_GT(inRun.mQueries, 0u);
@@ -85,6 +89,7 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mMainThreadStreamMs = {0.01, 0.02};
     run.mGameObjectLockWaitUs = {0.0, 12.5};
     run.mPhysicsHostTakenMs = {std::nan(""), 0.125}; // Unknown in the first frame
+    run.mMainThreadStreamHostTakenMs = {0.0};        // A series one short: its second field is empty
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
                    uint32_t inActive, uint32_t inPairs, uint32_t inPoints, double inLockWait)
     {
@@ -113,12 +118,13 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     EXPECT_EQ(lines[0],
               "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
               "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-              "game_object_lock_wait_us,physics_host_taken_ms");
-    EXPECT_EQ(lines[1],
-              "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00,");
+              "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms");
+    EXPECT_EQ(
+        lines[1],
+        "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00,,0.0000");
     EXPECT_EQ(
         lines[2],
-        "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50,0.1250");
+        "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50,0.1250,");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 
@@ -162,6 +168,14 @@ TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
     EXPECT_EQ(AttributeSpikes(DemoRunResult{}, 3.0).mSpikes, 0u);
 }
 
+TEST(DemoResultTest, MaxLessHostLeavesOutTheHostsKnownShareOfEachFrame)
+{
+    // 2.0 less 1.5 known; 1.5 less an unknown share; 1.0 less more than itself; a frame with no share at all
+    EXPECT_DOUBLE_EQ(MaxLessHost({2.0, 1.5, 1.0, 0.75}, {1.5, std::nan(""), 3.0}), 1.5);
+    EXPECT_DOUBLE_EQ(MaxLessHost({2.0, 1.25}, {1.5, 0.0}), 1.25);
+    EXPECT_TRUE(std::isnan(MaxLessHost({}, {})));
+}
+
 /// What inPrint writes to a file.
 template <class Print> std::string Printed(const Print& inPrint)
 {
@@ -195,8 +209,12 @@ TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
 
     run.mPhysicsMs[0] = 10.0; // A spike of about 9.9x the average
     run.mMainThreadStreamMs[7] = 0.75;
+    run.mMainThreadStreamHostTakenMs.assign(200, 0.0);
+    run.mMainThreadStreamHostTakenMs[7] = 0.5; // Of the 0.75 ms
     text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
     EXPECT_NE(text.find("(target <= 3x: NOT met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("(target <= 0.5 ms: NOT met)  less the host's time 0.250"), std::string::npos)
+        << text;
     EXPECT_NE(text.find("frames over 3x avg 1  of which the host's none"), std::string::npos) << text;
     run.mPhysicsHostTakenMs.assign(200, 0.0);
     run.mPhysicsHostTakenMs[0] = 8.5; // The host took most of the spike

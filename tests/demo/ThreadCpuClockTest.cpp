@@ -59,6 +59,20 @@ TEST(ThreadCpuClockTest, ABusyThreadsClockFollowsTheWallClockAndASleepIsASwitch)
     EXPECT_TRUE(std::isnan(HostTakenMs(sleepStart, sleepEnd, 20.0)));
 }
 
+TEST(ThreadCpuClockTest, TimeOnThisThreadTimesTheWork)
+{
+    int calls = 0;
+    const TimedWork sleeping = TimeOnThisThread(
+        [&]
+        {
+            ++calls;
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        });
+    EXPECT_EQ(calls, 1);
+    EXPECT_GE(sleeping.mWallMs, 5.0);
+    EXPECT_TRUE(std::isnan(sleeping.mHostTakenMs)); // A sleep switches the thread out: not told
+}
+
 TEST(ThreadCpuClockTest, GuestStealOnlyGrows)
 {
     const double first = GuestStealMs();

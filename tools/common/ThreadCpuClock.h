@@ -7,6 +7,7 @@
 // wall time beyond the thread's CPU time is time the host took the vCPU (or spent in interrupts); with a
 // switch, the guest's own scheduling may account for it, and the two can not be told apart.
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -51,6 +52,25 @@ inline double HostTakenMs(const ThreadCpuSample& inBefore, const ThreadCpuSample
     // The CPU clock is read just outside the wall window, so it can run a few microseconds ahead of it
     const double offCore = inWallMs - (inAfter.mCpuMs - inBefore.mCpuMs);
     return offCore > 0.0 ? offCore : 0.0;
+}
+
+/// A stretch of work on one thread: its wall time and the host's share of it (HostTakenMs).
+struct TimedWork
+{
+    double mWallMs = 0.0;
+    double mHostTakenMs = 0.0;
+};
+
+/// Runs inWork on the calling thread, timed, with the samples right outside the wall clock's reads.
+template <class Work> TimedWork TimeOnThisThread(Work&& inWork)
+{
+    const ThreadCpuSample before = SampleThisThreadCpu();
+    const auto start = std::chrono::steady_clock::now();
+    inWork();
+    const double wallMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const ThreadCpuSample after = SampleThisThreadCpu();
+    return {wallMs, HostTakenMs(before, after, wallMs)};
 }
 
 /// Time the host took from all of this machine's vCPUs since boot, in milliseconds, as the guest counts it

@@ -350,7 +350,9 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                           Ms(mainThreadStream, mainThreadStream.mMax) +
                               (mainThreadStream.mCount == 0
                                    ? std::string()
-                                   : AtMost(mainThreadStream.mMax, cMainThreadStreamTargetMs, " ms"))}}});
+                                   : AtMost(mainThreadStream.mMax, cMainThreadStreamTargetMs, " ms"))},
+                         {"less the host's time",
+                          Ms(MaxLessHost(inRun.mMainThreadStreamMs, inRun.mMainThreadStreamHostTakenMs))}}});
     sections.push_back(
         {"bodies peak",
          {{"static", Count(inRun.mStaticBodiesPeak)}, {"dynamic", Count(inRun.mDynamicBodiesPeak)}}});
@@ -928,7 +930,9 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "x its run's average. The host's share of one is the time the updating thread was off its core "
             "while the guest never switched it out (its CPU clock stood still while the wall clock ran): "
             "the hypervisor had taken its vCPU. Only the updating thread is watched, so a job thread that "
-            "lost its core while the updating thread waited for it is not counted. Guest steal is the "
+            "lost its core while the updating thread waited for it is not counted. The main thread's "
+            "streaming "
+            "time is split the same way. Guest steal is the "
             "same kind of time from all vCPUs over the run, as the guest counts it (10 ms ticks).\n\n";
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
@@ -961,6 +965,13 @@ struct TemporaryFiles
     }
 };
 
+/// A frame's host share for frames.csv: empty where it can not be told (the thread was switched out).
+std::string HostTakenField(const std::vector<double>& inHostTakenMs, size_t inFrame)
+{
+    if (inFrame >= inHostTakenMs.size() || !std::isfinite(inHostTakenMs[inFrame])) return {};
+    return Format("%.4f", inHostTakenMs[inFrame]);
+}
+
 } // namespace
 
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
@@ -968,7 +979,7 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
     std::string csv =
         "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
         "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-        "game_object_lock_wait_us,physics_host_taken_ms\n";
+        "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
@@ -979,15 +990,13 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            // Empty where the host's share can not be told (the updating thread was switched out)
-            const double host =
-                i < run.mPhysicsHostTakenMs.size() ? run.mPhysicsHostTakenMs[i] : std::nan("");
-            const std::string hostField = std::isfinite(host) ? Format("%.4f", host) : std::string();
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s\n",
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s,%s\n",
                           mode.c_str(), i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
                           step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
-                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i], hostField.c_str());
+                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i],
+                          HostTakenField(run.mPhysicsHostTakenMs, i).c_str(),
+                          HostTakenField(run.mMainThreadStreamHostTakenMs, i).c_str());
         }
     }
     return csv;

@@ -67,10 +67,11 @@ struct DemoRunResult
     std::vector<double> mBodyLockWaitMicrosPerThreadFrame; ///< The same for the body locks
     std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the game-object jobs' lock waits, all threads
     /// Streaming, measured on the loading thread per world tile
-    std::vector<double> mStreamInMs;         ///< Create + prepare + finalize of one tile's bodies
-    std::vector<double> mStreamLinkMs;       ///< The finalize (broad-phase link) alone
-    std::vector<double> mStreamOutMs;        ///< Remove + destroy of one tile's bodies
-    std::vector<double> mMainThreadStreamMs; ///< Per frame: time the main thread spent on streaming
+    std::vector<double> mStreamInMs;                  ///< Create + prepare + finalize of one tile's bodies
+    std::vector<double> mStreamLinkMs;                ///< The finalize (broad-phase link) alone
+    std::vector<double> mStreamOutMs;                 ///< Remove + destroy of one tile's bodies
+    std::vector<double> mMainThreadStreamMs;          ///< Per frame: time the main thread spent on streaming
+    std::vector<double> mMainThreadStreamHostTakenMs; ///< Per frame: the host's share of it (as for physics)
     uint32_t mTilesStreamedIn = 0;
     uint32_t mTilesStreamedOut = 0;
     uint32_t mStaticBodiesPeak = 0;
@@ -106,6 +107,9 @@ struct SpikeAttribution
 
 /// Frames of inRun.mPhysicsMs over inRatio times their mean: how many, and which the host accounts for.
 SpikeAttribution AttributeSpikes(const DemoRunResult& inRun, double inRatio);
+
+/// The largest of inWallMs[i] less inHostTakenMs[i] (an unknown or missing share counts as 0); NaN for none.
+double MaxLessHost(const std::vector<double>& inWallMs, const std::vector<double>& inHostTakenMs);
 
 /// The game-object jobs' lock waits of every kind, per thread (the sum of the per-kind series).
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun);

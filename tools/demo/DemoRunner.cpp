@@ -22,10 +22,7 @@ namespace cairn::demo
 namespace
 {
 using Clock = std::chrono::steady_clock;
-using tools::HostTakenMs;
 using tools::MillisecondsSince;
-using tools::SampleThisThreadCpu;
-using tools::ThreadCpuSample;
 
 /// Runs frames of physics and the navmesh sync point (no measuring) until inDone or inMaxSeconds.
 template <class Done>
@@ -110,20 +107,21 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         const float seconds = float(frame) * dt;
         const Vec3 player = generator.GetPlayerPosition(seconds);
 
-        const Clock::time_point streamStart = Clock::now();
-        streamer->SetFocus(player, generator.GetPlayerPosition(seconds + lookAhead));
-        result.mMainThreadStreamMs.push_back(MillisecondsSince(streamStart));
+        const tools::TimedWork streaming = tools::TimeOnThisThread(
+            [&] { streamer->SetFocus(player, generator.GetPlayerPosition(seconds + lookAhead)); });
+        result.mMainThreadStreamMs.push_back(streaming.mWallMs);
+        result.mMainThreadStreamHostTakenMs.push_back(streaming.mHostTakenMs);
 
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
 
-        const ThreadCpuSample cpuBefore = SampleThisThreadCpu();
-        const Clock::time_point physicsStart = Clock::now();
-        if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
-            result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
-        const double physicsMs = MillisecondsSince(physicsStart);
-        const ThreadCpuSample cpuAfter = SampleThisThreadCpu();
-        result.mPhysicsMs.push_back(physicsMs);
-        result.mPhysicsHostTakenMs.push_back(HostTakenMs(cpuBefore, cpuAfter, physicsMs));
+        const tools::TimedWork stepping = tools::TimeOnThisThread(
+            [&]
+            {
+                if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
+                    result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
+            });
+        result.mPhysicsMs.push_back(stepping.mWallMs);
+        result.mPhysicsHostTakenMs.push_back(stepping.mHostTakenMs);
         result.mSteps.push_back(physics.GetLastStepStatistics());
 
         const uint64_t waitedBefore = gameObjects->GetLockWaitNanosTotal();
