@@ -19,6 +19,19 @@ namespace cairn
 namespace
 {
 
+/// A random corner of inBox, or a random point on one of its edges, where a query's entry and exit meet.
+Vec3 CornerOrEdgePoint(const AABB& inBox, std::mt19937& ioRandom)
+{
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    Vec3 point((ioRandom() & 1) ? inBox.mMax.x() : inBox.mMin.x(),
+               (ioRandom() & 1) ? inBox.mMax.y() : inBox.mMin.y(),
+               (ioRandom() & 1) ? inBox.mMax.z() : inBox.mMin.z());
+    const int edgeAxis = int(ioRandom() % 4);
+    if (edgeAxis < 3)
+        point[edgeAxis] = inBox.mMin[edgeAxis] + unit(ioRandom) * (inBox.mMax - inBox.mMin)[edgeAxis];
+    return point;
+}
+
 TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnSpheresThatJustTouch)
 {
     std::mt19937 random(7);
@@ -71,13 +84,7 @@ TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnRaysThatGrazeABox)
         const BroadPhaseBody body{BodyID(3, 1), box, Layers::cStatic};
         bruteForce.AddBodiesFinalize(bruteForce.AddBodiesPrepare({&body, 1}));
         quadTree.AddBodiesFinalize(quadTree.AddBodiesPrepare({&body, 1}));
-        // A corner, or a point on an edge, of the box
-        Vec3 target((random() & 1) ? box.mMax.x() : box.mMin.x(),
-                    (random() & 1) ? box.mMax.y() : box.mMin.y(),
-                    (random() & 1) ? box.mMax.z() : box.mMin.z());
-        const int edgeAxis = int(random() % 4);
-        if (edgeAxis < 3)
-            target[edgeAxis] = box.mMin[edgeAxis] + unit(random) * (box.mMax - box.mMin)[edgeAxis];
+        const Vec3 target = CornerOrEdgePoint(box, random);
         const Vec3 origin(coordinate(random), coordinate(random), coordinate(random));
         const float reach = 0.5f + 1.5f * unit(random); // Short of, or past, the target
         const RayCast ray{origin, reach * (target - origin)};
@@ -126,12 +133,7 @@ TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnBoxesSweptPastACorner)
         const Vec3 halfExtent(0.5f * size(random), 0.5f * size(random), 0.5f * size(random));
         const AABB& target = bodies[random() % bodies.size()].mBounds;
         const AABB grown(target.mMin - halfExtent, target.mMax + halfExtent);
-        Vec3 aim((random() & 1) ? grown.mMax.x() : grown.mMin.x(),
-                 (random() & 1) ? grown.mMax.y() : grown.mMin.y(),
-                 (random() & 1) ? grown.mMax.z() : grown.mMin.z());
-        const int edgeAxis = int(random() % 4);
-        if (edgeAxis < 3)
-            aim[edgeAxis] = grown.mMin[edgeAxis] + unit(random) * (grown.mMax - grown.mMin)[edgeAxis];
+        const Vec3 aim = CornerOrEdgePoint(grown, random);
         const Vec3 start(coordinate(random), coordinate(random), coordinate(random));
         const AABB box(start - halfExtent, start + halfExtent);
         const Vec3 displacement = (0.5f + 1.5f * unit(random)) * (aim - start);
