@@ -68,6 +68,12 @@ std::string Ms(double inValue)
     return Fixed(inValue, 3);
 }
 
+/// "0.500-1.250", or one figure when both ends are the same.
+std::string MsRange(double inLeast, double inMost)
+{
+    return inLeast == inMost ? Ms(inLeast) : Ms(inLeast) + "-" + Ms(inMost);
+}
+
 std::string Micros(double inValue)
 {
     return Fixed(inValue, 2);
@@ -312,7 +318,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                           : spikes.mSpikesByHost == 0
                               ? std::string("none")
                               : Count(spikes.mSpikesByHost) + " (it took the updating thread's core for " +
-                                    Ms(spikes.mHostTakenMinMs) + "-" + Ms(spikes.mHostTakenMaxMs) + " ms)"},
+                                    MsRange(spikes.mHostTakenMinMs, spikes.mHostTakenMaxMs) + " ms)"},
                          {"max/avg less the host's time", Ratio(spikes.mMaxLessHostMs, physics.mMean)},
                          {"guest steal ms", Fixed(inRun.mGuestStealMs, 0)}}});
     sections.push_back({"frame ms",

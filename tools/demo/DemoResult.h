@@ -48,10 +48,11 @@ struct DemoRunResult
     /// Per frame: of mPhysicsMs, the time the updating thread was off its core while the guest never switched
     /// it out, so the host had taken its vCPU (tools::HostTakenMs); NaN when the thread was switched out (it
     /// blocked, or the guest preempted it): then it can not be told. Only the updating thread is watched: a
-    /// job thread that loses its core while the updating thread spins for it shows up in neither.
+    /// job thread that loses its core while the updating thread spins for it is not seen.
     std::vector<double> mPhysicsHostTakenMs;
-    double mGuestStealMs =
-        0.0; ///< Over the frames, from all vCPUs, as the guest counts it; NaN if it does not
+    /// Time the host took from all vCPUs over the frames, as the guest counts it (10 ms ticks); NaN if it
+    /// does not
+    double mGuestStealMs = 0.0;
     std::vector<double>
         mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
     /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics): the phase means of the
