@@ -7,6 +7,8 @@
 // wall time beyond the thread's CPU time is time the host took the vCPU (or spent in interrupts); with a
 // switch, the guest's own scheduling may account for it, and the two can not be told apart.
 
+#include "FrameTimes.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -67,8 +69,7 @@ template <class Work> TimedWork TimeOnThisThread(Work&& inWork)
     const ThreadCpuSample before = SampleThisThreadCpu();
     const auto start = std::chrono::steady_clock::now();
     inWork();
-    const double wallMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double wallMs = MillisecondsSince(start);
     const ThreadCpuSample after = SampleThisThreadCpu();
     return {wallMs, HostTakenMs(before, after, wallMs)};
 }

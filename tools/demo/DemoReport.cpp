@@ -926,9 +926,8 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "the game-object jobs (queries and moves) spent blocked on the engine's locks, per thread and "
             "frame, which is where the two modes differ. The modes are the reference talk's before and after "
             "as a whole: one mutex around the broad phase and one for all bodies, against the lock-free "
-            "trees "
-            "and 32 body mutexes (the talk's slide: 500 against 10 µs a thread); the two rows below the lock "
-            "waits split them between the broad phase's locks and the body locks.\n\n";
+            "trees and 32 body mutexes (the talk's slide: 500 against 10 µs a thread); the two rows below "
+            "the lock waits split them between the broad phase's locks and the body locks.\n\n";
     }
     if (!inRuns.empty())
         text +=
@@ -937,9 +936,8 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "while the guest never switched it out (its CPU clock stood still while the wall clock ran): "
             "the hypervisor had taken its vCPU. Only the updating thread is watched, so a job thread that "
             "lost its core while the updating thread waited for it is not counted. The main thread's "
-            "streaming "
-            "time is split the same way. Guest steal is the "
-            "same kind of time from all vCPUs over the run, as the guest counts it (10 ms ticks).\n\n";
+            "streaming time is split the same way. Guest steal is the same kind of time from all vCPUs over "
+            "the run, as the guest counts it (10 ms ticks).\n\n";
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
     text += "Every frame's figures, with the physics step's phases: [frames.csv](frames.csv).\n";

@@ -19,6 +19,18 @@ namespace cairn
 namespace
 {
 
+using Hits = std::vector<std::pair<BodyID, float>>;
+
+/// A cast's visitor that keeps every hit and its fraction, and never shortens the cast.
+auto CollectInto(Hits& outHits)
+{
+    return [&outHits](BodyID inID, float inFraction)
+    {
+        outHits.emplace_back(inID, inFraction);
+        return 1.0f;
+    };
+}
+
 /// A random corner of inBox, or a random point on one of its edges, where a query's entry and exit meet.
 Vec3 CornerOrEdgePoint(const AABB& inBox, std::mt19937& ioRandom)
 {
@@ -88,19 +100,9 @@ TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnRaysThatGrazeABox)
         const Vec3 origin(coordinate(random), coordinate(random), coordinate(random));
         const float reach = 0.5f + 1.5f * unit(random); // Short of, or past, the target
         const RayCast ray{origin, reach * (target - origin)};
-        std::vector<std::pair<BodyID, float>> bruteForceHits, quadTreeHits;
-        bruteForce.CastRay(ray, {},
-                           [&](BodyID inID, float inFraction)
-                           {
-                               bruteForceHits.emplace_back(inID, inFraction);
-                               return 1.0f;
-                           });
-        quadTree.CastRay(ray, {},
-                         [&](BodyID inID, float inFraction)
-                         {
-                             quadTreeHits.emplace_back(inID, inFraction);
-                             return 1.0f;
-                         });
+        Hits bruteForceHits, quadTreeHits;
+        bruteForce.CastRay(ray, {}, CollectInto(bruteForceHits));
+        quadTree.CastRay(ray, {}, CollectInto(quadTreeHits));
         ASSERT_EQ(bruteForceHits, quadTreeHits) << "trial " << trial;
         hits += int(bruteForceHits.size());
     }
@@ -138,17 +140,9 @@ TEST(QueryBoundaryTest, QuadTreeAndBruteForceAgreeOnBoxesSweptPastACorner)
         const AABB box(start - halfExtent, start + halfExtent);
         const Vec3 displacement = (0.5f + 1.5f * unit(random)) * (aim - start);
 
-        std::vector<std::pair<BodyID, float>> bruteForceHits, quadTreeHits;
-        const auto collect = [](std::vector<std::pair<BodyID, float>>& outHits)
-        {
-            return [&outHits](BodyID inID, float inFraction)
-            {
-                outHits.emplace_back(inID, inFraction);
-                return 1.0f;
-            };
-        };
-        bruteForce.CastAABox(box, displacement, {}, collect(bruteForceHits));
-        quadTree.CastAABox(box, displacement, {}, collect(quadTreeHits));
+        Hits bruteForceHits, quadTreeHits;
+        bruteForce.CastAABox(box, displacement, {}, CollectInto(bruteForceHits));
+        quadTree.CastAABox(box, displacement, {}, CollectInto(quadTreeHits));
         std::sort(bruteForceHits.begin(), bruteForceHits.end());
         std::sort(quadTreeHits.begin(), quadTreeHits.end());
         ASSERT_EQ(bruteForceHits, quadTreeHits) << "trial " << trial;
