@@ -71,10 +71,11 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
     // on an unreachable roof most of the time
     const float toPlayer =
         (Vec3(inPlayer.x(), 0, inPlayer.z()) - Vec3(ioAgent.mPosition.x(), 0, ioAgent.mPosition.z())).norm();
-    const Vec3 player(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
-    Result<Vec3> goal = toPlayer > cFollowDistance
-                            ? mNavMesh.FindNearestPoint(player, {}, Vec3(4.0f, 8.0f, 4.0f))
-                            : mNavMesh.FindRandomPointAround(ioAgent.mPosition, cWanderRadius, mRandom());
+    Result<Vec3> goal =
+        toPlayer > cFollowDistance
+            ? FollowGoal(mNavMesh, ioAgent.mPosition, inPlayer, cWanderRadius,
+                         [&](float inX, float inZ) { return mGenerator.GetTerrainHeight(inX, inZ); })
+            : mNavMesh.FindRandomPointAround(ioAgent.mPosition, cWanderRadius, mRandom());
     Result<navmesh::PathResult> path = goal ? mNavMesh.FindPath(ioAgent.mPosition, goal.Value())
                                             : Result<navmesh::PathResult>(goal.GetError());
     mStats.mPathMicros +=
@@ -85,7 +86,9 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
         // No navmesh under the agent or the goal yet (its tiles are still being built). An agent that stands
         // where there is none goes back to the player's path, which is kept clear
         ++mStats.mPathsFailed;
-        if (!mNavMesh.FindNearestPoint(ioAgent.mPosition)) ioAgent.mPosition = player;
+        if (!mNavMesh.FindNearestPoint(ioAgent.mPosition))
+            ioAgent.mPosition =
+                Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
         return;
     }
     ++(path.Value().mReachedEnd ? mStats.mPathsFound : mStats.mPathsPartial);
@@ -132,6 +135,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
                 Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
             agent.mPath.clear();
             agent.mRepathIn = 0.0f; // A new goal from where it stands now
+            ++mStats.mCatchUps;
         }
         mScheduler.MoveInvoker(agent.mInvoker, agent.mPosition);
     }

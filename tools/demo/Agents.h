@@ -2,11 +2,13 @@
 
 // Agents: the demo's AI. Each agent is a navmesh invoker (the tiles within its radius are built in the
 // background) and walks paths on the navmesh as it appears and changes: it picks a goal on the navmesh (a
-// random point reachable within 15 m, or the navmesh under the player when it falls behind), asks the
-// NavMeshWorld for a path, follows the straight path at walking speed, and asks again when it arrives at its
-// goal or every two seconds (half a second after a path that ended short of its goal, a quarter when there
-// was no navmesh to ask yet). Every new path is checked against the physics world: a point of it inside a
-// wall (a static body at chest height) counts as a path through a wall, which must never happen.
+// random point reachable within 15 m, or the navmesh under the player when it falls behind, and while there
+// is none there yet, the navmesh 15 m the player's way), asks the NavMeshWorld for a path, follows the
+// straight path at walking speed, and asks again when it arrives at its goal or every two seconds (half a
+// second after a path that ended short of its goal, a quarter when there was no navmesh to ask yet). The
+// player runs faster than the agents walk: one left 60 m behind catches up (is put back beside the player).
+// Every new path is checked against the physics world: a point of it inside a wall (a static body at chest
+// height) counts as a path through a wall, which must never happen.
 //
 // Threads: the main thread only (path queries may come from any thread; the demo keeps them on one).
 
@@ -21,6 +23,25 @@
 namespace cairn::demo
 {
 
+/// The goal of an agent that follows the player: the navmesh point nearest the player, or, while the player's
+/// tiles are not built yet, the one nearest the point inReach metres the player's way from the agent, on the
+/// ground that inGroundHeight(x, z) gives (the agent's own invoker radius reaches past it). Error when
+/// neither point has navmesh within 4 m across and 8 m up or down.
+template <class GroundHeight>
+Result<Vec3> FollowGoal(const navmesh::NavMeshWorld& inNavMesh, const Vec3& inAgent, const Vec3& inPlayer,
+                        float inReach, GroundHeight&& inGroundHeight)
+{
+    const Vec3 searchExtent(4.0f, 8.0f, 4.0f);
+    const Vec3 player(inPlayer.x(), inGroundHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
+    Result<Vec3> goal = inNavMesh.FindNearestPoint(player, {}, searchExtent);
+    const Vec3 away(inPlayer.x() - inAgent.x(), 0.0f, inPlayer.z() - inAgent.z());
+    const float distance = away.norm();
+    if (goal || !(distance > inReach)) return goal;
+    const Vec3 ahead = inAgent + away * (inReach / distance);
+    return inNavMesh.FindNearestPoint(Vec3(ahead.x(), inGroundHeight(ahead.x(), ahead.z()), ahead.z()), {},
+                                      searchExtent);
+}
+
 class Agents
 {
 public:
@@ -32,6 +53,7 @@ public:
         uint64_t mPathsFailed = 0;  ///< No path: mostly no navmesh under the agent or its goal yet
         double mPathMicros = 0.0;   ///< Summed
         double mDistance = 0.0;     ///< Metres walked by all agents
+        uint64_t mCatchUps = 0;     ///< Agents put back beside the player after falling 60 m behind
         uint32_t mPathsThroughWalls = 0;
         std::vector<std::string> mErrors;
     };

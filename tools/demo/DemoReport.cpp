@@ -373,9 +373,10 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"partial", ofQueries(inRun.mPathsPartial)},
                          {"failed (mostly no navmesh yet)", ofQueries(inRun.mPathsFailed)},
                          {"mean µs", Micros(inRun.mPathQueryMicrosMean)}}});
-    sections.push_back(
-        {"agents",
-         {{"agents", Format("%d", inRun.mAgents)}, {"walked m", Fixed(inRun.mAgentDistanceMetres, 1)}}});
+    sections.push_back({"agents",
+                        {{"agents", Format("%d", inRun.mAgents)},
+                         {"walked m", Fixed(inRun.mAgentDistanceMetres, 1)},
+                         {"caught up with the player", Count(inRun.mAgentCatchUps)}}});
     sections.push_back({"invariants",
                         {{"lost/duplicated bodies", Count(inRun.mLostOrDuplicatedBodies)},
                          {"tiles never built", Count(inRun.mTilesRequestedNeverBuilt)},

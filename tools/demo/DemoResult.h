@@ -87,6 +87,7 @@ struct DemoRunResult
     double mPathQueryMicrosMean = 0.0;
     int mAgents = 0;
     double mAgentDistanceMetres = 0.0; ///< Walked by all agents along their paths
+    uint64_t mAgentCatchUps = 0;       ///< Agents put back beside the player after falling too far behind
     /// Invariants (the demo test checks them)
     uint32_t mLostOrDuplicatedBodies = 0;
     uint32_t mTilesRequestedNeverBuilt = 0;

@@ -172,6 +172,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mPathQueryMicrosMean =
         agentStats.mPathQueries == 0 ? 0.0 : agentStats.mPathMicros / double(agentStats.mPathQueries);
     result.mAgentDistanceMetres = agentStats.mDistance;
+    result.mAgentCatchUps = agentStats.mCatchUps;
     result.mPathsThroughWalls = agentStats.mPathsThroughWalls;
     result.mQueries = gameObjects->GetNumQueries();
     if (const uint64_t queryErrors = gameObjects->GetNumQueryErrors(); queryErrors > 0)
