@@ -153,7 +153,8 @@ TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
     run.mPhysicsHostTakenMs.push_back(std::nan(""));
     run.mPhysicsMs.push_back(4.0); // The host's 0.5 ms leaves it over 3x
     run.mPhysicsHostTakenMs.push_back(0.5);
-    const SpikeAttribution spikes = AttributeSpikes(run, 3.0); // Bound 3 * 113.5 / 103 = 3.31 ms
+    const tools::SpikeAttribution spikes =
+        AttributePhysicsSpikes(run, 3.0); // Bound 3 * 113.5 / 103 = 3.31 ms
     EXPECT_EQ(spikes.mSpikes, 3u);
     EXPECT_EQ(spikes.mSpikesByHost, 1u);
     EXPECT_DOUBLE_EQ(spikes.mHostTakenMinMs, 2.5);
@@ -161,19 +162,19 @@ TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
     EXPECT_DOUBLE_EQ(spikes.mMaxLessHostMs, 4.5);
 
     run.mPhysicsHostTakenMs.clear(); // Not measured at all: nothing is the host's
-    const SpikeAttribution unmeasured = AttributeSpikes(run, 3.0);
+    const tools::SpikeAttribution unmeasured = AttributePhysicsSpikes(run, 3.0);
     EXPECT_EQ(unmeasured.mSpikes, 3u);
     EXPECT_EQ(unmeasured.mSpikesByHost, 0u);
     EXPECT_DOUBLE_EQ(unmeasured.mMaxLessHostMs, 5.0);
-    EXPECT_EQ(AttributeSpikes(DemoRunResult{}, 3.0).mSpikes, 0u);
+    EXPECT_EQ(AttributePhysicsSpikes(DemoRunResult{}, 3.0).mSpikes, 0u);
 }
 
 TEST(DemoResultTest, MaxLessHostLeavesOutTheHostsKnownShareOfEachFrame)
 {
     // 2.0 less 1.5 known; 1.5 less an unknown share; 1.0 less more than itself; a frame with no share at all
-    EXPECT_DOUBLE_EQ(MaxLessHost({2.0, 1.5, 1.0, 0.75}, {1.5, std::nan(""), 3.0}), 1.5);
-    EXPECT_DOUBLE_EQ(MaxLessHost({2.0, 1.25}, {1.5, 0.0}), 1.25);
-    EXPECT_TRUE(std::isnan(MaxLessHost({}, {})));
+    EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.5, 1.0, 0.75}, {1.5, std::nan(""), 3.0}), 1.5);
+    EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.25}, {1.5, 0.0}), 1.25);
+    EXPECT_TRUE(std::isnan(tools::MaxLessHost({}, {})));
 }
 
 /// What inPrint writes to a file.

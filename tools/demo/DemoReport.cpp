@@ -310,7 +310,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                                          AtMost(physics.mP99 / physics.mMean, cP99TargetRatio, "x")},
                          {"max/avg", Ratio(physics.mMax, physics.mMean) +
                                          AtMost(physics.mMax / physics.mMean, cSpikeTargetRatio, "x")}}});
-    const SpikeAttribution spikes = AttributeSpikes(inRun, cSpikeTargetRatio);
+    const tools::SpikeAttribution spikes = AttributePhysicsSpikes(inRun, cSpikeTargetRatio);
     sections.push_back({"physics spikes",
                         {{Format("frames over %gx avg", cSpikeTargetRatio), Count(spikes.mSpikes)},
                          {"of which the host's",
@@ -343,22 +343,23 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
           {"lock waits µs/frame per thread", MicrosList(LockWaitMicrosPerThreadFrame(inRun))},
           {"broad-phase / body locks", Micros(MeanOf(inRun.mBroadPhaseLockWaitMicrosPerThreadFrame)) + " / " +
                                            Micros(MeanOf(inRun.mBodyLockWaitMicrosPerThreadFrame))}}});
-    sections.push_back({"streaming",
-                        {{"tiles in", Count(inRun.mTilesStreamedIn)},
-                         {"tiles out", Count(inRun.mTilesStreamedOut)},
-                         {"tile in ms p50", Ms(streamIn, streamIn.mP50)},
-                         {"tile in ms max", Ms(streamIn, streamIn.mMax)},
-                         {"link ms p50", Ms(link, link.mP50)},
-                         {"link ms max", Ms(link, link.mMax)},
-                         {"tile out ms p50", Ms(streamOut, streamOut.mP50)},
-                         {"tile out ms max", Ms(streamOut, streamOut.mMax)},
-                         {"main-thread ms/frame max",
-                          Ms(mainThreadStream, mainThreadStream.mMax) +
-                              (mainThreadStream.mCount == 0
-                                   ? std::string()
-                                   : AtMost(mainThreadStream.mMax, cMainThreadStreamTargetMs, " ms"))},
-                         {"less the host's time",
-                          Ms(MaxLessHost(inRun.mMainThreadStreamMs, inRun.mMainThreadStreamHostTakenMs))}}});
+    sections.push_back(
+        {"streaming",
+         {{"tiles in", Count(inRun.mTilesStreamedIn)},
+          {"tiles out", Count(inRun.mTilesStreamedOut)},
+          {"tile in ms p50", Ms(streamIn, streamIn.mP50)},
+          {"tile in ms max", Ms(streamIn, streamIn.mMax)},
+          {"link ms p50", Ms(link, link.mP50)},
+          {"link ms max", Ms(link, link.mMax)},
+          {"tile out ms p50", Ms(streamOut, streamOut.mP50)},
+          {"tile out ms max", Ms(streamOut, streamOut.mMax)},
+          {"main-thread ms/frame max",
+           Ms(mainThreadStream, mainThreadStream.mMax) +
+               (mainThreadStream.mCount == 0
+                    ? std::string()
+                    : AtMost(mainThreadStream.mMax, cMainThreadStreamTargetMs, " ms"))},
+          {"less the host's time",
+           Ms(tools::MaxLessHost(inRun.mMainThreadStreamMs, inRun.mMainThreadStreamHostTakenMs))}}});
     sections.push_back(
         {"bodies peak",
          {{"static", Count(inRun.mStaticBodiesPeak)}, {"dynamic", Count(inRun.mDynamicBodiesPeak)}}});

@@ -46,46 +46,9 @@ PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
     return means;
 }
 
-namespace
+tools::SpikeAttribution AttributePhysicsSpikes(const DemoRunResult& inRun, double inRatio)
 {
-/// The host's share of frame inIndex, within [0, inWallMs]: an unknown (NaN) or missing one counts as 0.
-double HostShare(const std::vector<double>& inHostTakenMs, size_t inIndex, double inWallMs)
-{
-    if (inIndex >= inHostTakenMs.size() || !std::isfinite(inHostTakenMs[inIndex])) return 0.0;
-    return std::clamp(inHostTakenMs[inIndex], 0.0, inWallMs);
-}
-} // namespace
-
-double MaxLessHost(const std::vector<double>& inWallMs, const std::vector<double>& inHostTakenMs)
-{
-    double largest = std::nan("");
-    for (size_t i = 0; i < inWallMs.size(); ++i)
-        if (std::isfinite(inWallMs[i]))
-            largest =
-                std::fmax(largest, inWallMs[i] - HostShare(inHostTakenMs, i, inWallMs[i])); // fmax skips NaN
-    return largest;
-}
-
-SpikeAttribution AttributeSpikes(const DemoRunResult& inRun, double inRatio)
-{
-    SpikeAttribution attribution;
-    const SampleSummary physics = Summarize(inRun.mPhysicsMs);
-    if (physics.mCount == 0) return attribution;
-    attribution.mMaxLessHostMs = MaxLessHost(inRun.mPhysicsMs, inRun.mPhysicsHostTakenMs);
-    const double bound = inRatio * physics.mMean;
-    for (size_t i = 0; i < inRun.mPhysicsMs.size(); ++i)
-    {
-        const double wall = inRun.mPhysicsMs[i];
-        if (!std::isfinite(wall) || wall <= bound) continue;
-        ++attribution.mSpikes;
-        const double host = HostShare(inRun.mPhysicsHostTakenMs, i, wall);
-        if (wall - host > bound) continue;
-        ++attribution.mSpikesByHost;
-        attribution.mHostTakenMinMs =
-            std::fmin(attribution.mHostTakenMinMs, host); // fmin skips the NaN start
-        attribution.mHostTakenMaxMs = std::fmax(attribution.mHostTakenMaxMs, host);
-    }
-    return attribution;
+    return tools::AttributeSpikes(inRun.mPhysicsMs, inRun.mPhysicsHostTakenMs, inRatio);
 }
 
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun)

@@ -4,6 +4,7 @@
 // by DemoReport to print the summary and write the Markdown report.
 
 #include "cairn/physics/PhysicsSettings.h"
+#include "common/SpikeAttribution.h"
 
 #include <cmath>
 #include <cstdint>
@@ -96,22 +97,9 @@ struct DemoRunResult
     std::string mNavMeshObj;          ///< The navmesh at the end of the run, as Wavefront OBJ text
 };
 
-/// The physics frames over a bound (a multiple of their mean), and how many of them the host's taking the
-/// updating thread's vCPU accounts for (mPhysicsHostTakenMs).
-struct SpikeAttribution
-{
-    size_t mSpikes = 0;       ///< Frames over the bound
-    size_t mSpikesByHost = 0; ///< Of those, the frames that are within it once the host's time is left out
-    double mHostTakenMinMs = NAN; ///< The host's time in those frames: the least
-    double mHostTakenMaxMs = NAN; ///< ... and the most
-    double mMaxLessHostMs = NAN;  ///< The slowest frame once the host's time is left out of every frame
-};
-
-/// Frames of inRun.mPhysicsMs over inRatio times their mean: how many, and which the host accounts for.
-SpikeAttribution AttributeSpikes(const DemoRunResult& inRun, double inRatio);
-
-/// The largest of inWallMs[i] less inHostTakenMs[i] (an unknown or missing share counts as 0); NaN for none.
-double MaxLessHost(const std::vector<double>& inWallMs, const std::vector<double>& inHostTakenMs);
+/// The physics frames over inRatio times their mean, and how many of them the host's taking the updating
+/// thread's vCPU (mPhysicsHostTakenMs) accounts for.
+tools::SpikeAttribution AttributePhysicsSpikes(const DemoRunResult& inRun, double inRatio);
 
 /// The game-object jobs' lock waits of every kind, per thread (the sum of the per-kind series).
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun);
