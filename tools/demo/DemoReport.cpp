@@ -939,7 +939,10 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "the hypervisor had taken its vCPU. Only the updating thread is watched, so a job thread that "
             "lost its core while the updating thread waited for it is not counted. The main thread's "
             "streaming time is split the same way. Guest steal is the same kind of time from all vCPUs over "
-            "the run, as the guest counts it (10 ms ticks).\n\n";
+            "the run, as the guest counts it (10 ms ticks). A vCPU that runs slowly while it counts as "
+            "running is seen by neither measure: "
+            "`cairn-bench-host` times the same work every frame, without the engine, to show how steady the "
+            "machine itself is.\n\n";
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
     text += "Every frame's figures, with the physics step's phases: [frames.csv](frames.csv).\n";
