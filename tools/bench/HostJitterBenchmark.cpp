@@ -147,8 +147,8 @@ int main(int inArgc, char** inArgv)
     const double steal = GuestStealMs() - stealBefore;
 
     PrintLine("work ms/frame", wall);
-    PrintLine("  of it chase", chaseMs);
-    PrintLine("  arithmetic", arithmeticMs);
+    if (settings.mChaseSteps > 0) PrintLine("  of it chase", chaseMs); // A part with no steps times the clock
+    if (settings.mArithmeticSteps > 0) PrintLine("  arithmetic", arithmeticMs);
     const SpikeAttribution spikes = AttributeSpikes(wall, hostTaken, 3.0);
     const TimingSummary summary = Summarize(wall);
     std::printf(
