@@ -153,10 +153,13 @@ TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
     run.mPhysicsHostTakenMs.push_back(std::nan(""));
     run.mPhysicsMs.push_back(4.0); // The host's 0.5 ms leaves it over 3x
     run.mPhysicsHostTakenMs.push_back(0.5);
+    run.mPhysicsMs.push_back(std::nan("")); // A broken measurement: neither in the mean nor a spike
+    run.mPhysicsHostTakenMs.push_back(0.0);
     const tools::SpikeAttribution spikes =
         AttributePhysicsSpikes(run, 3.0); // Bound 3 * 113.5 / 103 = 3.31 ms
     EXPECT_EQ(spikes.mSpikes, 3u);
     EXPECT_EQ(spikes.mSpikesByHost, 1u);
+    EXPECT_EQ(spikes.mSpikesUnknown, 1u);
     EXPECT_DOUBLE_EQ(spikes.mHostTakenMinMs, 2.5);
     EXPECT_DOUBLE_EQ(spikes.mHostTakenMaxMs, 2.5);
     EXPECT_DOUBLE_EQ(spikes.mMaxLessHostMs, 4.5);
@@ -165,6 +168,7 @@ TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)
     const tools::SpikeAttribution unmeasured = AttributePhysicsSpikes(run, 3.0);
     EXPECT_EQ(unmeasured.mSpikes, 3u);
     EXPECT_EQ(unmeasured.mSpikesByHost, 0u);
+    EXPECT_EQ(unmeasured.mSpikesUnknown, 3u);
     EXPECT_DOUBLE_EQ(unmeasured.mMaxLessHostMs, 5.0);
     EXPECT_EQ(AttributePhysicsSpikes(DemoRunResult{}, 3.0).mSpikes, 0u);
 }
@@ -216,7 +220,8 @@ TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
     EXPECT_NE(text.find("(target <= 3x: NOT met)"), std::string::npos) << text;
     EXPECT_NE(text.find("(target <= 0.5 ms: NOT met)  less the host's time 0.250"), std::string::npos)
         << text;
-    EXPECT_NE(text.find("frames over 3x avg 1  of which the host's none"), std::string::npos) << text;
+    EXPECT_NE(text.find("frames over 3x avg 1  of which the host's none  share unknown 1"), std::string::npos)
+        << text;
     run.mPhysicsHostTakenMs.assign(200, 0.0);
     run.mPhysicsHostTakenMs[0] = 8.5; // The host took most of the spike
     text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });

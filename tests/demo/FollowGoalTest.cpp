@@ -64,8 +64,15 @@ TEST_F(FollowGoalTest, NoNavMeshEitherWayIsAnError)
 {
     // From the navmesh's east edge the point 15 m further east is off it too
     EXPECT_FALSE(Goal(Vec3(25, 0, 0), Vec3(60, 0, 0)));
-    // A player within reach that has no navmesh under it: the agent is as close as it gets that way
-    EXPECT_FALSE(Goal(Vec3(25, 0, 0), Vec3(35, 0, 0)));
+}
+
+TEST_F(FollowGoalTest, APlayerWithinReachWithNoNavMeshUnderItIsAnError)
+{
+    // The player stands on a roof 50 m up, 5 m from the agent: nothing is within the search's 8 m of it. The
+    // point 15 m on is on the ground's navmesh, but it is past the player: the agent is as close as it gets
+    auto roof = [](float inX, float) { return inX > 4.0f && inX < 6.0f ? 50.0f : 0.0f; };
+    const Result<Vec3> goal = FollowGoal(*mWorld, Vec3(0, 0, 0), Vec3(5, 50, 0), 15.0f, roof);
+    EXPECT_FALSE(goal) << "goal at x " << goal.Value().x();
 }
 
 } // namespace

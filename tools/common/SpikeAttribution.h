@@ -13,22 +13,35 @@
 namespace cairn::tools
 {
 
+/// The spike bound: no frame over this times the mean.
+inline constexpr double cSpikeRatio = 3.0;
+
 /// The frames over a bound (a multiple of their mean), and how many of them the host's time accounts for.
 struct SpikeAttribution
 {
     size_t mSpikes = 0;       ///< Frames over the bound
     size_t mSpikesByHost = 0; ///< Of those, the frames that are within it once the host's time is left out
+    /// Of those, the frames whose host share can not be told (the thread was switched out, or no share was
+    /// measured): counted as not the host's, so a frame here may still be one the host slowed
+    size_t mSpikesUnknown = 0;
     double mHostTakenMinMs = NAN; ///< The host's time in those frames: the least
     double mHostTakenMaxMs = NAN; ///< ... and the most
     double mMaxLessHostMs = NAN;  ///< The slowest frame once the host's time is left out of every frame
 };
 
+namespace spike_detail
+{
+inline bool IsShareKnown(const std::vector<double>& inHostTakenMs, size_t inIndex)
+{
+    return inIndex < inHostTakenMs.size() && std::isfinite(inHostTakenMs[inIndex]);
+}
+
 /// The host's share of frame inIndex, within [0, inWallMs]: an unknown (NaN) or missing one counts as 0.
 inline double HostShare(const std::vector<double>& inHostTakenMs, size_t inIndex, double inWallMs)
 {
-    if (inIndex >= inHostTakenMs.size() || !std::isfinite(inHostTakenMs[inIndex])) return 0.0;
-    return std::clamp(inHostTakenMs[inIndex], 0.0, inWallMs);
+    return IsShareKnown(inHostTakenMs, inIndex) ? std::clamp(inHostTakenMs[inIndex], 0.0, inWallMs) : 0.0;
 }
+} // namespace spike_detail
 
 /// The largest of inWallMs[i] less inHostTakenMs[i] (an unknown or missing share counts as 0); NaN for none.
 inline double MaxLessHost(const std::vector<double>& inWallMs, const std::vector<double>& inHostTakenMs)
@@ -36,8 +49,8 @@ inline double MaxLessHost(const std::vector<double>& inWallMs, const std::vector
     double largest = std::nan("");
     for (size_t i = 0; i < inWallMs.size(); ++i)
         if (std::isfinite(inWallMs[i]))
-            largest =
-                std::fmax(largest, inWallMs[i] - HostShare(inHostTakenMs, i, inWallMs[i])); // fmax skips NaN
+            largest = std::fmax(largest, inWallMs[i] - spike_detail::HostShare(
+                                                           inHostTakenMs, i, inWallMs[i])); // fmax skips NaN
     return largest;
 }
 
@@ -63,7 +76,8 @@ inline SpikeAttribution AttributeSpikes(const std::vector<double>& inWallMs,
         const double wall = inWallMs[i];
         if (!std::isfinite(wall) || wall <= bound) continue;
         ++attribution.mSpikes;
-        const double host = HostShare(inHostTakenMs, i, wall);
+        if (!spike_detail::IsShareKnown(inHostTakenMs, i)) ++attribution.mSpikesUnknown;
+        const double host = spike_detail::HostShare(inHostTakenMs, i, wall);
         if (wall - host > bound) continue;
         ++attribution.mSpikesByHost;
         attribution.mHostTakenMinMs =

@@ -11,7 +11,10 @@ constexpr float cSpeed = 3.0f;           ///< m/s
 constexpr float cInvokerRadius = 20.0f;  ///< m of navmesh each agent asks for
 constexpr float cWanderRadius = 15.0f;   ///< Goals within this of the agent, reachable from where it stands
 constexpr float cFollowDistance = 25.0f; ///< Further from the player, the agent heads for the player
-constexpr float cRetrySeconds = 0.25f;   ///< Wait before asking again when there was no navmesh to ask
+/// How far the player's way a follower heads while the player's tiles are not built (inside its own navmesh)
+constexpr float cFollowStep = 15.0f;
+constexpr float cCatchUpDistance = 60.0f;    ///< An agent this far behind is put back beside the player
+constexpr float cRetrySeconds = 0.25f;       ///< Wait before asking again when there was no navmesh to ask
 constexpr float cPartialRetrySeconds = 0.5f; ///< ... and after a path that ended short of its goal
 } // namespace
 
@@ -66,14 +69,14 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
     ioAgent.mNext = 0;
     ioAgent.mRepathIn = cRetrySeconds;
     const auto start = std::chrono::steady_clock::now();
-    // The goal is a navmesh point, as a game's AI picks one: a random point reachable from the agent, or the
-    // navmesh under the player when it has fallen behind. A random point on the terrain was inside a prop or
-    // on an unreachable roof most of the time
+    // The goal is a navmesh point, as a game's AI picks one: a random point reachable from the agent, or,
+    // when it has fallen behind, the navmesh under the player (or its way: FollowGoal). A random point on the
+    // terrain was inside a prop or on an unreachable roof most of the time
     const float toPlayer =
         (Vec3(inPlayer.x(), 0, inPlayer.z()) - Vec3(ioAgent.mPosition.x(), 0, ioAgent.mPosition.z())).norm();
     Result<Vec3> goal =
         toPlayer > cFollowDistance
-            ? FollowGoal(mNavMesh, ioAgent.mPosition, inPlayer, cWanderRadius,
+            ? FollowGoal(mNavMesh, ioAgent.mPosition, inPlayer, cFollowStep,
                          [&](float inX, float inZ) { return mGenerator.GetTerrainHeight(inX, inZ); })
             : mNavMesh.FindRandomPointAround(ioAgent.mPosition, cWanderRadius, mRandom());
     Result<navmesh::PathResult> path = goal ? mNavMesh.FindPath(ioAgent.mPosition, goal.Value())
@@ -129,7 +132,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
             }
         }
         // An agent left far behind by the player (its navmesh not built yet) catches up
-        if ((agent.mPosition - inPlayer).norm() > 60.0f)
+        if ((agent.mPosition - inPlayer).norm() > cCatchUpDistance)
         {
             agent.mPosition =
                 Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());

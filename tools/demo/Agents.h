@@ -25,8 +25,10 @@ namespace cairn::demo
 
 /// The goal of an agent that follows the player: the navmesh point nearest the player, or, while the player's
 /// tiles are not built yet, the one nearest the point inReach metres the player's way from the agent, on the
-/// ground that inGroundHeight(x, z) gives (the agent's own invoker radius reaches past it). Error when
-/// neither point has navmesh within 4 m across and 8 m up or down.
+/// ground that inGroundHeight(x, z) gives (the agent's own invoker radius reaches past it). Points are
+/// snapped within 4 m either way in x and z and 8 m up or down. Error when the player's point has no navmesh
+/// and either the player is within inReach (the agent is as close as it gets that way) or the point ahead has
+/// none either.
 template <class GroundHeight>
 Result<Vec3> FollowGoal(const navmesh::NavMeshWorld& inNavMesh, const Vec3& inAgent, const Vec3& inPlayer,
                         float inReach, GroundHeight&& inGroundHeight)
@@ -34,10 +36,10 @@ Result<Vec3> FollowGoal(const navmesh::NavMeshWorld& inNavMesh, const Vec3& inAg
     const Vec3 searchExtent(4.0f, 8.0f, 4.0f);
     const Vec3 player(inPlayer.x(), inGroundHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
     Result<Vec3> goal = inNavMesh.FindNearestPoint(player, {}, searchExtent);
-    const Vec3 away(inPlayer.x() - inAgent.x(), 0.0f, inPlayer.z() - inAgent.z());
-    const float distance = away.norm();
+    const Vec3 towardsPlayer(inPlayer.x() - inAgent.x(), 0.0f, inPlayer.z() - inAgent.z());
+    const float distance = towardsPlayer.norm();
     if (goal || !(distance > inReach)) return goal;
-    const Vec3 ahead = inAgent + away * (inReach / distance);
+    const Vec3 ahead = inAgent + towardsPlayer * (inReach / distance);
     return inNavMesh.FindNearestPoint(Vec3(ahead.x(), inGroundHeight(ahead.x(), ahead.z()), ahead.z()), {},
                                       searchExtent);
 }
@@ -53,7 +55,9 @@ public:
         uint64_t mPathsFailed = 0;  ///< No path: mostly no navmesh under the agent or its goal yet
         double mPathMicros = 0.0;   ///< Summed
         double mDistance = 0.0;     ///< Metres walked by all agents
-        uint64_t mCatchUps = 0;     ///< Agents put back beside the player after falling 60 m behind
+        /// Agents put back beside the player after falling 60 m behind (one that stands where there is no
+        /// navmesh after a failed path is put there too, not counted: it is mostly there already)
+        uint64_t mCatchUps = 0;
         uint32_t mPathsThroughWalls = 0;
         std::vector<std::string> mErrors;
     };
