@@ -99,11 +99,13 @@ struct Work
     }
 };
 
-void PrintLine(const char* inName, const std::vector<double>& inMs)
+/// Prints the summary of inMs on one line, and returns it.
+TimingSummary PrintLine(const char* inName, const std::vector<double>& inMs)
 {
     const TimingSummary s = Summarize(inMs);
     std::printf("%-14s avg %.3f  p50 %.3f  p99 %.3f  max %.3f  p99/avg %.2fx  max/avg %.2fx\n", inName,
                 s.mMean, s.mP50, s.mP99, s.mMax, s.mP99 / s.mMean, s.mMax / s.mMean);
+    return s;
 }
 
 } // namespace
@@ -149,11 +151,10 @@ int main(int inArgc, char** inArgv)
     }
     const double steal = GuestStealMs() - stealBefore;
 
-    PrintLine("work ms/frame", wall);
+    const TimingSummary summary = PrintLine("work ms/frame", wall);
     if (settings.mChaseSteps > 0) PrintLine("  of it chase", chaseMs); // A part with no steps times the clock
     if (settings.mArithmeticSteps > 0) PrintLine("  arithmetic", arithmeticMs);
     const SpikeAttribution spikes = AttributeSpikes(wall, hostTaken, cSpikeRatio);
-    const TimingSummary summary = Summarize(wall);
     std::printf(
         "spikes         frames over %gx avg %zu  of which the host's %zu  share unknown %zu  max/avg less "
         "the host's time %.2fx  guest steal ms %.0f\n",

@@ -42,6 +42,11 @@ Agents::~Agents()
         mScheduler.RemoveInvoker(agent.mInvoker);
 }
 
+Vec3 Agents::OnGround(const Vec3& inPoint) const
+{
+    return Vec3(inPoint.x(), mGenerator.GetTerrainHeight(inPoint.x(), inPoint.z()), inPoint.z());
+}
+
 bool Agents::GoesThroughWall(const std::vector<Vec3>& inPath) const
 {
     QueryFilter filter;
@@ -89,9 +94,7 @@ void Agents::Repath(Agent& ioAgent, const Vec3& inPlayer)
         // No navmesh under the agent or the goal yet (its tiles are still being built). An agent that stands
         // where there is none goes back to the player's path, which is kept clear
         ++mStats.mPathsFailed;
-        if (!mNavMesh.FindNearestPoint(ioAgent.mPosition))
-            ioAgent.mPosition =
-                Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
+        if (!mNavMesh.FindNearestPoint(ioAgent.mPosition)) ioAgent.mPosition = OnGround(inPlayer);
         return;
     }
     ++(path.Value().mReachedEnd ? mStats.mPathsFound : mStats.mPathsPartial);
@@ -134,8 +137,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
         // An agent left far behind by the player (its navmesh not built yet) catches up
         if ((agent.mPosition - inPlayer).norm() > cCatchUpDistance)
         {
-            agent.mPosition =
-                Vec3(inPlayer.x(), mGenerator.GetTerrainHeight(inPlayer.x(), inPlayer.z()), inPlayer.z());
+            agent.mPosition = OnGround(inPlayer);
             agent.mPath.clear();
             agent.mRepathIn = 0.0f; // A new goal from where it stands now
             ++mStats.mCatchUps;

@@ -82,6 +82,8 @@ private:
     };
 
     void Repath(Agent& ioAgent, const Vec3& inPlayer);
+    /// inPoint moved onto the terrain: where an agent put back beside the player stands.
+    Vec3 OnGround(const Vec3& inPoint) const;
     /// Points of the path inside a static body other than the terrain, sampled every 0.25 m at chest height.
     bool GoesThroughWall(const std::vector<Vec3>& inPath) const;
 
