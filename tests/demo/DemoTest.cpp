@@ -33,6 +33,20 @@ DemoSettings SmallDemo()
     return settings;
 }
 
+/// What inPrint writes to a file.
+template <class Print> std::string Printed(const Print& inPrint)
+{
+    std::FILE* file = std::tmpfile();
+    if (file == nullptr) return "";
+    inPrint(file);
+    std::rewind(file);
+    std::string text;
+    for (int c; (c = std::fgetc(file)) != EOF;)
+        text += char(c);
+    std::fclose(file);
+    return text;
+}
+
 void ExpectInvariants(const DemoRunResult& inRun)
 {
     EXPECT_EQ(inRun.mLostOrDuplicatedBodies, 0u) << inRun.mModeName;
@@ -72,7 +86,15 @@ void ExpectInvariants(const DemoRunResult& inRun)
 
 TEST(DemoTest, LockFreeModeKeepsItsInvariants)
 {
-    ExpectInvariants(RunDemo(SmallDemo(), BroadPhaseType::QuadTree, nullptr));
+    DemoRunResult run;
+    // A file is not a terminal: the progress comes as plain lines, the first and the last frame's among them
+    const std::string progress =
+        Printed([&](std::FILE* inFile) { run = RunDemo(SmallDemo(), BroadPhaseType::QuadTree, inFile); });
+    ExpectInvariants(run);
+    EXPECT_EQ(progress.find('\r'), std::string::npos) << progress;
+    EXPECT_NE(progress.find("frame     1/240"), std::string::npos) << progress;
+    EXPECT_NE(progress.find("frame   240/240"), std::string::npos) << progress;
+    EXPECT_TRUE(!progress.empty() && progress.back() == '\n') << progress;
 }
 
 TEST(DemoTest, GlobalMutexModeKeepsItsInvariants)
@@ -179,20 +201,6 @@ TEST(DemoResultTest, MaxLessHostLeavesOutTheHostsKnownShareOfEachFrame)
     EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.5, 1.0, 0.75}, {1.5, std::nan(""), 3.0}), 1.5);
     EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.25}, {1.5, 0.0}), 1.25);
     EXPECT_TRUE(std::isnan(tools::MaxLessHost({}, {})));
-}
-
-/// What inPrint writes to a file.
-template <class Print> std::string Printed(const Print& inPrint)
-{
-    std::FILE* file = std::tmpfile();
-    if (file == nullptr) return "";
-    inPrint(file);
-    std::rewind(file);
-    std::string text;
-    for (int c; (c = std::fgetc(file)) != EOF;)
-        text += char(c);
-    std::fclose(file);
-    return text;
 }
 
 TEST(DemoReportTest, SummaryJudgesTheFrameTargets)

@@ -15,6 +15,7 @@
 
 #include <chrono>
 #include <thread>
+#include <unistd.h>
 
 namespace cairn::demo
 {
@@ -38,6 +39,15 @@ bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, navmesh::TileSc
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     return true;
+}
+
+/// A terminal gets a live line rewritten every quarter second; a log file or a pipe gets a plain line every
+/// 5 s, since carriage returns would pile up hundreds of overwritten lines in it.
+bool IsProgressFrame(std::FILE* inProgress, bool inLive, int inFrame, int inFrames)
+{
+    if (inProgress == nullptr) return false;
+    const int period = inLive ? 15 : 300;
+    return inFrame % period == 0 || inFrame + 1 == inFrames;
 }
 } // namespace
 
@@ -101,6 +111,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     const float dt = 1.0f / 60.0f;
     const Clock::time_point begin = Clock::now();
     const double stealBefore = tools::GuestStealMs();
+    const bool liveProgress = inProgress != nullptr && isatty(fileno(inProgress)) == 1;
     for (int frame = 0; frame < inSettings.mFrames; ++frame)
     {
         const Clock::time_point frameStart = Clock::now();
@@ -132,21 +143,21 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         scheduler->Update();
         result.mFrameMs.push_back(MillisecondsSince(frameStart));
 
-        if (inProgress != nullptr && (frame % 15 == 0 || frame + 1 == inSettings.mFrames))
+        if (IsProgressFrame(inProgress, liveProgress, frame, inSettings.mFrames))
         {
             const TileStreamer::Stats streaming = streamer->GetStats();
             std::fprintf(inProgress,
-                         "\r  %-12s frame %5d/%d  physics %6.2f ms  world tiles %2zu  bodies %5u static %4u "
-                         "dynamic  navmesh tiles %3d   ",
-                         result.mModeName.c_str(), frame + 1, inSettings.mFrames, result.mPhysicsMs.back(),
-                         streamer->GetLoadedTiles().size(), streaming.mStaticBodies, streaming.mDynamicBodies,
-                         navMesh->GetNumTiles());
+                         "%s  %-12s frame %5d/%d  physics %6.2f ms  world tiles %2zu  bodies %5u static %4u "
+                         "dynamic  navmesh tiles %3d%s",
+                         liveProgress ? "\r" : "", result.mModeName.c_str(), frame + 1, inSettings.mFrames,
+                         result.mPhysicsMs.back(), streamer->GetLoadedTiles().size(), streaming.mStaticBodies,
+                         streaming.mDynamicBodies, navMesh->GetNumTiles(), liveProgress ? "   " : "\n");
             std::fflush(inProgress);
         }
         if (inSettings.mRealTime)
             std::this_thread::sleep_until(begin + std::chrono::microseconds(int64_t(16667.0 * (frame + 1))));
     }
-    if (inProgress != nullptr) std::fprintf(inProgress, "\n");
+    if (liveProgress) std::fprintf(inProgress, "\n");
     result.mGuestStealMs = tools::GuestStealMs() - stealBefore; // NaN where the guest does not count it
     result.mFrames = inSettings.mFrames;
     projectiles.RemoveAll(); // Before the streamer counts the world's bodies

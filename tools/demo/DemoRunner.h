@@ -35,7 +35,8 @@ struct DemoSettings
     bool mThrowBalls = true;   ///< The player throws balls that knock crates and stacks over
 };
 
-/// Runs the demo in inMode; inProgress (may be null) gets a live one-line display.
+/// Runs the demo in inMode; inProgress (may be null) gets a live one-line display on a terminal, a line every
+/// 5 s otherwise.
 DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress);
 
 } // namespace cairn::demo
