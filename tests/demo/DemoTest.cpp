@@ -274,5 +274,56 @@ TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)
     EXPECT_NE(bodies.find(" 3.00x"), std::string::npos) << text;
 }
 
+TEST(DemoReportTest, ComparisonJudgesTheQueryTargetBothWays)
+{
+    DemoRunResult lockFree, global;
+    lockFree.mModeName = "lock-free";
+    global.mModeName = "global mutex";
+    auto lineOf = [](const std::string& inText, const std::string& inName)
+    {
+        const size_t at = inText.find(inName);
+        return at == std::string::npos ? std::string() : inText.substr(at, inText.find('\n', at) - at);
+    };
+    auto compare = [&]
+    { return Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); }); };
+
+    // The queries' own time barely differs, their lock waits 12x: one reading is met, the other not
+    lockFree.mQueryMicrosMean = 2.0;
+    global.mQueryMicrosMean = 2.2;
+    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.5, 0.5};
+    global.mBroadPhaseLockWaitMicrosPerThreadFrame = {6.0, 6.0};
+    lockFree.mBodyLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    global.mBodyLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    std::string text = compare();
+    EXPECT_NE(lineOf(text, "query µs/query mean").find("1.10x  as µs per query: NOT met"), std::string::npos)
+        << text;
+    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread")
+                  .find("12.00x  as the talk's lock cost per thread: met"),
+              std::string::npos)
+        << text;
+
+    // Just under 10x on the waits, 10x on the queries: the verdicts turn over
+    global.mQueryMicrosMean = 20.0;
+    global.mBroadPhaseLockWaitMicrosPerThreadFrame = {4.9, 4.9};
+    text = compare();
+    EXPECT_NE(lineOf(text, "query µs/query mean").find("as µs per query: met"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("lock cost per thread: NOT met"),
+              std::string::npos)
+        << text;
+
+    // A lock-free mode that never waited against one that did meets it; nothing measured gives no verdict
+    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    lockFree.mQueryMicrosMean = 0.0;
+    text = compare();
+    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("no waits lock-free  as the talk's"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("lock cost per thread: met"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(lineOf(text, "query µs/query mean").find("as µs per query: unknown"), std::string::npos)
+        << text;
+}
+
 } // namespace
 } // namespace cairn::demo

@@ -22,8 +22,10 @@ namespace
 
 namespace fs = std::filesystem;
 
-constexpr double cQueryTargetRatio = 10.0; ///< The lock-free query path must be this much cheaper
-constexpr double cP99TargetRatio = 2.0;    ///< A physics frame's p99 at most this times its average
+/// The lock-free mode's game-object query cost per thread must be this much lower. The issue does not say
+/// whether that cost is the queries' whole time or the talk's lock cost per thread, so both are judged.
+constexpr double cQueryTargetRatio = 10.0;
+constexpr double cP99TargetRatio = 2.0; ///< A physics frame's p99 at most this times its average
 constexpr double cSpikeTargetRatio = tools::cSpikeRatio; ///< No physics frame over this times the average
 constexpr double cMainThreadStreamTargetMs = 0.5; ///< Streaming work on the main thread per frame, at most
 constexpr size_t cMaxHistogramBuckets = 40;
@@ -111,6 +113,18 @@ std::string AtMost(double inValue, double inBound, const char* inUnit)
 {
     if (!std::isfinite(inValue)) return "";
     return Format(" (target <= %g%s: %s)", inBound, inUnit, inValue <= inBound ? "met" : "NOT met");
+}
+
+/// "as <inReading>: met": the global/lock-free ratio against cQueryTargetRatio. A global mode that waited
+/// against a lock-free mode that never did meets it.
+std::string QueryTarget(double inGlobal, double inLockFree, const char* inReading)
+{
+    const char* verdict = "unknown";
+    if (std::isfinite(inGlobal) && std::isfinite(inLockFree) && inLockFree >= 0.0)
+        verdict = inLockFree == 0.0                            ? (inGlobal > 0.0 ? "met" : "unknown")
+                  : inGlobal / inLockFree >= cQueryTargetRatio ? "met"
+                                                               : "NOT met";
+    return Format("as %s: %s", inReading, verdict);
 }
 
 /// A ratio of two waits, where the lock-free side may be exactly 0.
@@ -267,7 +281,15 @@ struct Table
 {
     std::vector<std::string> mHeader;
     std::vector<std::vector<std::string>> mRows;
+    /// Right-aligned columns after the first (all unless set); the columns after them are left-aligned text
+    size_t mNumNumberColumns = std::numeric_limits<size_t>::max();
 };
+
+/// Whether column inColumn of inTable is left-aligned (the row names, and text after the numbers).
+bool IsTextColumn(const Table& inTable, size_t inColumn)
+{
+    return inColumn == 0 || inColumn > inTable.mNumNumberColumns;
+}
 
 SampleSummary SummarizeFrames(const std::vector<uint32_t>& inFrames)
 {
@@ -443,7 +465,8 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
 
     Table table;
     table.mHeader = {"metric", ModeName(inLockFree, "lock-free"), ModeName(inGlobal, "global mutex"),
-                     "global/lock-free"};
+                     "global/lock-free", Format("target >= %.0fx", cQueryTargetRatio)};
+    table.mNumNumberColumns = 3;
     table.mRows.push_back({"physics avg ms/frame", Ms(lockFree, lockFree.mMean), Ms(global, global.mMean),
                            Ratio(global.mMean, lockFree.mMean)});
     table.mRows.push_back({"physics p99 ms/frame", Ms(lockFree, lockFree.mP99), Ms(global, global.mP99),
@@ -452,15 +475,13 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
                            Ratio(global.mMax, lockFree.mMax)});
     table.mRows.push_back({"game-object queries", Count(inLockFree.mQueries), Count(inGlobal.mQueries), ""});
 
-    const double queryRatio = inGlobal.mQueryMicrosMean / inLockFree.mQueryMicrosMean;
-    const bool ratioKnown = inLockFree.mQueryMicrosMean > 0.0 && std::isfinite(queryRatio);
+    // A query that took no time at all was not measured: no verdict from it
+    const double lockFreeQuery =
+        inLockFree.mQueryMicrosMean > 0.0 ? inLockFree.mQueryMicrosMean : std::nan("");
     table.mRows.push_back({"query µs/query mean", Micros(inLockFree.mQueryMicrosMean),
                            Micros(inGlobal.mQueryMicrosMean),
-                           Ratio(inGlobal.mQueryMicrosMean, inLockFree.mQueryMicrosMean) +
-                               Format(" (target >= %.0fx: %s)", cQueryTargetRatio,
-                                      !ratioKnown                       ? "unknown"
-                                      : queryRatio >= cQueryTargetRatio ? "met"
-                                                                        : "NOT met")});
+                           Ratio(inGlobal.mQueryMicrosMean, inLockFree.mQueryMicrosMean),
+                           QueryTarget(inGlobal.mQueryMicrosMean, lockFreeQuery, "µs per query")});
 
     const size_t threads =
         std::max(inLockFree.mQueryMicrosPerThread.size(), inGlobal.mQueryMicrosPerThread.size());
@@ -479,7 +500,8 @@ Table BuildComparison(const DemoRunResult& inLockFree, const DemoRunResult& inGl
     const double lockFreeWaits = MeanOf(LockWaitMicrosPerThreadFrame(inLockFree));
     const double globalWaits = MeanOf(LockWaitMicrosPerThreadFrame(inGlobal));
     table.mRows.push_back({"lock waits µs/frame per thread", Micros(lockFreeWaits), Micros(globalWaits),
-                           WaitRatio(globalWaits, lockFreeWaits)});
+                           WaitRatio(globalWaits, lockFreeWaits),
+                           QueryTarget(globalWaits, lockFreeWaits, "the talk's lock cost per thread")});
     auto kindRow = [&](const char* inName, const std::vector<double> DemoRunResult::*inSeries)
     {
         const double lockFree = MeanOf(inLockFree.*inSeries);
@@ -503,12 +525,14 @@ std::string TableText(const Table& inTable)
     for (const std::vector<std::string>& row : inTable.mRows)
         measure(row);
 
-    // Metric names left-aligned, numbers right-aligned so their decimal points line up.
+    // Names and text left-aligned, numbers right-aligned so their decimal points line up.
     auto line = [&](const std::vector<std::string>& inCells)
     {
         std::string text;
         for (size_t c = 0; c < inCells.size() && c < widths.size(); ++c)
-            text += (c == 0 ? PadRight(inCells[c], widths[c]) : "  " + PadLeft(inCells[c], widths[c]));
+            text += (c == 0                     ? PadRight(inCells[c], widths[c])
+                     : IsTextColumn(inTable, c) ? "  " + PadRight(inCells[c], widths[c])
+                                                : "  " + PadLeft(inCells[c], widths[c]));
         while (!text.empty() && text.back() == ' ')
             text.pop_back();
         return text + "\n";
@@ -525,15 +549,15 @@ std::string TableText(const Table& inTable)
 
 std::string TableMarkdown(const Table& inTable)
 {
-    auto line = [](const std::vector<std::string>& inCells)
+    auto line = [&](const std::vector<std::string>& inCells)
     {
         // Appended piece by piece: g++ 12 warns (wrongly, -Wrestrict) about " " + std::string temporaries
-        // here
+        // here. A short row gets empty cells, so every row has the header's columns.
         std::string text = "|";
-        for (const std::string& cell : inCells)
+        for (size_t c = 0; c < std::max(inCells.size(), inTable.mHeader.size()); ++c)
         {
             text += ' ';
-            text += EscapeMarkdownCell(cell);
+            if (c < inCells.size()) text += EscapeMarkdownCell(inCells[c]);
             text += " |";
         }
         text += '\n';
@@ -541,7 +565,7 @@ std::string TableMarkdown(const Table& inTable)
     };
     std::string text = line(inTable.mHeader) + "|---|";
     for (size_t c = 1; c < inTable.mHeader.size(); ++c)
-        text += "--:|";
+        text += IsTextColumn(inTable, c) ? "---|" : "--:|";
     text += "\n";
     for (const std::vector<std::string>& row : inTable.mRows)
         text += line(row);
@@ -931,7 +955,12 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "frame, which is where the two modes differ. The modes are the reference talk's before and after "
             "as a whole: one mutex around the broad phase and one for all bodies, against the lock-free "
             "trees and 32 body mutexes (the talk's slide: 500 against 10 µs a thread); the two rows below "
-            "the lock waits split them between the broad phase's locks and the body locks.\n\n";
+            "the lock waits split them between the broad phase's locks and the body locks.\n\n"
+            "The 10x query-cost target is judged two ways, because the issue does not say which it means. "
+            "Read as the talk's figure, which follows its \"Overhead locks 10-20 %\", it is the locks' cost "
+            "per thread: the lock-waits row. Read as the queries' whole time, it is the µs/query row; no "
+            "lock scheme changes a query's narrow phase, so that ratio moves only as far as the waits grow "
+            "into the queries' own time, which takes more threads contending than 2 cores run at once.\n\n";
     }
     if (!inRuns.empty())
         text +=
