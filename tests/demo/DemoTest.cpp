@@ -150,18 +150,27 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 
-TEST(DemoResultTest, MeanPhasesAveragesThePhasesAndKeepsTheLargestLockWait)
+TEST(DemoResultTest, SummarizePhasesGivesEachPhaseItsMeanPercentilesAndMax)
 {
-    StepStatistics first, second;
-    first.mSolveMs = 0.1;
-    first.mLockWaitMs = 0.0;
-    second.mSolveMs = 0.3;
-    second.mLockWaitMs = 0.5;
-    const PhaseTimes means = MeanPhases({first, second});
-    EXPECT_DOUBLE_EQ(means.mSolveMs, 0.2);
-    EXPECT_DOUBLE_EQ(means.mLockWaitMs, 0.25);
-    EXPECT_DOUBLE_EQ(means.mLockWaitMaxMs, 0.5);
-    EXPECT_EQ(MeanPhases({}).mLockWaitMaxMs, 0.0);
+    // 99 ordinary steps and one whose solve and lock wait spiked
+    std::vector<StepStatistics> steps(100);
+    for (StepStatistics& step : steps)
+    {
+        step.mBroadPhaseUpdateMs = 0.05;
+        step.mSolveMs = 0.1;
+    }
+    steps[42].mSolveMs = 2.08;
+    steps[42].mLockWaitMs = 0.5;
+    const PhaseSummaries phases = SummarizePhases(steps);
+    EXPECT_NEAR(phases.mSolve.mMean, 0.1198, 1e-12);
+    EXPECT_DOUBLE_EQ(phases.mSolve.mP50, 0.1);
+    EXPECT_DOUBLE_EQ(phases.mSolve.mP99, 0.1);
+    EXPECT_DOUBLE_EQ(phases.mSolve.mMax, 2.08);
+    EXPECT_DOUBLE_EQ(phases.mBroadPhaseUpdate.mMax, 0.05);
+    EXPECT_DOUBLE_EQ(phases.mLockWait.mMean, 0.005);
+    EXPECT_DOUBLE_EQ(phases.mLockWait.mMax, 0.5);
+    EXPECT_EQ(phases.mIslands.mCount, 100u);
+    EXPECT_EQ(SummarizePhases({}).mSolve.mCount, 0u);
 }
 
 TEST(DemoResultTest, AttributeSpikesCountsTheSpikesTheHostsTimeAccountsFor)

@@ -29,7 +29,7 @@ constexpr double cP99TargetRatio = 2.0; ///< A physics frame's p99 at most this 
 constexpr double cSpikeTargetRatio = tools::cSpikeRatio; ///< No physics frame over this times the average
 constexpr double cMainThreadStreamTargetMs = 0.5; ///< Streaming work on the main thread per frame, at most
 constexpr size_t cMaxHistogramBuckets = 40;
-constexpr int cSummaryTitleWidth = 22; ///< Column of the first metric in the console summary
+constexpr int cSummaryTitleWidth = 23; ///< Column of the first metric in the console summary
 
 // Chart geometry, shared by the line chart and the histogram so the report's images line up.
 constexpr double cSvgWidth = 800.0;
@@ -350,15 +350,22 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"p50", Ms(frame, frame.mP50)},
                          {"p99", Ms(frame, frame.mP99)},
                          {"max", Ms(frame, frame.mMax)}}});
-    const PhaseTimes phases = MeanPhases(inRun.mSteps);
-    sections.push_back({"phase means ms/frame",
-                        {{"broad-phase update", Ms(phases.mBroadPhaseUpdateMs)},
-                         {"narrow phase + pairs", Ms(phases.mNarrowPhaseMs)},
-                         {"islands", Ms(phases.mIslandsMs)},
-                         {"solve", Ms(phases.mSolveMs)},
-                         {"finish", Ms(phases.mFinishMs)},
-                         {"lock waits", Ms(phases.mLockWaitMs)},
-                         {"lock waits max", Ms(phases.mLockWaitMaxMs)}}});
+    // Each phase as the whole step: where the step's average and its spikes come from
+    const PhaseSummaries phases = SummarizePhases(inRun.mSteps);
+    auto phaseSection = [&](const char* inTitle, const SampleSummary& inPhase)
+    {
+        sections.push_back({inTitle,
+                            {{"avg", Ms(inPhase, inPhase.mMean)},
+                             {"p50", Ms(inPhase, inPhase.mP50)},
+                             {"p99", Ms(inPhase, inPhase.mP99)},
+                             {"max", Ms(inPhase, inPhase.mMax)}}});
+    };
+    phaseSection("broad-phase update ms", phases.mBroadPhaseUpdate);
+    phaseSection("narrow phase+pairs ms", phases.mNarrowPhase);
+    phaseSection("islands ms", phases.mIslands);
+    phaseSection("solve ms", phases.mSolve);
+    phaseSection("finish ms", phases.mFinish);
+    phaseSection("step lock waits ms", phases.mLockWait);
     sections.push_back(
         {"game-object queries",
          {{"queries", Count(inRun.mQueries)},

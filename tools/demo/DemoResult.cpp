@@ -23,27 +23,19 @@ SampleSummary Summarize(std::vector<double> inSamples)
     return {timing.mMean, timing.mP50, timing.mP99, timing.mMax, count};
 }
 
-PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps)
+PhaseSummaries SummarizePhases(const std::vector<StepStatistics>& inSteps)
 {
-    PhaseTimes means;
-    for (const StepStatistics& step : inSteps)
+    auto phase = [&](double StepStatistics::*inPhase)
     {
-        means.mBroadPhaseUpdateMs += step.mBroadPhaseUpdateMs;
-        means.mNarrowPhaseMs += step.mNarrowPhaseMs;
-        means.mIslandsMs += step.mIslandsMs;
-        means.mSolveMs += step.mSolveMs;
-        means.mFinishMs += step.mFinishMs;
-        means.mLockWaitMs += step.mLockWaitMs;
-        means.mLockWaitMaxMs = std::max(means.mLockWaitMaxMs, step.mLockWaitMs);
-    }
-    const double frames = double(std::max<size_t>(1, inSteps.size()));
-    means.mBroadPhaseUpdateMs /= frames;
-    means.mNarrowPhaseMs /= frames;
-    means.mIslandsMs /= frames;
-    means.mSolveMs /= frames;
-    means.mFinishMs /= frames;
-    means.mLockWaitMs /= frames;
-    return means;
+        std::vector<double> samples;
+        samples.reserve(inSteps.size());
+        for (const StepStatistics& step : inSteps)
+            samples.push_back(step.*inPhase);
+        return Summarize(std::move(samples));
+    };
+    return {phase(&StepStatistics::mBroadPhaseUpdateMs), phase(&StepStatistics::mNarrowPhaseMs),
+            phase(&StepStatistics::mIslandsMs),          phase(&StepStatistics::mSolveMs),
+            phase(&StepStatistics::mFinishMs),           phase(&StepStatistics::mLockWaitMs)};
 }
 
 tools::SpikeAttribution AttributePhysicsSpikes(const DemoRunResult& inRun, double inRatio)

@@ -26,19 +26,18 @@ struct SampleSummary
 
 SampleSummary Summarize(std::vector<double> inSamples);
 
-struct PhaseTimes
+/// Each phase of the physics step over a run's frames, summarized as the whole step is (ms per frame).
+struct PhaseSummaries
 {
-    double mBroadPhaseUpdateMs = 0.0; ///< Means per frame
-    double mNarrowPhaseMs = 0.0;      ///< Pairs + narrow phase
-    double mIslandsMs = 0.0;
-    double mSolveMs = 0.0;
-    double mFinishMs = 0.0;
-    double mLockWaitMs = 0.0;    ///< The step's threads blocked on locks (not a phase: inside the others)
-    double mLockWaitMaxMs = 0.0; ///< The largest of one frame
+    SampleSummary mBroadPhaseUpdate;
+    SampleSummary mNarrowPhase; ///< Pairs + narrow phase
+    SampleSummary mIslands;
+    SampleSummary mSolve;
+    SampleSummary mFinish;
+    SampleSummary mLockWait; ///< The step's threads blocked on locks (not a phase: inside the others)
 };
 
-/// The step phases' means per frame over inSteps (zeros for none), and the largest lock wait.
-PhaseTimes MeanPhases(const std::vector<StepStatistics>& inSteps);
+PhaseSummaries SummarizePhases(const std::vector<StepStatistics>& inSteps);
 
 struct DemoRunResult
 {
@@ -56,8 +55,8 @@ struct DemoRunResult
     double mGuestStealMs = 0.0;
     std::vector<double>
         mFrameMs; ///< Per frame: the whole main-thread frame (physics, game objects, AI, sync)
-    /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics): the phase means of the
-    /// summary (MeanPhases) and frames.csv, where a slow frame's time went
+    /// Per frame, the step's statistics (PhysicsSystem::GetLastStepStatistics): the phases of the summary
+    /// (SummarizePhases) and frames.csv, where a slow frame's time went
     std::vector<StepStatistics> mSteps;
     /// Game-object query jobs: mean microseconds per query, per job-system thread (index = thread slot)
     std::vector<double> mQueryMicrosPerThread;
