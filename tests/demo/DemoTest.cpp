@@ -4,7 +4,9 @@
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
+#include "common/TempFiles.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <gtest/gtest.h>
@@ -84,14 +86,16 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(inRun.mDynamicBodiesPeak, 0u);
 }
 
-TEST(DemoTest, LockFreeModeKeepsItsInvariants)
+TEST(DemoTest, LockFreeModeKeepsItsInvariantsAndLogsItsProgress)
 {
     DemoRunResult run;
-    // A file is not a terminal: the progress comes as plain lines, the first and the last frame's among them
+    // A file is not a terminal: the progress comes as plain lines every 300 frames, so of 240 frames the
+    // first's and the last's
     const std::string progress =
         Printed([&](std::FILE* inFile) { run = RunDemo(SmallDemo(), BroadPhaseType::QuadTree, inFile); });
     ExpectInvariants(run);
     EXPECT_EQ(progress.find('\r'), std::string::npos) << progress;
+    EXPECT_EQ(std::count(progress.begin(), progress.end(), '\n'), 2) << progress;
     EXPECT_NE(progress.find("frame     1/240"), std::string::npos) << progress;
     EXPECT_NE(progress.find("frame   240/240"), std::string::npos) << progress;
     EXPECT_TRUE(!progress.empty() && progress.back() == '\n') << progress;
@@ -152,22 +156,29 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
 
 TEST(DemoResultTest, SummarizePhasesGivesEachPhaseItsMeanPercentilesAndMax)
 {
-    // 99 ordinary steps and one whose solve and lock wait spiked
+    // 99 ordinary steps, each phase its own time, and one whose solve and lock wait spiked
     std::vector<StepStatistics> steps(100);
     for (StepStatistics& step : steps)
     {
-        step.mBroadPhaseUpdateMs = 0.05;
+        step.mBroadPhaseUpdateMs = 0.125;
+        step.mNarrowPhaseMs = 0.25;
+        step.mIslandsMs = 0.0625;
         step.mSolveMs = 0.1;
+        step.mFinishMs = 0.03125;
     }
     steps[42].mSolveMs = 2.08;
     steps[42].mLockWaitMs = 0.5;
     const PhaseSummaries phases = SummarizePhases(steps);
+    EXPECT_NEAR(phases.mBroadPhaseUpdate.mMean, 0.125, 1e-12);
+    EXPECT_NEAR(phases.mNarrowPhase.mMean, 0.25, 1e-12);
+    EXPECT_NEAR(phases.mIslands.mMean, 0.0625, 1e-12);
+    EXPECT_DOUBLE_EQ(phases.mFinish.mP99, 0.03125);
     EXPECT_NEAR(phases.mSolve.mMean, 0.1198, 1e-12);
     EXPECT_DOUBLE_EQ(phases.mSolve.mP50, 0.1);
     EXPECT_DOUBLE_EQ(phases.mSolve.mP99, 0.1);
     EXPECT_DOUBLE_EQ(phases.mSolve.mMax, 2.08);
-    EXPECT_DOUBLE_EQ(phases.mBroadPhaseUpdate.mMax, 0.05);
-    EXPECT_DOUBLE_EQ(phases.mLockWait.mMean, 0.005);
+    EXPECT_NEAR(phases.mLockWait.mMean, 0.005, 1e-12);
+    EXPECT_DOUBLE_EQ(phases.mLockWait.mP50, 0.0);
     EXPECT_DOUBLE_EQ(phases.mLockWait.mMax, 0.5);
     EXPECT_EQ(phases.mIslands.mCount, 100u);
     EXPECT_EQ(SummarizePhases({}).mSolve.mCount, 0u);
@@ -288,6 +299,7 @@ TEST(DemoReportTest, ComparisonJudgesTheQueryTargetBothWays)
     DemoRunResult lockFree, global;
     lockFree.mModeName = "lock-free";
     global.mModeName = "global mutex";
+    lockFree.mQueries = global.mQueries = 1000;
     auto lineOf = [](const std::string& inText, const std::string& inName)
     {
         const size_t at = inText.find(inName);
@@ -295,6 +307,8 @@ TEST(DemoReportTest, ComparisonJudgesTheQueryTargetBothWays)
     };
     auto compare = [&]
     { return Printed([&](std::FILE* inFile) { PrintComparison(inFile, lockFree, global); }); };
+    const std::string queryRow = "query µs/query mean";
+    const std::string waitRow = "lock waits µs/frame per thread";
 
     // The queries' own time barely differs, their lock waits 12x: one reading is met, the other not
     lockFree.mQueryMicrosMean = 2.0;
@@ -304,34 +318,63 @@ TEST(DemoReportTest, ComparisonJudgesTheQueryTargetBothWays)
     lockFree.mBodyLockWaitMicrosPerThreadFrame = {0.0, 0.0};
     global.mBodyLockWaitMicrosPerThreadFrame = {0.0, 0.0};
     std::string text = compare();
-    EXPECT_NE(lineOf(text, "query µs/query mean").find("1.10x  as µs per query: NOT met"), std::string::npos)
-        << text;
-    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread")
-                  .find("12.00x  as the talk's lock cost per thread: met"),
-              std::string::npos)
-        << text;
+    EXPECT_NE(text.find("10x target, read as"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, queryRow).find("1.10x  µs per query: NOT met"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, waitRow).find("12.00x  lock cost per thread: met"), std::string::npos) << text;
 
     // Just under 10x on the waits, 10x on the queries: the verdicts turn over
     global.mQueryMicrosMean = 20.0;
     global.mBroadPhaseLockWaitMicrosPerThreadFrame = {4.9, 4.9};
     text = compare();
-    EXPECT_NE(lineOf(text, "query µs/query mean").find("as µs per query: met"), std::string::npos) << text;
-    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("lock cost per thread: NOT met"),
-              std::string::npos)
+    EXPECT_NE(lineOf(text, queryRow).find("µs per query: met"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, waitRow).find("lock cost per thread: NOT met"), std::string::npos) << text;
+
+    // A lock-free mode that never waited against one that did meets it
+    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    text = compare();
+    EXPECT_NE(lineOf(text, waitRow).find("no waits lock-free  lock cost per thread: met"), std::string::npos)
         << text;
 
-    // A lock-free mode that never waited against one that did meets it; nothing measured gives no verdict
-    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.0, 0.0};
-    lockFree.mQueryMicrosMean = 0.0;
+    // Neither waited, or nothing was measured, or a mode made no queries: no verdict
+    global.mBroadPhaseLockWaitMicrosPerThreadFrame = {0.0, 0.0};
+    lockFree.mQueries = 0;
     text = compare();
-    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("no waits lock-free  as the talk's"),
-              std::string::npos)
-        << text;
-    EXPECT_NE(lineOf(text, "lock waits µs/frame per thread").find("lock cost per thread: met"),
-              std::string::npos)
-        << text;
-    EXPECT_NE(lineOf(text, "query µs/query mean").find("as µs per query: unknown"), std::string::npos)
-        << text;
+    EXPECT_NE(lineOf(text, waitRow).find("lock cost per thread: unknown"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, queryRow).find("µs per query: unknown"), std::string::npos) << text;
+    lockFree.mQueries = 1000;
+    global.mQueries = 0;
+    lockFree.mBroadPhaseLockWaitMicrosPerThreadFrame.clear();
+    lockFree.mBodyLockWaitMicrosPerThreadFrame.clear();
+    global.mBroadPhaseLockWaitMicrosPerThreadFrame.clear();
+    global.mBodyLockWaitMicrosPerThreadFrame.clear();
+    text = compare();
+    EXPECT_NE(lineOf(text, waitRow).find("lock cost per thread: unknown"), std::string::npos) << text;
+    EXPECT_NE(lineOf(text, queryRow).find("µs per query: unknown"), std::string::npos) << text;
+}
+
+TEST(DemoReportTest, ReportMarkdownComparisonHasEveryColumnInEveryRow)
+{
+    DemoRunResult lockFree, global;
+    lockFree.mModeName = "lock-free";
+    global.mModeName = "global mutex";
+    lockFree.mQueries = global.mQueries = 1000;
+    lockFree.mQueryMicrosMean = 2.0;
+    global.mQueryMicrosMean = 2.5;
+    const test::TempFiles files;
+    std::string error;
+    ASSERT_TRUE(WriteReport(files.Path("report"), {lockFree, global}, "cairn-demo", error)) << error;
+    const std::vector<unsigned char> bytes = test::ReadBytes(files.Path("report/report.md"));
+    const std::string report(bytes.begin(), bytes.end());
+    const size_t comparison = report.find("## Comparison");
+    ASSERT_NE(comparison, std::string::npos) << report;
+    // The numbers right-aligned, the verdicts' text column left-aligned
+    EXPECT_NE(report.find("|---|--:|--:|--:|---|", comparison), std::string::npos) << report;
+    // A row without a verdict still has all five cells
+    const size_t row = report.find("| game-object queries |", comparison);
+    ASSERT_NE(row, std::string::npos) << report;
+    const std::string line = report.substr(row, report.find('\n', row) - row);
+    EXPECT_EQ(std::count(line.begin(), line.end(), '|'), 6) << line;
+    EXPECT_NE(report.find("| 1.25x | µs per query: NOT met |", comparison), std::string::npos) << report;
 }
 
 } // namespace

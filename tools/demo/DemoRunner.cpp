@@ -41,8 +41,8 @@ bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, navmesh::TileSc
     return true;
 }
 
-/// A terminal gets a live line rewritten every quarter second; a log file or a pipe gets a plain line every
-/// 5 s, since carriage returns would pile up hundreds of overwritten lines in it.
+/// A terminal gets a live line rewritten every 15 frames; a log file or a pipe gets a plain line every 300
+/// frames (5 s at 60 Hz), since carriage returns would leave dozens of overwritten lines in it.
 bool IsProgressFrame(std::FILE* inProgress, bool inLive, int inFrame, int inFrames)
 {
     if (inProgress == nullptr) return false;

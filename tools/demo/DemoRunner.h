@@ -36,7 +36,7 @@ struct DemoSettings
 };
 
 /// Runs the demo in inMode; inProgress (may be null) gets a live one-line display on a terminal, a line every
-/// 5 s otherwise.
+/// 300 frames otherwise.
 DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress);
 
 } // namespace cairn::demo
