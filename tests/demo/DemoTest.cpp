@@ -352,7 +352,7 @@ TEST(DemoReportTest, ComparisonJudgesTheQueryTargetBothWays)
     EXPECT_NE(lineOf(text, queryRow).find("µs per query: unknown"), std::string::npos) << text;
 }
 
-TEST(DemoReportTest, ReportMarkdownComparisonHasEveryColumnInEveryRow)
+TEST(DemoReportTest, ReportMarkdownTablesHaveEveryColumnInEveryRow)
 {
     DemoRunResult lockFree, global;
     lockFree.mModeName = "lock-free";
@@ -360,6 +360,10 @@ TEST(DemoReportTest, ReportMarkdownComparisonHasEveryColumnInEveryRow)
     lockFree.mQueries = global.mQueries = 1000;
     lockFree.mQueryMicrosMean = 2.0;
     global.mQueryMicrosMean = 2.5;
+    lockFree.mSteps.resize(3);
+    lockFree.mSteps[0].mSolveMs = 0.25;
+    lockFree.mSteps[1].mSolveMs = 0.5;
+    lockFree.mSteps[2].mSolveMs = 0.75;
     const test::TempFiles files;
     std::string error;
     ASSERT_TRUE(WriteReport(files.Path("report"), {lockFree, global}, "cairn-demo", error)) << error;
@@ -375,6 +379,13 @@ TEST(DemoReportTest, ReportMarkdownComparisonHasEveryColumnInEveryRow)
     const std::string line = report.substr(row, report.find('\n', row) - row);
     EXPECT_EQ(std::count(line.begin(), line.end(), '|'), 6) << line;
     EXPECT_NE(report.find("| 1.25x | µs per query: NOT met |", comparison), std::string::npos) << report;
+
+    // Each run's step phases: a row a phase with its avg, p50, p99 and max, not four rows in the summary
+    const size_t phases = report.find("| phase | avg | p50 | p99 | max |");
+    ASSERT_NE(phases, std::string::npos) << report;
+    EXPECT_LT(phases, comparison) << report;
+    EXPECT_NE(report.find("| solve | 0.500 | 0.500 | 0.750 | 0.750 |", phases), std::string::npos) << report;
+    EXPECT_EQ(report.find("| solve ms |"), std::string::npos) << report;
 }
 
 } // namespace
