@@ -16,6 +16,10 @@ Error StaleID()
 {
     return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
 }
+Error OtherWorldsBatch()
+{
+    return MakeError(ErrorCode::InvalidArgument, "add batch was prepared by another physics system");
+}
 Error InvalidVector(const char* inWhat)
 {
     return MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + " is NaN, infinite or out of range");
@@ -124,6 +128,7 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
 {
     if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
     AddBatch batch;
+    batch.mOwner = this;
     batch.mBodies.reserve(inIDs.size());
     auto undo = [&]
     {
@@ -166,6 +171,7 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
     if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
     if (ioBatch.mState == nullptr)
         return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
+    if (ioBatch.mOwner != this) return OtherWorldsBatch();
     mBroadPhase.AddBodiesFinalize(ioBatch.mState);
     ioBatch.mState = nullptr;
     for (const BroadPhaseBody& entry : ioBatch.mBodies)
@@ -190,8 +196,13 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
     return Status::Ok();
 }
 
-void BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
+Status BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
 {
+    if (ioBatch.mState == nullptr && ioBatch.mBodies.empty())
+        return Status::Ok(); // Finished: nothing to free
+    // Refused whole: a body lock this thread could not take would leave its body pending for good
+    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
+    if (ioBatch.mOwner != this) return OtherWorldsBatch();
     if (ioBatch.mState != nullptr) mBroadPhase.AddBodiesAbort(ioBatch.mState);
     ioBatch.mState = nullptr;
     for (const BroadPhaseBody& entry : ioBatch.mBodies)
@@ -200,6 +211,7 @@ void BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
         if (Body* body = lock.GetBody(); body != nullptr) body->mAddPending = false;
     }
     ioBatch.mBodies.clear();
+    return Status::Ok();
 }
 
 template <class F> Status BodyInterface::ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange)

@@ -43,11 +43,14 @@ public:
     {
         std::vector<BroadPhaseBody> mBodies;
         BroadPhase::AddState mState = nullptr;
+        /// The interface that prepared it: its ids and broad-phase state mean nothing to another world's
+        const BodyInterface* mOwner = nullptr;
         bool IsEmpty() const { return mBodies.empty(); }
 
         AddBatch() = default;
         AddBatch(AddBatch&& ioOther) noexcept
-            : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr))
+            : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr)),
+              mOwner(std::exchange(ioOther.mOwner, nullptr))
         {
             ioOther.mBodies.clear();
         }
@@ -57,8 +60,12 @@ public:
     };
     /// Fails (and marks nothing) if any id is stale, already in the world, or already in another batch.
     Result<AddBatch> AddBodiesPrepare(std::span<const BodyID> inIDs);
+    /// Fails (and changes nothing) for a batch already finalized or aborted, one another world prepared, or a
+    /// call from inside the step or under a body lock.
     Status AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation);
-    void AddBodiesAbort(AddBatch& ioBatch);
+    /// Frees the batch and frees its bodies for another add. Fails (and changes nothing) for a batch another
+    /// world prepared, or a call from inside the step or under a body lock; aborting a finished batch is Ok.
+    Status AddBodiesAbort(AddBatch& ioBatch);
 
     Status SetPosition(const BodyID& inID, const Vec3& inPosition, Activation inActivation);
     Status SetRotation(const BodyID& inID, const Quat& inRotation, Activation inActivation);
