@@ -9,6 +9,10 @@
 namespace cairn
 {
 
+/// The heaviest dynamic body CreateBody takes, kg (a rock cube of about 700 m). Contact impulses are mass
+/// times speed and friction squares them, so a heavier body could overflow a float on landing.
+constexpr float cMaxBodyMass = 1.0e12f;
+
 struct BodyCreationSettings
 {
     ShapeRef mShape;                      ///< Required
@@ -18,7 +22,7 @@ struct BodyCreationSettings
     Vec3 mAngularVelocity = Vec3::Zero(); ///< rad/s, world space
     MotionType mMotionType = MotionType::Dynamic;
     ObjectLayer mObjectLayer = Layers::cMoving;
-    float mDensity = 1000.0f;          ///< kg/m^3, used for the mass of dynamic bodies
+    float mDensity = 1000.0f;          ///< kg/m^3, used for the mass of dynamic bodies (at most cMaxBodyMass)
     float mFriction = 0.2f;            ///< Coulomb coefficient, >= 0 (combined as sqrt(a * b))
     float mRestitution = 0.0f;         ///< In [0, 1] (combined as max(a, b))
     float mLinearDamping = 0.05f;      ///< 1/s: dv/dt = -c v
