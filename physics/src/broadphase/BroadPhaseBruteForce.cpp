@@ -124,6 +124,7 @@ void BroadPhaseBruteForce::CollidePoint(const Vec3& inPoint, const BroadPhaseQue
 void BroadPhaseBruteForce::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
                                    RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inRay.mOrigin, inRay.mDirection)) return;
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     float maxFraction = 1.0f;
     const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);
@@ -142,6 +143,7 @@ void BroadPhaseBruteForce::CastRay(const RayCast& inRay, const BroadPhaseQueryFi
 void BroadPhaseBruteForce::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
                                      const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inBox, inDisplacement)) return;
     const SweptAABox sweep(inBox, inDisplacement);
     float maxFraction = 1.0f;
     const auto lock = SharedLockedCountingWait(mMutex, LockKind::BroadPhase);

@@ -310,6 +310,7 @@ void BroadPhaseQuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQuery
 void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
                                  RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inRay.mOrigin, inRay.mDirection)) return;
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // Shared by the trees, so a close hit in one prunes the others
     ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
@@ -319,6 +320,7 @@ void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilt
 void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
                                    const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inBox, inDisplacement)) return;
     auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // As in CastRay
     ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)

@@ -636,6 +636,7 @@ void BroadPhaseSortAndSweep::CollidePoint(const Vec3& inPoint, const BroadPhaseQ
 void BroadPhaseSortAndSweep::CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
                                      RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inRay.mOrigin, inRay.mDirection)) return;
     // The window holds the whole segment (fraction 0..1); pruning by the visitor only makes it conservative
     const Vec3 end = inRay.mOrigin + inRay.mDirection;
     const Window window{std::min(inRay.mOrigin.x(), end.x()), std::max(inRay.mOrigin.x(), end.x()),
@@ -662,6 +663,7 @@ void BroadPhaseSortAndSweep::CastRay(const RayCast& inRay, const BroadPhaseQuery
 void BroadPhaseSortAndSweep::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
                                        const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const
 {
+    if (!IsFiniteCast(inBox, inDisplacement)) return;
     const SweptAABox sweep(inBox, inDisplacement);
     // Absolute half extents: with an inverted box the grown body box is inverted too, and the slab test then
     // accepts the swapped slab, which still lies within body +- |half extent|

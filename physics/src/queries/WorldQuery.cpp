@@ -3,6 +3,7 @@
 #include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/CompoundShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
 #include <algorithm>
@@ -46,6 +47,18 @@ Status InvalidQuery(const char* inWhat)
     return MakeError(ErrorCode::InvalidArgument, std::string("world query: ") + inWhat);
 }
 
+/// Whether the narrow phase can collide inShape with any body: convex shapes and compounds of them. A
+/// triangle mesh or height field collides only with convex shapes, so against a mesh body it would answer
+/// "clear".
+bool CanBeQueryShape(const Shape& inShape)
+{
+    if (inShape.IsConvex()) return true;
+    if (inShape.GetType() != ShapeType::Compound) return false;
+    for (const CompoundShape::SubShape& child : static_cast<const CompoundShape&>(inShape).GetSubShapes())
+        if (!CanBeQueryShape(*child.mShape)) return false;
+    return true;
+}
+
 /// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
 Vec3 QueryHalfExtent(const AABB& inBox)
 {
@@ -75,7 +88,8 @@ Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bo
     if (Status thread = CheckThread(); !thread) return thread;
     if (!IsValidWorldPosition(inRay.mOrigin))
         return InvalidQuery("ray origin is NaN, infinite or beyond the world");
-    if (!IsFiniteLength(inRay.mDirection)) return InvalidQuery("ray direction is NaN, infinite or too long");
+    if (!(inRay.mDirection.norm() <= cMaxRayLength))
+        return InvalidQuery("ray direction is NaN, infinite or longer than cMaxRayLength (4e6 m)");
     std::vector<Candidate>& candidates = tCandidates;
     candidates.clear();
     mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter),
@@ -152,9 +166,18 @@ Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransfo
     if (!IsValidRotation(inTransform.mRotation))
         return InvalidQuery("shape rotation is not a finite unit quaternion");
     if (!std::isfinite(inMaxSeparation)) return InvalidQuery("maximum separation is NaN or infinite");
+    if (!CanBeQueryShape(inShape))
+        return InvalidQuery(
+            "a query shape must be convex or a compound of convex shapes, not a triangle mesh or "
+            "height field");
+    // A shape built around its checked Create (a NaN radius, an inverted box) has bounds the broad phase
+    // drops: the query would answer "nothing there"
+    const AABB shapeBounds = inShape.GetWorldBounds(inTransform);
+    if (!shapeBounds.IsFinite() || shapeBounds.IsEmpty())
+        return InvalidQuery("query shape's bounds are NaN, infinite or empty");
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
-    const AABB bounds = inShape.GetWorldBounds(inTransform).Expanded(std::max(inMaxSeparation, 0.0f));
+    const AABB bounds = shapeBounds.Expanded(std::max(inMaxSeparation, 0.0f));
     mBroadPhase.CollideAABox(bounds, ToBroadPhase(inFilter),
                              [&](BodyID inBody)
                              {

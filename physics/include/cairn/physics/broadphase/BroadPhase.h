@@ -53,6 +53,17 @@ using BodyPairVisitor = FunctionRef<void(BodyID inActive, BodyID inOther)>;
 using ParallelRanges =
     FunctionRef<void(uint32_t inCount, FunctionRef<void(uint32_t inBegin, uint32_t inEnd)> inBody)>;
 
+/// Whether a cast is made of finite numbers. A NaN in a slab test reads as "inside", so a NaN ray or sweep
+/// would report every body at fraction 0: the broad phases ignore such casts, as they ignore NaN boxes.
+inline bool IsFiniteCast(const Vec3& inStart, const Vec3& inDisplacement)
+{
+    return IsFinite(inStart) && IsFinite(inDisplacement);
+}
+inline bool IsFiniteCast(const AABB& inBox, const Vec3& inDisplacement)
+{
+    return inBox.IsFinite() && IsFinite(inDisplacement);
+}
+
 class BroadPhase
 {
 public:
@@ -92,10 +103,11 @@ public:
     virtual void CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
                               BodyVisitor inVisitor) const = 0;
     /// Bodies whose AABB the segment enters before the visitor's current maximum fraction (starting at 1),
-    /// in no particular order.
+    /// in no particular order. None for a ray that is not IsFiniteCast.
     virtual void CastRay(const RayCast& inRay, const BroadPhaseQueryFilter& inFilter,
                          RayBodyVisitor inVisitor) const = 0;
     /// Bodies whose AABB the box swept along inDisplacement touches; the fraction is where contact starts.
+    /// None for a sweep that is not IsFiniteCast.
     virtual void CastAABox(const AABB& inBox, const Vec3& inDisplacement,
                            const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const = 0;
 

@@ -36,10 +36,14 @@ struct MassProperties
 };
 
 /// A ray as a segment: points mOrigin + t * mDirection for t in [0, 1].
+/// The longest ray a world query takes, m: corner to corner of the world (about 3.5e6 m) and a margin. Longer
+/// ones overflow the squares in the shapes' ray tests (a sphere's b^2 - ac) and pass through what they hit.
+inline constexpr float cMaxRayLength = 4.0f * cMaxWorldCoordinate;
+
 struct RayCast
 {
     Vec3 mOrigin = Vec3::Zero();
-    Vec3 mDirection = Vec3::Zero(); ///< Full displacement, not unit length
+    Vec3 mDirection = Vec3::Zero(); ///< Full displacement, not unit length; at most cMaxRayLength for queries
 };
 
 /// Identifies a part of a shape: a triangle of a mesh, a cell half of a height field, a compound child...
