@@ -61,11 +61,22 @@ public:
     /// Symmetric: A collides with B iff B collides with A.
     void SetCollides(ObjectLayer inA, ObjectLayer inB, bool inCollides);
 
+    // A layer past the setup (an ObjectLayer goes to 255, the tables to 63) is in broad-phase layer 0 and
+    // collides with nothing: never a read past the tables, nor a shift past 63 bits
     bool IsValid(ObjectLayer inLayer) const { return inLayer < mNumObjectLayers; }
-    BroadPhaseLayer GetBroadPhaseLayer(ObjectLayer inLayer) const { return mBroadPhaseLayer[inLayer]; }
-    bool ShouldCollide(ObjectLayer inA, ObjectLayer inB) const { return (mCollidesWith[inA] >> inB) & 1u; }
+    BroadPhaseLayer GetBroadPhaseLayer(ObjectLayer inLayer) const
+    {
+        return IsValid(inLayer) ? mBroadPhaseLayer[inLayer] : BroadPhaseLayer(0);
+    }
+    bool ShouldCollide(ObjectLayer inA, ObjectLayer inB) const
+    {
+        return IsValid(inA) && IsValid(inB) && ((mCollidesWith[inA] >> inB) & 1u) != 0;
+    }
     /// The object layers that inLayer collides with.
-    ObjectLayerMask GetCollisionMask(ObjectLayer inLayer) const { return mCollidesWith[inLayer]; }
+    ObjectLayerMask GetCollisionMask(ObjectLayer inLayer) const
+    {
+        return IsValid(inLayer) ? mCollidesWith[inLayer] : ObjectLayerMask(0);
+    }
     /// The object layers that live in a broad-phase layer.
     ObjectLayerMask GetObjectLayersIn(BroadPhaseLayer inLayer) const;
 
