@@ -8,6 +8,16 @@
 namespace cairn::navmesh
 {
 
+namespace
+{
+/// Tiles an invoker's radius reaches from the tile it stands in, rounded up (in double: a tiny tile size
+/// would overflow an int).
+double ReachInTiles(float inRadius, float inTileSize)
+{
+    return std::ceil(double(inRadius) / double(inTileSize));
+}
+} // namespace
+
 TileScheduler::TileScheduler(PhysicsSystem& ioPhysics, NavMeshWorld& ioWorld, jobs::BackgroundQueue& ioQueue,
                              const Settings& inSettings)
     : mPhysics(ioPhysics), mWorld(ioWorld), mQueue(ioQueue), mSettings(inSettings),
@@ -44,6 +54,17 @@ Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPositio
         return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
     if (!(inRadius >= 0.0f && inRadius <= 1e5f))
         return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: radius must be in [0, 1e5] m");
+    // Checked here, not where the tiles are looked for: a radius that reached further would silently need
+    // none of the tiles past the square, or, cut off, none at all
+    const float tileSize = mWorld.GetGrid().GetTileSize();
+    if (ReachInTiles(inRadius, tileSize) > double(cMaxInvokerReachTiles))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "navmesh invoker: a radius of " + std::to_string(inRadius) + " m is over the " +
+                             std::to_string(float(cMaxInvokerReachTiles) * tileSize) + " m (" +
+                             std::to_string(cMaxInvokerReachTiles) +
+                             " tiles) an invoker may reach: its tiles are looked for in at most " +
+                             std::to_string(cMaxInvokerTilesAcross) + " x " +
+                             std::to_string(cMaxInvokerTilesAcross) + " tiles");
     std::lock_guard lock(mMutex);
     const InvokerID id = mNextID++;
     mInvokers[id] = {inPosition, inRadius};
@@ -68,6 +89,11 @@ Result<TileScheduler::AreaID> TileScheduler::AddArea(const AABB& inBounds)
     if (!IsValidWorldPosition(inBounds.mMin) || !IsValidWorldPosition(inBounds.mMax) || inBounds.IsEmpty())
         return MakeError(ErrorCode::InvalidArgument,
                          "navmesh area: bounds must be inside the world, min <= max");
+    // Its tiles are listed with this cut-off (CollectNeeded, RemoveArea): a larger area would need none
+    if (const uint64_t tiles = mWorld.GetGrid().CountTilesOverlapping(inBounds, 0.0f); tiles > cMaxAreaTiles)
+        return MakeError(ErrorCode::InvalidArgument,
+                         "navmesh area: it overlaps " + std::to_string(tiles) + " tiles, more than the " +
+                             std::to_string(cMaxAreaTiles) + " one area may keep: split it");
     std::lock_guard lock(mMutex);
     const AreaID id = mNextID++;
     mAreas[id] = inBounds;
@@ -79,7 +105,7 @@ void TileScheduler::RemoveArea(AreaID inArea)
     std::lock_guard lock(mMutex);
     auto it = mAreas.find(inArea);
     if (it == mAreas.end()) return;
-    mWorld.GetGrid().TilesOverlapping(it->second, 0.0f, mDropNow);
+    (void)mWorld.GetGrid().TilesOverlapping(it->second, 0.0f, mDropNow, cMaxAreaTiles); // AddArea checked
     mAreas.erase(it);
 }
 
@@ -152,35 +178,41 @@ void TileScheduler::OnBodyChanged(const BodyChange& inChange)
 
 void TileScheduler::CollectNeeded(std::unordered_map<TileCoord, float>& outNeeded) const
 {
-    const TileGrid& grid = mWorld.GetGrid();
-    std::vector<TileCoord> tiles;
     for (const auto& [id, invoker] : mInvokers)
-    {
-        tiles.clear();
-        const Vec3 extent(invoker.mRadius, 0.0f, invoker.mRadius);
-        grid.TilesOverlapping(AABB(invoker.mPosition - extent, invoker.mPosition + extent), 0.0f, tiles,
-                              4096);
-        for (const TileCoord& tile : tiles)
-        {
-            // x-z distance from the invoker to the tile's area: within the radius, the tile is needed
-            const AABB box = grid.GetTileBounds(tile);
-            const float dx =
-                std::max({box.mMin.x() - invoker.mPosition.x(), 0.0f, invoker.mPosition.x() - box.mMax.x()});
-            const float dz =
-                std::max({box.mMin.z() - invoker.mPosition.z(), 0.0f, invoker.mPosition.z() - box.mMax.z()});
-            const float distance = std::sqrt(dx * dx + dz * dz);
-            if (distance > invoker.mRadius) continue;
-            auto [it, inserted] = outNeeded.try_emplace(tile, distance);
-            if (!inserted) it->second = std::min(it->second, distance);
-        }
-    }
+        CollectInvokerTiles(invoker, outNeeded);
+    std::vector<TileCoord> tiles;
     for (const auto& [id, bounds] : mAreas)
     {
         tiles.clear();
-        grid.TilesOverlapping(bounds, 0.0f, tiles);
+        (void)mWorld.GetGrid().TilesOverlapping(bounds, 0.0f, tiles, cMaxAreaTiles); // AddArea checked
         for (const TileCoord& tile : tiles)
             outNeeded[tile] = 0.0f;
     }
+}
+
+void TileScheduler::CollectInvokerTiles(const Invoker& inInvoker,
+                                        std::unordered_map<TileCoord, float>& ioNeeded) const
+{
+    const TileGrid& grid = mWorld.GetGrid();
+    // A tile within the radius is at most ceil(radius / tile size) tiles from the invoker's own on each axis,
+    // one more below where the radius ends on a tile's edge: the square takes one more on each side. Sized by
+    // the radius alone, not by where the invoker stands, so AddInvoker's limit holds wherever MoveInvoker
+    // takes it, and no list is cut off
+    const int32_t reach = int32_t(ReachInTiles(inInvoker.mRadius, grid.GetTileSize())) + 1;
+    const TileCoord centre = grid.TileAt(inInvoker.mPosition.x(), inInvoker.mPosition.z());
+    for (int32_t z = centre.mZ - reach; z <= centre.mZ + reach; ++z) // TileAt clamps to +-2^30: no overflow
+        for (int32_t x = centre.mX - reach; x <= centre.mX + reach; ++x)
+        {
+            // x-z distance from the invoker to the tile's area: within the radius, the tile is needed
+            const AABB box = grid.GetTileBounds({x, z});
+            const Vec3& position = inInvoker.mPosition;
+            const float dx = std::max({box.mMin.x() - position.x(), 0.0f, position.x() - box.mMax.x()});
+            const float dz = std::max({box.mMin.z() - position.z(), 0.0f, position.z() - box.mMax.z()});
+            const float distance = std::sqrt(dx * dx + dz * dz);
+            if (distance > inInvoker.mRadius) continue;
+            auto [it, inserted] = ioNeeded.try_emplace({x, z}, distance);
+            if (!inserted) it->second = std::min(it->second, distance);
+        }
 }
 
 void TileScheduler::StartJob(const TileCoord& inTile, TileState& ioState)

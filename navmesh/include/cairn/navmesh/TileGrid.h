@@ -64,21 +64,42 @@ public:
     bool TilesOverlapping(const AABB& inBox, float inBorder, std::vector<TileCoord>& outTiles,
                           size_t inMaxTiles = 65536) const
     {
-        if (inBox.IsEmpty() || !std::isfinite(inBox.mMin.x()) || !std::isfinite(inBox.mMax.x()) ||
-            !std::isfinite(inBox.mMin.z()) || !std::isfinite(inBox.mMax.z()))
-            return true;
-        const TileCoord lo = TileAt(inBox.mMin.x() - inBorder, inBox.mMin.z() - inBorder);
-        const TileCoord hi = TileAt(inBox.mMax.x() + inBorder, inBox.mMax.z() + inBorder);
-        // In 64 bits: a box of 5e10 m spans more tiles than an int32 difference holds
-        if (double(int64_t(hi.mX) - lo.mX + 1) * double(int64_t(hi.mZ) - lo.mZ + 1) > double(inMaxTiles))
-            return false;
+        TileCoord lo, hi;
+        if (!TileRange(inBox, inBorder, lo, hi)) return true;
+        if (CountTiles(lo, hi) > inMaxTiles) return false;
         for (int32_t z = lo.mZ; z <= hi.mZ; ++z)
             for (int32_t x = lo.mX; x <= hi.mX; ++x)
                 outTiles.push_back({x, z});
         return true;
     }
 
+    /// How many tiles TilesOverlapping would list without a cut-off: to refuse a box before keeping it.
+    uint64_t CountTilesOverlapping(const AABB& inBox, float inBorder) const
+    {
+        TileCoord lo, hi;
+        return TileRange(inBox, inBorder, lo, hi) ? CountTiles(lo, hi) : 0;
+    }
+
 private:
+    /// The first and last tile on each axis of TilesOverlapping; false when there is none (an empty or
+    /// non-finite box).
+    bool TileRange(const AABB& inBox, float inBorder, TileCoord& outLo, TileCoord& outHi) const
+    {
+        if (inBox.IsEmpty() || !std::isfinite(inBox.mMin.x()) || !std::isfinite(inBox.mMax.x()) ||
+            !std::isfinite(inBox.mMin.z()) || !std::isfinite(inBox.mMax.z()))
+            return false;
+        outLo = TileAt(inBox.mMin.x() - inBorder, inBox.mMin.z() - inBorder);
+        outHi = TileAt(inBox.mMax.x() + inBorder, inBox.mMax.z() + inBorder);
+        return outLo.mX <= outHi.mX && outLo.mZ <= outHi.mZ; // A negative border can shrink a box to nothing
+    }
+
+    static uint64_t CountTiles(const TileCoord& inLo, const TileCoord& inHi)
+    {
+        // In 64 bits: a box of 5e10 m spans more tiles than an int32 difference holds (at most (2^31 + 1)^2,
+        // as TileAt clamps to +-2^30)
+        return uint64_t(int64_t(inHi.mX) - inLo.mX + 1) * uint64_t(int64_t(inHi.mZ) - inLo.mZ + 1);
+    }
+
     int32_t ToTile(float inOffset) const
     {
         const double tile = std::floor(double(inOffset) / double(mTileSize));

@@ -74,14 +74,27 @@ public:
     TileScheduler(const TileScheduler&) = delete;
     TileScheduler& operator=(const TileScheduler&) = delete;
 
+    /// The tiles an invoker needs are looked for in a square around the tile it stands in, at most this many
+    /// tiles across (4096 tiles) wherever it moves: a real engine's budget, and what AddInvoker's radius
+    /// limit keeps to.
+    static constexpr int cMaxInvokerTilesAcross = 64;
+    /// Tiles an invoker's radius may reach from the tile it stands in, rounded up: the square has one more
+    /// on each side for a radius ending on a tile's edge. 30 tiles: 384 m on the default 12.8 m tiles.
+    static constexpr int cMaxInvokerReachTiles = (cMaxInvokerTilesAcross - 3) / 2;
+    /// The most tiles one kept area may overlap (256 x 256); a larger area is refused, not cut off.
+    static constexpr uint64_t cMaxAreaTiles = 65536;
+
     /// Invokers: the tiles within inRadius (x-z distance from inPosition) are kept built. Any thread. Error
-    /// for a position outside the world or a radius that is not in [0, 1e5] m.
+    /// for a position outside the world, a radius that is not in [0, 1e5] m, or one that reaches more than
+    /// cMaxInvokerReachTiles tiles (the error names the limit in metres).
     Result<InvokerID> AddInvoker(const Vec3& inPosition, float inRadius);
+    /// A position outside the world is ignored. The radius keeps to the limit wherever the invoker goes: it
+    /// never needs more tiles than are looked for.
     void MoveInvoker(InvokerID inInvoker, const Vec3& inPosition);
     void RemoveInvoker(InvokerID inInvoker);
     /// Areas: every tile overlapping inBounds is kept built until RemoveArea, which drops them at once
     /// (unless an invoker or another area still needs them). Any thread.
-    /// Error for bounds outside the world or empty.
+    /// Error for bounds outside the world, empty, or overlapping more than cMaxAreaTiles tiles.
     Result<AreaID> AddArea(const AABB& inBounds);
     void RemoveArea(AreaID inArea);
 
@@ -129,6 +142,8 @@ private:
 
     /// Tiles the invokers and areas need now, with the x-z distance to the nearest invoker (areas: 0).
     void CollectNeeded(std::unordered_map<TileCoord, float>& outNeeded) const;
+    /// The tiles within an invoker's radius, each with its x-z distance (the nearest invoker's is kept).
+    void CollectInvokerTiles(const Invoker& inInvoker, std::unordered_map<TileCoord, float>& ioNeeded) const;
     void MarkDirtyLocked(const AABB& inBounds);
     void StartJob(const TileCoord& inTile, TileState& ioState);
     /// Takes a finished job's tile into the navmesh's queue; false while the job still runs.
