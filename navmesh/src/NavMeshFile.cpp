@@ -48,17 +48,21 @@ bool ReadTileCoord(const std::vector<unsigned char>& inData, TileCoord& outTile)
 }
 
 /// Reads element inIndex of an array of T at inOffset of inData (unaligned-safe).
-template <class T> T ReadAt(const std::vector<unsigned char>& inData, size_t inOffset, size_t inIndex)
+template <class T> T ReadAt(std::span<const unsigned char> inData, size_t inOffset, size_t inIndex)
 {
     T value;
     std::memcpy(&value, inData.data() + inOffset + inIndex * sizeof(T), sizeof(T));
     return value;
 }
 
-/// Empty when inData is a Detour tile whose sections fit its size and whose indices stay inside their arrays,
-/// else what is wrong. Detour's addTile trusts the header's counts and the polygons' indices: a flipped bit
-/// in a file made it write and read outside the tile's buffer.
-std::string CheckTileData(const std::vector<unsigned char>& inData)
+void SortTiles(NavMeshFileContents& ioContents)
+{
+    std::sort(ioContents.mTiles.begin(), ioContents.mTiles.end(),
+              [](const NavMeshFileTile& inL, const NavMeshFileTile& inR) { return inL.mTile < inR.mTile; });
+}
+} // namespace
+
+std::string CheckTileData(std::span<const unsigned char> inData)
 {
     if (inData.size() < sizeof(dtMeshHeader)) return "shorter than a Detour tile header";
     const dtMeshHeader h = ReadAt<dtMeshHeader>(inData, 0, 0);
@@ -126,13 +130,6 @@ std::string CheckTileData(const std::vector<unsigned char>& inData)
             return "off-mesh connection " + std::to_string(i) + " names a missing polygon";
     return "";
 }
-
-void SortTiles(NavMeshFileContents& ioContents)
-{
-    std::sort(ioContents.mTiles.begin(), ioContents.mTiles.end(),
-              [](const NavMeshFileTile& inL, const NavMeshFileTile& inR) { return inL.mTile < inR.mTile; });
-}
-} // namespace
 
 Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles)
 {

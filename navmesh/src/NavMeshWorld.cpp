@@ -108,13 +108,6 @@ float NextRandomFloat()
     z ^= z >> 31;
     return float(z >> 40) * (1.0f / 16777216.0f); // 24 bits: in [0, 1)
 }
-
-bool IsFiniteGrid(const TileGrid& inGrid)
-{
-    return std::isfinite(inGrid.GetOriginX()) && std::isfinite(inGrid.GetOriginZ()) &&
-           std::isfinite(inGrid.GetMinY()) && std::isfinite(inGrid.GetMaxY()) &&
-           inGrid.GetMinY() < inGrid.GetMaxY();
-}
 } // namespace
 
 NavMeshWorld::NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile)
@@ -125,17 +118,8 @@ NavMeshWorld::NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile
 Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGrid,
                                                            const AgentProfile& inProfile, int inMaxTiles)
 {
-    if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
-    // The grid's tiles are the profile's: a different size would misplace every tile built with the profile
-    if (!(inGrid.GetTileSize() == inProfile.mTileSize))
-        return MakeError(ErrorCode::InvalidArgument, "navmesh: the tile grid's tile size (" +
-                                                         std::to_string(inGrid.GetTileSize()) +
-                                                         " m) is not the agent profile's (" +
-                                                         std::to_string(inProfile.mTileSize) + " m)");
-    if (!IsFiniteGrid(inGrid))
-        return MakeError(
-            ErrorCode::InvalidArgument,
-            "navmesh: the tile grid's origin and height range must be finite, min y below max y");
+    // The same check as BuildTile's: every tile built on a grid this world takes is one it can hold
+    if (Status valid = ValidateProfileAndGrid(inProfile, inGrid); !valid) return valid.GetError();
     Result<dtNavMeshParams> params = MakeNavMeshParams(inGrid, inMaxTiles);
     if (!params) return params.GetError();
     std::unique_ptr<NavMeshWorld> world(new NavMeshWorld(inGrid, inProfile));
@@ -147,6 +131,7 @@ Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGri
 
 NavMeshWorld::~NavMeshWorld()
 {
+    // Before mTiles frees the tiles' data: the navmesh points into it to the end
     dtFreeNavMesh(mNavMesh);
 }
 
@@ -177,38 +162,91 @@ int NavMeshWorld::Publish()
     for (auto& [coord, entry] : pending)
     {
         BuiltTile& tile = entry.mTile;
-        const dtTileRef old = mNavMesh->getTileRefAt(coord.mX, coord.mZ, 0);
-        auto refuse = [&](const std::string& inWhy)
+        if (tile.mData == nullptr)
         {
-            ++mRefusedTiles;
-            mLastRefusal = "tile " + std::to_string(coord.mX) + "," + std::to_string(coord.mZ) + ": " + inWhy;
-        };
-        // Checked before the old tile goes: a refused tile must not leave a hole where a good one was
-        if (tile.mData != nullptr && tile.mNumPolygons > mNavMesh->getParams()->maxPolys)
-        {
-            refuse(std::to_string(tile.mNumPolygons) + " polygons, over the " +
-                   std::to_string(mNavMesh->getParams()->maxPolys) + " a tile reference holds");
+            changed += RemoveTileLocked(coord);
             continue;
         }
-        if (old != 0)
-        {
-            mNavMesh->removeTile(old, nullptr, nullptr); // Frees its data (added with DT_TILE_FREE_DATA)
-            mTilePolygons.erase(coord);
-            ++changed;
-        }
-        if (tile.mData == nullptr) continue;
-        // On success the navmesh owns the data; on failure (out of tiles) it stays ours and is freed
-        if (dtStatusSucceed(
-                mNavMesh->addTile(tile.mData.get(), tile.mDataSize, DT_TILE_FREE_DATA, 0, nullptr)))
-        {
-            (void)tile.mData.release();
-            mTilePolygons[coord] = tile.mNumPolygons;
-            ++changed;
-        }
+        // Checked before the old tile goes: a refused tile must not leave a hole where a good one was
+        if (const std::string problem = CheckTileLocked(coord, tile); !problem.empty())
+            RefuseLocked(coord, problem);
         else
-            refuse("Detour refused it (no free tile slot, or its data is invalid)");
+            changed += ReplaceTileLocked(coord, tile);
     }
     return changed;
+}
+
+std::string NavMeshWorld::CheckTileLocked(const TileCoord& inCoord, const BuiltTile& inTile) const
+{
+    if (inTile.mDataSize <= 0) return "its data size is " + std::to_string(inTile.mDataSize);
+    // Detour's addTile trusts the header's counts and indices: corrupt data would be read past its end
+    const std::span<const unsigned char> data(inTile.mData.get(), size_t(inTile.mDataSize));
+    if (std::string problem = CheckTileData(data); !problem.empty()) return problem;
+    dtMeshHeader header;
+    std::memcpy(&header, data.data(), sizeof(header));
+    // Detour places a tile by its header: one handed in under another coordinate (or layer) would sit where
+    // this world's bookkeeping does not look, and could never be replaced or removed
+    if (header.x != inCoord.mX || header.y != inCoord.mZ || header.layer != 0)
+        return "its data is tile " + std::to_string(header.x) + "," + std::to_string(header.y) + " (layer " +
+               std::to_string(header.layer) + ")";
+    const int maxPolygons = mNavMesh->getParams()->maxPolys;
+    const int polygons = std::max(inTile.mNumPolygons, header.polyCount);
+    if (polygons > maxPolygons)
+        return std::to_string(polygons) + " polygons, over the " + std::to_string(maxPolygons) +
+               " a tile reference holds";
+    return {};
+}
+
+int NavMeshWorld::RemoveTileLocked(const TileCoord& inCoord)
+{
+    auto it = mTiles.find(inCoord);
+    if (it == mTiles.end()) return 0;
+    // Added without DT_TILE_FREE_DATA: Detour lets go of the data, and erasing the entry frees it
+    mNavMesh->removeTile(dtTileRef(it->second.mRef), nullptr, nullptr);
+    mTiles.erase(it);
+    return 1;
+}
+
+int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
+{
+    // Detour holds one tile per place, so the old one leaves first; its data stays ours until the new tile is
+    // in, to go back if Detour refuses the new one after all
+    PublishedTile old;
+    if (auto it = mTiles.find(inCoord); it != mTiles.end())
+    {
+        mNavMesh->removeTile(dtTileRef(it->second.mRef), nullptr, nullptr);
+        old = std::move(it->second);
+        mTiles.erase(it);
+    }
+    dtTileRef ref = 0;
+    const dtStatus added = mNavMesh->addTile(ioTile.mData.get(), ioTile.mDataSize, 0, 0, &ref);
+    if (dtStatusSucceed(added))
+    {
+        mTiles[inCoord] = {ref, ioTile.mNumPolygons, ioTile.mDataSize, std::move(ioTile.mData)};
+        return old.mData != nullptr ? 2 : 1;
+    }
+    const std::string why = dtStatusDetail(added, DT_OUT_OF_MEMORY) ? "no free tile slot" : "invalid data";
+    if (old.mData == nullptr)
+    {
+        RefuseLocked(inCoord, "Detour refused it (" + why + ")");
+        return 0;
+    }
+    // Back under its old reference (Detour restores the salt): polygon references taken before stay valid.
+    // The slot it left is free and Detour took its data before, so this fails only with a bug in Detour
+    if (dtStatusSucceed(mNavMesh->addTile(old.mData.get(), old.mDataSize, 0, dtTileRef(old.mRef), nullptr)))
+    {
+        mTiles[inCoord] = std::move(old);
+        RefuseLocked(inCoord, "Detour refused it (" + why + "); the old tile stays");
+        return 0;
+    }
+    RefuseLocked(inCoord, "Detour refused it (" + why + "), and the old tile could not go back: a hole");
+    return 1; // The old tile's removal
+}
+
+void NavMeshWorld::RefuseLocked(const TileCoord& inCoord, const std::string& inWhy)
+{
+    ++mRefusedTiles;
+    mLastRefusal = "tile " + std::to_string(inCoord.mX) + "," + std::to_string(inCoord.mZ) + ": " + inWhy;
 }
 
 uint64_t NavMeshWorld::GetRefusedTiles(std::string* outLastReason) const
@@ -360,20 +398,20 @@ Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inR
 int NavMeshWorld::GetNumTiles() const
 {
     std::shared_lock lock(mNavMeshMutex);
-    return int(mTilePolygons.size());
+    return int(mTiles.size());
 }
 
 bool NavMeshWorld::HasTile(const TileCoord& inTile) const
 {
     std::shared_lock lock(mNavMeshMutex);
-    return mTilePolygons.contains(inTile);
+    return mTiles.contains(inTile);
 }
 
 int NavMeshWorld::GetTilePolygonCount(const TileCoord& inTile) const
 {
     std::shared_lock lock(mNavMeshMutex);
-    auto it = mTilePolygons.find(inTile);
-    return it == mTilePolygons.end() ? 0 : it->second;
+    auto it = mTiles.find(inTile);
+    return it == mTiles.end() ? 0 : it->second.mNumPolygons;
 }
 
 std::string NavMeshWorld::ToObj() const

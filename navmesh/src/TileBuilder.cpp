@@ -50,10 +50,29 @@ unsigned char ToRecastArea(uint8_t inArea)
 }
 } // namespace
 
+Status ValidateProfileAndGrid(const AgentProfile& inProfile, const TileGrid& inGrid)
+{
+    if (Status valid = inProfile.Validate(); !valid) return valid;
+    // The grid's tiles are the profile's: a different size would misplace every tile built with the profile
+    if (!(inGrid.GetTileSize() == inProfile.mTileSize))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: the tile grid's tile size (" +
+                                                         std::to_string(inGrid.GetTileSize()) +
+                                                         " m) is not the agent profile's (" +
+                                                         std::to_string(inProfile.mTileSize) + " m)");
+    // A NaN origin puts every tile nowhere, and an empty height range rasterises nothing
+    if (!std::isfinite(inGrid.GetOriginX()) || !std::isfinite(inGrid.GetOriginZ()) ||
+        !std::isfinite(inGrid.GetMinY()) || !std::isfinite(inGrid.GetMaxY()) ||
+        !(inGrid.GetMinY() < inGrid.GetMaxY()))
+        return MakeError(
+            ErrorCode::InvalidArgument,
+            "navmesh: the tile grid's origin and height range must be finite, min y below max y");
+    return Status::Ok();
+}
+
 Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGrid, const TileCoord& inTile,
                             const TileGeometry& inGeometry, std::span<const OffMeshLink> inLinks)
 {
-    if (Status valid = inProfile.Validate(); !valid) return valid.GetError();
+    if (Status valid = ValidateProfileAndGrid(inProfile, inGrid); !valid) return valid.GetError();
     const int numVertices = inGeometry.GetNumVertices(), numTriangles = inGeometry.GetNumTriangles();
     if (inGeometry.mTriangles.size() % 3 != 0 || inGeometry.mAreas.size() != size_t(numTriangles))
         return MakeError(ErrorCode::InvalidArgument, "tile geometry: one area per triangle of 3 indices");

@@ -33,6 +33,11 @@ struct NavMeshFileContents
     std::vector<NavMeshFileTile> mTiles; ///< Sorted by tile once saved or loaded
 };
 
+/// Empty when inData is a Detour tile whose sections fit its size and whose indices stay inside their arrays,
+/// else what is wrong. Detour's addTile trusts the header's counts and the polygons' indices: a flipped bit
+/// in a file, or a corrupt tile handed to NavMeshWorld, made it write and read outside the tile's buffer.
+std::string CheckTileData(std::span<const unsigned char> inData);
+
 /// Detour's navmesh parameters for a tiled navmesh on inGrid: tile and polygon bits shared out of a 32-bit
 /// polygon reference (10 bits of salt). Error when inMaxTiles leaves too few bits for polygons.
 Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles);

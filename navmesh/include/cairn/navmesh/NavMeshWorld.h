@@ -61,10 +61,12 @@ public:
     void SubmitTile(BuiltTile&& inTile);
     /// Queues the removal of a tile for the next Publish. Any thread.
     void SubmitRemoval(const TileCoord& inTile);
-    /// The sync point: swaps every queued tile in (or out). Returns how many tiles changed. Any thread, but
-    /// meant for one place in the frame; it waits for path queries in progress. A tile Detour cannot take
-    /// (more polygons than a tile reference holds, or no free tile slot) is refused: the tile already there
-    /// stays, and the refusal is counted (GetRefusedTiles).
+    /// The sync point: swaps every queued tile in (or out). Returns how many tiles changed (a replaced tile
+    /// counts its removal and its addition). Any thread, but meant for one place in the frame; it waits for
+    /// path queries in progress. A tile Detour cannot take is refused: data that is not a whole, consistent
+    /// Detour tile (CheckTileData), data of another tile than the one it was submitted as, more polygons than
+    /// a tile reference holds, or no free tile slot. The tile already there stays, and the refusal is counted
+    /// (GetRefusedTiles).
     int Publish();
     /// Tiles Publish refused so far, and why the last one was. Any thread.
     uint64_t GetRefusedTiles(std::string* outLastReason = nullptr) const;
@@ -107,16 +109,35 @@ public:
     std::map<TileCoord, std::vector<unsigned char>> SnapshotTiles() const;
 
 private:
+    /// A tile Detour holds. Its data is added without DT_TILE_FREE_DATA, so the world frees it, after Detour
+    /// has let go: a replaced tile's data can go back when Detour refuses its successor.
+    struct PublishedTile
+    {
+        uint64_t mRef = 0; ///< Its dtTileRef (whose width is Detour's build option)
+        int mNumPolygons = 0;
+        int mDataSize = 0;
+        TileDataPtr mData; ///< Null only in a moved-from tile
+    };
+
     NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile);
+
+    // Publish's steps, with mNavMeshMutex held exclusively. Each returns how many tiles changed.
+    /// Empty when Detour can take inTile (data not null) at inCoord, else why not.
+    std::string CheckTileLocked(const TileCoord& inCoord, const BuiltTile& inTile) const;
+    int RemoveTileLocked(const TileCoord& inCoord);
+    /// Swaps a checked tile in for the one at inCoord; when Detour refuses it, the old one goes back.
+    int ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile);
+    void RefuseLocked(const TileCoord& inCoord, const std::string& inWhy);
 
     const TileGrid mGrid;
     const AgentProfile mProfile;
     const uint64_t mSerial;                  ///< Tells apart worlds for the per-thread query objects
     mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish; shared: queries
     dtNavMesh* mNavMesh = nullptr;           ///< Guarded by mNavMeshMutex
-    std::map<TileCoord, int> mTilePolygons;  ///< Guarded by mNavMeshMutex
-    uint64_t mRefusedTiles = 0;              ///< Guarded by mNavMeshMutex
-    std::string mLastRefusal;                ///< Guarded by mNavMeshMutex
+    /// Guarded by mNavMeshMutex; exactly the tiles mNavMesh holds (each at its own coordinate, layer 0)
+    std::map<TileCoord, PublishedTile> mTiles;
+    uint64_t mRefusedTiles = 0; ///< Guarded by mNavMeshMutex
+    std::string mLastRefusal;   ///< Guarded by mNavMeshMutex
     std::mutex mPendingMutex;
     struct Pending
     {

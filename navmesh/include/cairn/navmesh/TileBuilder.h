@@ -47,9 +47,14 @@ struct BuiltTile
     double mBuildMs = 0.0; ///< Time spent in Recast and Detour
 };
 
+/// Error unless inProfile is valid (AgentProfile::Validate) and inGrid is a grid of its tiles: the profile's
+/// tile size, a finite origin and height range, min y below max y. BuildTile and NavMeshWorld::Create both
+/// check with it, so no tile is built on a grid the navmesh world would refuse.
+Status ValidateProfileAndGrid(const AgentProfile& inProfile, const TileGrid& inGrid);
+
 /// Builds tile inTile of inGrid from inGeometry (world space, covering at least the tile's bordered area) and
-/// the off-mesh links whose start lies in the tile (others are ignored). Errors: invalid profile, non-finite
-/// vertices or links, bad indices, or Recast running out of memory.
+/// the off-mesh links whose start lies in the tile (others are ignored). Errors: invalid profile or grid
+/// (ValidateProfileAndGrid), non-finite vertices or links, bad indices, or Recast running out of memory.
 Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGrid, const TileCoord& inTile,
                             const TileGeometry& inGeometry, std::span<const OffMeshLink> inLinks = {});
 
