@@ -1,0 +1,190 @@
+// Hostile input to the navmesh pipeline, beyond NavMeshBadInputTest and TileSchedulerTest. It proves that an
+// invoker or kept area the scheduler accepts really gets its tiles (a radius or box past the tile-list
+// cut-off must be refused, not silently need nothing); that a tile Publish cannot take leaves the tile
+// already there in place; that a tile handed in under another coordinate than its data's does not
+// desynchronise the world's bookkeeping from Detour's; that tile data with a corrupt header is refused before
+// Detour reads it; and that BuildTile refuses a tile grid that NavMeshWorld::Create would refuse.
+
+#include "NavMeshSceneFixture.h"
+#include "cairn/navmesh/TileBuilder.h"
+
+#include <DetourAlloc.h>
+#include <DetourNavMesh.h>
+#include <cstdlib>
+#include <cstring>
+#include <gtest/gtest.h>
+#include <limits>
+
+namespace cairn::navmesh::test
+{
+namespace
+{
+
+/// A flat 10 m square in tile (0, 0) of inGrid, built with the default profile.
+BuiltTile BuildFlatTile(const TileGrid& inGrid)
+{
+    TileGeometry geometry;
+    geometry.AddTriangle(Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 0), cDefaultArea);
+    geometry.AddTriangle(Vec3(10, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 10), cDefaultArea);
+    Result<BuiltTile> built = BuildTile(AgentProfile{}, inGrid, {0, 0}, geometry);
+    EXPECT_TRUE(built.IsOk());
+    EXPECT_NE(built.Value().mData, nullptr);
+    return std::move(built.Value());
+}
+
+/// A copy of inTile's data (Detour-allocated, as BuiltTile owns it), changed by inCorrupt.
+template <class F> BuiltTile CopyTile(const BuiltTile& inTile, F&& inCorrupt)
+{
+    BuiltTile copy;
+    copy.mTile = inTile.mTile;
+    copy.mDataSize = inTile.mDataSize;
+    copy.mNumPolygons = inTile.mNumPolygons;
+    copy.mNumVertices = inTile.mNumVertices;
+    auto* data = static_cast<unsigned char*>(dtAlloc(size_t(inTile.mDataSize), DT_ALLOC_PERM));
+    std::memcpy(data, inTile.mData.get(), size_t(inTile.mDataSize));
+    dtMeshHeader header;
+    std::memcpy(&header, data, sizeof(header));
+    inCorrupt(header);
+    std::memcpy(data, &header, sizeof(header));
+    copy.mData.reset(data);
+    return copy;
+}
+
+class NavMeshHostileInputTest : public NavMeshSceneFixture
+{
+protected:
+    /// A floor of 4 x 4 tiles and no kept area, as TileSchedulerTest's.
+    void MakeFloorWorld()
+    {
+        AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25.6f, 0.5f, 25.6f));
+        MakeNavMesh(2);
+        mScheduler->RemoveArea(mArea);
+        ASSERT_EQ(mScheduler->CountNeededNeverPublished(), 0u);
+    }
+};
+
+TEST_F(NavMeshHostileInputTest, AnInvokerWithAnAcceptedRadiusNeedsTheTilesAroundIt)
+{
+    MakeFloorWorld();
+    // In AddInvoker's range [0, 1e5] m, but its square spans more tiles than the scheduler lists (4096)
+    const Result<TileScheduler::InvokerID> invoker = mScheduler->AddInvoker(Vec3(2, 0, 2), 500.0f);
+    if (!invoker.IsOk())
+    {
+        EXPECT_EQ(invoker.GetError().mCode, ErrorCode::InvalidArgument) << "a clear refusal is fine";
+        return;
+    }
+    EXPECT_GT(mScheduler->CountNeededNeverPublished(), 0u)
+        << "accepted, yet not even the tile under the invoker is needed";
+    EXPECT_FALSE(mScheduler->IsIdle()) << "idle with an invoker standing on unbuilt ground";
+}
+
+TEST_F(NavMeshHostileInputTest, AnAcceptedAreaNeedsItsTiles)
+{
+    MakeFloorWorld();
+    // Inside the world's coordinates, but more tiles than the scheduler lists (65536)
+    const Result<TileScheduler::AreaID> area =
+        mScheduler->AddArea(AABB(Vec3(-2000, -5, -2000), Vec3(2000, 20, 2000)));
+    if (!area.IsOk())
+    {
+        EXPECT_EQ(area.GetError().mCode, ErrorCode::InvalidArgument) << "a clear refusal is fine";
+        return;
+    }
+    EXPECT_GT(mScheduler->CountNeededNeverPublished(), 0u) << "accepted, yet no tile of it is needed";
+    EXPECT_FALSE(mScheduler->IsIdle());
+}
+
+TEST(NavMeshHostileInputWorldTest, ATileDetourRefusesLeavesTheOldOneInPlace)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    ASSERT_TRUE(world);
+    const BuiltTile good = BuildFlatTile(grid);
+    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader&) {}));
+    ASSERT_EQ(world.Value()->Publish(), 1);
+    const int polygons = world.Value()->GetTilePolygonCount({0, 0});
+    ASSERT_GT(polygons, 0);
+
+    // Not Detour data at all (its magic number is gone): Detour refuses it without reading further
+    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.magic = 0; }));
+    (void)world.Value()->Publish();
+    EXPECT_EQ(world.Value()->GetRefusedTiles(), 1u);
+    EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons)
+        << "the refused tile took the good one with it: a hole in the navmesh";
+    EXPECT_TRUE(world.Value()->FindNearestPoint(Vec3(5, 0, 5)).IsOk()) << "no navmesh left at (5, 0, 5)";
+}
+
+TEST(NavMeshHostileInputWorldTest, ATileHandedInUnderAnotherCoordinateKeepsTheBookkeepingTrue)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    ASSERT_TRUE(world);
+    NavMeshWorld& navMesh = *world.Value();
+    // Data built for tile (0, 0), handed in as tile (3, 3)
+    BuiltTile mislabelled = BuildFlatTile(grid);
+    mislabelled.mTile = {3, 3};
+    navMesh.SubmitTile(std::move(mislabelled));
+    (void)navMesh.Publish();
+    const bool navMeshAtOrigin = navMesh.FindNearestPoint(Vec3(5, 0, 5)).IsOk();
+    EXPECT_FALSE(navMesh.HasTile({3, 3})) << "reported at (3, 3), where Detour has nothing";
+    EXPECT_EQ(navMesh.HasTile({0, 0}), navMeshAtOrigin)
+        << "Detour has a tile at (0, 0) the world does not list";
+    EXPECT_EQ(navMesh.GetNumTiles(), int(navMesh.SnapshotTiles().size()));
+
+    // Removing it by the coordinate it was handed in under must remove it
+    navMesh.SubmitRemoval({3, 3});
+    (void)navMesh.Publish();
+    EXPECT_EQ(navMesh.GetNumTiles(), 0) << "the world still lists it";
+    EXPECT_TRUE(navMesh.SnapshotTiles().empty()) << "Detour still holds it: it can never be removed";
+    EXPECT_FALSE(navMesh.FindNearestPoint(Vec3(5, 0, 5)).IsOk()) << "paths still use it";
+}
+
+TEST(NavMeshHostileInputWorldTest, BuildTileRefusesAGridTheWorldWouldRefuse)
+{
+    const AgentProfile profile;
+    TileGeometry geometry;
+    geometry.AddTriangle(Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 0), cDefaultArea);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const TileGrid nanOrigin(nan, 0, profile.mTileSize, -1, 10);
+    const TileGrid otherTileSize(0, 0, 4.0f * profile.mTileSize, -1, 10);
+    const TileGrid upsideDown(0, 0, profile.mTileSize, 10, -1);
+    ASSERT_FALSE(NavMeshWorld::Create(nanOrigin, profile));
+    ASSERT_FALSE(NavMeshWorld::Create(otherTileSize, profile));
+    ASSERT_FALSE(NavMeshWorld::Create(upsideDown, profile));
+    for (const auto& [grid, name] :
+         {std::pair{&nanOrigin, "NaN origin"}, std::pair{&otherTileSize, "tile size"},
+          std::pair{&upsideDown, "min y above max y"}})
+    {
+        const Result<BuiltTile> built = BuildTile(profile, *grid, {0, 0}, geometry);
+        EXPECT_FALSE(built.IsOk()) << name << ": built a tile of " << built.Value().mNumPolygons
+                                   << " polygons on a grid the navmesh world refuses";
+    }
+}
+
+/// Hands the world tile data whose header claims 1000 more vertices than it holds; exits 0 when Publish
+/// refused it, 1 when Detour took it (and read past the buffer).
+[[noreturn]] void PublishATileWithACorruptHeader()
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    if (!world) std::exit(2);
+    const BuiltTile good = BuildFlatTile(grid);
+    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.vertCount += 1000; }));
+    const int changed = world.Value()->Publish();
+    // Use what Detour linked, as a path query would
+    (void)world.Value()->FindNearestPoint(Vec3(5, 0, 5));
+    (void)world.Value()->ToObj();
+    std::exit(changed == 0 && world.Value()->GetRefusedTiles() == 1 ? 0 : 1);
+}
+
+TEST(NavMeshHostileInputDeathTest, TileDataWithACorruptHeaderIsRefusedBeforeDetourReadsIt)
+{
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(PublishATileWithACorruptHeader(), ::testing::ExitedWithCode(0), "")
+        << "exit code 1: Publish handed the corrupt tile to Detour; a signal: it crashed";
+}
+
+} // namespace
+} // namespace cairn::navmesh::test
