@@ -16,6 +16,12 @@ double ReachInTiles(float inRadius, float inTileSize)
 {
     return std::ceil(double(inRadius) / double(inTileSize));
 }
+
+Error UnknownInvoker(TileScheduler::InvokerID inInvoker)
+{
+    return MakeError(ErrorCode::InvalidArgument, "navmesh invoker " + std::to_string(inInvoker) +
+                                                     " is unknown (never added, or removed)");
+}
 } // namespace
 
 TileScheduler::TileScheduler(PhysicsSystem& ioPhysics, NavMeshWorld& ioWorld, jobs::BackgroundQueue& ioQueue,
@@ -71,17 +77,22 @@ Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPositio
     return id;
 }
 
-void TileScheduler::MoveInvoker(InvokerID inInvoker, const Vec3& inPosition)
+Status TileScheduler::MoveInvoker(InvokerID inInvoker, const Vec3& inPosition)
 {
+    if (!IsValidWorldPosition(inPosition))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
     std::lock_guard lock(mMutex);
-    if (auto it = mInvokers.find(inInvoker); it != mInvokers.end() && IsValidWorldPosition(inPosition))
-        it->second.mPosition = inPosition;
+    auto it = mInvokers.find(inInvoker);
+    if (it == mInvokers.end()) return UnknownInvoker(inInvoker);
+    it->second.mPosition = inPosition;
+    return Status::Ok();
 }
 
-void TileScheduler::RemoveInvoker(InvokerID inInvoker)
+Status TileScheduler::RemoveInvoker(InvokerID inInvoker)
 {
     std::lock_guard lock(mMutex);
-    mInvokers.erase(inInvoker);
+    if (mInvokers.erase(inInvoker) == 0) return UnknownInvoker(inInvoker);
+    return Status::Ok();
 }
 
 Result<TileScheduler::AreaID> TileScheduler::AddArea(const AABB& inBounds)
@@ -100,13 +111,16 @@ Result<TileScheduler::AreaID> TileScheduler::AddArea(const AABB& inBounds)
     return id;
 }
 
-void TileScheduler::RemoveArea(AreaID inArea)
+Status TileScheduler::RemoveArea(AreaID inArea)
 {
     std::lock_guard lock(mMutex);
     auto it = mAreas.find(inArea);
-    if (it == mAreas.end()) return;
+    if (it == mAreas.end())
+        return MakeError(ErrorCode::InvalidArgument,
+                         "navmesh area " + std::to_string(inArea) + " is unknown (never added, or removed)");
     (void)mWorld.GetGrid().TilesOverlapping(it->second, 0.0f, mDropNow, cMaxAreaTiles); // AddArea checked
     mAreas.erase(it);
+    return Status::Ok();
 }
 
 Result<TileScheduler::LinkID> TileScheduler::AddOffMeshLink(const OffMeshLink& inLink)

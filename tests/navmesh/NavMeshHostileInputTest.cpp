@@ -1,9 +1,10 @@
 // Hostile input to the navmesh pipeline, beyond NavMeshBadInputTest and TileSchedulerTest. It proves that an
 // invoker or kept area the scheduler accepts really gets its tiles (a radius or box past the tile-list
-// cut-off must be refused, not silently need nothing); that a tile Publish cannot take leaves the tile
-// already there in place; that a tile handed in under another coordinate than its data's does not
-// desynchronise the world's bookkeeping from Detour's; that tile data with a corrupt header is refused before
-// Detour reads it; and that BuildTile refuses a tile grid that NavMeshWorld::Create would refuse.
+// cut-off must be refused, not silently need nothing); that moving an invoker to nowhere, or moving or
+// removing an unknown invoker or area, is an error that changes nothing; that a tile Publish cannot take
+// leaves the tile already there in place; that a tile handed in under another coordinate than its data's does
+// not desynchronise the world's bookkeeping from Detour's; that tile data with a corrupt header is refused
+// before Detour reads it; and that BuildTile refuses a tile grid that NavMeshWorld::Create would refuse.
 
 #include "NavMeshSceneFixture.h"
 #include "cairn/navmesh/TileBuilder.h"
@@ -58,7 +59,7 @@ protected:
     {
         AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25.6f, 0.5f, 25.6f));
         MakeNavMesh(2);
-        mScheduler->RemoveArea(mArea);
+        ASSERT_TRUE(mScheduler->RemoveArea(mArea).IsOk());
         ASSERT_EQ(mScheduler->CountNeededNeverPublished(), 0u);
     }
 };
@@ -91,6 +92,32 @@ TEST_F(NavMeshHostileInputTest, AnAcceptedAreaNeedsItsTiles)
     }
     EXPECT_GT(mScheduler->CountNeededNeverPublished(), 0u) << "accepted, yet no tile of it is needed";
     EXPECT_FALSE(mScheduler->IsIdle());
+}
+
+TEST_F(NavMeshHostileInputTest, MovesAndRemovalsOfUnknownInvokersAndAreasOrToNowhereAreErrors)
+{
+    MakeFloorWorld();
+    const Result<TileScheduler::InvokerID> invoker = mScheduler->AddInvoker(Vec3(2, 0, 2), 5.0f);
+    ASSERT_TRUE(invoker.IsOk());
+    const size_t needed = mScheduler->CountNeededNeverPublished();
+    ASSERT_GT(needed, 0u);
+    // A NaN or far-off position is refused, and the invoker stays where it was
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(mScheduler->MoveInvoker(invoker.Value(), Vec3(nan, 0, 0)).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(mScheduler->MoveInvoker(invoker.Value(), Vec3(1e9f, 0, 0)).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(mScheduler->CountNeededNeverPublished(), needed);
+    // Ids that were never handed out, or were removed already
+    const TileScheduler::InvokerID unknown = invoker.Value() + 1000;
+    EXPECT_EQ(mScheduler->MoveInvoker(unknown, Vec3(2, 0, 2)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(mScheduler->RemoveInvoker(unknown).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_TRUE(mScheduler->RemoveInvoker(invoker.Value()).IsOk());
+    EXPECT_EQ(mScheduler->RemoveInvoker(invoker.Value()).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(mScheduler->MoveInvoker(invoker.Value(), Vec3(2, 0, 2)).GetError().mCode,
+              ErrorCode::InvalidArgument);
+    EXPECT_EQ(mScheduler->RemoveArea(mArea).GetError().mCode, ErrorCode::InvalidArgument)
+        << "removed already";
 }
 
 TEST(NavMeshHostileInputWorldTest, ATileDetourRefusesLeavesTheOldOneInPlace)

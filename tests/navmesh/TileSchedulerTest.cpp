@@ -19,7 +19,7 @@ protected:
     {
         AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25.6f, 0.5f, 25.6f));
         MakeNavMesh(2, inSettings);
-        mScheduler->RemoveArea(mArea);
+        ASSERT_TRUE(mScheduler->RemoveArea(mArea).IsOk());
     }
     TileCoord TileAt(float inX, float inZ) const { return mWorld->GetGrid().TileAt(inX, inZ); }
 };
@@ -61,7 +61,7 @@ TEST_F(TileSchedulerTest, TilesNoInvokerNeedsAreDroppedAfterTheDelay)
     ASSERT_TRUE(RunUntilIdle());
     const TileCoord before = TileAt(6.4f, 6.4f), after = TileAt(-19.2f, -19.2f);
     ASSERT_TRUE(mWorld->HasTile(before));
-    mScheduler->MoveInvoker(invoker, Vec3(-19.2f, 0, -19.2f)); // The centre of another tile
+    ASSERT_TRUE(mScheduler->MoveInvoker(invoker, Vec3(-19.2f, 0, -19.2f)).IsOk()); // Another tile's centre
     for (int frame = 0; frame < 5; ++frame)
         Frame();
     EXPECT_TRUE(mWorld->HasTile(before)); // Kept for a while: the agent may come back
@@ -79,7 +79,7 @@ TEST_F(TileSchedulerTest, ARemovedAreasTilesGoAtOnce)
     MakeNavMesh(1);
     ASSERT_TRUE(RunUntilIdle());
     ASSERT_EQ(mWorld->GetNumTiles(), 4);
-    mScheduler->RemoveArea(mArea); // Streamed out
+    ASSERT_TRUE(mScheduler->RemoveArea(mArea).IsOk()); // Streamed out
     Frame();
     EXPECT_EQ(mWorld->GetNumTiles(), 0);
 }

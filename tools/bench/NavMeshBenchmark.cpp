@@ -251,7 +251,7 @@ void RunInvokerLatency(const SharedBenchData& inData)
     {
         if (frame % 20 == 0)
         {
-            if (invoker != 0) scheduler.RemoveInvoker(invoker);
+            if (invoker != 0) (void)scheduler.RemoveInvoker(invoker); // The one added 20 frames before
             const int index = frame / 20;
             invoker = scheduler
                           .AddInvoker(Vec3(6.4f + 12.8f * float(index % 30), 0.0f,

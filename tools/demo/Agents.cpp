@@ -39,7 +39,7 @@ Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, cons
 Agents::~Agents()
 {
     for (const Agent& agent : mAgents)
-        mScheduler.RemoveInvoker(agent.mInvoker);
+        (void)mScheduler.RemoveInvoker(agent.mInvoker); // Its own, added once: it can not be unknown
 }
 
 Vec3 Agents::OnGround(const Vec3& inPoint) const
@@ -142,7 +142,9 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer)
             agent.mRepathIn = 0.0f; // A new goal from where it stands now
             ++mStats.mCatchUps;
         }
-        mScheduler.MoveInvoker(agent.mInvoker, agent.mPosition);
+        if (Status moved = mScheduler.MoveInvoker(agent.mInvoker, agent.mPosition);
+            !moved && mStats.mErrors.size() < 20)
+            mStats.mErrors.push_back("agent's navmesh invoker: " + moved.GetError().mMessage);
     }
 }
 

@@ -88,15 +88,18 @@ public:
     /// for a position outside the world, a radius that is not in [0, 1e5] m, or one that reaches more than
     /// cMaxInvokerReachTiles tiles (the error names the limit in metres).
     Result<InvokerID> AddInvoker(const Vec3& inPosition, float inRadius);
-    /// A position outside the world is ignored. The radius keeps to the limit wherever the invoker goes: it
-    /// never needs more tiles than are looked for.
-    void MoveInvoker(InvokerID inInvoker, const Vec3& inPosition);
-    void RemoveInvoker(InvokerID inInvoker);
+    /// Error (and the invoker stays where it was) for an unknown invoker or a position that is NaN or outside
+    /// the world. The radius keeps to the limit wherever the invoker goes: it never needs more tiles than are
+    /// looked for.
+    Status MoveInvoker(InvokerID inInvoker, const Vec3& inPosition);
+    /// Error for an unknown invoker (never added, or removed already).
+    Status RemoveInvoker(InvokerID inInvoker);
     /// Areas: every tile overlapping inBounds is kept built until RemoveArea, which drops them at once
     /// (unless an invoker or another area still needs them). Any thread.
     /// Error for bounds outside the world, empty, or overlapping more than cMaxAreaTiles tiles.
     Result<AreaID> AddArea(const AABB& inBounds);
-    void RemoveArea(AreaID inArea);
+    /// Error for an unknown area (never added, or removed already).
+    Status RemoveArea(AreaID inArea);
 
     /// Off-mesh links (jumps, ladders): built into the tile that holds the start; adding or removing one
     /// makes that tile dirty. Any thread.
