@@ -85,6 +85,20 @@ TEST(HeightFieldShapeTest, RejectsBadInput)
     EXPECT_EQ(field->GetType(), ShapeType::HeightField);
 }
 
+TEST(HeightFieldShapeTest, SamplesAndCellsOutsideTheGridReadAsHoles)
+{
+    const std::vector<float> heights = {0, 1, 2, 3, 4, 5}; // 3 x 2 samples, 2 x 1 cells
+    auto field = HeightFieldShape::Create(3, 2, 1.0f, heights).Value();
+    EXPECT_EQ(field->GetHeight(2, 1), 5.0f);
+    EXPECT_TRUE(std::isnan(field->GetHeight(3, 0))) << "one past the row";
+    EXPECT_TRUE(std::isnan(field->GetHeight(0, 2))) << "one past the last row";
+    EXPECT_TRUE(std::isnan(field->GetHeight(UINT32_MAX, UINT32_MAX)));
+    EXPECT_EQ(field->GetCellActiveEdges(2, 0), 0u) << "the samples' last column has no cell";
+    EXPECT_EQ(field->GetCellActiveEdges(0, 1), 0u);
+    EXPECT_EQ(field->GetCellActiveEdges(UINT32_MAX, 0), 0u) << "x + 1 wraps in 32 bits";
+    EXPECT_EQ(field->GetCellActiveEdges(0, UINT32_MAX), 0u);
+}
+
 TEST(HeightFieldShapeTest, TrianglesLayoutAndIds)
 {
     // 3 x 2 samples, cell size 2: 2 cells, 4 triangles facing up

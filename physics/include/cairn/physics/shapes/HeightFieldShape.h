@@ -9,7 +9,6 @@
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/shapes/Shape.h"
 
-#include <cassert>
 #include <span>
 
 namespace cairn
@@ -33,13 +32,18 @@ public:
     uint32_t GetSampleCountX() const { return mSampleCountX; }
     uint32_t GetSampleCountZ() const { return mSampleCountZ; }
     float GetCellSize() const { return mCellSize; }
-    /// Height of sample (x, z); NaN for a hole.
-    float GetHeight(uint32_t inX, uint32_t inZ) const { return mHeights[inX + size_t(inZ) * mSampleCountX]; }
+    /// Height of sample (x, z); NaN for a hole, and for a sample outside the grid (never a read past it).
+    float GetHeight(uint32_t inX, uint32_t inZ) const
+    {
+        if (inX >= mSampleCountX || inZ >= mSampleCountZ) return cHole;
+        return mHeights[inX + size_t(inZ) * mSampleCountX];
+    }
     /// Active-edge bits of cell (x, z) (x < GetSampleCountX() - 1, z < GetSampleCountZ() - 1): bits 0-2 are
-    /// those of its half 0, bits 3-5 of its half 1 (Triangle::mActiveEdges); 0 for a hole.
+    /// those of its half 0, bits 3-5 of its half 1 (Triangle::mActiveEdges); 0 for a hole, and for a cell
+    /// outside the grid.
     uint8_t GetCellActiveEdges(uint32_t inX, uint32_t inZ) const
     {
-        assert(inX + 1 < mSampleCountX && inZ + 1 < mSampleCountZ);
+        if (uint64_t(inX) + 1 >= mSampleCountX || uint64_t(inZ) + 1 >= mSampleCountZ) return 0;
         return mCellActiveEdges[inX + size_t(inZ) * (mSampleCountX - 1)];
     }
 
