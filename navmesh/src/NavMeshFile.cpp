@@ -71,6 +71,12 @@ std::string CheckTileData(std::span<const unsigned char> inData)
     for (const int count : {h.vertCount, h.polyCount, h.maxLinkCount, h.detailMeshCount, h.detailVertCount,
                             h.detailTriCount, h.bvNodeCount, h.offMeshConCount})
         if (count < 0 || count > cMaxCount) return "a section count is negative or over 2^20";
+    // addTile threads the links into a free list and ends it at link maxLinkCount - 1: with none it writes
+    // before the section (every real tile has a link per polygon edge at least)
+    if (h.maxLinkCount < 1) return "it has no room for links";
+    if (h.offMeshBase < 0 || h.offMeshBase > h.polyCount) return "the off-mesh base is outside the polygons";
+    if (h.offMeshConCount > h.polyCount - h.offMeshBase)
+        return "more off-mesh connections than polygons from the off-mesh base";
     // The sections in Detour's order, each padded to 4 bytes (dtNavMesh::addTile)
     size_t offset = size_t(dtAlign4(int(sizeof(dtMeshHeader))));
     auto section = [&](size_t inElementSize, int inCount)
@@ -95,6 +101,9 @@ std::string CheckTileData(std::span<const unsigned char> inData)
     {
         const dtPoly poly = ReadAt<dtPoly>(inData, polys, size_t(i));
         const bool offMeshPoly = poly.getType() == DT_POLYTYPE_OFFMESH_CONNECTION;
+        // Detour finds an off-mesh polygon's connection at index i - offMeshBase, unchecked
+        if (offMeshPoly && (i < h.offMeshBase || i - h.offMeshBase >= h.offMeshConCount))
+            return "off-mesh polygon " + std::to_string(i) + " has no off-mesh connection";
         if (poly.vertCount > DT_VERTS_PER_POLYGON || poly.vertCount < (offMeshPoly ? 2 : 3))
             return "polygon " + std::to_string(i) + " has " + std::to_string(poly.vertCount) + " vertices";
         for (int j = 0; j < poly.vertCount; ++j)
@@ -124,7 +133,6 @@ std::string CheckTileData(std::span<const unsigned char> inData)
         if (index >= h.polyCount || (index < 0 && (index == INT32_MIN || -index > h.bvNodeCount - i)))
             return "bounding-volume node " + std::to_string(i) + " points outside the tree";
     }
-    if (h.offMeshBase < 0 || h.offMeshBase > h.polyCount) return "the off-mesh base is outside the polygons";
     for (int i = 0; i < h.offMeshConCount; ++i)
         if (ReadAt<dtOffMeshConnection>(inData, offMesh, size_t(i)).poly >= h.polyCount)
             return "off-mesh connection " + std::to_string(i) + " names a missing polygon";

@@ -123,6 +123,7 @@ Result<std::unique_ptr<NavMeshWorld>> NavMeshWorld::Create(const TileGrid& inGri
     Result<dtNavMeshParams> params = MakeNavMeshParams(inGrid, inMaxTiles);
     if (!params) return params.GetError();
     std::unique_ptr<NavMeshWorld> world(new NavMeshWorld(inGrid, inProfile));
+    world->mMaxTilePolygons = params.Value().maxPolys;
     world->mNavMesh = dtAllocNavMesh();
     if (world->mNavMesh == nullptr || dtStatusFailed(world->mNavMesh->init(&params.Value())))
         return MakeError(ErrorCode::OutOfCapacity, "navmesh: Detour could not allocate the navmesh");
@@ -157,18 +158,22 @@ int NavMeshWorld::Publish()
         pending.swap(mPending);
     }
     if (pending.empty()) return 0;
+    // Checked before the navmesh mutex is taken (the checks walk every polygon; path queries need not wait
+    // for them) and before the old tile goes: a refused tile must not leave a hole where a good one was
+    std::vector<std::string> problems;
+    problems.reserve(pending.size());
+    for (const auto& [coord, entry] : pending)
+        problems.push_back(entry.mTile.mData == nullptr ? std::string() : CheckTile(coord, entry.mTile));
     std::unique_lock lock(mNavMeshMutex);
     int changed = 0;
+    size_t index = 0;
     for (auto& [coord, entry] : pending)
     {
         BuiltTile& tile = entry.mTile;
+        const std::string& problem = problems[index++];
         if (tile.mData == nullptr)
-        {
             changed += RemoveTileLocked(coord);
-            continue;
-        }
-        // Checked before the old tile goes: a refused tile must not leave a hole where a good one was
-        if (const std::string problem = CheckTileLocked(coord, tile); !problem.empty())
+        else if (!problem.empty())
             RefuseLocked(coord, problem);
         else
             changed += ReplaceTileLocked(coord, tile);
@@ -176,7 +181,7 @@ int NavMeshWorld::Publish()
     return changed;
 }
 
-std::string NavMeshWorld::CheckTileLocked(const TileCoord& inCoord, const BuiltTile& inTile) const
+std::string NavMeshWorld::CheckTile(const TileCoord& inCoord, const BuiltTile& inTile) const
 {
     if (inTile.mDataSize <= 0) return "its data size is " + std::to_string(inTile.mDataSize);
     // Detour's addTile trusts the header's counts and indices: corrupt data would be read past its end
@@ -189,7 +194,7 @@ std::string NavMeshWorld::CheckTileLocked(const TileCoord& inCoord, const BuiltT
     if (header.x != inCoord.mX || header.y != inCoord.mZ || header.layer != 0)
         return "its data is tile " + std::to_string(header.x) + "," + std::to_string(header.y) + " (layer " +
                std::to_string(header.layer) + ")";
-    const int maxPolygons = mNavMesh->getParams()->maxPolys;
+    const int maxPolygons = mMaxTilePolygons;
     const int polygons = std::max(inTile.mNumPolygons, header.polyCount);
     if (polygons > maxPolygons)
         return std::to_string(polygons) + " polygons, over the " + std::to_string(maxPolygons) +
@@ -201,33 +206,45 @@ int NavMeshWorld::RemoveTileLocked(const TileCoord& inCoord)
 {
     auto it = mTiles.find(inCoord);
     if (it == mTiles.end()) return 0;
-    // Added without DT_TILE_FREE_DATA: Detour lets go of the data, and erasing the entry frees it
-    mNavMesh->removeTile(dtTileRef(it->second.mRef), nullptr, nullptr);
+    // Added without DT_TILE_FREE_DATA: Detour lets go of the data, and erasing the entry frees it. Should
+    // Detour not let go, the data must stay: it would still point into it
+    if (dtStatusFailed(mNavMesh->removeTile(dtTileRef(it->second.mRef), nullptr, nullptr)))
+    {
+        RefuseLocked(inCoord, "Detour could not remove it (its tile reference is wrong); it stays");
+        return 0;
+    }
     mTiles.erase(it);
     return 1;
 }
 
 int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
 {
+    // The map's node first: once Detour has taken the data, nothing may throw before the world keeps it
+    auto [entry, isNew] = mTiles.try_emplace(inCoord);
     // Detour holds one tile per place, so the old one leaves first; its data stays ours until the new tile is
     // in, to go back if Detour refuses the new one after all
     PublishedTile old;
-    if (auto it = mTiles.find(inCoord); it != mTiles.end())
+    if (!isNew)
     {
-        mNavMesh->removeTile(dtTileRef(it->second.mRef), nullptr, nullptr);
-        old = std::move(it->second);
-        mTiles.erase(it);
+        if (dtStatusFailed(mNavMesh->removeTile(dtTileRef(entry->second.mRef), nullptr, nullptr)))
+        {
+            RefuseLocked(inCoord, "Detour could not remove the tile there (its tile reference is wrong); it "
+                                  "stays");
+            return 0;
+        }
+        old = std::move(entry->second);
     }
     dtTileRef ref = 0;
     const dtStatus added = mNavMesh->addTile(ioTile.mData.get(), ioTile.mDataSize, 0, 0, &ref);
     if (dtStatusSucceed(added))
     {
-        mTiles[inCoord] = {ref, ioTile.mNumPolygons, ioTile.mDataSize, std::move(ioTile.mData)};
-        return old.mData != nullptr ? 2 : 1;
+        entry->second = {ref, ioTile.mNumPolygons, ioTile.mDataSize, std::move(ioTile.mData)};
+        return isNew ? 1 : 2;
     }
     const std::string why = dtStatusDetail(added, DT_OUT_OF_MEMORY) ? "no free tile slot" : "invalid data";
-    if (old.mData == nullptr)
+    if (isNew)
     {
+        mTiles.erase(entry);
         RefuseLocked(inCoord, "Detour refused it (" + why + ")");
         return 0;
     }
@@ -235,10 +252,11 @@ int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
     // The slot it left is free and Detour took its data before, so this fails only with a bug in Detour
     if (dtStatusSucceed(mNavMesh->addTile(old.mData.get(), old.mDataSize, 0, dtTileRef(old.mRef), nullptr)))
     {
-        mTiles[inCoord] = std::move(old);
+        entry->second = std::move(old);
         RefuseLocked(inCoord, "Detour refused it (" + why + "); the old tile stays");
         return 0;
     }
+    mTiles.erase(entry);
     RefuseLocked(inCoord, "Detour refused it (" + why + "), and the old tile could not go back: a hole");
     return 1; // The old tile's removal
 }

@@ -62,12 +62,12 @@ Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPositio
         return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: radius must be in [0, 1e5] m");
     // Checked here, not where the tiles are looked for: a radius that reached further would silently need
     // none of the tiles past the square, or, cut off, none at all
-    const float tileSize = mWorld.GetGrid().GetTileSize();
-    if (ReachInTiles(inRadius, tileSize) > double(cMaxInvokerReachTiles))
+    // In double, where 30 tile sizes are exact: a radius at the limit is taken, and then reaches 30 tiles
+    const double maxRadius = double(cMaxInvokerReachTiles) * double(mWorld.GetGrid().GetTileSize());
+    if (double(inRadius) > maxRadius)
         return MakeError(ErrorCode::InvalidArgument,
                          "navmesh invoker: a radius of " + std::to_string(inRadius) + " m is over the " +
-                             std::to_string(float(cMaxInvokerReachTiles) * tileSize) + " m (" +
-                             std::to_string(cMaxInvokerReachTiles) +
+                             std::to_string(maxRadius) + " m (" + std::to_string(cMaxInvokerReachTiles) +
                              " tiles) an invoker may reach: its tiles are looked for in at most " +
                              std::to_string(cMaxInvokerTilesAcross) + " x " +
                              std::to_string(cMaxInvokerTilesAcross) + " tiles");

@@ -11,6 +11,8 @@
 
 #include <DetourAlloc.h>
 #include <DetourNavMesh.h>
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <gtest/gtest.h>
@@ -47,6 +49,34 @@ template <class F> BuiltTile CopyTile(const BuiltTile& inTile, F&& inCorrupt)
     std::memcpy(&header, data, sizeof(header));
     inCorrupt(header);
     std::memcpy(data, &header, sizeof(header));
+    copy.mData.reset(data);
+    return copy;
+}
+
+/// inTile's data rebuilt without its links section and with maxLinkCount 0: every other section intact and
+/// where the header's counts put it, so only the missing links are wrong.
+BuiltTile WithoutLinks(const BuiltTile& inTile)
+{
+    const unsigned char* source = inTile.mData.get();
+    dtMeshHeader header;
+    std::memcpy(&header, source, sizeof(header));
+    auto padded = [](size_t inBytes) { return (inBytes + 3) & ~size_t(3); };
+    const size_t headerBytes = padded(sizeof(dtMeshHeader));
+    const size_t beforeLinks = padded(3 * sizeof(float) * size_t(header.vertCount)) +
+                               padded(sizeof(dtPoly) * size_t(header.polyCount));
+    const size_t linkBytes = padded(sizeof(dtLink) * size_t(header.maxLinkCount));
+    const size_t afterLinks = size_t(inTile.mDataSize) - headerBytes - beforeLinks - linkBytes;
+    header.maxLinkCount = 0;
+    BuiltTile copy;
+    copy.mTile = inTile.mTile;
+    copy.mNumPolygons = inTile.mNumPolygons;
+    copy.mNumVertices = inTile.mNumVertices;
+    copy.mDataSize = int(headerBytes + beforeLinks + afterLinks);
+    auto* data = static_cast<unsigned char*>(dtAlloc(size_t(copy.mDataSize), DT_ALLOC_PERM));
+    std::memset(data, 0, headerBytes);
+    std::memcpy(data, &header, sizeof(header));
+    std::memcpy(data + headerBytes, source + headerBytes, beforeLinks);
+    std::memcpy(data + headerBytes + beforeLinks, source + headerBytes + beforeLinks + linkBytes, afterLinks);
     copy.mData.reset(data);
     return copy;
 }
@@ -94,6 +124,37 @@ TEST_F(NavMeshHostileInputTest, AnAcceptedAreaNeedsItsTiles)
     EXPECT_FALSE(mScheduler->IsIdle());
 }
 
+TEST_F(NavMeshHostileInputTest, AnInvokerAtTheRadiusLimitNeedsEveryTileWithinIt)
+{
+    MakeFloorWorld();
+    const TileGrid& grid = mWorld->GetGrid();
+    const float limit = float(TileScheduler::cMaxInvokerReachTiles) * grid.GetTileSize(); // 384 m
+    EXPECT_FALSE(mScheduler->AddInvoker(Vec3(0, 0, 0), std::nextafter(limit, 1e6f)).IsOk())
+        << "past the limit";
+    // At the limit, standing on a tile's corner (where the radius reaches furthest into other tiles) and
+    // inside one: every tile within the radius is needed, as a brute-force count over the grid says
+    for (const Vec3& position : {Vec3(grid.GetOriginX() + 40.0f * grid.GetTileSize(), 0,
+                                      grid.GetOriginZ() + 40.0f * grid.GetTileSize()),
+                                 Vec3(503.3f, 0, -731.9f)})
+    {
+        const Result<TileScheduler::InvokerID> invoker = mScheduler->AddInvoker(position, limit);
+        ASSERT_TRUE(invoker.IsOk()) << invoker.GetError().mMessage;
+        const TileCoord centre = grid.TileAt(position.x(), position.z());
+        uint32_t within = 0;
+        for (int32_t z = centre.mZ - 40; z <= centre.mZ + 40; ++z)
+            for (int32_t x = centre.mX - 40; x <= centre.mX + 40; ++x)
+            {
+                const AABB box = grid.GetTileBounds({x, z});
+                const float dx = std::max({box.mMin.x() - position.x(), 0.0f, position.x() - box.mMax.x()});
+                const float dz = std::max({box.mMin.z() - position.z(), 0.0f, position.z() - box.mMax.z()});
+                if (std::sqrt(dx * dx + dz * dz) <= limit) ++within;
+            }
+        EXPECT_GT(within, 2000u);
+        EXPECT_EQ(mScheduler->CountNeededNeverPublished(), within) << position.transpose();
+        ASSERT_TRUE(mScheduler->RemoveInvoker(invoker.Value()).IsOk());
+    }
+}
+
 TEST_F(NavMeshHostileInputTest, MovesAndRemovalsOfUnknownInvokersAndAreasOrToNowhereAreErrors)
 {
     MakeFloorWorld();
@@ -139,6 +200,25 @@ TEST(NavMeshHostileInputWorldTest, ATileDetourRefusesLeavesTheOldOneInPlace)
     EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons)
         << "the refused tile took the good one with it: a hole in the navmesh";
     EXPECT_TRUE(world.Value()->FindNearestPoint(Vec3(5, 0, 5)).IsOk()) << "no navmesh left at (5, 0, 5)";
+}
+
+TEST(NavMeshHostileInputWorldTest, ATileWithNoRoomForLinksIsRefused)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    ASSERT_TRUE(world);
+    const BuiltTile good = BuildFlatTile(grid);
+    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader&) {}));
+    ASSERT_EQ(world.Value()->Publish(), 1);
+    const int polygons = world.Value()->GetTilePolygonCount({0, 0});
+    // Whole and consistent but with no room for links: addTile would end its free list before the section
+    // and hand out links over the detail meshes
+    world.Value()->SubmitTile(WithoutLinks(good));
+    EXPECT_EQ(world.Value()->Publish(), 0);
+    EXPECT_EQ(world.Value()->GetRefusedTiles(), 1u);
+    EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons);
+    EXPECT_TRUE(world.Value()->FindNearestPoint(Vec3(5, 0, 5)).IsOk());
 }
 
 TEST(NavMeshHostileInputWorldTest, ATileHandedInUnderAnotherCoordinateKeepsTheBookkeepingTrue)

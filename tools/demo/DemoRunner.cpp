@@ -185,6 +185,8 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mAgentDistanceMetres = agentStats.mDistance;
     result.mAgentCatchUps = agentStats.mCatchUps;
     result.mPathsThroughWalls = agentStats.mPathsThroughWalls;
+    for (const std::string& error : agentStats.mErrors)
+        result.mErrors.push_back("agents: " + error);
     result.mQueries = gameObjects->GetNumQueries();
     if (const uint64_t queryErrors = gameObjects->GetNumQueryErrors(); queryErrors > 0)
         result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");

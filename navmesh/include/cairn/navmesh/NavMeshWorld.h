@@ -121,9 +121,10 @@ private:
 
     NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile);
 
+    /// Empty when Detour can take inTile (data not null) at inCoord, else why not. No lock: it reads the tile
+    /// and mMaxTilePolygons only.
+    std::string CheckTile(const TileCoord& inCoord, const BuiltTile& inTile) const;
     // Publish's steps, with mNavMeshMutex held exclusively. Each returns how many tiles changed.
-    /// Empty when Detour can take inTile (data not null) at inCoord, else why not.
-    std::string CheckTileLocked(const TileCoord& inCoord, const BuiltTile& inTile) const;
     int RemoveTileLocked(const TileCoord& inCoord);
     /// Swaps a checked tile in for the one at inCoord; when Detour refuses it, the old one goes back.
     int ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile);
@@ -134,6 +135,7 @@ private:
     const uint64_t mSerial;                  ///< Tells apart worlds for the per-thread query objects
     mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish; shared: queries
     dtNavMesh* mNavMesh = nullptr;           ///< Guarded by mNavMeshMutex
+    int mMaxTilePolygons = 0; ///< Detour's polygons per tile reference: set by Create, read-only after
     /// Guarded by mNavMeshMutex; exactly the tiles mNavMesh holds (each at its own coordinate, layer 0)
     std::map<TileCoord, PublishedTile> mTiles;
     uint64_t mRefusedTiles = 0; ///< Guarded by mNavMeshMutex

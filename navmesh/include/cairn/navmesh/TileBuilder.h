@@ -15,7 +15,8 @@
 namespace cairn::navmesh
 {
 
-/// Detour tile data (dtAlloc'ed), freed with dtFree unless handed to a dtNavMesh.
+/// Detour tile data (dtAlloc'ed), freed with dtFree by whoever holds it last (NavMeshWorld keeps the data of
+/// the tiles it hands to Detour, and frees it after Detour lets go).
 struct DetourFree
 {
     void operator()(unsigned char* inData) const;
