@@ -140,7 +140,7 @@ void NavMeshWorld::SubmitTile(BuiltTile&& inTile)
 {
     std::lock_guard lock(mPendingMutex);
     const TileCoord tile = inTile.mTile;
-    mPending[tile] = Pending{std::move(inTile)};
+    mPending[tile] = Pending{std::move(inTile), {}};
 }
 
 void NavMeshWorld::SubmitRemoval(const TileCoord& inTile)
@@ -160,23 +160,18 @@ int NavMeshWorld::Publish()
     if (pending.empty()) return 0;
     // Checked before the navmesh mutex is taken (the checks walk every polygon; path queries need not wait
     // for them) and before the old tile goes: a refused tile must not leave a hole where a good one was
-    std::vector<std::string> problems;
-    problems.reserve(pending.size());
-    for (const auto& [coord, entry] : pending)
-        problems.push_back(entry.mTile.mData == nullptr ? std::string() : CheckTile(coord, entry.mTile));
+    for (auto& [coord, entry] : pending)
+        if (entry.mTile.mData != nullptr) entry.mProblem = CheckTile(coord, entry.mTile);
     std::unique_lock lock(mNavMeshMutex);
     int changed = 0;
-    size_t index = 0;
     for (auto& [coord, entry] : pending)
     {
-        BuiltTile& tile = entry.mTile;
-        const std::string& problem = problems[index++];
-        if (tile.mData == nullptr)
+        if (entry.mTile.mData == nullptr)
             changed += RemoveTileLocked(coord);
-        else if (!problem.empty())
-            RefuseLocked(coord, problem);
+        else if (!entry.mProblem.empty())
+            RefuseLocked(coord, entry.mProblem);
         else
-            changed += ReplaceTileLocked(coord, tile);
+            changed += ReplaceTileLocked(coord, entry.mTile);
     }
     return changed;
 }

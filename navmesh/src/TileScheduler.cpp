@@ -17,6 +17,11 @@ double ReachInTiles(float inRadius, float inTileSize)
     return std::ceil(double(inRadius) / double(inTileSize));
 }
 
+Error InvalidInvokerPosition()
+{
+    return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
+}
+
 Error UnknownInvoker(TileScheduler::InvokerID inInvoker)
 {
     return MakeError(ErrorCode::InvalidArgument, "navmesh invoker " + std::to_string(inInvoker) +
@@ -56,8 +61,7 @@ TileScheduler::~TileScheduler()
 
 Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPosition, float inRadius)
 {
-    if (!IsValidWorldPosition(inPosition))
-        return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
+    if (!IsValidWorldPosition(inPosition)) return InvalidInvokerPosition();
     if (!(inRadius >= 0.0f && inRadius <= 1e5f))
         return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: radius must be in [0, 1e5] m");
     // Checked here, not where the tiles are looked for: a radius that reached further would silently need
@@ -79,8 +83,7 @@ Result<TileScheduler::InvokerID> TileScheduler::AddInvoker(const Vec3& inPositio
 
 Status TileScheduler::MoveInvoker(InvokerID inInvoker, const Vec3& inPosition)
 {
-    if (!IsValidWorldPosition(inPosition))
-        return MakeError(ErrorCode::InvalidArgument, "navmesh invoker: position is NaN or outside the world");
+    if (!IsValidWorldPosition(inPosition)) return InvalidInvokerPosition();
     std::lock_guard lock(mMutex);
     auto it = mInvokers.find(inInvoker);
     if (it == mInvokers.end()) return UnknownInvoker(inInvoker);

@@ -143,7 +143,8 @@ private:
     std::mutex mPendingMutex;
     struct Pending
     {
-        BuiltTile mTile; ///< mData null: remove
+        BuiltTile mTile;      ///< mData null: remove
+        std::string mProblem; ///< Why Detour can not take mTile (CheckTile, in Publish), empty when it can
     };
     std::map<TileCoord, Pending> mPending; ///< Guarded by mPendingMutex; the latest submission per tile wins
 };
