@@ -275,8 +275,9 @@ struct Section
 {
     std::string mTitle;
     std::vector<Row> mRows;
-    bool mIsStepPhase =
-        false; ///< One phase of the physics step: report.md puts these in a table of their own
+    /// For a phase of the physics step, its name (the title adds the unit): report.md puts these in a table
+    /// of their own
+    std::string mStepPhase = {};
 };
 
 struct Table
@@ -354,21 +355,21 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"max", Ms(frame, frame.mMax)}}});
     // Each phase as the whole step: where the step's average and its spikes come from
     const PhaseSummaries phases = SummarizePhases(inRun.mSteps);
-    auto phaseSection = [&](const char* inTitle, const SampleSummary& inPhase)
+    auto phaseSection = [&](const char* inPhase, const SampleSummary& inSummary)
     {
-        sections.push_back({inTitle,
-                            {{"avg", Ms(inPhase, inPhase.mMean)},
-                             {"p50", Ms(inPhase, inPhase.mP50)},
-                             {"p99", Ms(inPhase, inPhase.mP99)},
-                             {"max", Ms(inPhase, inPhase.mMax)}},
-                            true});
+        sections.push_back({std::string(inPhase) + " ms",
+                            {{"avg", Ms(inSummary, inSummary.mMean)},
+                             {"p50", Ms(inSummary, inSummary.mP50)},
+                             {"p99", Ms(inSummary, inSummary.mP99)},
+                             {"max", Ms(inSummary, inSummary.mMax)}},
+                            inPhase});
     };
-    phaseSection("broad-phase update ms", phases.mBroadPhaseUpdate);
-    phaseSection("narrow phase+pairs ms", phases.mNarrowPhase);
-    phaseSection("islands ms", phases.mIslands);
-    phaseSection("solve ms", phases.mSolve);
-    phaseSection("finish ms", phases.mFinish);
-    phaseSection("step lock waits ms", phases.mLockWait);
+    phaseSection("broad-phase update", phases.mBroadPhaseUpdate);
+    phaseSection("narrow phase+pairs", phases.mNarrowPhase);
+    phaseSection("islands", phases.mIslands);
+    phaseSection("solve", phases.mSolve);
+    phaseSection("finish", phases.mFinish);
+    phaseSection("step lock waits", phases.mLockWait);
     sections.push_back(
         {"game-object queries",
          {{"queries", Count(inRun.mQueries)},
@@ -456,11 +457,9 @@ std::string SummaryMarkdown(const DemoRunResult& inRun)
         phases; // A row a phase, its figures side by side, instead of 4 rows a phase in the table above
     for (const Section& section : sections)
     {
-        if (section.mIsStepPhase)
+        if (!section.mStepPhase.empty())
         {
-            std::string name = section.mTitle;
-            if (name.size() > 3 && name.compare(name.size() - 3, 3, " ms") == 0) name.resize(name.size() - 3);
-            phases += "| " + EscapeMarkdownCell(name);
+            phases += "| " + EscapeMarkdownCell(section.mStepPhase);
             for (const Row& row : section.mRows)
                 phases += " | " + EscapeMarkdownCell(row.mValue);
             phases += " |\n";
