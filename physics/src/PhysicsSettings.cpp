@@ -44,6 +44,9 @@ Status ValidateSettings(const PhysicsSettings& inSettings)
     default:
         return Invalid("mBroadPhase is not a BroadPhaseType");
     }
+    if (inSettings.mQueryReads != QueryReads::PublishedPoses &&
+        inSettings.mQueryReads != QueryReads::BodyLocks)
+        return Invalid("mQueryReads is not a QueryReads");
     if (inSettings.mNumBodyMutexes < 1 || inSettings.mNumBodyMutexes > 32 ||
         !std::has_single_bit(inSettings.mNumBodyMutexes))
         return Invalid("mNumBodyMutexes must be a power of two from 1 to 32");

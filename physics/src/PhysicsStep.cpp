@@ -1,5 +1,6 @@
 #include "PhysicsStep.h"
 
+#include "body/PublishedPoseStore.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/math/RadixSort.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
@@ -1314,20 +1315,33 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
 {
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     mMovedBodies.resize(active.size());
+    // The broad phase gets the bounds swept over the next step plus the speculative distance, so the next
+    // step finds the pairs this body can reach
+    auto sweptBounds = [&](const Body& inBody)
+    {
+        AABB swept = inBody.mBounds;
+        swept.Encapsulate(AABB(inBody.mBounds.mMin + inDeltaTime * inBody.mLinearVelocity,
+                               inBody.mBounds.mMax + inDeltaTime * inBody.mLinearVelocity));
+        return swept.Expanded(mSettings.mSpeculativeDistance);
+    };
+    PublishedPoseStore& poses = mBodies.GetPublishedPosesForStep();
     ParallelFor(uint32_t(active.size()), 256, 90, // A body's bounds and broad-phase move
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
+                    // The broad phase must hold a body's published bounds at every moment (PublishedPose.h):
+                    // a body whose new bounds do not cover those of the pose it still publishes gets a box
+                    // over both until its new pose is published, then its own
+                    bool anyGrown = false;
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
                         Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+                        poses.Prefetch(active[i]); // Written below, after the broad phase's move
+                        const AABB published = body.mBounds;
                         body.UpdateBounds();
-                        // The broad phase gets the bounds swept over the next step plus the speculative
-                        // distance, so the next step finds the pairs this body can reach
-                        AABB swept = body.mBounds;
-                        swept.Encapsulate(AABB(body.mBounds.mMin + inDeltaTime * body.mLinearVelocity,
-                                               body.mBounds.mMax + inDeltaTime * body.mLinearVelocity));
-                        mMovedBodies[i] = {body.GetID(), swept.Expanded(mSettings.mSpeculativeDistance),
-                                           body.GetObjectLayer()};
+                        AABB during = sweptBounds(body);
+                        anyGrown |= !during.Contains(published);
+                        during.Encapsulate(published);
+                        mMovedBodies[i] = {body.GetID(), during, body.GetObjectLayer()};
 
                         const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
                         const float speed =
@@ -1338,8 +1352,17 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                     }
                     // Any thread may move bodies in the broad phase (each body here is in one range only)
                     const uint64_t waited = GetThisThreadLockWaitNanoseconds();
-                    mBroadPhase.NotifyBodiesAABBChanged(
-                        std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
+                    const std::span<BroadPhaseBody> moved(mMovedBodies.data() + inBegin, inEnd - inBegin);
+                    mBroadPhase.NotifyBodiesAABBChanged(moved);
+                    // The broad phase holds the new bounds: this collision step's positions are final
+                    for (uint32_t i = inBegin; i < inEnd; ++i)
+                    {
+                        const Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+                        poses.PublishMotion(body);
+                        if (anyGrown) mMovedBodies[i].mBounds = sweptBounds(body);
+                    }
+                    // The grown boxes shrink to the swept bounds, so the next step's pairs are the same
+                    if (anyGrown) mBroadPhase.NotifyBodiesAABBShrunk(moved);
                     mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
                                                    std::memory_order_relaxed); // See the member
                 });

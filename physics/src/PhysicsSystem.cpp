@@ -54,7 +54,7 @@ PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup
       mBodies(std::make_unique<BodyManager>(mSettings.mMaxBodies, mSettings.mNumBodyMutexes)),
       mBroadPhase(CreateBroadPhase(mSettings, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
-      mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase)),
+      mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase, mSettings.mQueryReads)),
       mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase))
 {
 }
@@ -100,6 +100,8 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     for (int step = 0; step < inCollisionSteps; ++step)
         mStep->Run(stepTime, mLastStatistics, ioJobs);
     mBodies->UnlockAllBodies();
+    // Shapes of bodies destroyed meanwhile, once no query can hold them
+    mBodies->CollectRetiredShapes();
 
     mUpdating.store(false, std::memory_order_release);
     return Status::Ok();

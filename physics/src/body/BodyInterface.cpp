@@ -64,6 +64,7 @@ Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
         return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this body");
     mBroadPhase.AddBodiesFinalize(state);
     body->mInWorld = true;
+    mBodies.PublishPose(*body); // After the broad phase has its bounds: see PublishedPose.h
     mBodies.NotifyChange(BodyChangeKind::Added, *body, AABB::Empty());
     if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     return Status::Ok();
@@ -94,6 +95,7 @@ Status BodyInterface::RemoveBody(const BodyID& inID)
         mBroadPhase.RemoveBodies({&inID, 1});
         mBodies.DeactivateBody(*body);
         body->mInWorld = false;
+        mBodies.PublishPose(*body);
         bounds = body->GetWorldBounds();
         mBodies.NotifyChange(BodyChangeKind::Removed, *body, bounds);
     }
@@ -189,6 +191,7 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
             const BroadPhaseBody moved = ToBroadPhase(*body);
             mBroadPhase.NotifyBodiesAABBChanged({&moved, 1});
         }
+        mBodies.PublishPose(*body);
         mBodies.NotifyChange(BodyChangeKind::Added, *body, AABB::Empty());
         if (inActivation == Activation::Activate) mBodies.ActivateBody(*body);
     }
@@ -237,8 +240,17 @@ void BodyInterface::OnBodyMoved(Body& ioBody, Activation inActivation)
 {
     const AABB oldBounds = ioBody.mBounds;
     ioBody.UpdateBounds();
-    if (ioBody.mInWorld)
+    if (!ioBody.mInWorld)
+        mBodies.PublishPose(ioBody);
+    else
     {
+        // The broad phase holds both poses' bounds while the pose changes, so a query that reads either
+        // pose finds the body (PublishedPose.h); then only the new one's
+        AABB both = oldBounds;
+        both.Encapsulate(ioBody.mBounds);
+        const BroadPhaseBody during{ioBody.GetID(), both, ioBody.GetObjectLayer()};
+        mBroadPhase.NotifyBodiesAABBChanged({&during, 1});
+        mBodies.PublishPose(ioBody);
         const BroadPhaseBody entry = ToBroadPhase(ioBody);
         mBroadPhase.NotifyBodiesAABBChanged({&entry, 1});
         mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, oldBounds);

@@ -1,5 +1,6 @@
 #include "cairn/physics/body/BodyManager.h"
 
+#include "PublishedPoseStore.h"
 #include "cairn/physics/LockWaits.h"
 
 #include <algorithm>
@@ -70,7 +71,8 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
 
 BodyManager::BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes)
     : mMaxBodies(inMaxBodies), mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
-      mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]())
+      mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]()),
+      mPoses(std::make_unique<PublishedPoseStore>(inMaxBodies))
 {
     // Hand out low indices first: they pack the hot part of the array
     mFreeList.reserve(inMaxBodies);
@@ -113,6 +115,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
     const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
     mSlotInUse[index] = true;
+    mPoses->Publish(body);
     return id;
 }
 
@@ -123,6 +126,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
                          "DestroyBody called inside the physics step or while holding a body lock");
     if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)
         return MakeError(ErrorCode::InvalidBodyID, "unknown body id");
+    ShapeRef shape; // Kept until no query can be using it
     {
         const auto lock = LockedCountingWait(GetMutexForBody(inID.GetIndex()), LockKind::Body);
         const auto staticLock = LockedCountingWait(GetStaticMutexForBody(inID.GetIndex()), LockKind::Body);
@@ -131,11 +135,13 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         if (body->mInWorld || body->mAddPending)
             return MakeError(ErrorCode::AlreadyAdded,
                              "remove the body from the world (or abort its add batch) before destroying it");
-        body->mShape.reset();
+        shape = std::move(body->mShape);
         // A new sequence makes every copy of the old id stale
         body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);
         mSlotInUse[inID.GetIndex()] = false;
+        mPoses->Publish(*body); // Names the shape no more, so it can be retired
     }
+    mPoses->Retire(std::move(shape));
     const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
     mFreeList.push_back(inID.GetIndex());
     --mNumBodies;
@@ -169,6 +175,7 @@ void BodyManager::ActivateBody(Body& ioBody)
     }
     ioBody.SetActiveIndex(uint32_t(mActiveBodies.size()));
     mActiveBodies.push_back(ioBody.mID.GetIndex());
+    mPoses->Publish(ioBody);
     NotifyChange(BodyChangeKind::Woke, ioBody, ioBody.mBounds);
 }
 
@@ -187,6 +194,7 @@ void BodyManager::DeactivateBody(Body& ioBody)
     ioBody.mLinearVelocity.setZero();
     ioBody.mAngularVelocity.setZero();
     ioBody.mSleepTimer = 0.0f;
+    mPoses->Publish(ioBody);
     NotifyChange(BodyChangeKind::FellAsleep, ioBody, ioBody.mBounds);
 }
 
@@ -228,6 +236,16 @@ void BodyManager::NotifyChange(BodyChangeKind inKind, const Body& inBody, const 
         // Acquire: pairs with the release in AddChangeListener
         if (BodyChangeListener* listener = slot.load(std::memory_order_acquire); listener != nullptr)
             listener->OnBodyChanged(change);
+}
+
+void BodyManager::PublishPose(const Body& inBody)
+{
+    mPoses->Publish(inBody);
+}
+
+void BodyManager::CollectRetiredShapes()
+{
+    mPoses->CollectRetired();
 }
 
 void BodyManager::LockAllBodies() const

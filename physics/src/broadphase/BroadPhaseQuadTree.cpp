@@ -186,7 +186,8 @@ void BroadPhaseQuadTree::RemoveBodies(std::span<const BodyID> inBodies)
     CountTreeChanges(changed);
 }
 
-uint32_t BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
+uint32_t BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody,
+                                      std::optional<QuadTree::MoveScope>& ioScope)
 {
     const uint32_t index = inBody.mID.GetIndex();
     const bool ok = !inBody.mID.IsInvalid() && index < mMaxBodies && mLayerSetup.IsValid(inBody.mLayer) &&
@@ -197,15 +198,17 @@ uint32_t BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody)
     const ObjectLayer oldLayer = mBodies[index].mLayer.load(std::memory_order_relaxed);
     if (!mLayerSetup.IsValid(oldLayer)) return 0;
     QuadTree& oldTree = TreeOf(oldLayer);
-    if (!oldTree.Contains(inBody.mID)) return 0;
     QuadTree& newTree = TreeOf(inBody.mLayer);
     if (&oldTree == &newTree)
     {
+        if (!ioScope.has_value() || &ioScope->GetTree() != &oldTree) ioScope.emplace(oldTree);
+        if (!oldTree.MoveBodyHeld(*ioScope, inBody.mID, inBody.mBounds)) return 0;
         if (oldLayer != inBody.mLayer) oldTree.SetBodyLayer(inBody.mID, inBody.mLayer);
-        oldTree.MoveBody(inBody.mID, inBody.mBounds);
         return 1u << TreeIndexOf(oldLayer);
     }
-    // Another broad-phase layer: the slow path, a remove and a one-body add
+    if (!oldTree.Contains(inBody.mID)) return 0;
+    // Another broad-phase layer: the slow path, a remove and a one-body add, which lock on their own
+    ioScope.reset();
     oldTree.RemoveBody(inBody.mID);
     const QuadTree::SubTree subTree = newTree.BuildSubTree(std::span(&inBody, 1));
     if (subTree.mChild == QuadTree::cInvalidChild)
@@ -223,6 +226,7 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
     // of a move overlap those of the next ones instead of following each other
     constexpr size_t cTableAhead = 8, cNodeAhead = 4;
     uint32_t changed = 0;
+    std::optional<QuadTree::MoveScope> scope;
     for (size_t i = 0; i < inBodies.size(); ++i)
     {
         if (i + cTableAhead < inBodies.size())
@@ -236,8 +240,27 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
         if (i + cNodeAhead < inBodies.size())
             if (const BroadPhaseBody& ahead = inBodies[i + cNodeAhead]; mLayerSetup.IsValid(ahead.mLayer))
                 TreeOf(ahead.mLayer).PrefetchNodeOf(ahead.mID.GetIndex());
-        changed |= MoveBody(inBodies[i]);
+        changed |= MoveBody(inBodies[i], scope);
     }
+    scope.reset(); // Before the change counts: a search that sees them must see the moves
+    CountTreeChanges(changed);
+}
+
+void BroadPhaseQuadTree::NotifyBodiesAABBShrunk(std::span<const BroadPhaseBody> inBodies)
+{
+    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
+    uint32_t changed = 0;
+    std::optional<QuadTree::MoveScope> scope;
+    for (const BroadPhaseBody& body : inBodies)
+    {
+        if (body.mID.IsInvalid() || body.mID.GetIndex() >= mMaxBodies || !mLayerSetup.IsValid(body.mLayer))
+            continue;
+        QuadTree& tree = TreeOf(body.mLayer);
+        if (!scope.has_value() || &scope->GetTree() != &tree) scope.emplace(tree);
+        tree.ShrinkBodyHeld(*scope, body.mID, body.mBounds);
+        changed |= 1u << TreeIndexOf(body.mLayer);
+    }
+    scope.reset(); // Before the change counts: see NotifyBodiesAABBChanged
     CountTreeChanges(changed);
 }
 

@@ -535,12 +535,18 @@ bool QuadTree::RemoveBody(BodyID inBody)
 
 void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
 {
+    const MoveScope scope(*this); // Keeps out of a rebuild commit only
+    MoveBodyHeld(scope, inBody, inBounds);
+}
+
+bool QuadTree::MoveBodyHeld([[maybe_unused]] const MoveScope& inScope, BodyID inBody, const AABB& inBounds)
+{
+    assert(&inScope.GetTree() == this);
     const uint32_t index = inBody.GetIndex();
-    if (index >= mBodies.GetMaxBodies() || !IsValidBroadPhaseBounds(inBounds)) return;
-    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
+    if (index >= mBodies.GetMaxBodies() || !IsValidBroadPhaseBounds(inBounds)) return false;
     QuadTreeBodyTable::Entry& entry = mBodies[index];
     const uint32_t location = FindLocation(inBody);
-    if (location == QuadTreeBodyTable::cInvalidLocation) return;
+    if (location == QuadTreeBodyTable::cInvalidLocation) return false;
     const uint32_t nodeIndex = location >> 2;
     const int slot = int(location & 3);
     Node& node = GetNode(nodeIndex);
@@ -555,12 +561,28 @@ void QuadTree::MoveBody(BodyID inBody, const AABB& inBounds)
     // body's serialised operations grow its slot, and each of them returned after growing every ancestor,
     // so the ancestors contain the slot already. Writing nothing keeps the nodes' cache lines shared, and
     // the node unchanged for the rebuild
-    if (LoadSlot(node, slot).Contains(inBounds)) return;
+    if (LoadSlot(node, slot).Contains(inBounds)) return true;
     GrowSlot(node, slot, inBounds);
     MarkChanged(node);
     // Always walk to the root (no early out when a parent already contains the box): another mover may have
     // grown a slot below without having reached the parent yet, and our bounds must be visible when we return
     PropagateUp(nodeIndex, inBounds);
+    return true;
+}
+
+void QuadTree::ShrinkBodyHeld([[maybe_unused]] const MoveScope& inScope, BodyID inBody, const AABB& inBounds)
+{
+    assert(&inScope.GetTree() == this);
+    if (!IsValidBroadPhaseBounds(inBounds) || FindLocation(inBody) == QuadTreeBodyTable::cInvalidLocation)
+        return;
+    QuadTreeBodyTable::Entry& entry = mBodies[inBody.GetIndex()];
+#ifndef NDEBUG
+    AABB last;
+    assert((!QuadTreeBodyTable::LoadBounds(entry, last) || last.Contains(inBounds)) &&
+           "ShrinkBodyHeld: the bounds grew");
+#endif
+    // Inside the last bounds, so inside the slot; the slot is loose since the move that gave those bounds
+    QuadTreeBodyTable::StoreBounds(entry, inBounds);
 }
 
 void QuadTree::SetBodyLayer(BodyID inBody, ObjectLayer inLayer)

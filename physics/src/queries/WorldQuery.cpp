@@ -30,9 +30,11 @@ BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter)
     return {inFilter.mObjectLayers};
 }
 
-/// WrongThread when this thread may not read bodies now, else Ok.
-Status CheckThread()
+/// WrongThread when this thread may not read bodies under their locks now, else Ok. Published poses need no
+/// lock: any thread may read them.
+Status CheckThread(bool inReadsBodyLocks)
 {
+    if (!inReadsBodyLocks) return Status::Ok();
     if (BodyManager::IsInsideStep())
         return MakeError(ErrorCode::WrongThread, "world query called from inside the physics step");
     if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
@@ -66,18 +68,27 @@ Vec3 QueryHalfExtent(const AABB& inBox)
 }
 } // namespace
 
-WorldQuery::WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase)
-    : mBodies(inBodies), mBroadPhase(inBroadPhase)
+WorldQuery::WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase, QueryReads inReads)
+    : mBodies(inBodies), mBroadPhase(inBroadPhase), mReads(inReads)
 {
 }
 
-bool WorldQuery::ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& outTransform) const
+bool WorldQuery::ReadBody(const PoseReader& inPoses, const BodyID& inID, BodyView& outBody) const
 {
+    if (mReads == QueryReads::PublishedPoses)
+    {
+        PublishedPose pose;
+        if (!inPoses.Read(inID, pose)) return false;
+        outBody.mShape = pose.mShape; // Alive while inPoses is
+        outBody.mTransform = pose.mTransform;
+        return true;
+    }
     BodyLockRead lock(mBodies, inID);
     const Body* body = lock.GetBody();
     if (body == nullptr || !body->IsInWorld()) return false;
-    outShape = body->GetShape();
-    outTransform = body->GetTransform();
+    outBody.mHold = body->GetShape();
+    outBody.mShape = outBody.mHold.get();
+    outBody.mTransform = body->GetTransform();
     return true;
 }
 
@@ -85,11 +96,13 @@ Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bo
                            std::vector<RayCastResult>& outHits, bool inClosestOnly) const
 {
     outHits.clear();
-    if (Status thread = CheckThread(); !thread) return thread;
+    if (Status thread = CheckThread(mReads == QueryReads::BodyLocks); !thread) return thread;
     if (!IsValidWorldPosition(inRay.mOrigin))
         return InvalidQuery("ray origin is NaN, infinite or beyond the world");
     if (!(inRay.mDirection.norm() <= cMaxRayLength))
         return InvalidQuery("ray direction is NaN, infinite or longer than cMaxRayLength (4e6 m)");
+    // One read section for the whole query: the shapes it reads stay alive until it returns
+    const PoseReader poses(mBodies);
     std::vector<Candidate>& candidates = tCandidates;
     candidates.clear();
     mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter),
@@ -106,16 +119,15 @@ Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bo
     for (const Candidate& candidate : candidates)
     {
         if (inClosestOnly && candidate.mEntry > best) break;
-        ShapeRef shape;
-        Transform transform;
-        if (!ReadBody(candidate.mBody, shape, transform)) continue;
-        const RayCast local{transform.InverseTransformPoint(inRay.mOrigin),
-                            transform.InverseRotateVector(inRay.mDirection)};
+        BodyView body;
+        if (!ReadBody(poses, candidate.mBody, body)) continue;
+        const RayCast local{body.mTransform.InverseTransformPoint(inRay.mOrigin),
+                            body.mTransform.InverseRotateVector(inRay.mDirection)};
         RayHit hit;
         hit.mFraction = inClosestOnly ? std::nextafter(best, 2.0f) : 1.0f + 1.0e-6f;
-        if (!shape->CastRay(local, hit)) continue;
+        if (!body.mShape->CastRay(local, hit)) continue;
         const RayCastResult result{candidate.mBody, std::min(hit.mFraction, 1.0f),
-                                   transform.RotateVector(hit.mNormal), hit.mSubShape};
+                                   body.mTransform.RotateVector(hit.mNormal), hit.mSubShape};
         if (inClosestOnly)
         {
             outHits.assign(1, result);
@@ -160,7 +172,7 @@ Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransfo
                                 float inMaxSeparation) const
 {
     outHits.clear();
-    if (Status thread = CheckThread(); !thread) return thread;
+    if (Status thread = CheckThread(mReads == QueryReads::BodyLocks); !thread) return thread;
     if (!IsValidWorldPosition(inTransform.mPosition))
         return InvalidQuery("shape position is NaN, infinite or beyond the world");
     if (!IsValidRotation(inTransform.mRotation))
@@ -175,6 +187,7 @@ Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransfo
     const AABB shapeBounds = inShape.GetWorldBounds(inTransform);
     if (!shapeBounds.IsFinite() || shapeBounds.IsEmpty())
         return InvalidQuery("query shape's bounds are NaN, infinite or empty");
+    const PoseReader poses(mBodies); // See CastRay
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
     const AABB bounds = shapeBounds.Expanded(std::max(inMaxSeparation, 0.0f));
@@ -188,13 +201,12 @@ Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransfo
     settings.mMaxSeparation = std::max(inMaxSeparation, 0.0f);
     for (const BodyID& id : bodies)
     {
-        ShapeRef shape;
-        Transform transform;
-        if (!ReadBody(id, shape, transform)) continue;
+        BodyView body;
+        if (!ReadBody(poses, id, body)) continue;
         // Keep only the deepest manifold per body: callers ask "which bodies, and how"
         ShapeQueryHit hit{id, {}};
         float deepest = -cLargeFloat;
-        CollideShapes(inShape, inTransform, *shape, transform, settings,
+        CollideShapes(inShape, inTransform, *body.mShape, body.mTransform, settings,
                       [&](const ContactManifold& inManifold)
                       {
                           for (int i = 0; i < inManifold.mNumPoints; ++i)
@@ -246,8 +258,9 @@ Status WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBod
                                 const QueryFilter& inFilter) const
 {
     outBodies.clear();
-    if (Status thread = CheckThread(); !thread) return thread;
+    if (Status thread = CheckThread(mReads == QueryReads::BodyLocks); !thread) return thread;
     if (!IsValidWorldPosition(inPoint)) return InvalidQuery("point is NaN, infinite or beyond the world");
+    const PoseReader poses(mBodies); // See CastRay
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();
     mBroadPhase.CollidePoint(inPoint, {inFilter.mObjectLayers},
@@ -258,13 +271,12 @@ Status WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBod
     std::sort(bodies.begin(), bodies.end());
     for (const BodyID& id : bodies)
     {
-        ShapeRef shape;
-        Transform transform;
-        if (!ReadBody(id, shape, transform)) continue;
+        BodyView body;
+        if (!ReadBody(poses, id, body)) continue;
         // A zero-length ray hits a solid shape exactly when it starts inside
         RayHit hit;
         hit.mFraction = 1.0f;
-        if (shape->CastRay({transform.InverseTransformPoint(inPoint), Vec3::Zero()}, hit))
+        if (body.mShape->CastRay({body.mTransform.InverseTransformPoint(inPoint), Vec3::Zero()}, hit))
             outBodies.push_back(id);
     }
     return Status::Ok();

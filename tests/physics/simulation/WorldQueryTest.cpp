@@ -131,8 +131,27 @@ TEST_F(WorldQueryTest, BadInputIsAnErrorNotAMiss)
               ErrorCode::InvalidArgument);
 }
 
-TEST_F(WorldQueryTest, AQueryWhileHoldingABodyLockIsRefusedNotEmpty)
+TEST_F(WorldQueryTest, AQueryWhileHoldingABodyLockReadsPublishedPoses)
 {
+    BodyLockRead lock(System().GetBodyManager(), mFloor);
+    ASSERT_TRUE(lock.Succeeded());
+    // Published poses take no lock, so holding one is no reason to refuse (or to answer "nothing there")
+    const Result<std::optional<RayCastResult>> hit =
+        Query().CastRayClosest({Vec3(0, 10, 0), Vec3(0, -20, 0)});
+    ASSERT_TRUE(hit.IsOk());
+    ASSERT_TRUE(hit.Value().has_value());
+    EXPECT_EQ(hit.Value()->mBody, mSphere);
+    std::vector<BodyID> bodies;
+    ASSERT_TRUE(Query().CollidePoint(Vec3(0.0f, 1.5f, 0.0f), bodies).IsOk());
+    EXPECT_EQ(bodies, std::vector<BodyID>{mSphere});
+}
+
+TEST_F(WorldQueryTest, ABodyLockQueryWhileHoldingABodyLockIsRefusedNotEmpty)
+{
+    PhysicsSettings settings;
+    settings.mQueryReads = QueryReads::BodyLocks;
+    ResetWorld(settings);
+    SetUp();
     BodyLockRead lock(System().GetBodyManager(), mFloor);
     ASSERT_TRUE(lock.Succeeded());
     // It could not read the bodies under their locks: before, it returned no hits as if the way were clear

@@ -19,6 +19,13 @@ enum class BroadPhaseType : uint8_t
     QuadTreeGlobalMutex, ///< The same trees behind one global reader-writer mutex (the "before" mode)
 };
 
+/// Where WorldQuery reads the bodies it tests.
+enum class QueryReads : uint8_t
+{
+    PublishedPoses, ///< No lock: never waits for the step (the default)
+    BodyLocks,      ///< Each body under its read lock: waits for the step (the "before" mode, for measuring)
+};
+
 struct PhysicsSettings
 {
     static constexpr uint32_t cMaxBodiesLimit =
@@ -50,6 +57,9 @@ struct PhysicsSettings
     /// change) within this margin (m) of each active body and reuses them while the body stays inside it; 0
     /// turns it off. Larger keeps candidates longer but more of them (see BroadPhaseQuadTree)
     float mBroadPhaseCandidateMargin = 0.25f;
+    /// Where WorldQuery reads bodies: their published poses, with no lock (the default), or each under its
+    /// body lock, waiting for the step (the reference engine's "before", for measuring)
+    QueryReads mQueryReads = QueryReads::PublishedPoses;
 };
 
 /// Ok, or an InvalidArgument error naming the first field out of its documented range (NaN, infinity, a

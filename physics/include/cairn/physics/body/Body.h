@@ -64,6 +64,7 @@ private:
     friend class BodyInterface;
     friend class PhysicsSystem;
     friend class PhysicsStep;
+    friend class PublishedPoseStore;
     friend struct SolverAccess;
 
     /// Sets mass properties and everything else from the settings (validated by the caller).

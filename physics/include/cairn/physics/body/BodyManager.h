@@ -19,6 +19,9 @@
 //    read a static body while the step runs: StaticBodyLockRead, with which background navmesh jobs read
 //    level geometry without waiting for a whole step.
 //  - Every one of these mutexes that has to wait adds its wait to the thread's LockWaits total.
+//  - Published poses (PublishedPose.h): written by whoever writes the body (under its write lock, or the
+//  step),
+//    read by any thread with no lock at all.
 
 #include "cairn/physics/body/Body.h"
 #include "cairn/physics/body/BodyChangeListener.h"
@@ -34,6 +37,8 @@
 
 namespace cairn
 {
+
+class PublishedPoseStore;
 
 class BodyManager
 {
@@ -91,6 +96,14 @@ public:
     /// Indices of active bodies. Physics step only (it holds every body mutex).
     std::span<const uint32_t> GetActiveBodiesUnsafe() const { return mActiveBodies; }
 
+    /// Publishes inBody's pose (PublishedPose.h). The caller holds the body's write lock, or is the step.
+    void PublishPose(const Body& inBody);
+    /// Frees the shapes of destroyed bodies that no PoseReader can hold any more. Any thread (the updating
+    /// thread calls it after each Update).
+    void CollectRetiredShapes();
+    /// The published poses, for PoseReader.
+    const PublishedPoseStore& GetPublishedPoses() const { return *mPoses; }
+
     /// Locks every body mutex for write, in index order. The physics step only.
     void LockAllBodies() const;
     void UnlockAllBodies() const;
@@ -110,6 +123,8 @@ private:
         mutable std::shared_mutex mMutex;
     };
 
+    /// Published poses with the step's privileges (it publishes the motion of every active body).
+    PublishedPoseStore& GetPublishedPosesForStep() { return *mPoses; }
     /// Active list with the step's privileges (it holds every body mutex).
     std::vector<uint32_t>& GetActiveBodiesForStep() { return mActiveBodies; }
 
@@ -117,6 +132,7 @@ private:
     uint32_t mMutexMask;                ///< Shards - 1 (a power of two minus one); set at construction
     std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
+    std::unique_ptr<PublishedPoseStore> mPoses; ///< A record per slot; see PublishedPoseStore.h
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
     mutable PaddedMutex mStaticMutexes[cNumBodyMutexes]; ///< Also held by writers outside the step
     std::array<std::atomic<BodyChangeListener*>, cMaxChangeListeners> mChangeListeners{}; ///< Null: free

@@ -36,6 +36,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace cairn
@@ -123,6 +124,8 @@ public:
     /// Stores the exact bounds and grows the slots up to the root. A body whose object layer moved it to
     /// another broad-phase layer is moved to that tree.
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
+    /// Stores the exact bounds only: a box inside the last one is inside its slot already.
+    void NotifyBodiesAABBShrunk(std::span<const BroadPhaseBody> inBodies) override;
     /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
     void Update() override;
     /// In LockMode::LockFree only: the global mutex would make the pair queries wait for the update.
@@ -196,7 +199,9 @@ private:
     void CountTreeChanges(uint32_t inTrees);
     /// Remove and move of one body; return the trees they changed (a bit per tree).
     uint32_t RemoveBody(BodyID inBody);
-    uint32_t MoveBody(const BroadPhaseBody& inBody);
+    /// ioScope: the move scope of the tree of the body before, kept for the next body when it is that body's
+    /// tree too (a batch takes each tree's lock once), released before any other modification.
+    uint32_t MoveBody(const BroadPhaseBody& inBody, std::optional<QuadTree::MoveScope>& ioScope);
     /// Trees FindCollidingPairs may serve from the pair cache in this call (a bit per tree): those whose
     /// change count is the one the last call saw, with cMinCachedTreeBodies or more. Starts a new cache
     /// generation when that set differs from the last call's. FindCollidingPairs only.

@@ -136,6 +136,22 @@ public:
     bool RemoveBody(BodyID inBody);
     /// Stores the body's new exact bounds and grows its slot (and the parents') to contain them.
     void MoveBody(BodyID inBody, const AABB& inBounds);
+    /// A shared hold of the tree's modification lock over several moves (a batch pays for the lock once; a
+    /// rebuild commit waits for the whole batch). The holder calls no other modifying method of the tree.
+    class MoveScope
+    {
+    public:
+        explicit MoveScope(QuadTree& inTree) : mTree(inTree), mLock(inTree.mModificationLock) {}
+        QuadTree& GetTree() const { return mTree; }
+
+    private:
+        QuadTree& mTree;
+        StripedSharedMutex::SharedLock mLock;
+    };
+    /// MoveBody under a MoveScope of this tree; false (nothing changed) when the body is not in it.
+    bool MoveBodyHeld(const MoveScope& inScope, BodyID inBody, const AABB& inBounds);
+    /// MoveBody for bounds inside the body's last bounds (so inside its slot): stores them, writes no node.
+    void ShrinkBodyHeld(const MoveScope& inScope, BodyID inBody, const AABB& inBounds);
     /// Sets the object layer of a linked body (same broad-phase layer).
     void SetBodyLayer(BodyID inBody, ObjectLayer inLayer);
 

@@ -1,17 +1,22 @@
 #pragma once
 
-// WorldQuery: ray casts and shape / box / sphere / point overlap queries against the world, from any thread
-// outside step callbacks. Each query first asks the broad phase (under its own shared lock) for candidates,
-// collected in a thread-local buffer; then, with the broad-phase lock released, it reads each candidate's
-// shape and transform under that body's read lock, releases it, and runs the exact test on the copy (shapes
-// are immutable, and the ShapeRef keeps the shape alive). So a query never holds two locks at once, and it
-// waits for a body only while the physics step is writing it.
+// WorldQuery: ray casts and shape / box / sphere / point overlap queries against the world, from any thread.
+// Each query first asks the broad phase (lock-free) for candidates, collected in a thread-local buffer, then
+// tests each candidate's shape at its published pose (PublishedPose.h), read with no lock: a query never
+// waits for the physics step, also while the step runs. It sees every body as the last collision step (or
+// the last move by hand) published it: a pose is never torn, a body removed meanwhile is reported with its
+// last pose or not at all, a stale id never, and a body whose published pose overlaps the query is never
+// missed (the broad phase's bounds contain the published pose's).
+// QueryReads::BodyLocks is the reference engine's "before", for measuring: each candidate is read under its
+// body's read lock, so a query waits for a step that holds it; from inside the step or from a thread that
+// holds a body lock such a query is refused (WrongThread).
 // Errors: a query refuses bad input (a NaN or out-of-world origin or centre, a direction or radius that is
-// not finite, a rotation that is not a unit quaternion) with InvalidArgument, and a call from inside the step
-// or from a thread that holds a body lock (it could not read the bodies) with WrongThread, instead of
-// returning "nothing there": a caller must be able to tell a clear line of sight from a failed query.
+// not finite, a rotation that is not a unit quaternion) with InvalidArgument, instead of returning "nothing
+// there": a caller must be able to tell a clear line of sight from a failed query.
 
+#include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
+#include "cairn/physics/body/PublishedPose.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
@@ -46,7 +51,8 @@ struct ShapeQueryHit
 class WorldQuery
 {
 public:
-    WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase);
+    WorldQuery(const BodyManager& inBodies, const BroadPhase& inBroadPhase,
+               QueryReads inReads = QueryReads::PublishedPoses);
 
     /// The closest hit along the segment, or nullopt when there is none.
     Result<std::optional<RayCastResult>> CastRayClosest(const RayCast& inRay,
@@ -74,14 +80,22 @@ public:
                         const QueryFilter& inFilter = {}) const;
 
 private:
-    /// Shape and transform of a body, read under its read lock; false for a stale id or a removed body.
-    bool ReadBody(const BodyID& inID, ShapeRef& outShape, Transform& outTransform) const;
+    /// A candidate as a query tests it.
+    struct BodyView
+    {
+        const Shape* mShape = nullptr; ///< Kept alive by the query's PoseReader, or by mHold
+        ShapeRef mHold;                ///< QueryReads::BodyLocks: the reference copied under the lock
+        Transform mTransform;
+    };
+    /// A candidate's shape and transform, as mReads says; false for a stale id or a body not in the world.
+    bool ReadBody(const PoseReader& inPoses, const BodyID& inID, BodyView& outBody) const;
     /// Runs the ray against candidate bodies; inAny stops at the first hit.
     Status CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
                    std::vector<RayCastResult>& outHits, bool inClosestOnly) const;
 
     const BodyManager& mBodies;
     const BroadPhase& mBroadPhase;
+    QueryReads mReads;
 };
 
 } // namespace cairn

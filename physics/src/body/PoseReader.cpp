@@ -1,0 +1,18 @@
+#include "PublishedPoseStore.h"
+#include "cairn/physics/body/BodyManager.h"
+
+namespace cairn
+{
+
+PoseReader::PoseReader(const BodyManager& inBodies)
+    : mStore(inBodies.GetPublishedPoses()), mScope(mStore.GetReclaimer())
+{
+}
+
+bool PoseReader::Read(const BodyID& inID, PublishedPose& outPose) const
+{
+    if (inID.IsInvalid()) return false;
+    return mStore.Read(inID.GetIndex(), outPose) && outPose.mID == inID;
+}
+
+} // namespace cairn

@@ -1,0 +1,124 @@
+#pragma once
+
+// PublishedPoseStore: the published pose of every body slot (see PublishedPose.h for what readers may see),
+// and the shapes of destroyed bodies waiting until no reader can hold them.
+//
+// Threads and locks:
+//  - A record: one writer at a time, the thread that holds the body's write lock or the physics step (which
+//    holds every body lock); readers on any thread with no lock (a sequence lock per record, read again when
+//    a write is in progress).
+//  - Retired shapes: mRetiredMutex, taken by DestroyBody's thread and by whoever collects (the updating
+//  thread
+//    after each Update). Never taken by a reader.
+//  - The epoch: readers register in the reclaimer's stripes (never wait); it is advanced only under
+//    mRetiredMutex, so by one thread at a time as EpochReclaimer requires.
+
+#include "cairn/physics/body/Body.h"
+#include "cairn/physics/body/PublishedPose.h"
+#include "cairn/physics/broadphase/EpochReclaimer.h"
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace cairn
+{
+
+class PublishedPoseStore
+{
+public:
+    explicit PublishedPoseStore(uint32_t inMaxBodies);
+    ~PublishedPoseStore();
+    PublishedPoseStore(const PublishedPoseStore&) = delete;
+    PublishedPoseStore& operator=(const PublishedPoseStore&) = delete;
+
+    /// Publishes inBody's current state. The caller holds the body's write lock or is the step.
+    void Publish(const Body& inBody)
+    {
+        Record& record = BeginWrite(inBody);
+        // Release, each: see BeginWrite
+        record.mSequence.store(inBody.GetID().GetSequence(), std::memory_order_release);
+        record.mFlags.store(PackFlags(inBody), std::memory_order_release);
+        for (int i = 0; i < 3; ++i)
+            record.mCenterOfMassOffset[i].store(inBody.mCenterOfMassOffset[i], std::memory_order_release);
+        record.mShape.store(inBody.GetShape().get(), std::memory_order_release);
+        StoreMotionAndEndWrite(record, inBody);
+    }
+    /// Publishes the position and rotation of a body whose other fields are published already (the step, at
+    /// the end of a collision step: it changes nothing else of a body without publishing it whole).
+    void PublishMotion(const Body& inBody) { StoreMotionAndEndWrite(BeginWrite(inBody), inBody); }
+
+    /// Starts fetching a record that the caller will publish soon (the step, a range of bodies at a time).
+    void Prefetch(uint32_t inIndex) const { __builtin_prefetch(&mRecords[inIndex], 1); }
+    /// The record of body slot inIndex, whatever its id; false when it holds no body in the world. The
+    /// caller is inside a read section of GetReclaimer().
+    bool Read(uint32_t inIndex, PublishedPose& outPose) const;
+
+    /// Keeps a destroyed body's shape until no reader can hold it (its record must name it no more). Any
+    /// thread.
+    void Retire(ShapeRef&& ioShape);
+    /// Advances the epoch when no reader holds it back and frees the shapes no reader can reach. Any thread.
+    void CollectRetired();
+
+    const EpochReclaimer& GetReclaimer() const { return mReclaimer; }
+
+private:
+    /// One cache line a body, so that the step's threads, which publish bodies of scattered indices, never
+    /// write the same line. Every field is atomic so that a reader racing a writer reads stale or torn data
+    /// (and then discards it), never undefined behaviour.
+    struct alignas(64) Record
+    {
+        std::atomic<uint32_t> mVersion{0};           ///< Odd while written
+        std::atomic<uint32_t> mSequence{0};          ///< The body id's sequence (the index is the record's)
+        std::atomic<uint32_t> mFlags{0};             ///< See PackFlags
+        std::atomic<float> mPosition[3] = {0, 0, 0}; ///< Centre of mass, world
+        std::atomic<float> mRotation[4] = {0, 0, 0, 1};        ///< x, y, z, w
+        std::atomic<float> mCenterOfMassOffset[3] = {0, 0, 0}; ///< Shape-local: the reader finds the origin
+        std::atomic<const Shape*> mShape{nullptr};
+    };
+    static_assert(sizeof(Record) == 64, "a published pose is one cache line");
+
+    static uint32_t PackFlags(const Body& inBody);
+
+    /// Makes the body's record odd (a write in progress) and returns it.
+    Record& BeginWrite(const Body& inBody)
+    {
+        Record& record = mRecords[inBody.GetID().GetIndex()];
+        // Relaxed load: only this thread writes the version now (the body's lock holder or the step)
+        const uint32_t version = record.mVersion.load(std::memory_order_relaxed);
+        // Relaxed: published by the release stores of the fields that follow (no fences: ThreadSanitizer does
+        // not model them; a reader that acquires a new field value also sees this odd version)
+        record.mVersion.store(version + 1, std::memory_order_relaxed);
+        return record;
+    }
+    /// Stores the centre of mass and rotation, then makes the version even again.
+    static void StoreMotionAndEndWrite(Record& ioRecord, const Body& inBody)
+    {
+        // Release, each: see BeginWrite
+        for (int i = 0; i < 3; ++i)
+            ioRecord.mPosition[i].store(inBody.mPosition[i], std::memory_order_release);
+        for (int i = 0; i < 4; ++i)
+            ioRecord.mRotation[i].store(inBody.mRotation.coeffs()[i], std::memory_order_release);
+        // Relaxed load: this thread made it odd. Release: a reader that acquires the even version sees every
+        // field stored since
+        ioRecord.mVersion.store(ioRecord.mVersion.load(std::memory_order_relaxed) + 1,
+                                std::memory_order_release);
+    }
+
+    /// Frees the retired shapes no reader can reach. Caller holds mRetiredMutex.
+    void FreeUnreachable();
+
+    uint32_t mMaxBodies;
+    std::unique_ptr<Record[]> mRecords;
+    EpochReclaimer mReclaimer;
+    std::mutex mRetiredMutex;
+    struct RetiredShape
+    {
+        uint64_t mEpoch;
+        ShapeRef mShape;
+    };
+    std::vector<RetiredShape> mRetired; ///< Guarded by mRetiredMutex; in epoch order
+};
+
+} // namespace cairn
