@@ -1,6 +1,7 @@
 #include "cairn/navmesh/GeometryCollector.h"
 
-#include "cairn/physics/body/BodyLock.h"
+#include "cairn/physics/body/PublishedPose.h"
+#include "cairn/physics/shapes/Shape.h"
 
 #include <algorithm>
 #include <chrono>
@@ -17,19 +18,19 @@ double MillisecondsSince(Clock::time_point inStart)
     return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count();
 }
 
-/// What a body contributes, copied under its lock.
-struct BodyCopy
+/// Whether inInclusion takes a body as published.
+bool Takes(const PublishedPose& inPose, const NavMeshInclusion& inInclusion)
 {
-    ShapeRef mShape;
-    Transform mTransform;
-    uint8_t mArea = cDefaultArea;
-};
-
-/// Whether inInclusion takes a body that is not static.
-bool Takes(const Body& inBody, const NavMeshInclusion& inInclusion)
-{
-    if (inBody.IsKinematic()) return inInclusion.mKinematic;
-    return inBody.IsDynamic() && inInclusion.mSleepingDynamic && !inBody.IsActive();
+    switch (inPose.mMotionType)
+    {
+    case MotionType::Static:
+        return true;
+    case MotionType::Kinematic:
+        return inInclusion.mKinematic;
+    case MotionType::Dynamic:
+        return inPose.mActive ? inInclusion.mAwakeDynamic : inInclusion.mSleepingDynamic;
+    }
+    return false;
 }
 } // namespace
 
@@ -45,55 +46,18 @@ void GeometryCollector::FindBodies(const AABB& inBox, const NavMeshInclusion& in
 
 void GeometryCollector::CollectTriangles(const AABB& inBox, const NavMeshInclusion& inInclusion,
                                          std::span<const BodyID> inBodies, TileGeometry& ioGeometry,
-                                         std::vector<BodyID>& outBusy, CollectStats& ioStats,
-                                         BodyKinds inKinds) const
+                                         CollectStats& ioStats) const
 {
     const Clock::time_point start = Clock::now();
+    const PoseReader poses(mBodies); // The shapes read stay alive until the collection ends
     thread_local std::vector<Vec3> triangles;
     for (const BodyID& id : inBodies)
     {
-        BodyCopy copy;
-        bool taken = false;
-        {
-            double waitMs = 0.0;
-            StaticBodyLockRead staticLock(mBodies, id, &waitMs);
-            ioStats.mLongestLockWaitMs = std::max(ioStats.mLongestLockWaitMs, waitMs);
-            if (const Body* body = staticLock.GetBody();
-                body != nullptr && body->IsInWorld() && inKinds != BodyKinds::NonStatic)
-            {
-                copy = {body->GetShape(), body->GetTransform(), body->GetNavMeshArea()};
-                taken = true;
-            }
-            else if (staticLock.WasNotStatic() && inKinds != BodyKinds::Static)
-            {
-                // An awake dynamic body is no obstacle: skipped without its body lock, which the step may
-                // hold (if it falls asleep after this, the change marks the tile dirty again)
-                const MotionType motion = staticLock.GetNotStaticMotionType();
-                const bool wanted = motion == MotionType::Kinematic
-                                        ? inInclusion.mKinematic
-                                        : inInclusion.mSleepingDynamic && !staticLock.WasActive();
-                staticLock.Release();
-                if (!wanted) continue;
-                BodyLockRead lock(mBodies, id, TryLock{});
-                if (lock.WasBusy())
-                {
-                    outBusy.push_back(id);
-                    ++ioStats.mBusy;
-                    continue;
-                }
-                if (const Body* body = lock.GetBody();
-                    body != nullptr && body->IsInWorld() && Takes(*body, inInclusion))
-                {
-                    copy = {body->GetShape(), body->GetTransform(), body->GetNavMeshArea()};
-                    taken = true;
-                }
-            }
-        }
-        // Every lock released: the shape is immutable and the copied reference keeps it alive
-        if (!taken || copy.mShape == nullptr) continue;
+        PublishedPose pose;
+        if (!poses.Read(id, pose) || !Takes(pose, inInclusion)) continue;
         triangles.clear();
-        copy.mShape->CollectTriangles(inBox, copy.mTransform, triangles);
-        const uint8_t area = std::min<uint8_t>(copy.mArea, cMaxAreaId);
+        pose.mShape->CollectTriangles(inBox, pose.mTransform, triangles);
+        const uint8_t area = std::min<uint8_t>(pose.mNavMeshArea, cMaxAreaId);
         for (size_t i = 0; i + 2 < triangles.size(); i += 3)
             ioGeometry.AddTriangle(triangles[i], triangles[i + 1], triangles[i + 2], area);
         ioStats.mTriangles += uint32_t(triangles.size() / 3);

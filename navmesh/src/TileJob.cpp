@@ -1,7 +1,5 @@
 #include "TileJob.h"
 
-#include <thread>
-
 namespace cairn::navmesh
 {
 
@@ -17,29 +15,9 @@ jobs::BackgroundStep TileJob::Step(jobs::BackgroundTaskContext& ioContext)
     if (ioContext.IsCancelRequested()) return Finish(std::nullopt, jobs::BackgroundStep::Done);
     switch (mStage)
     {
-    case Stage::Static:
+    case Stage::Collect:
         mCollector.FindBodies(mBox, mInclusion, mBodies);
-        mCollector.CollectTriangles(mBox, mInclusion, mBodies, mGeometry, mBusy, mStats, BodyKinds::Static);
-        mStaticTriangles = mGeometry.GetNumTriangles();
-        mStage = Stage::Others;
-        ioContext.SetProgress(0.3f);
-        return jobs::BackgroundStep::Continue;
-
-    case Stage::Others:
-        mBusy.clear();
-        mCollector.CollectTriangles(mBox, mInclusion, mBodies, mGeometry, mBusy, mStats,
-                                    BodyKinds::NonStatic);
-        if (!mBusy.empty())
-        {
-            // The step holds a body: drop this pass's triangles (so they keep their order) and try again in
-            // the next chunk, after a pause short next to a step
-            mGeometry.mVertices.resize(size_t(mStaticTriangles) * 9);
-            mGeometry.mTriangles.resize(size_t(mStaticTriangles) * 3);
-            mGeometry.mAreas.resize(size_t(mStaticTriangles));
-            ++mBusyRetries;
-            std::this_thread::sleep_for(std::chrono::microseconds(200));
-            return jobs::BackgroundStep::Continue;
-        }
+        mCollector.CollectTriangles(mBox, mInclusion, mBodies, mGeometry, mStats);
         mStage = Stage::Build;
         ioContext.SetProgress(0.4f);
         return jobs::BackgroundStep::Continue;

@@ -1,9 +1,9 @@
 #pragma once
 
 // TileJob: one tile's build, run chunk by chunk on a BackgroundQueue thread (see TileScheduler.h):
-//   chunk 1: broad-phase query of the bordered tile box, then the static bodies' triangles;
-//   chunk 2+: the other bodies' triangles, all again in a later chunk while the step holds any of them;
-//   last:    Recast and Detour.
+//   chunk 1: broad-phase query of the bordered tile box, then the bodies' triangles at their published poses
+//            (no lock: never waits for the step, never tries again);
+//   chunk 2: Recast and Detour.
 // Its fields are written only by the queue thread running it; the scheduler reads the result after seeing
 // mFinished (acquire, paired with the release that sets it).
 
@@ -36,13 +36,11 @@ public:
     /// After IsFinished: the tile, or why it failed (empty optional: cancelled).
     std::optional<Result<BuiltTile>>& GetResult() { return mResult; }
     const CollectStats& GetCollectStats() const { return mStats; }
-    uint32_t GetBusyRetries() const { return mBusyRetries; }
 
 private:
     enum class Stage : uint8_t
     {
-        Static,
-        Others,
+        Collect,
         Build,
     };
     jobs::BackgroundStep Finish(std::optional<Result<BuiltTile>> inResult, jobs::BackgroundStep inStep);
@@ -54,13 +52,10 @@ private:
     const TileCoord mTile;
     const AABB mBox;
     const std::vector<OffMeshLink> mLinks;
-    Stage mStage = Stage::Static;
+    Stage mStage = Stage::Collect;
     std::vector<BodyID> mBodies;
-    std::vector<BodyID> mBusy;
     TileGeometry mGeometry;
-    int mStaticTriangles = 0; ///< Where the other bodies' triangles start (cut back on a retry)
     CollectStats mStats;
-    uint32_t mBusyRetries = 0;
     std::optional<Result<BuiltTile>> mResult;
     std::atomic<bool> mFinished{false};
 };

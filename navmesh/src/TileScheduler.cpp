@@ -278,9 +278,7 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
         return true;
     }
     const CollectStats& stats = job.GetCollectStats();
-    mStats.mLongestLockWaitMs = std::max(mStats.mLongestLockWaitMs, stats.mLongestLockWaitMs);
     mStats.mCollectMs += stats.mCollectMs;
-    mStats.mBusyRetries += job.GetBusyRetries();
     std::optional<Result<BuiltTile>>& result = job.GetResult();
     if (!result.has_value())
         ioState.mDirty = true;

@@ -83,7 +83,7 @@ void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
 {
     const BakeSettings& settings = *inContext.mSettings;
     const AABB box = inContext.mGrid->GetTileBoundsWithBorder(ioTile.mTile, inContext.mBorder);
-    std::vector<BodyID> found, ordered, busy;
+    std::vector<BodyID> found, ordered;
     inContext.mCollector->FindBodies(box, {}, found);
     // The bodies the query found, in the order of their objects' keys: body ids depend on which tiles were in
     // flight, keys do not, so the triangles (and the input hash) are the same however the bake ran. A body of
@@ -94,7 +94,7 @@ void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
         if (std::binary_search(found.begin(), found.end(), object.mBody)) ordered.push_back(object.mBody);
     navmesh::TileGeometry geometry;
     navmesh::CollectStats stats;
-    inContext.mCollector->CollectTriangles(box, {}, ordered, geometry, busy, stats);
+    inContext.mCollector->CollectTriangles(box, {}, ordered, geometry, stats);
     uint64_t hash = Hash64Of(std::span<const int32_t>(&ioTile.mTile.mX, 1), inContext.mSettingsHash);
     hash = Hash64Of(std::span<const int32_t>(&ioTile.mTile.mZ, 1), hash);
     hash = Hash64Of(std::span<const float>(geometry.mVertices), hash);

@@ -104,11 +104,11 @@ void RunTiles(const SharedBenchData& inData, int inRepetitions)
                 const TileCoord tile{x, z};
                 const AABB box = grid.GetTileBoundsWithBorder(tile, border);
                 const Clock::time_point start = Clock::now();
-                std::vector<BodyID> found, busy;
+                std::vector<BodyID> found;
                 TileGeometry geometry;
                 CollectStats stats;
                 collector.FindBodies(box, {}, found);
-                collector.CollectTriangles(box, {}, found, geometry, busy, stats);
+                collector.CollectTriangles(box, {}, found, geometry, stats);
                 collectMs.push_back(MillisecondsSince(start));
                 Result<BuiltTile> built = BuildTile(profile, grid, tile, geometry);
                 if (!built)
@@ -145,9 +145,7 @@ void RunTiles(const SharedBenchData& inData, int inRepetitions)
 struct PileRun
 {
     tools::TimingSummary mStep;
-    double mLongestLockWaitMs = 0.0;
     uint64_t mTilesBuilt = 0;
-    uint64_t mBusyRetries = 0;
 };
 
 /// step_pile2k on one physics thread, with inBackgroundJobs tile jobs kept running (0: none).
@@ -198,34 +196,28 @@ PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
     if (scheduler != nullptr)
     {
         const TileScheduler::Stats stats = scheduler->GetStats();
-        run.mLongestLockWaitMs = stats.mLongestLockWaitMs;
         run.mTilesBuilt = stats.mTilesPublished;
-        run.mBusyRetries = stats.mBusyRetries;
     }
     return run;
 }
 
 void RunPileWithJobs(const SharedBenchData& inData, int inRepetitions)
 {
-    std::vector<double> without, with, lockWaits;
+    std::vector<double> without, with;
     for (int rep = 0; rep < inRepetitions; ++rep)
     {
         const PileRun none = RunPile(inData, 0);
         const PileRun two = RunPile(inData, 2);
         std::printf(
             "nav_step_pile2k_jobs rep %d: 0 jobs mean %.3f ms p99 %.3f  | 2 jobs mean %.3f ms p99 %.3f  "
-            "tiles built %llu  busy retries %llu  longest lock wait %.4f ms\n",
+            "tiles built %llu\n",
             rep, none.mStep.mMean, none.mStep.mP99, two.mStep.mMean, two.mStep.mP99,
-            (unsigned long long)two.mTilesBuilt, (unsigned long long)two.mBusyRetries,
-            two.mLongestLockWaitMs);
+            (unsigned long long)two.mTilesBuilt);
         without.push_back(none.mStep.mMean);
         with.push_back(two.mStep.mMean);
-        lockWaits.push_back(two.mLongestLockWaitMs);
     }
-    std::printf("nav_step_pile2k_jobs median of %d: step %.3f ms with 0 jobs, %.3f ms with 2 jobs (%.2fx)  "
-                "longest lock wait %.4f ms (max over reps %.4f)\n",
-                inRepetitions, Median(without), Median(with), Median(with) / Median(without),
-                Median(lockWaits), *std::max_element(lockWaits.begin(), lockWaits.end()));
+    std::printf("nav_step_pile2k_jobs median of %d: step %.3f ms with 0 jobs, %.3f ms with 2 jobs (%.2fx)\n",
+                inRepetitions, Median(without), Median(with), Median(with) / Median(without));
 }
 
 void RunInvokerLatency(const SharedBenchData& inData)

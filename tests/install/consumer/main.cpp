@@ -33,11 +33,11 @@ int main()
     const cairn::AABB box =
         grid.GetTileBoundsWithBorder(tile, float(profile.GetBorderCells()) * profile.mCellSize);
     const cairn::navmesh::GeometryCollector collector(system.GetBodyManager(), system.GetBroadPhase());
-    std::vector<cairn::BodyID> bodies, busy;
+    std::vector<cairn::BodyID> bodies;
     cairn::navmesh::TileGeometry geometry;
     cairn::navmesh::CollectStats stats;
     collector.FindBodies(box, {}, bodies);
-    collector.CollectTriangles(box, {}, bodies, geometry, busy, stats);
+    collector.CollectTriangles(box, {}, bodies, geometry, stats);
     const auto built = cairn::navmesh::BuildTile(profile, grid, tile, geometry);
     std::printf("navmesh tile polygons: %d\n", built ? built.Value().mNumPolygons : -1);
     return 0;

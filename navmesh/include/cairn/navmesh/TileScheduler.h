@@ -54,11 +54,9 @@ public:
         uint64_t mJobsFailed = 0;
         uint64_t mTilesPublished = 0; ///< Tiles swapped into the navmesh (built or emptied)
         uint64_t mTilesDropped = 0;
-        uint64_t mRebuilds = 0;        ///< Builds of a tile that was already built (dirty again)
-        uint64_t mBusyRetries = 0;     ///< Chunks that found a body held by the step and tried again later
-        double mLongestLockWaitMs = 0; ///< Longest single lock acquisition of any job
-        double mCollectMs = 0;         ///< Summed over jobs: query and triangle copies
-        double mBuildMs = 0;           ///< Summed over jobs: Recast and Detour
+        uint64_t mRebuilds = 0; ///< Builds of a tile that was already built (dirty again)
+        double mCollectMs = 0;  ///< Summed over jobs: query and triangle copies
+        double mBuildMs = 0;    ///< Summed over jobs: Recast and Detour
         /// Frames from a tile being needed to its first publication, one entry per tile
         std::vector<uint32_t> mFirstPublishFrames;
         std::string mLastError;
