@@ -182,10 +182,11 @@ void TileScheduler::OnBodyChanged(const BodyChange& inChange)
 {
     const NavMeshInclusion& inclusion = mSettings.mInclusion;
     if ((inclusion.mObjectLayers & ObjectLayerMask(1) << inChange.mObjectLayer) == 0) return;
-    // Awake dynamic bodies are never in the navmesh, but falling asleep, waking, or being placed or removed
-    // while asleep changes it
+    // Dynamic bodies: falling asleep, waking, or being placed or removed changes the navmesh of the tiles
+    // that take sleeping ones, or awake ones too
     const bool matters = inChange.mMotionType == MotionType::Static ||
-                         (inChange.mMotionType == MotionType::Dynamic && inclusion.mSleepingDynamic) ||
+                         (inChange.mMotionType == MotionType::Dynamic &&
+                          (inclusion.mSleepingDynamic || inclusion.mAwakeDynamic)) ||
                          (inChange.mMotionType == MotionType::Kinematic && inclusion.mKinematic);
     if (!matters) return;
     std::lock_guard lock(mMutex);

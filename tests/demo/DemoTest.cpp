@@ -94,6 +94,10 @@ TEST(DemoTest, LockFreeModeKeepsItsInvariantsAndLogsItsProgress)
     const std::string progress =
         Printed([&](std::FILE* inFile) { run = RunDemo(SmallDemo(), BroadPhaseType::QuadTree, inFile); });
     ExpectInvariants(run);
+    // Its queries ran beside the step and read published poses: not one of them waited for a lock
+    for (double waited : LockWaitMicrosPerThreadFrame(run))
+        EXPECT_EQ(waited, 0.0);
+    EXPECT_EQ(QueryLockWaitMicrosPerQuery(run), 0.0);
     EXPECT_EQ(progress.find('\r'), std::string::npos) << progress;
     EXPECT_EQ(std::count(progress.begin(), progress.end(), '\n'), 2) << progress;
     EXPECT_NE(progress.find("frame     1/240"), std::string::npos) << progress;

@@ -52,4 +52,13 @@ std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun)
     return total;
 }
 
+double QueryLockWaitMicrosPerQuery(const DemoRunResult& inRun)
+{
+    if (inRun.mQueries == 0) return std::nan("");
+    double totalMicros = 0.0;
+    for (double frameMicros : inRun.mGameObjectLockWaitUs)
+        totalMicros += frameMicros;
+    return totalMicros / double(inRun.mQueries);
+}
+
 } // namespace cairn::demo

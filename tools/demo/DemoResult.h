@@ -62,11 +62,13 @@ struct DemoRunResult
     std::vector<double> mQueryMicrosPerThread;
     uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs
     double mQueryMicrosMean = 0.0; ///< Over all queries
-    /// Game-object jobs: microseconds per frame each thread spent waiting for the broad phase's locks
-    /// (LockWaits), in the order of mQueryMicrosPerThread
+    /// Game-object query jobs (during the step): microseconds per frame each thread spent waiting for the
+    /// broad phase's locks (LockWaits), in the order of mQueryMicrosPerThread
     std::vector<double> mBroadPhaseLockWaitMicrosPerThreadFrame;
     std::vector<double> mBodyLockWaitMicrosPerThreadFrame; ///< The same for the body locks
-    std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the game-object jobs' lock waits, all threads
+    /// Game-object move jobs (after the step): microseconds per frame each thread waited for any lock
+    std::vector<double> mMoveLockWaitMicrosPerThreadFrame;
+    std::vector<double> mGameObjectLockWaitUs; ///< Per frame: the query jobs' lock waits, all threads
     /// Streaming, measured on the loading thread per world tile
     std::vector<double> mStreamInMs;                  ///< Create + prepare + finalize of one tile's bodies
     std::vector<double> mStreamLinkMs;                ///< The finalize (broad-phase link) alone
@@ -100,7 +102,9 @@ struct DemoRunResult
 /// thread's vCPU (mPhysicsHostTakenMs) accounts for.
 tools::SpikeAttribution AttributePhysicsSpikes(const DemoRunResult& inRun, double inRatio);
 
-/// The game-object jobs' lock waits of every kind, per thread (the sum of the per-kind series).
+/// The game-object query jobs' lock waits of every kind, per thread (the sum of the per-kind series).
 std::vector<double> LockWaitMicrosPerThreadFrame(const DemoRunResult& inRun);
+/// The game-object query jobs' lock waits per query, µs (all threads and frames; NaN without queries).
+double QueryLockWaitMicrosPerQuery(const DemoRunResult& inRun);
 
 } // namespace cairn::demo

@@ -61,9 +61,14 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     physicsSettings.mMaxBodies = 65536;
     physicsSettings.mBroadPhase = inMode;
     physicsSettings.mBroadPhaseCandidateMargin = inSettings.mCandidateMargin;
-    // The reference engine's "before": one read-write mutex around the broad phase and one for every body
-    // (its "after": the lock-free trees and 32 body mutexes)
-    if (inMode == BroadPhaseType::QuadTreeGlobalMutex) physicsSettings.mNumBodyMutexes = 1;
+    // The reference engine's "before": one read-write mutex around the broad phase and one for every body,
+    // which queries take to read a body, so they wait for the step (its "after": the lock-free trees, 32 body
+    // mutexes, and queries on published poses that take none)
+    if (inMode == BroadPhaseType::QuadTreeGlobalMutex)
+    {
+        physicsSettings.mNumBodyMutexes = 1;
+        physicsSettings.mQueryReads = QueryReads::BodyLocks;
+    }
     PhysicsSystem physics(physicsSettings);
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
@@ -125,20 +130,35 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
 
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
 
-        const tools::TimedWork stepping = tools::TimeOnThisThread(
-            [&]
-            {
-                if (Status stepped = physics.Update(dt, inSettings.mCollisionSteps, frameJobs); !stepped)
-                    result.mErrors.push_back("physics update: " + stepped.GetError().mMessage);
-            });
-        result.mPhysicsMs.push_back(stepping.mWallMs);
-        result.mPhysicsHostTakenMs.push_back(stepping.mHostTakenMs);
-        result.mSteps.push_back(physics.GetLastStepStatistics());
-
+        // A frame pipeline: the game objects' queries and the step are two jobs that run at once (each waits
+        // only for jobs it scheduled itself, so neither runs the other's work on its stack); the queries
+        // first, so that this thread takes them and a worker the step. The objects' moves follow the step.
+        // The step is timed on the thread that runs it
+        struct Stepping
+        {
+            tools::TimedWork mTimed;
+            Status mStatus;
+        } stepping;
         const uint64_t waitedBefore = gameObjects->GetLockWaitNanosTotal();
-        gameObjects->Update(frameJobs, inSettings.mGameObjectJobs, player, dt);
+        const jobs::JobHandle frameWork[] = {
+            frameJobs.Schedule(
+                "game-object queries", [&gameObjects, &frameJobs, &inSettings, &player, dt]
+                { gameObjects->UpdateQueries(frameJobs, inSettings.mGameObjectJobs, player, dt); }),
+            frameJobs.Schedule("physics step",
+                               [&stepping, &physics, &frameJobs, dt, steps = inSettings.mCollisionSteps]
+                               {
+                                   stepping.mTimed = tools::TimeOnThisThread(
+                                       [&] { stepping.mStatus = physics.Update(dt, steps, frameJobs); });
+                               })};
+        frameJobs.WaitAll(frameWork); // Orders the jobs' writes before the reads below
         result.mGameObjectLockWaitUs.push_back(double(gameObjects->GetLockWaitNanosTotal() - waitedBefore) /
                                                1000.0);
+        if (!stepping.mStatus)
+            result.mErrors.push_back("physics update: " + stepping.mStatus.GetError().mMessage);
+        result.mPhysicsMs.push_back(stepping.mTimed.mWallMs);
+        result.mPhysicsHostTakenMs.push_back(stepping.mTimed.mHostTakenMs);
+        result.mSteps.push_back(physics.GetLastStepStatistics());
+        gameObjects->ApplyMoves(frameJobs, inSettings.mGameObjectJobs);
         agents->Update(dt, player);
         scheduler->Update();
         result.mFrameMs.push_back(MillisecondsSince(frameStart));
@@ -195,6 +215,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mBroadPhaseLockWaitMicrosPerThreadFrame =
         gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::BroadPhase);
     result.mBodyLockWaitMicrosPerThreadFrame = gameObjects->GetLockWaitMicrosPerThreadFrame(LockKind::Body);
+    result.mMoveLockWaitMicrosPerThreadFrame = gameObjects->GetMoveLockWaitMicrosPerThreadFrame();
     const TileStreamer::Stats streaming = streamer->GetStats();
     result.mStreamInMs = streaming.mStreamInMs;
     result.mStreamLinkMs = streaming.mStreamLinkMs;

@@ -4,6 +4,7 @@
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/shapes/BoxShape.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -55,7 +56,7 @@ GameObjects::~GameObjects()
     }
 }
 
-void GameObjects::UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries)
+void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries)
 {
     const WorldQuery& query = mPhysics.GetWorldQuery();
     // A patrol circle around its spot near the player
@@ -87,13 +88,11 @@ void GameObjects::UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t&
     if (errors > 0) mQueryErrors.fetch_add(uint64_t(errors), std::memory_order_relaxed); // A count only
     ioNanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
     ioQueries += 3;
-
-    // Move: a broad-phase write from this thread
-    (void)mPhysics.GetBodyInterface().SetPosition(
-        ioObject.mBody, Vec3(spot.x(), ioObject.mGroundY + 0.9f, spot.z()), Activation::DontActivate);
+    ioObject.mTarget = Vec3(spot.x(), ioObject.mGroundY + 0.9f, spot.z());
 }
 
-void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime)
+void GameObjects::UpdateQueries(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer,
+                                float inDeltaTime)
 {
     mTime += inDeltaTime * 0.5f;
     const uint32_t count = uint32_t(mObjects.size());
@@ -108,7 +107,7 @@ void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& i
                            for (size_t kind = 0; kind < cNumLockKinds; ++kind)
                                waitedBefore[kind] = GetThisThreadLockWaitNanoseconds(LockKind(kind));
                            for (uint32_t i = inBegin; i < inEnd; ++i)
-                               UpdateObject(mObjects[i], inPlayer, nanos, queries);
+                               QueryObject(mObjects[i], inPlayer, nanos, queries);
                            ThreadSlot& slot = mSlots[ThreadSlotIndex()];
                            // Relaxed: totals read after the jobs are waited for (the wait orders them)
                            slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
@@ -117,6 +116,32 @@ void GameObjects::Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& i
                                slot.mWaitNanos[kind].fetch_add(
                                    GetThisThreadLockWaitNanoseconds(LockKind(kind)) - waitedBefore[kind],
                                    std::memory_order_relaxed);
+                       });
+}
+
+void GameObjects::ApplyMoves(jobs::JobSystem& ioJobs, uint32_t inJobs)
+{
+    const uint32_t count = uint32_t(mObjects.size());
+    if (count == 0) return;
+    // Job j moves objects j, j + jobs, j + 2 jobs...: the objects' bodies have consecutive indices, so jobs
+    // running at once lock different body shards (contiguous ranges would walk the shards in lockstep, 128
+    // bodies apart being 4 times round the 32 shards, and wait for each other at every body)
+    const uint32_t jobCount = std::clamp(inJobs, 1u, count);
+    ioJobs.ParallelFor(jobCount, 1,
+                       [&](uint32_t inBegin, uint32_t inEnd)
+                       {
+                           const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
+                           uint64_t moves = 0;
+                           for (uint32_t job = inBegin; job < inEnd; ++job)
+                               for (uint32_t i = job; i < count; i += jobCount, ++moves)
+                                   // A broad-phase write from this thread
+                                   (void)mPhysics.GetBodyInterface().SetPosition(
+                                       mObjects[i].mBody, mObjects[i].mTarget, Activation::DontActivate);
+                           ThreadSlot& slot = mSlots[ThreadSlotIndex()];
+                           // Relaxed: totals read after the jobs are waited for (the wait orders them)
+                           slot.mMoves.fetch_add(moves, std::memory_order_relaxed);
+                           slot.mMoveWaitNanos.fetch_add(GetThisThreadLockWaitNanoseconds() - waitedBefore,
+                                                         std::memory_order_relaxed);
                        });
 }
 
@@ -148,6 +173,16 @@ std::vector<double> GameObjects::GetLockWaitMicrosPerThreadFrame(LockKind inKind
         if (slot.mQueries.load(std::memory_order_relaxed) > 0) // The threads of GetQueryMicrosPerThread
             perThread.push_back(double(slot.mWaitNanos[size_t(inKind)].load(std::memory_order_relaxed)) /
                                 1000.0 / double(std::max<uint64_t>(1, mFrames)));
+    return perThread;
+}
+
+std::vector<double> GameObjects::GetMoveLockWaitMicrosPerThreadFrame() const
+{
+    std::vector<double> perThread;
+    for (const ThreadSlot& slot : mSlots)
+        if (slot.mMoves.load(std::memory_order_relaxed) > 0)
+            perThread.push_back(double(slot.mMoveWaitNanos.load(std::memory_order_relaxed)) / 1000.0 /
+                                double(std::max<uint64_t>(1, mFrames)));
     return perThread;
 }
 

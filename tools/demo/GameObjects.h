@@ -1,15 +1,18 @@
 #pragma once
 
 // GameObjects: the game-object update of the demo. Many independent game objects (patrolling kinematic bodies
-// around the player) are updated each frame by K jobs on the job system's threads, as a game does: each
-// object probes the ground (a ray cast down), checks its line of sight to the player (a ray cast), looks for
-// bodies around it (a sphere query), then moves its body (a broad-phase write). These queries and moves from
-// several threads at once are the load under which the lock-free broad phase and the global-mutex mode are
-// compared: the time each thread's jobs spend in queries, and the time they spend blocked on the engine's
-// locks (LockWaits, read around each job).
+// around the player) are updated each frame by K jobs on the job system's threads, as a game with a frame
+// pipeline does: while the physics step runs on another thread, each object probes the ground (a ray cast
+// down), checks its line of sight to the player (a ray cast), looks for bodies around it (a sphere query) and
+// decides where to go (UpdateQueries); after the step, K jobs move the bodies (ApplyMoves: broad-phase
+// writes). The queries during the step are the load under which the two modes are compared: lock-free
+// (queries read published poses and never wait) and global mutex (queries read each body under the one body
+// mutex, which the step holds: the reference engine's "before"). The time each thread's jobs spend in
+// queries, and the time they spend blocked on the engine's locks (LockWaits, read around each job), are kept
+// apart for the queries and the moves.
 //
-// Threads: Update on the main thread, which runs the jobs and waits for them; each object is touched by one
-// job only. The per-thread query figures are atomics added once per job.
+// Threads: UpdateQueries and ApplyMoves on the main thread, which runs the jobs and waits for them; each
+// object is touched by one job only. The per-thread figures are atomics added once per job.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/LockWaits.h"
@@ -34,8 +37,12 @@ public:
                 uint64_t inSeed);
     ~GameObjects();
 
-    /// One frame: inJobs jobs on ioJobs update every object around inPlayer.
-    void Update(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime);
+    /// One frame's queries: inJobs jobs on ioJobs look around every object near inPlayer and choose where it
+    /// goes; meant to run while the physics step does.
+    void UpdateQueries(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer, float inDeltaTime);
+    /// One frame's moves, after the step: inJobs jobs on ioJobs move every object's body where its queries
+    /// chose.
+    void ApplyMoves(jobs::JobSystem& ioJobs, uint32_t inJobs);
 
     uint64_t GetNumQueries() const;
     /// Queries that returned an error (bad input or a wrong thread: a bug in the demo); 0 in a good run.
@@ -44,10 +51,12 @@ public:
     /// came).
     std::vector<double> GetQueryMicrosPerThread() const;
     double GetQueryMicrosMean() const;
-    /// Microseconds per frame that each thread's game-object jobs spent waiting for the engine's locks of
-    /// inKind (LockWaits: queries and moves), in the order of GetQueryMicrosPerThread.
+    /// Microseconds per frame that each thread's query jobs spent waiting for the engine's locks of inKind
+    /// (LockWaits), in the order of GetQueryMicrosPerThread.
     std::vector<double> GetLockWaitMicrosPerThreadFrame(LockKind inKind) const;
-    /// Nanoseconds all game-object jobs have waited for the engine's locks so far (take differences).
+    /// The same for the move jobs, all lock kinds together (their own threads' order).
+    std::vector<double> GetMoveLockWaitMicrosPerThreadFrame() const;
+    /// Nanoseconds all query jobs have waited for the engine's locks so far (take differences).
     uint64_t GetLockWaitNanosTotal() const;
 
 private:
@@ -58,15 +67,18 @@ private:
         float mPhase; ///< Of its patrol circle
         bool mCanSeePlayer = false;
         float mGroundY = 0.0f;
+        Vec3 mTarget = Vec3::Zero(); ///< Where its queries sent it this frame (the body's origin)
     };
     struct alignas(64) ThreadSlot
     {
         std::atomic<uint64_t> mNanos{0};
         std::atomic<uint64_t> mQueries{0};
-        std::array<std::atomic<uint64_t>, cNumLockKinds> mWaitNanos{}; ///< Indexed by LockKind
+        std::array<std::atomic<uint64_t>, cNumLockKinds> mWaitNanos{}; ///< Queries', indexed by LockKind
+        std::atomic<uint64_t> mMoves{0};
+        std::atomic<uint64_t> mMoveWaitNanos{0}; ///< Moves', all lock kinds
     };
 
-    void UpdateObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);
+    void QueryObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries);
     static uint32_t ThreadSlotIndex();
 
     PhysicsSystem& mPhysics;
