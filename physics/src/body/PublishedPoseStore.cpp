@@ -1,5 +1,7 @@
 #include "PublishedPoseStore.h"
 
+#include "cairn/physics/LockWaits.h"
+
 #include <thread>
 
 #if defined(__x86_64__) || defined(_M_X64)
@@ -93,7 +95,7 @@ bool PublishedPoseStore::Read(uint32_t inIndex, PublishedPose& outPose) const
 void PublishedPoseStore::Retire(ShapeRef&& ioShape)
 {
     if (ioShape == nullptr) return;
-    const std::lock_guard lock(mRetiredMutex);
+    const auto lock = LockedCountingWait(mRetiredMutex, LockKind::Body);
     // The epoch read after the record stopped naming the shape: a reader that still holds it entered at or
     // before this epoch
     mRetired.push_back({mReclaimer.GetEpoch(), std::move(ioShape)});
@@ -106,7 +108,7 @@ void PublishedPoseStore::Retire(ShapeRef&& ioShape)
 
 void PublishedPoseStore::CollectRetired()
 {
-    const std::lock_guard lock(mRetiredMutex);
+    const auto lock = LockedCountingWait(mRetiredMutex, LockKind::Body);
     if (mRetired.empty()) return;
     mReclaimer.TryAdvance();
     FreeUnreachable();
