@@ -9,8 +9,8 @@
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
-#include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchOptions.h"
+#include "common/BenchScenes.h"
 #include "common/FrameTimes.h"
 #include "common/MachineInfo.h"
 #include "common/SharedBenchData.h"
@@ -24,6 +24,9 @@
 #include <vector>
 
 using namespace cairn;
+using tools::AddBatch;
+using tools::BenchSettings;
+using tools::BoxSettings;
 
 namespace
 {
@@ -45,33 +48,6 @@ struct RunResult
 /// The broad phase's margin for cached static candidates (--candidate-margin); the engine's default unless
 /// given.
 float gCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;
-
-BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, float inYaw,
-                                 MotionType inMotion, float inFriction)
-{
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(inHalfExtent).Value();
-    settings.mPosition = inCenter;
-    settings.mRotation = Quat(Eigen::AngleAxisf(inYaw, Vec3::UnitY()));
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    settings.mFriction = inFriction;
-    settings.mRestitution = 0.0f;
-    settings.mDensity = 1000.0f;
-    return settings;
-}
-
-/// Adds bodies in one batch, as a streaming loader would.
-void AddBatch(BodyInterface& ioBodies, const std::vector<BodyCreationSettings>& inSettings,
-              Activation inActivation, std::vector<BodyID>& outIDs)
-{
-    std::vector<BodyID> ids;
-    for (const BodyCreationSettings& settings : inSettings)
-        ids.push_back(ioBodies.CreateBody(settings).Value());
-    BodyInterface::AddBatch batch = ioBodies.AddBodiesPrepare(ids).Value();
-    (void)ioBodies.AddBodiesFinalize(batch, inActivation);
-    outIDs.insert(outIDs.end(), ids.begin(), ids.end());
-}
 
 RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic, int inSteps,
                    jobs::JobSystem& ioJobs)
@@ -107,20 +83,9 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     return result;
 }
 
-PhysicsSettings BenchSettings(bool inAllowSleeping)
-{
-    PhysicsSettings settings;
-    settings.mMaxBodies = 32768;
-    settings.mSolver.mVelocityIterations = 10;
-    settings.mSolver.mPositionIterations = 2;
-    settings.mAllowSleeping = inAllowSleeping;
-    settings.mBroadPhaseCandidateMargin = gCandidateMargin;
-    return settings;
-}
-
 RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 {
-    PhysicsSystem system(BenchSettings(true));
+    PhysicsSystem system(BenchSettings(true, gCandidateMargin));
     std::vector<BodyCreationSettings> statics, dynamics;
     for (const BenchBox& box : inData.mStatic)
         statics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Static, 0.5f));
@@ -134,23 +99,9 @@ RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 
 RunResult RunPyramid(jobs::JobSystem& ioJobs)
 {
-    PhysicsSystem system(BenchSettings(false));
-    std::vector<BodyCreationSettings> boxes;
-    std::vector<BodyID> floorIDs, boxIDs;
-    AddBatch(system.GetBodyInterface(),
-             {BoxSettings(Vec3(0, -1, 0), Vec3(50, 1, 50), 0, MotionType::Static, 0.2f)},
-             Activation::DontActivate, floorIDs);
-    for (int i = 0; i < 15; ++i)
-        for (int j = i / 2; j < 15 - (i + 1) / 2; ++j)
-            for (int k = i / 2; k < 15 - (i + 1) / 2; ++k)
-            {
-                const float offset = (i % 2 == 1) ? 1.0f : 0.0f;
-                boxes.push_back(BoxSettings(Vec3(-15.0f + 2.0f * float(j) + offset, 1.0f + 2.5f * float(i),
-                                                 -15.0f + 2.0f * float(k) + offset),
-                                            Vec3(1, 1, 1), 0, MotionType::Dynamic, 0.2f));
-            }
-    AddBatch(system.GetBodyInterface(), boxes, Activation::Activate, boxIDs);
-    return RunScene(system, boxIDs, 500, ioJobs);
+    PhysicsSystem system(BenchSettings(tools::cPyramidAllowSleeping, gCandidateMargin));
+    const tools::PyramidScene scene = tools::AddPyramid(system.GetBodyInterface());
+    return RunScene(system, scene.mBoxes, 500, ioJobs);
 }
 
 /// Prints the repetitions and returns the median of the mean step times.
