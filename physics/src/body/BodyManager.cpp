@@ -148,18 +148,6 @@ Status BodyManager::DestroyBody(const BodyID& inID)
     return Status::Ok();
 }
 
-Body* BodyManager::TryGetBody(const BodyID& inID) const
-{
-    if (inID.GetIndex() >= mMaxBodies || !mSlotInUse[inID.GetIndex()]) return nullptr;
-    Body& body = mBodies[inID.GetIndex()];
-    return body.mID == inID ? &body : nullptr;
-}
-
-Body* BodyManager::TryGetBodyAtIndex(uint32_t inIndex) const
-{
-    return inIndex < mMaxBodies && mSlotInUse[inIndex] ? &mBodies[inIndex] : nullptr;
-}
-
 void BodyManager::ActivateBody(Body& ioBody)
 {
     if (ioBody.IsActive() || ioBody.IsStatic() || !ioBody.mInWorld) return;

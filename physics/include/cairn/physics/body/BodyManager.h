@@ -72,10 +72,17 @@ public:
 
     /// The body for inID if it exists and has not been destroyed, else nullptr. The caller must hold the
     /// body's mutex (or be the physics step).
-    Body* TryGetBody(const BodyID& inID) const;
+    Body* TryGetBody(const BodyID& inID) const
+    {
+        Body* body = TryGetBodyAtIndex(inID.GetIndex());
+        return body != nullptr && body->mID == inID ? body : nullptr;
+    }
     /// The body in slot inIndex whatever its sequence, or nullptr when the slot is free. Same locking as
-    /// TryGetBody.
-    Body* TryGetBodyAtIndex(uint32_t inIndex) const;
+    /// TryGetBody. Inline: the step calls it for every body in every phase.
+    Body* TryGetBodyAtIndex(uint32_t inIndex) const
+    {
+        return inIndex < mMaxBodies && mSlotInUse[inIndex] ? &mBodies[inIndex] : nullptr;
+    }
 
     static constexpr uint32_t cMaxChangeListeners = 8;
     /// Adds a listener told about bodies added, removed, moved, falling asleep and waking (several may
