@@ -1313,35 +1313,62 @@ void PhysicsStep::IntegratePositions(Body& ioBody, float inDeltaTime)
 
 void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
 {
+    // A body whose new bounds lie this far inside the box the broad phase holds for it may publish before it
+    // moves (m): far below the speculative distance by which that box reaches past the body, far above
+    // rounding
+    constexpr float cHeldBoxTolerance = 1.0e-4f;
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     mMovedBodies.resize(active.size());
-    // The broad phase gets the bounds swept over the next step plus the speculative distance, so the next
-    // step finds the pairs this body can reach
-    auto sweptBounds = [&](const Body& inBody)
+    // The broad phase gets the bounds swept over the next step (by inSweep: the step's velocity times its
+    // time) plus the speculative distance, so the next step finds the pairs this body can reach
+    auto sweptBounds = [&](const AABB& inBounds, const Vec3& inSweep)
     {
-        AABB swept = inBody.mBounds;
-        swept.Encapsulate(AABB(inBody.mBounds.mMin + inDeltaTime * inBody.mLinearVelocity,
-                               inBody.mBounds.mMax + inDeltaTime * inBody.mLinearVelocity));
+        AABB swept = inBounds;
+        swept.Encapsulate(AABB(inBounds.mMin + inSweep, inBounds.mMax + inSweep));
         return swept.Expanded(mSettings.mSpeculativeDistance);
     };
     PublishedPoseStore& poses = mBodies.GetPublishedPosesForStep();
-    ParallelFor(uint32_t(active.size()), 256, 90, // A body's bounds and broad-phase move
+    mPublishOrders.resize(active.size());
+    ParallelFor(uint32_t(active.size()), 256, 90, // A body's bounds, broad-phase move and publication
                 [&](uint32_t inBegin, uint32_t inEnd)
                 {
-                    // The broad phase must hold a body's published bounds at every moment (PublishedPose.h):
-                    // a body whose new bounds do not cover those of the pose it still publishes gets a box
-                    // over both until its new pose is published, then its own
+                    // The broad phase must hold a body's published bounds at every moment (PublishedPose.h).
+                    // A body whose new bounds lie inside the box the broad phase holds for it (the box this
+                    // step's last finish gave it, if nobody published the body since) publishes first, then
+                    // moves: a falling or sliding body, whose box reached ahead. Another moves first and
+                    // publishes after, with a box grown over its published bounds meanwhile where its new
+                    // box does not cover them, shrunk back once published.
                     bool anyGrown = false;
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
-                        Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
-                        poses.Prefetch(active[i]); // Written below, after the broad phase's move
+                        const uint32_t index = active[i];
+                        Body& body = *mBodies.TryGetBodyAtIndex(index);
+                        poses.Prefetch(index);
                         const AABB published = body.mBounds;
                         body.UpdateBounds();
-                        AABB during = sweptBounds(body);
-                        anyGrown |= !during.Contains(published);
-                        during.Encapsulate(published);
-                        mMovedBodies[i] = {body.GetID(), during, body.GetObjectLayer()};
+                        const Vec3 sweep = inDeltaTime * body.mLinearVelocity;
+                        const AABB swept = sweptBounds(body.mBounds, sweep);
+                        AABB box = swept;
+                        PublishOrder order = PublishOrder::AfterMove;
+                        // The box held is made again as it was made, and checked a little inside, so that a
+                        // rounding difference could only make the check fail
+                        if (poses.GetVersion(index) == body.mStepBroadPhaseVersion &&
+                            sweptBounds(published, body.mStepSweep)
+                                .Expanded(-cHeldBoxTolerance)
+                                .Contains(body.mBounds))
+                        {
+                            body.mStepBroadPhaseVersion = poses.PublishMotion(body);
+                            order = PublishOrder::BeforeMove;
+                        }
+                        else if (!swept.Contains(published))
+                        {
+                            box.Encapsulate(published);
+                            order = PublishOrder::AfterGrownMove;
+                            anyGrown = true;
+                        }
+                        body.mStepSweep = sweep;
+                        mPublishOrders[i] = order;
+                        mMovedBodies[i] = {body.GetID(), box, body.GetObjectLayer()};
 
                         const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
                         const float speed =
@@ -1352,17 +1379,24 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                     }
                     // Any thread may move bodies in the broad phase (each body here is in one range only)
                     const uint64_t waited = GetThisThreadLockWaitNanoseconds();
-                    const std::span<BroadPhaseBody> moved(mMovedBodies.data() + inBegin, inEnd - inBegin);
-                    mBroadPhase.NotifyBodiesAABBChanged(moved);
-                    // The broad phase holds the new bounds: this collision step's positions are final
+                    mBroadPhase.NotifyBodiesAABBChanged(
+                        std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
+                    // The broad phase holds the new bounds: this collision step's positions are final. The
+                    // grown boxes go to the front of the range, shrunk to the swept bounds, so that the next
+                    // step's pairs are those of the swept bounds alone
+                    uint32_t grown = inBegin;
                     for (uint32_t i = inBegin; i < inEnd; ++i)
                     {
-                        const Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
-                        poses.PublishMotion(body);
-                        if (anyGrown) mMovedBodies[i].mBounds = sweptBounds(body);
+                        if (mPublishOrders[i] == PublishOrder::BeforeMove) continue;
+                        Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+                        body.mStepBroadPhaseVersion = poses.PublishMotion(body);
+                        if (mPublishOrders[i] == PublishOrder::AfterGrownMove)
+                            mMovedBodies[grown++] = {body.GetID(), sweptBounds(body.mBounds, body.mStepSweep),
+                                                     body.GetObjectLayer()};
                     }
-                    // The grown boxes shrink to the swept bounds, so the next step's pairs are the same
-                    if (anyGrown) mBroadPhase.NotifyBodiesAABBShrunk(moved);
+                    if (anyGrown)
+                        mBroadPhase.NotifyBodiesAABBShrunk(
+                            std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, grown - inBegin));
                     mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
                                                    std::memory_order_relaxed); // See the member
                 });

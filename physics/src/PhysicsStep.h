@@ -442,6 +442,14 @@ private:
 #endif
     uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
     std::vector<BroadPhaseBody> mMovedBodies; ///< Scratch for the broad-phase notify
+    /// When the finish publishes an active body's pose, against its broad-phase move (UpdateBoundsAndSleep)
+    enum class PublishOrder : uint8_t
+    {
+        BeforeMove,     ///< Its new bounds lie inside the box the broad phase holds for it
+        AfterMove,      ///< Its new box covers its published bounds
+        AfterGrownMove, ///< Its box is grown over its published bounds until then, and shrunk after
+    };
+    std::vector<PublishOrder> mPublishOrders; ///< Scratch, by active index
     /// This step's waits for locks (LockWaits), added by whichever of its threads waited. Relaxed: a sum,
     /// read by the stepping thread after it waited for every job that adds to it
     std::atomic<uint64_t> mLockWaitNanoseconds{0};

@@ -46,8 +46,16 @@ public:
         StoreMotionAndEndWrite(record, inBody);
     }
     /// Publishes the position and rotation of a body whose other fields are published already (the step, at
-    /// the end of a collision step: it changes nothing else of a body without publishing it whole).
-    void PublishMotion(const Body& inBody) { StoreMotionAndEndWrite(BeginWrite(inBody), inBody); }
+    /// the end of a collision step: it changes nothing else of a body without publishing it whole). Returns
+    /// the record's new version.
+    uint32_t PublishMotion(const Body& inBody) { return StoreMotionAndEndWrite(BeginWrite(inBody), inBody); }
+    /// The version of body slot inIndex's record, for its writer (the step) to tell whether anyone published
+    /// it since.
+    uint32_t GetVersion(uint32_t inIndex) const
+    {
+        // Relaxed: only a writer of the record calls it, and writers are serialised by the body's lock
+        return mRecords[inIndex].mVersion.load(std::memory_order_relaxed);
+    }
 
     /// Starts fetching a record that the caller will publish soon (the step, a range of bodies at a time).
     void Prefetch(uint32_t inIndex) const { __builtin_prefetch(&mRecords[inIndex], 1); }
@@ -92,8 +100,8 @@ private:
         record.mVersion.store(version + 1, std::memory_order_relaxed);
         return record;
     }
-    /// Stores the centre of mass and rotation, then makes the version even again.
-    static void StoreMotionAndEndWrite(Record& ioRecord, const Body& inBody)
+    /// Stores the centre of mass and rotation, then makes the version even again; returns it.
+    static uint32_t StoreMotionAndEndWrite(Record& ioRecord, const Body& inBody)
     {
         // Release, each: see BeginWrite
         for (int i = 0; i < 3; ++i)
@@ -102,8 +110,9 @@ private:
             ioRecord.mRotation[i].store(inBody.mRotation.coeffs()[i], std::memory_order_release);
         // Relaxed load: this thread made it odd. Release: a reader that acquires the even version sees every
         // field stored since
-        ioRecord.mVersion.store(ioRecord.mVersion.load(std::memory_order_relaxed) + 1,
-                                std::memory_order_release);
+        const uint32_t version = ioRecord.mVersion.load(std::memory_order_relaxed) + 1;
+        ioRecord.mVersion.store(version, std::memory_order_release);
+        return version;
     }
 
     /// Frees the retired shapes no reader can reach. Caller holds mRetiredMutex.
