@@ -371,8 +371,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     phaseSection("finish", phases.mFinish);
     phaseSection("step lock waits", phases.mLockWait);
     sections.push_back(
-        {"game-object queries (during the step)",
-         {{"queries", Count(inRun.mQueries)},
+        {"game-object queries",
+         {{"queries (beside the step)", Count(inRun.mQueries)},
           {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
           {"µs/query per thread", MicrosList(inRun.mQueryMicrosPerThread)},
           {"lock waits µs/query", Micros(QueryLockWaitMicrosPerQuery(inRun))},
