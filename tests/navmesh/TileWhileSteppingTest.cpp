@@ -171,6 +171,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
 
     // Relaxed for the stop flag; the flag and the count are read around each collection
     std::atomic<bool> stop{false};
+    // Seq-cst (the default): a label around each Update, the plainest to reason about
     std::atomic<bool> stepping{false};
     std::atomic<uint64_t> updates{0};
     std::atomic<uint64_t> failedUpdates{0};
