@@ -1,6 +1,7 @@
 #pragma once
 
-// The static box floor that many step tests stand their bodies on: its top face at y = 0.
+// The static box floor that many step tests stand their bodies on (its top face at y = 0), and the box bodies
+// they stand there.
 
 #include "cairn/physics/body/BodyCreationSettings.h"
 #include "cairn/physics/body/Layers.h"
@@ -19,6 +20,18 @@ inline BodyCreationSettings StaticFloorSettings(float inHalfWidth)
     floor.mMotionType = MotionType::Static;
     floor.mObjectLayer = Layers::cStatic;
     return floor;
+}
+
+/// Settings of a box body of any motion type, in the static layer when static and the moving one otherwise.
+inline BodyCreationSettings BoxBodySettings(const Vec3& inCenter, const Vec3& inHalfExtent,
+                                            MotionType inMotion)
+{
+    BodyCreationSettings settings;
+    settings.mShape = BoxShape::Create(inHalfExtent).Value();
+    settings.mPosition = inCenter;
+    settings.mMotionType = inMotion;
+    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
+    return settings;
 }
 
 } // namespace cairn::test

@@ -8,6 +8,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/StaticFloor.h"
 
 #include <atomic>
 #include <chrono>
@@ -24,15 +25,7 @@ namespace
 
 constexpr float cHalfWorld = 12.8f; // 2 x 2 tiles around the origin
 
-BodyCreationSettings BoxSettings(const Vec3& inCenter, const Vec3& inHalfExtent, MotionType inMotion)
-{
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(inHalfExtent).Value();
-    settings.mPosition = inCenter;
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    return settings;
-}
+using test::BoxBodySettings;
 
 struct NavMeshUnderTest
 {
@@ -77,13 +70,13 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
     PhysicsSystem physics;
     BodyInterface& bodies = physics.GetBodyInterface();
     ASSERT_TRUE(bodies.CreateAndAddBody(
-        BoxSettings(Vec3(0, -0.5f, 0), Vec3(cHalfWorld, 0.5f, cHalfWorld), MotionType::Static),
+        BoxBodySettings(Vec3(0, -0.5f, 0), Vec3(cHalfWorld, 0.5f, cHalfWorld), MotionType::Static),
         Activation::DontActivate));
     // Pillars: level geometry the jobs read while the step runs
     for (int i = -3; i <= 3; ++i)
         for (int k = -3; k <= 3; k += 2)
-            ASSERT_TRUE(bodies.CreateAndAddBody(BoxSettings(Vec3(3.0f * float(i), 1.0f, 3.0f * float(k)),
-                                                            Vec3(0.4f, 1.0f, 0.4f), MotionType::Static),
+            ASSERT_TRUE(bodies.CreateAndAddBody(BoxBodySettings(Vec3(3.0f * float(i), 1.0f, 3.0f * float(k)),
+                                                                Vec3(0.4f, 1.0f, 0.4f), MotionType::Static),
                                                 Activation::DontActivate));
 
     jobs::BackgroundQueue::Settings queueSettings;
@@ -110,10 +103,10 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
             {
                 const bool isStatic = random() % 2 == 0;
                 const Vec3 center(position(random), isStatic ? 0.5f : 2.0f, position(random));
-                Result<BodyID> id =
-                    bodies.CreateAndAddBody(BoxSettings(center, Vec3(0.5f, 0.5f, 0.5f),
-                                                        isStatic ? MotionType::Static : MotionType::Dynamic),
-                                            isStatic ? Activation::DontActivate : Activation::Activate);
+                Result<BodyID> id = bodies.CreateAndAddBody(
+                    BoxBodySettings(center, Vec3(0.5f, 0.5f, 0.5f),
+                                    isStatic ? MotionType::Static : MotionType::Dynamic),
+                    isStatic ? Activation::DontActivate : Activation::Activate);
                 ASSERT_TRUE(id);
                 std::lock_guard lock(addedMutex);
                 added.push_back({id.Value(), isStatic});

@@ -42,15 +42,7 @@ namespace cairn::navmesh
 namespace
 {
 
-BodyCreationSettings Box(const Vec3& inCenter, const Vec3& inHalfExtent, MotionType inMotion)
-{
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(inHalfExtent).Value();
-    settings.mPosition = inCenter;
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    return settings;
-}
+using test::BoxBodySettings;
 
 /// One tile build: what was collected and what Recast and Detour made of it.
 struct TileBuild
@@ -102,8 +94,8 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     for (const auto& [center, halfExtent] : {std::pair{Vec3(3.0f, 0.75f, 9.0f), Vec3(0.6f, 0.75f, 1.5f)},
                                              std::pair{Vec3(9.0f, 0.5f, 3.0f), Vec3(1.2f, 0.5f, 0.4f)},
                                              std::pair{Vec3(6.4f, 1.0f, 11.0f), Vec3(0.5f, 1.0f, 0.5f)}})
-        ASSERT_TRUE(
-            bodies.CreateAndAddBody(Box(center, halfExtent, MotionType::Static), Activation::DontActivate));
+        ASSERT_TRUE(bodies.CreateAndAddBody(BoxBodySettings(center, halfExtent, MotionType::Static),
+                                            Activation::DontActivate));
 
     // The sleeping crates, resting on the floor, 1 m high (higher than the agent climbs: obstacles)
     std::vector<BodyID> crates;
@@ -111,7 +103,8 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
                                    Vec3(6.0f, 0.5f, 6.0f), Vec3(8.0f, 0.5f, 8.5f), Vec3(10.5f, 0.5f, 6.5f)};
     for (size_t i = 0; i < std::size(cratePositions); ++i)
     {
-        BodyCreationSettings crate = Box(cratePositions[i], Vec3(0.5f, 0.5f, 0.5f), MotionType::Dynamic);
+        BodyCreationSettings crate =
+            BoxBodySettings(cratePositions[i], Vec3(0.5f, 0.5f, 0.5f), MotionType::Dynamic);
         crate.mRotation = Quat(Eigen::AngleAxisf(0.25f * float(i), Vec3::UnitY()));
         crates.push_back(bodies.CreateAndAddBody(crate, Activation::DontActivate).Value());
     }
@@ -119,7 +112,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     // Moving in the tile, all left out by the default inclusion, and well clear of every crate (a touch would
     // wake it)
     BodyCreationSettings paddle =
-        Box(Vec3(10.0f, 0.5f, 11.0f), Vec3(1.2f, 0.25f, 0.2f), MotionType::Kinematic);
+        BoxBodySettings(Vec3(10.0f, 0.5f, 11.0f), Vec3(1.2f, 0.25f, 0.2f), MotionType::Kinematic);
     const BodyID paddleID = bodies.CreateAndAddBody(paddle, Activation::Activate).Value();
     ASSERT_TRUE(bodies.SetAngularVelocity(paddleID, Vec3(0.0f, 1.5f, 0.0f)));
     BodyCreationSettings bouncer;
@@ -129,32 +122,34 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     bouncer.mLinearDamping = 0.0f;
     bouncer.mAllowSleeping = false;
     ASSERT_TRUE(bodies.CreateAndAddBody(bouncer, Activation::Activate));
-    BodyCreationSettings resting = Box(Vec3(1.0f, 0.4f, 11.5f), Vec3(0.4f, 0.4f, 0.4f), MotionType::Dynamic);
+    BodyCreationSettings resting =
+        BoxBodySettings(Vec3(1.0f, 0.4f, 11.5f), Vec3(0.4f, 0.4f, 0.4f), MotionType::Dynamic);
     resting.mAllowSleeping = false; // Awake, published every step, left out
     ASSERT_TRUE(bodies.CreateAndAddBody(resting, Activation::Activate));
 
     // Outside the bordered box: a walled pile pushed back and forth by a kinematic piston
     for (float side : {-1.0f, 1.0f})
     {
+        ASSERT_TRUE(bodies.CreateAndAddBody(BoxBodySettings(Vec3(35.0f + side * 10.5f, 1.5f, 0.0f),
+                                                            Vec3(0.5f, 1.5f, 11.0f), MotionType::Static),
+                                            Activation::DontActivate));
         ASSERT_TRUE(bodies.CreateAndAddBody(
-            Box(Vec3(35.0f + side * 10.5f, 1.5f, 0.0f), Vec3(0.5f, 1.5f, 11.0f), MotionType::Static),
-            Activation::DontActivate));
-        ASSERT_TRUE(bodies.CreateAndAddBody(
-            Box(Vec3(35.0f, 1.5f, side * 10.5f), Vec3(11.0f, 1.5f, 0.5f), MotionType::Static),
+            BoxBodySettings(Vec3(35.0f, 1.5f, side * 10.5f), Vec3(11.0f, 1.5f, 0.5f), MotionType::Static),
             Activation::DontActivate));
     }
     for (int i = 0; i < 150; ++i)
     {
-        BodyCreationSettings box =
-            Box(Vec3(30.0f + float(i % 10), 0.5f + float(i / 50), -7.0f + 2.8f * float((i / 10) % 5)),
-                Vec3(0.35f, 0.35f, 0.35f), MotionType::Dynamic);
+        BodyCreationSettings box = BoxBodySettings(
+            Vec3(30.0f + float(i % 10), 0.5f + float(i / 50), -7.0f + 2.8f * float((i / 10) % 5)),
+            Vec3(0.35f, 0.35f, 0.35f), MotionType::Dynamic);
         box.mAllowSleeping = false;
         ASSERT_TRUE(bodies.CreateAndAddBody(box, Activation::Activate));
     }
     const BodyID piston =
         bodies
-            .CreateAndAddBody(Box(Vec3(26.5f, 0.8f, 0.0f), Vec3(0.3f, 0.75f, 9.5f), MotionType::Kinematic),
-                              Activation::Activate)
+            .CreateAndAddBody(
+                BoxBodySettings(Vec3(26.5f, 0.8f, 0.0f), Vec3(0.3f, 0.75f, 9.5f), MotionType::Kinematic),
+                Activation::Activate)
             .Value();
     ASSERT_TRUE(bodies.SetLinearVelocity(piston, Vec3(2.0f, 0.0f, 0.0f)));
 
