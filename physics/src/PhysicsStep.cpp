@@ -1329,77 +1329,82 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
     };
     PublishedPoseStore& poses = mBodies.GetPublishedPosesForStep();
     mPublishOrders.resize(active.size());
-    ParallelFor(uint32_t(active.size()), 256, 90, // A body's bounds, broad-phase move and publication
-                [&](uint32_t inBegin, uint32_t inEnd)
+    ParallelFor(
+        uint32_t(active.size()), 256, 90, // A body's bounds, broad-phase move and publication
+        [&](uint32_t inBegin, uint32_t inEnd)
+        {
+            // The broad phase must hold a body's published bounds at every moment (PublishedPose.h).
+            // A body whose new bounds lie inside the box the broad phase holds for it (the box this
+            // step's last finish gave it, if nobody published the body since) publishes first, then
+            // moves: a falling or sliding body, whose box reached ahead. Another moves first and
+            // publishes after, with a box grown over its published bounds meanwhile where its new
+            // box does not cover them, shrunk back once published.
+            bool anyGrown = false;
+            for (uint32_t i = inBegin; i < inEnd; ++i)
+            {
+                const uint32_t index = active[i];
+                Body& body = *mBodies.TryGetBodyAtIndex(index);
+                poses.Prefetch(index);
+                const AABB published = body.mBounds;
+                body.UpdateBounds();
+                const Vec3 sweep = inDeltaTime * body.mLinearVelocity;
+                const AABB swept = sweptBounds(body.mBounds, sweep);
+                AABB box = swept;
+                PublishOrder order = PublishOrder::AfterMove;
+                // The box held is made again as it was made, and checked a little inside, so that a
+                // rounding difference could only make the check fail
+                PublishedPoseStore::StepMemory& memory = poses.GetStepMemory(index);
+                if (poses.GetVersion(index) == memory.mVersion &&
+                    sweptBounds(published, Vec3(memory.mSweep[0], memory.mSweep[1], memory.mSweep[2]))
+                        .Expanded(-cHeldBoxTolerance)
+                        .Contains(body.mBounds))
                 {
-                    // The broad phase must hold a body's published bounds at every moment (PublishedPose.h).
-                    // A body whose new bounds lie inside the box the broad phase holds for it (the box this
-                    // step's last finish gave it, if nobody published the body since) publishes first, then
-                    // moves: a falling or sliding body, whose box reached ahead. Another moves first and
-                    // publishes after, with a box grown over its published bounds meanwhile where its new
-                    // box does not cover them, shrunk back once published.
-                    bool anyGrown = false;
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                    {
-                        const uint32_t index = active[i];
-                        Body& body = *mBodies.TryGetBodyAtIndex(index);
-                        poses.Prefetch(index);
-                        const AABB published = body.mBounds;
-                        body.UpdateBounds();
-                        const Vec3 sweep = inDeltaTime * body.mLinearVelocity;
-                        const AABB swept = sweptBounds(body.mBounds, sweep);
-                        AABB box = swept;
-                        PublishOrder order = PublishOrder::AfterMove;
-                        // The box held is made again as it was made, and checked a little inside, so that a
-                        // rounding difference could only make the check fail
-                        if (poses.GetVersion(index) == body.mStepBroadPhaseVersion &&
-                            sweptBounds(published, body.mStepSweep)
-                                .Expanded(-cHeldBoxTolerance)
-                                .Contains(body.mBounds))
-                        {
-                            body.mStepBroadPhaseVersion = poses.PublishMotion(body);
-                            order = PublishOrder::BeforeMove;
-                        }
-                        else if (!swept.Contains(published))
-                        {
-                            box.Encapsulate(published);
-                            order = PublishOrder::AfterGrownMove;
-                            anyGrown = true;
-                        }
-                        body.mStepSweep = sweep;
-                        mPublishOrders[i] = order;
-                        mMovedBodies[i] = {body.GetID(), box, body.GetObjectLayer()};
+                    memory.mVersion = poses.PublishMotion(body);
+                    order = PublishOrder::BeforeMove;
+                }
+                else if (!swept.Contains(published))
+                {
+                    box.Encapsulate(published);
+                    order = PublishOrder::AfterGrownMove;
+                    anyGrown = true;
+                }
+                for (int axis = 0; axis < 3; ++axis)
+                    memory.mSweep[axis] = sweep[axis];
+                mPublishOrders[i] = order;
+                mMovedBodies[i] = {body.GetID(), box, body.GetObjectLayer()};
 
-                        const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
-                        const float speed =
-                            body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
-                        const bool slow = mSettings.mAllowSleeping && body.mAllowSleeping &&
-                                          speed < mSettings.mSleepVelocity;
-                        body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
-                    }
-                    // Any thread may move bodies in the broad phase (each body here is in one range only)
-                    const uint64_t waited = GetThisThreadLockWaitNanoseconds();
-                    mBroadPhase.NotifyBodiesAABBChanged(
-                        std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
-                    // The broad phase holds the new bounds: this collision step's positions are final. The
-                    // grown boxes go to the front of the range, shrunk to the swept bounds, so that the next
-                    // step's pairs are those of the swept bounds alone
-                    uint32_t grown = inBegin;
-                    for (uint32_t i = inBegin; i < inEnd; ++i)
-                    {
-                        if (mPublishOrders[i] == PublishOrder::BeforeMove) continue;
-                        Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
-                        body.mStepBroadPhaseVersion = poses.PublishMotion(body);
-                        if (mPublishOrders[i] == PublishOrder::AfterGrownMove)
-                            mMovedBodies[grown++] = {body.GetID(), sweptBounds(body.mBounds, body.mStepSweep),
-                                                     body.GetObjectLayer()};
-                    }
-                    if (anyGrown)
-                        mBroadPhase.NotifyBodiesAABBShrunk(
-                            std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, grown - inBegin));
-                    mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
-                                                   std::memory_order_relaxed); // See the member
-                });
+                const float radius = body.mShape->GetLocalBounds().HalfExtent().norm();
+                const float speed = body.mLinearVelocity.norm() + radius * body.mAngularVelocity.norm();
+                const bool slow =
+                    mSettings.mAllowSleeping && body.mAllowSleeping && speed < mSettings.mSleepVelocity;
+                body.mSleepTimer = slow ? body.mSleepTimer + inDeltaTime : 0.0f;
+            }
+            // Any thread may move bodies in the broad phase (each body here is in one range only)
+            const uint64_t waited = GetThisThreadLockWaitNanoseconds();
+            mBroadPhase.NotifyBodiesAABBChanged(
+                std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, inEnd - inBegin));
+            // The broad phase holds the new bounds: this collision step's positions are final. The
+            // grown boxes go to the front of the range, shrunk to the swept bounds, so that the next
+            // step's pairs are those of the swept bounds alone
+            uint32_t grown = inBegin;
+            for (uint32_t i = inBegin; i < inEnd; ++i)
+            {
+                if (mPublishOrders[i] == PublishOrder::BeforeMove) continue;
+                const Body& body = *mBodies.TryGetBodyAtIndex(active[i]);
+                PublishedPoseStore::StepMemory& memory = poses.GetStepMemory(active[i]);
+                memory.mVersion = poses.PublishMotion(body);
+                if (mPublishOrders[i] == PublishOrder::AfterGrownMove)
+                    mMovedBodies[grown++] = {
+                        body.GetID(),
+                        sweptBounds(body.mBounds, Vec3(memory.mSweep[0], memory.mSweep[1], memory.mSweep[2])),
+                        body.GetObjectLayer()};
+            }
+            if (anyGrown)
+                mBroadPhase.NotifyBodiesAABBShrunk(
+                    std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, grown - inBegin));
+            mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
+                                           std::memory_order_relaxed); // See the member
+        });
 
     // An island sleeps as a whole when every body in it has been slow long enough
     mSleepingIslands.clear();

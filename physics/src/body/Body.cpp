@@ -29,8 +29,6 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     mInWorld = false;
     mAddPending = false;
     mWakeIsland = false;
-    mStepSweep.setZero();
-    mStepBroadPhaseVersion = 1;
     mSleepRingNext = inID;
 
     mInvMass = 0.0f;

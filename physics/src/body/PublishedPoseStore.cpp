@@ -60,17 +60,11 @@ bool PublishedPoseStore::Read(uint32_t inIndex, PublishedPose& outPose) const
             // write in progress implies its odd version is visible to that re-read
             const uint32_t sequence = record.mSequence.load(std::memory_order_acquire);
             const uint32_t flags = record.mFlags.load(std::memory_order_acquire);
-            Vec3 centerOfMass, centerOfMassOffset;
             for (int i = 0; i < 3; ++i)
-            {
-                centerOfMass[i] = record.mPosition[i].load(std::memory_order_acquire);
-                centerOfMassOffset[i] = record.mCenterOfMassOffset[i].load(std::memory_order_acquire);
-            }
-            Quat& rotation = outPose.mTransform.mRotation;
+                outPose.mTransform.mPosition[i] = record.mPosition[i].load(std::memory_order_acquire);
             for (int i = 0; i < 4; ++i)
-                rotation.coeffs()[i] = record.mRotation[i].load(std::memory_order_acquire);
-            // As Body::GetPosition computes it, so a query sees the very transform the step had
-            outPose.mTransform.mPosition = centerOfMass - rotation * centerOfMassOffset;
+                outPose.mTransform.mRotation.coeffs()[i] =
+                    record.mRotation[i].load(std::memory_order_acquire);
             outPose.mShape = record.mShape.load(std::memory_order_acquire);
             // Relaxed: ordered after the acquire loads above
             if (record.mVersion.load(std::memory_order_relaxed) == before)

@@ -40,8 +40,6 @@ public:
         // Release, each: see BeginWrite
         record.mSequence.store(inBody.GetID().GetSequence(), std::memory_order_release);
         record.mFlags.store(PackFlags(inBody), std::memory_order_release);
-        for (int i = 0; i < 3; ++i)
-            record.mCenterOfMassOffset[i].store(inBody.mCenterOfMassOffset[i], std::memory_order_release);
         record.mShape.store(inBody.GetShape().get(), std::memory_order_release);
         StoreMotionAndEndWrite(record, inBody);
     }
@@ -56,6 +54,19 @@ public:
         // Relaxed: only a writer of the record calls it, and writers are serialised by the body's lock
         return mRecords[inIndex].mVersion.load(std::memory_order_relaxed);
     }
+
+    /// What the physics step remembers of a body between its finishes (see
+    /// PhysicsStep::UpdateBoundsAndSleep): the displacement it last swept the body's bounds by for the broad
+    /// phase, and the body's version right after it published it. While the version is still that one nobody
+    /// has given the broad phase another box since (every change of a body's box publishes it). Kept in the
+    /// record's spare bytes, on the line the step writes anyway; read and written by the step only (it holds
+    /// every body lock), never by readers.
+    struct StepMemory
+    {
+        float mSweep[3] = {0, 0, 0};
+        uint32_t mVersion = 1; ///< Odd, so never a published version until the step sets it
+    };
+    StepMemory& GetStepMemory(uint32_t inIndex) { return mRecords[inIndex].mStep; }
 
     /// Starts fetching a record that the caller will publish soon (the step, a range of bodies at a time).
     void Prefetch(uint32_t inIndex) const { __builtin_prefetch(&mRecords[inIndex], 1); }
@@ -80,10 +91,10 @@ private:
         std::atomic<uint32_t> mVersion{0};           ///< Odd while written
         std::atomic<uint32_t> mSequence{0};          ///< The body id's sequence (the index is the record's)
         std::atomic<uint32_t> mFlags{0};             ///< See PackFlags
-        std::atomic<float> mPosition[3] = {0, 0, 0}; ///< Centre of mass, world
-        std::atomic<float> mRotation[4] = {0, 0, 0, 1};        ///< x, y, z, w
-        std::atomic<float> mCenterOfMassOffset[3] = {0, 0, 0}; ///< Shape-local: the reader finds the origin
+        std::atomic<float> mPosition[3] = {0, 0, 0}; ///< The shape's origin, world
+        std::atomic<float> mRotation[4] = {0, 0, 0, 1}; ///< x, y, z, w
         std::atomic<const Shape*> mShape{nullptr};
+        StepMemory mStep; ///< Not published: the step's own (see StepMemory)
     };
     static_assert(sizeof(Record) == 64, "a published pose is one cache line");
 
@@ -100,12 +111,15 @@ private:
         record.mVersion.store(version + 1, std::memory_order_relaxed);
         return record;
     }
-    /// Stores the centre of mass and rotation, then makes the version even again; returns it.
+    /// Stores the shape's origin and rotation, then makes the version even again; returns it.
     static uint32_t StoreMotionAndEndWrite(Record& ioRecord, const Body& inBody)
     {
+        // The origin as Body::GetPosition finds it, so a reader sees the very transform the step had; most
+        // shapes have their centre of mass at their origin, and then it is the centre of mass itself
+        const Vec3 origin = inBody.mCenterOfMassOffset.isZero(0.0f) ? inBody.mPosition : inBody.GetPosition();
         // Release, each: see BeginWrite
         for (int i = 0; i < 3; ++i)
-            ioRecord.mPosition[i].store(inBody.mPosition[i], std::memory_order_release);
+            ioRecord.mPosition[i].store(origin[i], std::memory_order_release);
         for (int i = 0; i < 4; ++i)
             ioRecord.mRotation[i].store(inBody.mRotation.coeffs()[i], std::memory_order_release);
         // Relaxed load: this thread made it odd. Release: a reader that acquires the even version sees every

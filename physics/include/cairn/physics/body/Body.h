@@ -111,12 +111,6 @@ private:
     bool mInWorld = false;    ///< Added to the broad phase and simulated
     bool mAddPending = false; ///< In a prepared add batch that is not finalized yet
     bool mWakeIsland = false; ///< Woken from outside the step: the step wakes its sleeping island too
-    /// The physics step's own (see PhysicsStep::UpdateBoundsAndSleep): the displacement its last finish swept
-    /// the body's bounds by for the broad phase, and the body's published version right after. While the
-    /// version is still that one nobody has given the broad phase another box since (every change of a body's
-    /// box publishes it), so the broad phase holds mBounds swept by mStepSweep
-    Vec3 mStepSweep = Vec3::Zero();
-    uint32_t mStepBroadPhaseVersion = 1; ///< Odd, so never a published version until the step sets it
 };
 
 } // namespace cairn
