@@ -1400,7 +1400,7 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                         body.GetObjectLayer()};
             }
             if (anyGrown)
-                mBroadPhase.NotifyBodiesAABBShrunk(
+                mBroadPhase.NotifyBodiesAABBChanged(
                     std::span<const BroadPhaseBody>(mMovedBodies.data() + inBegin, grown - inBegin));
             mLockWaitNanoseconds.fetch_add(GetThisThreadLockWaitNanoseconds() - waited,
                                            std::memory_order_relaxed); // See the member

@@ -246,24 +246,6 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
     CountTreeChanges(changed);
 }
 
-void BroadPhaseQuadTree::NotifyBodiesAABBShrunk(std::span<const BroadPhaseBody> inBodies)
-{
-    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
-    uint32_t changed = 0;
-    std::optional<QuadTree::MoveScope> scope;
-    for (const BroadPhaseBody& body : inBodies)
-    {
-        if (body.mID.IsInvalid() || body.mID.GetIndex() >= mMaxBodies || !mLayerSetup.IsValid(body.mLayer))
-            continue;
-        QuadTree& tree = TreeOf(body.mLayer);
-        if (!scope.has_value() || &scope->GetTree() != &tree) scope.emplace(tree);
-        tree.ShrinkBodyHeld(*scope, body.mID, body.mBounds);
-        changed |= 1u << TreeIndexOf(body.mLayer);
-    }
-    scope.reset(); // Before the change counts: see NotifyBodiesAABBChanged
-    CountTreeChanges(changed);
-}
-
 void BroadPhaseQuadTree::Update()
 {
     UpdateImpl(false);

@@ -570,21 +570,6 @@ bool QuadTree::MoveBodyHeld([[maybe_unused]] const MoveScope& inScope, BodyID in
     return true;
 }
 
-void QuadTree::ShrinkBodyHeld([[maybe_unused]] const MoveScope& inScope, BodyID inBody, const AABB& inBounds)
-{
-    assert(&inScope.GetTree() == this);
-    if (!IsValidBroadPhaseBounds(inBounds) || FindLocation(inBody) == QuadTreeBodyTable::cInvalidLocation)
-        return;
-    QuadTreeBodyTable::Entry& entry = mBodies[inBody.GetIndex()];
-#ifndef NDEBUG
-    AABB last;
-    assert((!QuadTreeBodyTable::LoadBounds(entry, last) || last.Contains(inBounds)) &&
-           "ShrinkBodyHeld: the bounds grew");
-#endif
-    // Inside the last bounds, so inside the slot; the slot is loose since the move that gave those bounds
-    QuadTreeBodyTable::StoreBounds(entry, inBounds);
-}
-
 void QuadTree::SetBodyLayer(BodyID inBody, ObjectLayer inLayer)
 {
     const uint32_t index = inBody.GetIndex();

@@ -86,13 +86,6 @@ public:
 
     /// New world AABBs for added bodies (after a move).
     virtual void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) = 0;
-    /// The same for bodies whose new AABB lies inside the one they were last given, in the same object layer
-    /// (the physics step shrinks the boxes it grew while it published the bodies' poses); a broad phase that
-    /// can do this cheaper overrides it.
-    virtual void NotifyBodiesAABBShrunk(std::span<const BroadPhaseBody> inBodies)
-    {
-        NotifyBodiesAABBChanged(inBodies);
-    }
 
     /// Optimises the structure after moves, adds and removes (re-sort, rebuild). Physics step only.
     virtual void Update() = 0;

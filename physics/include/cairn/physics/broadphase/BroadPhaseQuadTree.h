@@ -124,8 +124,6 @@ public:
     /// Stores the exact bounds and grows the slots up to the root. A body whose object layer moved it to
     /// another broad-phase layer is moved to that tree.
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
-    /// Stores the exact bounds only: a box inside the last one is inside its slot already.
-    void NotifyBodiesAABBShrunk(std::span<const BroadPhaseBody> inBodies) override;
     /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
     void Update() override;
     /// In LockMode::LockFree only: the global mutex would make the pair queries wait for the update.

@@ -150,8 +150,6 @@ public:
     };
     /// MoveBody under a MoveScope of this tree; false (nothing changed) when the body is not in it.
     bool MoveBodyHeld(const MoveScope& inScope, BodyID inBody, const AABB& inBounds);
-    /// MoveBody for bounds inside the body's last bounds (so inside its slot): stores them, writes no node.
-    void ShrinkBodyHeld(const MoveScope& inScope, BodyID inBody, const AABB& inBounds);
     /// Sets the object layer of a linked body (same broad-phase layer).
     void SetBodyLayer(BodyID inBody, ObjectLayer inLayer);
 
