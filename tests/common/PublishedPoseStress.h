@@ -117,6 +117,10 @@ constexpr float cPistonOut = 12.5f;  ///< A piston turns inwards beyond this dis
 constexpr float cPistonIn = 5.0f;    ///< ...and outwards within this one
 constexpr float cPistonSpeed = 1.5f; ///< m/s
 constexpr float cPaddleSpin = 1.5f;  ///< rad/s
+/// The paddles turn round every this many updates: a second of simulated time, so that even a run cut short
+/// by its time cap (ThreadSanitizer on a loaded machine: about 230 updates in 20 s) changes a kinematic
+/// velocity mid-run
+constexpr uint64_t cPaddleTurnUpdates = 60;
 constexpr float cProbeHalfSize = 1.5f;
 
 /// A body a query thread may pick, and how to choose a point well inside it.
@@ -345,10 +349,10 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
                     }
                 }
             }
-            if (count % 240 == 0)
+            if (count % cPaddleTurnUpdates == 0)
                 for (size_t i = 0; i < paddles.size(); ++i)
                 {
-                    const float sign = (count / 240) % 2 == 0 ? 1.0f : -1.0f;
+                    const float sign = (count / cPaddleTurnUpdates) % 2 == 0 ? 1.0f : -1.0f;
                     failed += bodies.SetAngularVelocity(
                                   paddles[i], Vec3(0.0f, (i == 0 ? sign : -sign) * cPaddleSpin, 0.0f))
                                   ? 0
