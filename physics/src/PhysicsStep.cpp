@@ -1355,9 +1355,7 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                 // rounding difference could only make the check fail
                 PublishedPoseStore::StepMemory& memory = poses.GetStepMemory(index);
                 if (poses.GetVersion(index) == memory.mVersion &&
-                    sweptBounds(published, Vec3(memory.mSweep[0], memory.mSweep[1], memory.mSweep[2]))
-                        .Expanded(-cHeldBoxTolerance)
-                        .Contains(body.mBounds))
+                    sweptBounds(published, memory.mSweep).Expanded(-cHeldBoxTolerance).Contains(body.mBounds))
                 {
                     memory.mVersion = poses.PublishMotion(body);
                     order = PublishOrder::BeforeMove;
@@ -1368,8 +1366,7 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                     order = PublishOrder::AfterGrownMove;
                     anyGrown = true;
                 }
-                for (int axis = 0; axis < 3; ++axis)
-                    memory.mSweep[axis] = sweep[axis];
+                memory.mSweep = sweep;
                 mPublishOrders[i] = order;
                 mMovedBodies[i] = {body.GetID(), box, body.GetObjectLayer()};
 
@@ -1394,10 +1391,8 @@ void PhysicsStep::UpdateBoundsAndSleep(float inDeltaTime)
                 PublishedPoseStore::StepMemory& memory = poses.GetStepMemory(active[i]);
                 memory.mVersion = poses.PublishMotion(body);
                 if (mPublishOrders[i] == PublishOrder::AfterGrownMove)
-                    mMovedBodies[grown++] = {
-                        body.GetID(),
-                        sweptBounds(body.mBounds, Vec3(memory.mSweep[0], memory.mSweep[1], memory.mSweep[2])),
-                        body.GetObjectLayer()};
+                    mMovedBodies[grown++] = {body.GetID(), sweptBounds(body.mBounds, memory.mSweep),
+                                             body.GetObjectLayer()};
             }
             if (anyGrown)
                 mBroadPhase.NotifyBodiesAABBChanged(

@@ -63,7 +63,7 @@ public:
     /// every body lock), never by readers.
     struct StepMemory
     {
-        float mSweep[3] = {0, 0, 0};
+        Vec3 mSweep = Vec3::Zero();
         uint32_t mVersion = 1; ///< Odd, so never a published version until the step sets it
     };
     StepMemory& GetStepMemory(uint32_t inIndex) { return mRecords[inIndex].mStep; }
