@@ -97,11 +97,16 @@ private:
         if (components <= 0 || componentSize <= 0) return Fail(where, "unknown type");
         const size_t elementSize = size_t(components) * size_t(componentSize);
         const size_t stride = view.byteStride != 0 ? view.byteStride : elementSize;
-        const size_t start = view.byteOffset + accessor.byteOffset;
+        // Offsets, lengths and counts come from the file: compared by subtraction from what is known to fit,
+        // never summed or multiplied, where a hostile value would wrap around and pass (a count of 2^62, an
+        // offset near 2^64)
+        if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset)
+            return Fail(where, "has a buffer view beyond its buffer");
         if (accessor.count > 0 &&
-            (start + stride * (accessor.count - 1) + elementSize > view.byteOffset + view.byteLength ||
-             view.byteOffset + view.byteLength > buffer.size()))
+            (accessor.byteOffset > view.byteLength || elementSize > view.byteLength - accessor.byteOffset ||
+             accessor.count - 1 > (view.byteLength - accessor.byteOffset - elementSize) / stride))
             return Fail(where, "reads beyond its buffer");
+        const size_t start = view.byteOffset + accessor.byteOffset; // Both inside the buffer: no wrap
         outValues.clear();
         for (size_t i = 0; i < accessor.count; ++i)
             for (int c = 0; c < components; ++c)

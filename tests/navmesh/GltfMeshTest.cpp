@@ -104,6 +104,32 @@ TEST(GltfMeshTest, MalformedFilesNameTheFileAndElement)
     EXPECT_NE(accessor.GetError().mMessage.find("accessors[0]"), std::string::npos)
         << accessor.GetError().mMessage;
 
+    // Sizes whose sums or products wrap around in 64 bits: they passed the bounds check and read far outside
+    // the buffer (2^62 elements), or 2 KB before it (an offset 2,048 short of 2^64, over 171 elements whose
+    // end wraps round to 4 bytes into the view)
+    tinygltf::Model hugeCount = FloorModel({0, 0, 0});
+    hugeCount.accessors[0].count = size_t(1) << 62;
+    Write(hugeCount, path, false);
+    Result<IndexedMesh> huge = LoadGltfMesh(path);
+    ASSERT_FALSE(huge);
+    EXPECT_NE(huge.GetError().mMessage.find("accessors[0]: reads beyond its buffer"), std::string::npos)
+        << huge.GetError().mMessage;
+    tinygltf::Model wrappingOffset = FloorModel({0, 0, 0});
+    wrappingOffset.accessors[0].byteOffset = ~size_t(0) - 2047;
+    wrappingOffset.accessors[0].count = 171;
+    Write(wrappingOffset, path, false);
+    Result<IndexedMesh> wrapped = LoadGltfMesh(path);
+    ASSERT_FALSE(wrapped);
+    EXPECT_NE(wrapped.GetError().mMessage.find("accessors[0]: reads beyond its buffer"), std::string::npos)
+        << wrapped.GetError().mMessage;
+    tinygltf::Model badView = FloorModel({0, 0, 0});
+    badView.bufferViews[1].byteOffset = ~size_t(0) - 7; // The view's own end wraps round
+    Write(badView, path, false);
+    Result<IndexedMesh> view = LoadGltfMesh(path);
+    ASSERT_FALSE(view);
+    EXPECT_NE(view.GetError().mMessage.find("buffer view beyond its buffer"), std::string::npos)
+        << view.GetError().mMessage;
+
     EXPECT_EQ(LoadLevelMesh(TempPath("level.fbx")).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(LoadGltfMesh(TempPath("missing.glb")).GetError().mCode, ErrorCode::IOError);
     std::filesystem::remove(path);
