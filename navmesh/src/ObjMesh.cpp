@@ -108,7 +108,9 @@ public:
             if (ioMap->find(name) == ioMap->end())
             {
                 (*ioMap)[name] = int(ioMaterials->size());
-                tinyobj::material_t material;
+                // Value-initialised: material_t is a plain aggregate, and a default-initialised one has
+                // indeterminate bools and enums that the copy below would read (UBSan)
+                tinyobj::material_t material{};
                 material.name = name;
                 ioMaterials->push_back(material);
             }
