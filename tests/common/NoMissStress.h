@@ -28,11 +28,14 @@ namespace cairn::test
 
 struct NoMissStressConfig
 {
-    uint32_t mNumPermanent = 1500;                 ///< Moved, never removed
-    uint32_t mNumChurned = 500;                    ///< Removed and re-added
-    uint32_t mNumQueryThreads = 2;                 ///< Threads doing checks
-    uint64_t mTargetChecks = 100000;               ///< Stop once this many checks are done...
-    std::chrono::milliseconds mMinDuration{500};   ///< ...and at least this long has passed,
+    uint32_t mNumPermanent = 1500;               ///< Moved, never removed
+    uint32_t mNumChurned = 500;                  ///< Removed and re-added
+    uint32_t mNumQueryThreads = 2;               ///< Threads doing checks
+    uint64_t mTargetChecks = 100000;             ///< Stop once this many checks are done...
+    std::chrono::milliseconds mMinDuration{500}; ///< ...and at least this long has passed,
+    /// ...and the step thread has updated this often (a full rebuild every 16th: under ThreadSanitizer,
+    /// beside other stress tests, a run that stopped on checks and time alone had done 15),
+    uint64_t mMinUpdates = 17;
     std::chrono::milliseconds mMaxDuration{60000}; ///< or when this has passed
 };
 
@@ -210,7 +213,8 @@ NoMissStressResult RunNoMissStress(BroadPhase& ioBroadPhase, const NoMissStressC
         const auto elapsed = std::chrono::steady_clock::now() - start;
         if (elapsed >= inConfig.mMaxDuration) break;
         if (elapsed >= inConfig.mMinDuration &&
-            checks.load(std::memory_order_relaxed) >= inConfig.mTargetChecks)
+            checks.load(std::memory_order_relaxed) >= inConfig.mTargetChecks &&
+            updates.load(std::memory_order_relaxed) >= inConfig.mMinUpdates)
             break;
     }
     stop.store(true, std::memory_order_relaxed);
