@@ -18,12 +18,6 @@
 namespace cairn
 {
 
-/// Asks a read lock not to wait: if the body's mutex is held for writing (by the physics step, most often),
-/// the lock fails at once and WasBusy() is true.
-struct TryLock
-{
-};
-
 template <bool Write> class BodyLock
 {
 public:
@@ -43,20 +37,6 @@ public:
         mBody = inManager.TryGetBody(inID);
     }
 
-    /// A read lock that does not wait.
-    BodyLock(const BodyManager& inManager, const BodyID& inID, TryLock) requires(!Write)
-    {
-        if (!Prepare(inManager, inID)) return;
-        std::shared_mutex& mutex = inManager.GetMutexForBody(inID.GetIndex());
-        if (!mutex.try_lock_shared())
-        {
-            mBusy = true;
-            return;
-        }
-        mMutex = &mutex;
-        BodyManager::NoteBodyLockHeld(+1);
-        mBody = inManager.TryGetBody(inID);
-    }
     ~BodyLock() { Release(); }
     BodyLock(const BodyLock&) = delete;
     BodyLock& operator=(const BodyLock&) = delete;
@@ -80,8 +60,6 @@ public:
 
     bool Succeeded() const { return mBody != nullptr; }
     bool WasWrongThread() const { return mWrongThread; }
-    /// A TryLock found the body locked for writing.
-    bool WasBusy() const { return mBusy; }
     /// The locked body, or nullptr for an unknown or stale id.
     std::conditional_t<Write, Body*, const Body*> GetBody() const { return mBody; }
 
@@ -101,7 +79,6 @@ private:
     std::shared_mutex* mStaticMutex = nullptr; ///< Write locks only
     Body* mBody = nullptr;
     bool mWrongThread = false;
-    bool mBusy = false;
 };
 
 using BodyLockRead = BodyLock<false>;
@@ -114,10 +91,8 @@ using BodyLockWrite = BodyLock<true>;
 class StaticBodyLockRead
 {
 public:
-    /// ioWaitMs, when given, gets the time spent waiting for the mutex if another thread held it (0 if not).
-    StaticBodyLockRead(const BodyManager& inManager, const BodyID& inID, double* ioWaitMs = nullptr)
+    StaticBodyLockRead(const BodyManager& inManager, const BodyID& inID)
     {
-        if (ioWaitMs != nullptr) *ioWaitMs = 0.0;
         if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
         {
             mWrongThread = true;
@@ -132,17 +107,15 @@ public:
             mMutex->lock_shared();
             const auto wait = std::chrono::steady_clock::now() - start;
             AddThisThreadLockWait(LockKind::Body, wait);
-            if (ioWaitMs != nullptr) *ioWaitMs = std::chrono::duration<double, std::milli>(wait).count();
         }
         BodyManager::NoteBodyLockHeld(+1);
         const Body* body = inManager.TryGetBody(inID);
         if (body != nullptr && body->IsStatic()) mBody = body;
         if (body != nullptr && !body->IsStatic())
         {
-            // Written only under both mutexes (motion type) or atomic (active index): safe to read here
+            // Written only under both mutexes: safe to read here
             mNotStatic = true;
             mMotionType = body->GetMotionType();
-            mActive = body->IsActive();
         }
     }
     ~StaticBodyLockRead() { Release(); }
@@ -161,11 +134,9 @@ public:
     /// The locked static body, or nullptr.
     const Body* GetBody() const { return mBody; }
     bool WasWrongThread() const { return mWrongThread; }
-    /// The body exists but is not static: only its motion type and whether it is active were read.
+    /// The body exists but is not static: only its motion type was read.
     bool WasNotStatic() const { return mNotStatic; }
     MotionType GetNotStaticMotionType() const { return mMotionType; }
-    /// Whether the non-static body was active (awake) when locked; it may change at any moment after.
-    bool WasActive() const { return mActive; }
 
 private:
     std::shared_mutex* mMutex = nullptr;
@@ -173,7 +144,6 @@ private:
     bool mWrongThread = false;
     bool mNotStatic = false;
     MotionType mMotionType = MotionType::Static;
-    bool mActive = false;
 };
 
 } // namespace cairn
