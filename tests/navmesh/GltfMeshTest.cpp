@@ -88,47 +88,35 @@ TEST(GltfMeshTest, MalformedFilesNameTheFileAndElement)
     EXPECT_EQ(notJson.GetError().mCode, ErrorCode::ParseError);
     EXPECT_NE(notJson.GetError().mMessage.find(path), std::string::npos);
 
+    // A model written out must be refused with a message holding inExpected
+    auto expectRefused = [&](const tinygltf::Model& inModel, const std::string& inExpected)
+    {
+        Write(inModel, path, false);
+        const Result<IndexedMesh> loaded = LoadGltfMesh(path);
+        ASSERT_FALSE(loaded) << inExpected;
+        EXPECT_NE(loaded.GetError().mMessage.find(inExpected), std::string::npos)
+            << loaded.GetError().mMessage;
+    };
     tinygltf::Model badIndex = FloorModel({0, 0, 0});
     reinterpret_cast<uint16_t*>(badIndex.buffers[0].data.data() + 48)[2] = 9; // Beyond the 4 vertices
-    Write(badIndex, path, false);
-    Result<IndexedMesh> index = LoadGltfMesh(path);
-    ASSERT_FALSE(index);
-    EXPECT_NE(index.GetError().mMessage.find("meshes[0].primitives[0]"), std::string::npos)
-        << index.GetError().mMessage;
-
+    expectRefused(badIndex, "meshes[0].primitives[0]");
     tinygltf::Model badAccessor = FloorModel({0, 0, 0});
     badAccessor.accessors[0].count = 400; // Reads beyond its buffer
-    Write(badAccessor, path, false);
-    Result<IndexedMesh> accessor = LoadGltfMesh(path);
-    ASSERT_FALSE(accessor);
-    EXPECT_NE(accessor.GetError().mMessage.find("accessors[0]"), std::string::npos)
-        << accessor.GetError().mMessage;
+    expectRefused(badAccessor, "accessors[0]");
 
     // Sizes whose sums or products wrap around in 64 bits: they passed the bounds check and read far outside
     // the buffer (2^62 elements), or 2 KB before it (an offset 2,048 short of 2^64, over 171 elements whose
     // end wraps round to 4 bytes into the view)
     tinygltf::Model hugeCount = FloorModel({0, 0, 0});
     hugeCount.accessors[0].count = size_t(1) << 62;
-    Write(hugeCount, path, false);
-    Result<IndexedMesh> huge = LoadGltfMesh(path);
-    ASSERT_FALSE(huge);
-    EXPECT_NE(huge.GetError().mMessage.find("accessors[0]: reads beyond its buffer"), std::string::npos)
-        << huge.GetError().mMessage;
+    expectRefused(hugeCount, "accessors[0]: reads beyond its buffer");
     tinygltf::Model wrappingOffset = FloorModel({0, 0, 0});
     wrappingOffset.accessors[0].byteOffset = ~size_t(0) - 2047;
     wrappingOffset.accessors[0].count = 171;
-    Write(wrappingOffset, path, false);
-    Result<IndexedMesh> wrapped = LoadGltfMesh(path);
-    ASSERT_FALSE(wrapped);
-    EXPECT_NE(wrapped.GetError().mMessage.find("accessors[0]: reads beyond its buffer"), std::string::npos)
-        << wrapped.GetError().mMessage;
+    expectRefused(wrappingOffset, "accessors[0]: reads beyond its buffer");
     tinygltf::Model badView = FloorModel({0, 0, 0});
     badView.bufferViews[1].byteOffset = ~size_t(0) - 7; // The view's own end wraps round
-    Write(badView, path, false);
-    Result<IndexedMesh> view = LoadGltfMesh(path);
-    ASSERT_FALSE(view);
-    EXPECT_NE(view.GetError().mMessage.find("buffer view beyond its buffer"), std::string::npos)
-        << view.GetError().mMessage;
+    expectRefused(badView, "buffer view beyond its buffer");
 
     EXPECT_EQ(LoadLevelMesh(TempPath("level.fbx")).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(LoadGltfMesh(TempPath("missing.glb")).GetError().mCode, ErrorCode::IOError);
