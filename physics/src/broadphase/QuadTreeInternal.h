@@ -40,8 +40,8 @@ inline void AtomicMax(std::atomic<float>& ioValue, float inValue)
 /// True when min > max on some axis (an empty slot). Not AABB::IsEmpty: no Eigen reduction in the hot loop.
 inline bool IsEmptyBox(const AABB& inBox)
 {
-    return (inBox.mMin.x() > inBox.mMax.x()) | (inBox.mMin.y() > inBox.mMax.y()) |
-           (inBox.mMin.z() > inBox.mMax.z());
+    return (int(inBox.mMin.x() > inBox.mMax.x()) | int(inBox.mMin.y() > inBox.mMax.y()) |
+            int(inBox.mMin.z() > inBox.mMax.z())) != 0;
 }
 
 /// Traversal stack: fixed-size array, spilling to the heap only for pathological depths (the tree grows a

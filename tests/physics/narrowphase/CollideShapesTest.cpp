@@ -200,7 +200,7 @@ TEST(CollideShapesTest, ManifoldsOfAMeshInsideACompoundKeepTheirTriangles)
     const auto box = BoxShape::Create(Vec3(2, 0.5f, 2)).Value();
     for (const bool compoundFirst : {true, false})
     {
-        const Transform boxAt(Vec3(5, 0.49f, 5), Quat::Identity()); // On the quad's diagonal
+        const Transform boxAt{Vec3(5, 0.49f, 5), Quat::Identity()}; // On the quad's diagonal
         const auto manifolds =
             compoundFirst ? Collide(*compound, {}, *box, boxAt) : Collide(*box, boxAt, *compound, {});
         ASSERT_GE(manifolds.size(), 2u);

@@ -30,16 +30,18 @@ inline bool IsInLayerMask(ObjectLayerMask inMask, ObjectLayer inLayer)
 /// same result.
 inline bool AABBsOverlap(const AABB& inA, const AABB& inB)
 {
-    return (inA.mMin.x() <= inB.mMax.x()) & (inB.mMin.x() <= inA.mMax.x()) & (inA.mMin.y() <= inB.mMax.y()) &
-           (inB.mMin.y() <= inA.mMax.y()) & (inA.mMin.z() <= inB.mMax.z()) & (inB.mMin.z() <= inA.mMax.z());
+    // int, not bool, operands: the bitwise and is the point, and Clang warns on it over bools
+    return (int(inA.mMin.x() <= inB.mMax.x()) & int(inB.mMin.x() <= inA.mMax.x()) &
+            int(inA.mMin.y() <= inB.mMax.y()) & int(inB.mMin.y() <= inA.mMax.y()) &
+            int(inA.mMin.z() <= inB.mMax.z()) & int(inB.mMin.z() <= inA.mMax.z())) != 0;
 }
 
 /// AABB::Contains without branches, for the same reason.
 inline bool AABBContains(const AABB& inBox, const Vec3& inPoint)
 {
-    return (inBox.mMin.x() <= inPoint.x()) & (inPoint.x() <= inBox.mMax.x()) &
-           (inBox.mMin.y() <= inPoint.y()) & (inPoint.y() <= inBox.mMax.y()) &
-           (inBox.mMin.z() <= inPoint.z()) & (inPoint.z() <= inBox.mMax.z());
+    return (int(inBox.mMin.x() <= inPoint.x()) & int(inPoint.x() <= inBox.mMax.x()) &
+            int(inBox.mMin.y() <= inPoint.y()) & int(inPoint.y() <= inBox.mMax.y()) &
+            int(inBox.mMin.z() <= inPoint.z()) & int(inPoint.z() <= inBox.mMax.z())) != 0;
 }
 
 /// Closed-interval sphere-box test: the point of the box closest to the centre is within inRadius. The
