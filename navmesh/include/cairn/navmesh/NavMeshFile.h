@@ -33,10 +33,25 @@ struct NavMeshFileContents
     std::vector<NavMeshFileTile> mTiles; ///< Sorted by tile once saved or loaded
 };
 
-/// Empty when inData is a Detour tile whose sections fit its size and whose indices stay inside their arrays,
-/// else what is wrong. Detour's addTile trusts the header's counts and the polygons' indices: a flipped bit
-/// in a file, or a corrupt tile handed to NavMeshWorld, made it write and read outside the tile's buffer.
+/// Empty when inData is a Detour tile whose sections fit its size, whose indices stay inside their arrays and
+/// whose coordinates are finite and within the world's range, else what is wrong. Detour's addTile trusts
+/// the header's counts and the polygons' indices: a flipped bit in a file, or a corrupt tile handed to
+/// NavMeshWorld, made it write and read outside the tile's buffer; and its path search never ends on the NaN
+/// costs that non-finite coordinates give.
 std::string CheckTileData(std::span<const unsigned char> inData);
+
+/// The most tiles a navmesh may be made for: Detour allocates a tile record for each when it is created, so a
+/// file's header must not choose more (2^20 records are about 120 MB).
+inline constexpr int cMaxNavMeshTiles = 1 << 20;
+
+/// Empty when Detour can hold a navmesh of inParams: an origin and tile size finite and within the world's
+/// range, 1 to cMaxNavMeshTiles tiles, and tile and polygon bits that leave Detour its 10 bits of salt in a
+/// 32-bit reference (Detour's own test wraps around for large counts and passes). Else what is wrong.
+std::string CheckNavMeshParams(const dtNavMeshParams& inParams);
+
+/// Empty when the tile inData (which passed CheckTileData) has no more polygons than inParams' polygon bits
+/// hold: past them, a polygon index spills into the tile bits and names another tile's polygon.
+std::string CheckTileFitsParams(std::span<const unsigned char> inData, const dtNavMeshParams& inParams);
 
 /// Detour's navmesh parameters for a tiled navmesh on inGrid: tile and polygon bits shared out of a 32-bit
 /// polygon reference (10 bits of salt). Error when inMaxTiles leaves too few bits for polygons.
@@ -63,8 +78,14 @@ public:
     /// Errors: a tile out of order, more than the parameters' maxTiles, data that is not a Detour tile at
     /// inTile.
     Status Add(const TileCoord& inTile, std::span<const unsigned char> inData);
-    /// Writes the tile count and renames the file into place.
-    Status Finish();
+    /// Writes the tile count and closes the temporary file, complete but not yet in place.
+    Status Complete();
+    /// Completes (if not yet) and renames the file into place.
+    Status Commit();
+    /// Complete and Commit.
+    Status Finish() { return Commit(); }
+    /// Where the file is until Commit: to read it back first.
+    const std::string& GetTemporaryPath() const { return mFile.GetTemporaryPath(); }
 
 private:
     NavMeshFileWriter(std::string inPath, const dtNavMeshParams& inParams);
@@ -75,11 +96,14 @@ private:
     PendingFile mFile;
     int32_t mNumTiles = 0;
     TileCoord mLastTile;
+    bool mCompleted = false;
 };
 
 /// Writes inContents to inPath (through a temporary file renamed into place: no partial file on failure).
 Status SaveNavMeshFile(const std::string& inPath, NavMeshFileContents inContents);
-/// Reads a file written by SaveNavMeshFile or Recast's demo. Errors name the file and what is wrong.
+/// Reads a file written by SaveNavMeshFile or Recast's demo. Errors name the file and what is wrong: bad
+/// parameters (CheckNavMeshParams), counts and sizes beyond the file's bytes (checked before anything is
+/// allocated for them), a tile CheckTileData refuses, two tiles at one place, bytes after the last tile.
 Result<NavMeshFileContents> LoadNavMeshFile(const std::string& inPath);
 
 /// A dtNavMesh holding copies of the tiles, as a runtime would load it.

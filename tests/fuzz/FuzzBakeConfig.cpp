@@ -1,0 +1,13 @@
+// libFuzzer: the baker's JSON readers, the agent profile config and the material area mapping, on each input.
+
+#include "BakeConfig.h"
+#include "FuzzInputFile.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* inData, size_t inSize)
+{
+    const std::string path = cairn::fuzz::WriteInputFile(inData, inSize, ".json");
+    cairn::navmesh::AgentProfile profile;
+    (void)cairn::bake::LoadBakeConfig(path, profile);
+    (void)cairn::bake::LoadAreaMapping(path);
+    return 0;
+}
