@@ -1,3 +1,4 @@
+#include "LevelFileAccess.h"
 #include "cairn/navmesh/ObjMesh.h"
 
 #include <Eigen/Geometry>
@@ -41,7 +42,8 @@ Mat4 LocalTransform(const tinygltf::Node& inNode)
 class GltfReader
 {
 public:
-    GltfReader(const std::string& inPath, const tinygltf::Model& inModel) : mPath(inPath), mModel(inModel)
+    GltfReader(const std::string& inPath, const tinygltf::Model& inModel, const LevelLoadLimits& inLimits)
+        : mPath(inPath), mModel(inModel), mLimits(inLimits), mReached(inModel.nodes.size(), false)
     {
         for (size_t i = 0; i < inModel.materials.size(); ++i)
             mMesh.mMaterials.push_back(!inModel.materials[i].name.empty()
@@ -49,23 +51,45 @@ public:
                                            : "materials[" + std::to_string(i) + "]");
     }
 
-    Status AddNode(int inNode, const Mat4& inParent, int inDepth)
+    /// The node inRoot and the tree under it, depth first (children in order), without recursion.
+    Status AddTree(int inRoot)
     {
-        if (inNode < 0 || size_t(inNode) >= mModel.nodes.size() || inDepth > 64)
-            return Fail("nodes[" + std::to_string(inNode) + "]", "does not exist or nests too deep");
-        const tinygltf::Node& node = mModel.nodes[size_t(inNode)];
-        const Mat4 world = inParent * LocalTransform(node);
-        if (node.mesh >= 0)
+        struct Pending
         {
-            // Each node with a mesh is an object of its own (instances of one mesh included)
-            MeshObject object{!node.name.empty() ? node.name : "nodes[" + std::to_string(inNode) + "]",
-                              uint32_t(mMesh.mTriangles.size()), 0};
-            if (Status added = AddMesh(node.mesh, world); !added) return added;
-            object.mNumTriangles = uint32_t(mMesh.mTriangles.size()) - object.mFirstTriangle;
-            if (object.mNumTriangles > 0) mMesh.mObjects.push_back(std::move(object));
+            int mNode;
+            Mat4 mParent;
+            uint32_t mDepth;
+        };
+        std::vector<Pending> pending{{inRoot, Mat4::Identity(), 0}};
+        while (!pending.empty())
+        {
+            const Pending next = pending.back();
+            pending.pop_back();
+            const std::string where = "nodes[" + std::to_string(next.mNode) + "]";
+            if (next.mNode < 0 || size_t(next.mNode) >= mModel.nodes.size())
+                return Fail(where, "does not exist");
+            if (next.mDepth > mLimits.mMaxNodeDepth)
+                return Fail(where, "is deeper than " + std::to_string(mLimits.mMaxNodeDepth) +
+                                       " nodes (LevelLoadLimits::mMaxNodeDepth)");
+            // glTF's nodes form trees: a node reached twice is under two parents, or its own ancestor, and
+            // graphs that share nodes multiply (a 40-level diamond is 2^40 instances)
+            if (mReached[size_t(next.mNode)])
+                return Fail(where, "is reached a second time: a glTF node has one parent at most");
+            mReached[size_t(next.mNode)] = true;
+            const tinygltf::Node& node = mModel.nodes[size_t(next.mNode)];
+            const Mat4 world = next.mParent * LocalTransform(node);
+            if (node.mesh >= 0)
+            {
+                // Each node with a mesh is an object of its own (instances of one mesh included)
+                MeshObject object{!node.name.empty() ? node.name : where, uint32_t(mMesh.mTriangles.size()),
+                                  0};
+                if (Status added = AddMesh(node.mesh, world); !added) return added;
+                object.mNumTriangles = uint32_t(mMesh.mTriangles.size()) - object.mFirstTriangle;
+                if (object.mNumTriangles > 0) mMesh.mObjects.push_back(std::move(object));
+            }
+            for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
+                pending.push_back({*child, world, next.mDepth + 1});
         }
-        for (int child : node.children)
-            if (Status added = AddNode(child, world, inDepth + 1); !added) return added;
         return Status::Ok();
     }
 
@@ -164,6 +188,9 @@ private:
                     Elements(position->second, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, positions);
                 !read)
                 return read;
+            if (positions.size() / 3 > mLimits.mMaxVertices - mMesh.mVertices.size())
+                return Fail(where, "brings the level over " + std::to_string(mLimits.mMaxVertices) +
+                                       " vertices (LevelLoadLimits::mMaxVertices)");
             const uint32_t first = uint32_t(mMesh.mVertices.size());
             for (size_t i = 0; i + 2 < positions.size(); i += 3)
             {
@@ -190,6 +217,9 @@ private:
                                        std::to_string(mModel.materials.size()));
             const uint32_t material =
                 primitive.material >= 0 ? uint32_t(primitive.material) : IndexedMesh::cNoMaterial;
+            if (indices.size() / 3 > mLimits.mMaxTriangles - mMesh.mTriangles.size())
+                return Fail(where, "brings the level over " + std::to_string(mLimits.mMaxTriangles) +
+                                       " triangles (LevelLoadLimits::mMaxTriangles)");
             for (size_t i = 0; i + 2 < indices.size(); i += 3)
             {
                 std::array<uint32_t, 3> triangle;
@@ -209,42 +239,147 @@ private:
 
     const std::string& mPath;
     const tinygltf::Model& mModel;
+    const LevelLoadLimits& mLimits;
+    std::vector<bool> mReached; ///< Per node
 };
 } // namespace
 
-Result<IndexedMesh> LoadGltfMesh(const std::string& inPath)
+namespace
 {
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(inPath, error))
-        return MakeError(ErrorCode::IOError, inPath + ": not a readable file");
+/// tinygltf's file access for one level: files only from the level's folder (unless the limits allow more),
+/// regular files only, within the byte limit, and never a write.
+struct GltfFileAccess
+{
+    std::filesystem::path mFolder;
+    const LevelLoadLimits& mLimits;
+
+    static bool FileExists(const std::string& inPath, void* inAccess)
+    {
+        // A file outside the folder "exists": its read is refused with a message that says why, and the
+        // answer tells nothing of the files there
+        const auto& access = *static_cast<const GltfFileAccess*>(inAccess);
+        std::error_code error;
+        return !access.Allows(inPath) || std::filesystem::exists(inPath, error);
+    }
+
+    /// The URI as the file gives it: tinygltf's default expands it as a shell word ($HOME, ~)
+    static std::string ExpandFilePath(const std::string& inPath, void*) { return inPath; }
+
+    static bool ReadWholeFile(std::vector<unsigned char>* outBytes, std::string* outError,
+                              const std::string& inPath, void* inAccess)
+    {
+        const auto& access = *static_cast<const GltfFileAccess*>(inAccess);
+        if (!access.Allows(inPath))
+        {
+            *outError = "outside the level's folder (LevelLoadLimits::mAllowFilesOutsideFolder)";
+            return false;
+        }
+        Result<std::vector<unsigned char>> bytes = ReadLevelFile(inPath, access.mLimits.mMaxFileBytes);
+        if (!bytes)
+        {
+            *outError = bytes.GetError().mMessage;
+            return false;
+        }
+        *outBytes = std::move(bytes.Value());
+        return true;
+    }
+
+    static bool RefuseWrite(std::string* outError, const std::string&, const std::vector<unsigned char>&,
+                            void*)
+    {
+        *outError = "a level load writes no file";
+        return false;
+    }
+
+    bool Allows(const std::string& inPath) const
+    {
+        return mLimits.mAllowFilesOutsideFolder || IsInsideFolder(inPath, mFolder);
+    }
+};
+
+/// Images are texture, not floor: never decoded (a 16384^2 PNG took 27 s and 2 GB)
+bool SkipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+               void*)
+{
+    return true;
+}
+
+/// The JSON chunk of a .glb, or empty when the container is malformed (tinygltf then says how).
+std::string_view GlbJson(const std::vector<unsigned char>& inBytes)
+{
+    if (inBytes.size() < 20) return {};
+    uint32_t length = 0;
+    std::memcpy(&length, inBytes.data() + 12, 4);
+    if (length > inBytes.size() - 20) return {};
+    return {reinterpret_cast<const char*>(inBytes.data() + 20), length};
+}
+} // namespace
+
+Result<IndexedMesh> LoadGltfMesh(const std::string& inPath, const LevelLoadLimits& inLimits)
+{
+    Result<std::vector<unsigned char>> bytes =
+        ReadLevelFile(inPath, std::min<uint64_t>(inLimits.mMaxFileBytes, 0xffffffffu));
+    if (!bytes) return bytes.GetError();
+    const std::vector<unsigned char>& file = bytes.Value();
+    const bool binary = LowerCaseExtension(inPath) == ".glb";
+    // tinygltf converts extras and extensions recursively: nesting 100,000 deep overflowed the stack
+    const std::string_view json =
+        binary ? GlbJson(file) : std::string_view(reinterpret_cast<const char*>(file.data()), file.size());
+    if (JsonNestingDepth(json, inLimits.mMaxNesting) > inLimits.mMaxNesting)
+        return MakeError(ErrorCode::ParseError, inPath + ": JSON nests deeper than " +
+                                                    std::to_string(inLimits.mMaxNesting) +
+                                                    " (LevelLoadLimits::mMaxNesting)");
+    const std::filesystem::path folder = std::filesystem::path(inPath).parent_path();
+    GltfFileAccess access{folder.empty() ? std::filesystem::path(".") : folder, inLimits};
     tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(&SkipImage, nullptr);
+    loader.SetFsCallbacks({&GltfFileAccess::FileExists, &GltfFileAccess::ExpandFilePath,
+                           &GltfFileAccess::ReadWholeFile, &GltfFileAccess::RefuseWrite, &access});
     tinygltf::Model model;
     std::string errors, warnings;
-    const bool binary = std::filesystem::path(inPath).extension() == ".glb";
-    const bool loaded = binary ? loader.LoadBinaryFromFile(&model, &errors, &warnings, inPath)
-                               : loader.LoadASCIIFromFile(&model, &errors, &warnings, inPath);
+    bool loaded = false;
+    try
+    {
+        loaded = binary ? loader.LoadBinaryFromMemory(&model, &errors, &warnings, file.data(),
+                                                      unsigned(file.size()), access.mFolder.string())
+                        : loader.LoadASCIIFromString(&model, &errors, &warnings,
+                                                     reinterpret_cast<const char*>(file.data()),
+                                                     unsigned(file.size()), access.mFolder.string());
+    }
+    catch (const std::exception& exception)
+    {
+        // tinygltf's JSON library and allocations throw: a file is an error, never an abort
+        return MakeError(ErrorCode::ParseError, inPath + ": the glTF parser failed: " + exception.what());
+    }
     if (!loaded)
         return MakeError(ErrorCode::ParseError, inPath + ": " + (errors.empty() ? "malformed glTF" : errors));
-    GltfReader reader(inPath, model);
+    GltfReader reader(inPath, model, inLimits);
     std::vector<int> roots;
     if (model.defaultScene >= 0 && size_t(model.defaultScene) < model.scenes.size())
         roots = model.scenes[size_t(model.defaultScene)].nodes;
     else if (!model.scenes.empty())
         roots = model.scenes.front().nodes;
     else
+    {
+        // No scene: every tree of nodes, from the nodes that are no one's child
+        std::vector<bool> child(model.nodes.size(), false);
+        for (const tinygltf::Node& node : model.nodes)
+            for (int c : node.children)
+                if (c >= 0 && size_t(c) < child.size()) child[size_t(c)] = true;
         for (size_t i = 0; i < model.nodes.size(); ++i)
-            roots.push_back(int(i));
+            if (!child[i]) roots.push_back(int(i));
+    }
     for (int node : roots)
-        if (Status added = reader.AddNode(node, Mat4::Identity(), 0); !added) return added.GetError();
+        if (Status added = reader.AddTree(node); !added) return added.GetError();
     if (reader.mMesh.mTriangles.empty()) return MakeError(ErrorCode::ParseError, inPath + ": no triangles");
     return std::move(reader.mMesh);
 }
 
-Result<IndexedMesh> LoadLevelMesh(const std::string& inPath)
+Result<IndexedMesh> LoadLevelMesh(const std::string& inPath, const LevelLoadLimits& inLimits)
 {
-    const std::string extension = std::filesystem::path(inPath).extension().string();
-    if (extension == ".gltf" || extension == ".glb") return LoadGltfMesh(inPath);
-    if (extension == ".obj" || extension == ".OBJ") return LoadObjMesh(inPath);
+    const std::string extension = LowerCaseExtension(inPath);
+    if (extension == ".gltf" || extension == ".glb") return LoadGltfMesh(inPath, inLimits);
+    if (extension == ".obj") return LoadObjMesh(inPath, inLimits);
     return MakeError(ErrorCode::InvalidArgument,
                      inPath + ": unknown level format (expected .obj, .gltf or .glb)");
 }

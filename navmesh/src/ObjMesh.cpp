@@ -1,5 +1,7 @@
 #include "cairn/navmesh/ObjMesh.h"
 
+#include "LevelFileAccess.h"
+
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -53,16 +55,60 @@ bool StartsWithKeyword(const std::string& inLine, const char* inKeyword)
            (inLine[length] == ' ' || inLine[length] == '\t');
 }
 
-Result<ObjScan> ScanLines(const std::string& inPath)
+/// Empty when inToken is a face corner tinyobjloader reads as written: a non-zero vertex index (negative
+/// counts back from the last vertex) that fits an int, then optionally /texcoord and /normal indices, which
+/// may be empty. Else what is wrong: tinyobjloader wraps an index that overflows into some other vertex.
+std::string CheckFaceCorner(const std::string& inToken, int& outVertex)
+{
+    size_t start = 0;
+    for (int part = 0; part < 3 && start <= inToken.size(); ++part)
+    {
+        const size_t slash = std::min(inToken.find('/', start), inToken.size());
+        const char* first = inToken.data() + start;
+        const char* last = inToken.data() + slash;
+        if (first != last || part == 0)
+        {
+            int index = 0;
+            const auto [end, error] = std::from_chars(first, last, index);
+            if (error != std::errc() || end != last || index == 0)
+                return "'" + inToken +
+                       "' is not a face corner (vertex/texcoord/normal, whole non-zero numbers)";
+            if (part == 0) outVertex = index;
+        }
+        start = slash + 1;
+    }
+    if (start <= inToken.size()) return "'" + inToken + "' has more than three indices";
+    return "";
+}
+
+/// inText with CR LF and lone CR line ends made LF: tinyobjloader ends lines at all three, and the checks
+/// here must see the lines it sees (a CR-only file was one line to them, and escaped them all).
+std::string NormalizeLineEnds(const std::vector<unsigned char>& inBytes)
+{
+    std::string text;
+    text.reserve(inBytes.size());
+    for (size_t i = 0; i < inBytes.size(); ++i)
+    {
+        const char c = char(inBytes[i]);
+        if (c != '\r')
+            text += c;
+        else if (i + 1 >= inBytes.size() || inBytes[i + 1] != '\n')
+            text += '\n';
+    }
+    return text;
+}
+
+Result<ObjScan> ScanLines(const std::string& inPath, const std::string& inText)
 {
     ObjScan scan;
     std::set<std::string> seen;
     bool library = false;
-    std::ifstream file(inPath);
+    std::istringstream file(inText);
     std::string line;
+    int vertices = 0;                       // Vertex lines so far: a negative index counts back from here
+    int highestVertex = 0, highestLine = 0; // A positive index may name a vertex defined later
     for (int number = 1; std::getline(file, line); ++number)
     {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
         // tinyobjloader skips leading blanks: so must we, or an indented line would escape the checks
         line.erase(0, line.find_first_not_of(" \t"));
         if (StartsWithKeyword(line, "mtllib")) library = true;
@@ -73,6 +119,32 @@ Result<ObjScan> ScanLines(const std::string& inPath)
             tokens >> name;
             if (!name.empty() && seen.insert(name).second) scan.mMaterialNames.push_back(name);
             scan.mMaterialBeforeLibrary = scan.mMaterialBeforeLibrary || !library;
+        }
+        if (StartsWithKeyword(line, "f"))
+        {
+            std::istringstream tokens(line.substr(2));
+            std::string token;
+            int corners = 0;
+            while (tokens >> token)
+            {
+                int vertex = 0;
+                if (const std::string problem = CheckFaceCorner(token, vertex); !problem.empty())
+                    return MakeError(ErrorCode::ParseError,
+                                     inPath + ":" + std::to_string(number) + ": " + problem);
+                if (vertex < 0 && -int64_t(vertex) > vertices)
+                    return MakeError(ErrorCode::ParseError,
+                                     inPath + ":" + std::to_string(number) + ": a face names vertex " +
+                                         std::to_string(vertex) + ", back past the first of " +
+                                         std::to_string(vertices));
+                if (vertex > highestVertex) highestVertex = vertex, highestLine = number;
+                ++corners;
+            }
+            // tinyobjloader drops a face of fewer corners without a word
+            if (corners < 3)
+                return MakeError(ErrorCode::ParseError, inPath + ":" + std::to_string(number) +
+                                                            ": a face needs 3 corners or more, it has " +
+                                                            std::to_string(corners));
+            continue;
         }
         if (!StartsWithKeyword(line, "v")) continue;
         std::istringstream tokens(line.substr(2));
@@ -90,7 +162,12 @@ Result<ObjScan> ScanLines(const std::string& inPath)
         if (coordinates < 3)
             return MakeError(ErrorCode::ParseError,
                              inPath + ":" + std::to_string(number) + ": a vertex needs x, y and z");
+        ++vertices;
     }
+    if (highestVertex > vertices)
+        return MakeError(ErrorCode::ParseError, inPath + ":" + std::to_string(highestLine) +
+                                                    ": a face names vertex " + std::to_string(highestVertex) +
+                                                    " of " + std::to_string(vertices));
     return scan;
 }
 
@@ -139,19 +216,18 @@ std::string ShiftLineNumbers(const std::string& inMessage, int inShift)
 }
 } // namespace
 
-Result<IndexedMesh> LoadObjMesh(const std::string& inPath)
+Result<IndexedMesh> LoadObjMesh(const std::string& inPath, const LevelLoadLimits& inLimits)
 {
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(inPath, error))
-        return MakeError(ErrorCode::IOError, inPath + ": not a readable file");
-    Result<ObjScan> scan = ScanLines(inPath);
+    Result<std::vector<unsigned char>> bytes = ReadLevelFile(inPath, inLimits.mMaxFileBytes);
+    if (!bytes) return bytes.GetError();
+    const std::string normalized = NormalizeLineEnds(bytes.Value());
+    Result<ObjScan> scan = ScanLines(inPath, normalized);
     if (!scan) return scan.GetError();
-    std::ifstream file(inPath, std::ios::binary);
     std::stringstream text;
     // Materials used before any library would have no name: a library line of our own goes first then
     const int linesBefore = scan.Value().mMaterialBeforeLibrary ? 1 : 0;
     if (linesBefore != 0) text << "mtllib cairn-used-materials\n";
-    text << file.rdbuf();
+    text << normalized;
     tinyobj::attrib_t attributes;
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
@@ -163,6 +239,18 @@ Result<IndexedMesh> LoadObjMesh(const std::string& inPath)
 
     IndexedMesh mesh;
     const std::vector<tinyobj::real_t>& positions = attributes.vertices;
+    if (positions.size() / 3 > inLimits.mMaxVertices)
+        return MakeError(ErrorCode::ParseError, inPath + ": " + std::to_string(positions.size() / 3) +
+                                                    " vertices, over the limit of " +
+                                                    std::to_string(inLimits.mMaxVertices) +
+                                                    " (LevelLoadLimits::mMaxVertices)");
+    size_t triangles = 0;
+    for (const tinyobj::shape_t& shape : shapes)
+        triangles += shape.mesh.num_face_vertices.size();
+    if (triangles > inLimits.mMaxTriangles)
+        return MakeError(ErrorCode::ParseError,
+                         inPath + ": " + std::to_string(triangles) + " triangles, over the limit of " +
+                             std::to_string(inLimits.mMaxTriangles) + " (LevelLoadLimits::mMaxTriangles)");
     mesh.mVertices.reserve(positions.size() / 3);
     for (size_t i = 0; i + 2 < positions.size(); i += 3)
     {

@@ -77,13 +77,14 @@ TEST_F(LevelPartsTest, TrianglesWithoutAMaterialHaveNone)
 
 TEST_F(LevelPartsTest, ErrorLinesStayTheFilesWhenALibraryLineIsAdded)
 {
-    // A material before any library makes the loader put a line of its own first; tinyobjloader's line
-    // numbers must still be the file's. Line 5 has a zero index, which tinyobjloader rejects with its line
+    // A material before any library makes the loader put a line of its own first; the line numbers of
+    // errors must still be the file's. Line 5 counts back past the first vertex
     Result<IndexedMesh> loaded = LoadObjMesh(Write("bad-face.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\n"
-                                                                   "usemtl road\nf 0 1 2\n"));
+                                                                   "usemtl road\nf -9 1 2\n"));
     ASSERT_FALSE(loaded);
     EXPECT_EQ(loaded.GetError().mCode, ErrorCode::ParseError);
-    EXPECT_NE(loaded.GetError().mMessage.find("line 5"), std::string::npos) << loaded.GetError().mMessage;
+    EXPECT_NE(loaded.GetError().mMessage.find("bad-face.obj:5:"), std::string::npos)
+        << loaded.GetError().mMessage;
 }
 
 TEST_F(LevelPartsTest, PartsPerObjectAndArea)

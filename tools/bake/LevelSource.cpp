@@ -10,7 +10,8 @@ namespace cairn::bake
 
 Result<std::unique_ptr<FileLevelSource>> FileLevelSource::Load(const std::vector<std::string>& inPaths,
                                                                const navmesh::AreaMapping& inAreas,
-                                                               float inCellSize)
+                                                               float inCellSize,
+                                                               const navmesh::LevelLoadLimits& inLimits)
 {
     if (Status valid = inAreas.Validate(); !valid) return valid.GetError();
     if (!(inCellSize > 0.0f) || !std::isfinite(inCellSize))
@@ -20,7 +21,7 @@ Result<std::unique_ptr<FileLevelSource>> FileLevelSource::Load(const std::vector
     source->mCellSize = inCellSize;
     for (const std::string& path : inPaths)
     {
-        Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(path);
+        Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(path, inLimits);
         if (!mesh) return mesh.GetError();
         source->mBounds.Encapsulate(mesh.Value().GetBounds());
         for (navmesh::LevelPart& part : navmesh::SplitIntoParts(mesh.Value(), inAreas))

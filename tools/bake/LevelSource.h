@@ -61,8 +61,10 @@ class FileLevelSource final : public LevelSource
 {
 public:
     /// Errors: the loaders' (file and line or element), a bad area mapping.
-    static Result<std::unique_ptr<FileLevelSource>>
-    Load(const std::vector<std::string>& inPaths, const navmesh::AreaMapping& inAreas, float inCellSize);
+    static Result<std::unique_ptr<FileLevelSource>> Load(const std::vector<std::string>& inPaths,
+                                                         const navmesh::AreaMapping& inAreas,
+                                                         float inCellSize,
+                                                         const navmesh::LevelLoadLimits& inLimits = {});
 
     AABB GetBounds() const override { return mBounds; }
     uint32_t GetMaxObjectsNear() const override { return uint32_t(mParts.size()); }

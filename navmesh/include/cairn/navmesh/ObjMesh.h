@@ -69,16 +69,33 @@ struct LevelPart
 /// in the order of the objects and then of each area's first triangle. A mesh without objects is one.
 std::vector<LevelPart> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas);
 
+/// What a level file may make a loader do: work and memory follow the file's size, and a hostile file (a
+/// node graph that instances one mesh 2^40 times, JSON nested 100,000 deep) is refused with the name of the
+/// limit it broke rather than exhausting the machine. The defaults take any real level.
+struct LevelLoadLimits
+{
+    uint64_t mMaxFileBytes = 4ull << 30; ///< The level file, and each file a glTF reads beside it
+    uint32_t mMaxNesting = 64;           ///< JSON arrays and objects inside each other (glTF)
+    uint32_t mMaxNodeDepth = 64;         ///< glTF nodes under each other
+    uint64_t mMaxTriangles = 1ull << 27; ///< In the whole level, each instance of a mesh counted
+    uint64_t mMaxVertices = 1ull << 27;
+    /// glTF buffers come from inline data: URIs, the .glb itself or files in the level's folder (and below):
+    /// a level must not read /etc/passwd or ../other-level. True lifts the folder rule.
+    bool mAllowFilesOutsideFolder = false;
+};
+
 /// Errors: IOError when the file cannot be read; ParseError for a malformed file (bad numbers or indices),
-/// non-finite or out-of-range coordinates, or a mesh without triangles.
-Result<IndexedMesh> LoadObjMesh(const std::string& inPath);
+/// non-finite or out-of-range coordinates, a mesh without triangles, or a limit of inLimits exceeded.
+Result<IndexedMesh> LoadObjMesh(const std::string& inPath, const LevelLoadLimits& inLimits = {});
 
 /// glTF 2.0 (.gltf with its buffers, or .glb), read with tinygltf (Debian's libtinygltf-dev): the triangles
 /// of every mesh of the default scene (or of every node when there is none), placed by their nodes'
-/// transforms. Errors name the file and the element (meshes[i].primitives[j], accessors[k]) that is wrong.
-Result<IndexedMesh> LoadGltfMesh(const std::string& inPath);
+/// transforms. Images are never decoded (a navmesh has no use for them). Errors name the file and the element
+/// (meshes[i].primitives[j], accessors[k]) or limit that is wrong; a node reached twice is an error (glTF's
+/// nodes form trees, and a graph that shares nodes grows exponentially).
+Result<IndexedMesh> LoadGltfMesh(const std::string& inPath, const LevelLoadLimits& inLimits = {});
 
-/// OBJ or glTF by the file's extension (.obj, .gltf, .glb).
-Result<IndexedMesh> LoadLevelMesh(const std::string& inPath);
+/// OBJ or glTF by the file's extension (.obj, .gltf, .glb, in any case).
+Result<IndexedMesh> LoadLevelMesh(const std::string& inPath, const LevelLoadLimits& inLimits = {});
 
 } // namespace cairn::navmesh
