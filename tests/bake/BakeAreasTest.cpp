@@ -115,7 +115,9 @@ TEST_F(BakeAreasTest, MappingFilesAreReadAndCheckedByName)
         {R"({"default": 1.5})", "'default'"},
         {R"({"defualt": 1})", "'defualt'"},
         {R"([1, 2])", "not a JSON object"},
-        {R"({"materials": {)", "not a JSON object"},
+        {R"({"materials": {)", "parse error at line 1, column 16"},
+        {R"({"default": 1e400})", "number overflow"},
+        {R"({"default": 4294967296})", "'default'"},
     };
     for (const BadCase& bad : cases)
     {

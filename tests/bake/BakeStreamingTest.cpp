@@ -105,7 +105,7 @@ TEST_F(GeneratedBakeTest, ThreadsAndShardsGiveTheSameBytesWithAFewObjectsInTheWo
         settings.mOutputPath = mFiles.Path(inName);
         Result<BakeResult> result = BakeSource(*level, settings);
         EXPECT_TRUE(result) << result.GetError().mMessage;
-        return result ? result.Value() : BakeResult{};
+        return result ? std::move(result.Value()) : BakeResult{};
     };
     const BakeResult one = bakeTo(1, 0, 1, "one.navmesh");
     const BakeResult two = bakeTo(2, 0, 1, "two.navmesh");

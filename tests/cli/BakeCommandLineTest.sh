@@ -62,9 +62,9 @@ expect_error() { # <what the message names> <output file> <arguments...>
 echo '{"materials": {"road": 99}}' >bad-areas.json
 expect_error "bad-areas.json" out1.navmesh bake level.obj -o out1.navmesh --areas bad-areas.json
 expect_error "missing-areas.json" out2.navmesh bake level.obj -o out2.navmesh --areas missing-areas.json
-printf 'v 0 0 0\nv 1 0 0\nv 1 0 1\nusemtl road\nf 1 2 0\n' >broken.obj
+printf 'v 0 0 0\nv 1 0 0\nv 1 0 1\nusemtl road\nf 1 2 -9\n' >broken.obj
 expect_error "broken.obj" out3.navmesh bake broken.obj -o out3.navmesh
-expect_error "line 5" out3.navmesh bake broken.obj -o out3.navmesh
+expect_error "broken.obj:5:" out3.navmesh bake broken.obj -o out3.navmesh
 printf 'v 0 0 0\nv 1 0 nan\nv 1 0 1\nf 1 2 3\n' >nan.obj
 expect_error "nan.obj:2" out4.navmesh bake nan.obj -o out4.navmesh
 expect_error "(7, 0)" out5.navmesh bake level.obj -o out5.navmesh --tile 7,0
@@ -73,5 +73,82 @@ expect_error "--box" out5.navmesh bake level.obj -o out5.navmesh --box 1,2,3
 expect_error "not a box" out5.navmesh bake level.obj -o out5.navmesh --box 5,5,1,1
 echo "not a navmesh" >junk.navmesh
 expect_error "junk.navmesh" merged.navmesh merge junk.navmesh -o merged.navmesh
+expect_error "--shard 1/-1" out5.navmesh bake level.obj -o out5.navmesh --shard 1/-1
+
+# Outputs are checked before any work: never an input, another output's file, a link or a device
+cp level.obj level-before.obj
+expect_error "is the input" out6.navmesh bake level.obj -o level.obj --tile 0,0
+cmp -s level.obj level-before.obj || fail "-o naming the input changed the level"
+expect_error "each output needs a file of its own" out6.navmesh bake level.obj -o out6.navmesh --summary out6.navmesh
+expect_error "-o: an empty path" out6.navmesh bake level.obj -o ""
+ln -s link-target.navmesh link.navmesh
+expect_error "symbolic link" link-target.navmesh bake level.obj -o link.navmesh
+[ -L link.navmesh ] || fail "the link was replaced"
+mkfifo pipe.navmesh
+expect_error "not a regular file" out6.navmesh bake level.obj -o pipe.navmesh
+[ -p pipe.navmesh ] || fail "the pipe was replaced"
+expect_error "does not exist" no-such-folder/out.navmesh bake level.obj -o no-such-folder/out.navmesh
+expect_error "is the input" out6.navmesh merge level.navmesh -o level.navmesh
+expect_error "is the input" out6.navmesh bake level.obj -o out6.navmesh --previous level.json \
+    --previous-navmesh level.navmesh --summary level.json
+
+# An incremental bake takes the previous navmesh only with its own summary
+cat >other.obj <<'OBJ'
+v 0 0 0
+v 30 0 0
+v 30 0 30
+v 0 0 30
+f 1 3 2
+f 1 4 3
+OBJ
+"$bake" bake other.obj -o other.navmesh --summary other.json >/dev/null 2>&1 || fail "the other level's bake failed"
+expect_error "from different bakes" out7.navmesh bake level.obj -o out7.navmesh --previous level.json \
+    --previous-navmesh other.navmesh
+
+# A failed summary write leaves the previous outputs as they were: a level whose summary is far larger than
+# its navmesh (thousands of empty tiles between two small floors), under a file size limit the navmesh fits
+cat >sparse.obj <<'OBJ'
+v 0 0 0
+v 4 0 0
+v 4 0 4
+v 0 0 4
+v 500 0 500
+v 504 0 500
+v 504 0 504
+v 500 0 504
+f 1 3 2
+f 1 4 3
+f 5 7 6
+f 5 8 7
+OBJ
+echo "the previous bake" >sparse.navmesh
+(
+    ulimit -f 64 # 32 KB
+    trap '' XFSZ # An oversized write fails (EFBIG) instead of killing the baker
+    "$bake" bake sparse.obj -o sparse.navmesh --summary sparse.json >sparse.log 2>&1
+)
+code=$?
+[ "$code" -eq 1 ] || fail "a bake whose summary could not be written exited with $code: $(cat sparse.log)"
+[ "$(cat sparse.navmesh)" = "the previous bake" ] || fail "a failed bake replaced its navmesh"
+[ ! -e sparse.json ] || fail "a failed bake left a summary"
+
+# SIGTERM during a bake leaves no temporary file: a level big enough to be interrupted, killed once its
+# navmesh's temporary exists
+awk 'BEGIN { n = 120; for (z = 0; z <= n; ++z) for (x = 0; x <= n; ++x) printf "v %d %.2f %d\n", x, ((x * 7 + z * 13) % 5) * 0.05, z;
+             for (z = 0; z < n; ++z) for (x = 0; x < n; ++x) { a = z * (n + 1) + x + 1; b = a + 1; c = a + n + 1; d = c + 1;
+             printf "f %d %d %d\nf %d %d %d\n", a, c, b, b, c, d } }' >terrain.obj
+"$bake" bake terrain.obj -o terrain.navmesh --threads 1 --cell-size 0.1 >terrain.log 2>&1 &
+baker=$!
+for _ in $(seq 200); do
+    if ls terrain.navmesh.tmp-* >/dev/null 2>&1; then break; fi
+    sleep 0.05
+done
+ls terrain.navmesh.tmp-* >/dev/null 2>&1 || fail "the terrain bake made no temporary file: $(cat terrain.log)"
+kill -TERM "$baker"
+wait "$baker"
+code=$?
+[ "$code" -eq 143 ] || fail "the terrain bake was not ended by SIGTERM (exit $code): $(cat terrain.log)"
+[ ! -e terrain.navmesh ] || fail "an interrupted bake left its navmesh"
+
 if ls ./*.tmp* >/dev/null 2>&1; then fail "temporary files left: $(ls ./*.tmp*)"; fi
 echo "cairn-bake command line: all checks passed"

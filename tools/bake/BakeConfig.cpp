@@ -1,6 +1,8 @@
 #include "BakeConfig.h"
 
-#include <fstream>
+#include "JsonFile.h"
+
+#include <DetourNavMesh.h>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -9,11 +11,10 @@ namespace cairn::bake
 
 Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfile)
 {
-    std::ifstream in(inPath);
-    if (!in) return MakeError(ErrorCode::IOError, inPath + ": cannot be read");
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-    if (json.is_discarded() || !json.is_object())
-        return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
+    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    if (!read) return read.GetError();
+    const nlohmann::json& json = read.Value();
+    if (!json.is_object()) return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
     navmesh::AgentProfile& p = ioProfile;
     const std::map<std::string, float*> numbers = {
         {"agent_height", &p.mHeight},
@@ -40,9 +41,12 @@ Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfil
         }
         else if (key == "max_verts_per_poly")
         {
-            if (!value.is_number_integer())
-                return MakeError(ErrorCode::ParseError, inPath + ": '" + key + "' must be a whole number");
-            p.mMaxVertsPerPoly = value.get<int>();
+            int64_t number = 0;
+            if (!GetWholeNumber(value, 3, DT_VERTS_PER_POLYGON, number))
+                return MakeError(ErrorCode::ParseError, inPath + ": '" + key +
+                                                            "' must be a whole number from 3 to " +
+                                                            std::to_string(DT_VERTS_PER_POLYGON));
+            p.mMaxVertsPerPoly = int(number);
         }
         else if (key == "region_partition")
         {
@@ -68,19 +72,18 @@ Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfil
 
 Result<navmesh::AreaMapping> LoadAreaMapping(const std::string& inPath)
 {
-    std::ifstream in(inPath);
-    if (!in) return MakeError(ErrorCode::IOError, inPath + ": cannot be read");
-    const nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-    if (json.is_discarded() || !json.is_object())
-        return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
+    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    if (!read) return read.GetError();
+    const nlohmann::json& json = read.Value();
+    if (!json.is_object()) return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
     auto areaId = [&](const nlohmann::json& inValue, const std::string& inWhat) -> Result<uint8_t>
     {
-        if (!inValue.is_number_integer() || inValue.get<int64_t>() < 0 ||
-            inValue.get<int64_t>() > navmesh::cMaxAreaId)
+        int64_t id = 0;
+        if (!GetWholeNumber(inValue, 0, navmesh::cMaxAreaId, id))
             return MakeError(ErrorCode::ParseError, inPath + ": " + inWhat +
                                                         " must be a whole number from 0 to " +
                                                         std::to_string(navmesh::cMaxAreaId));
-        return uint8_t(inValue.get<int64_t>());
+        return uint8_t(id);
     };
     navmesh::AreaMapping mapping;
     for (const auto& [key, value] : json.items())

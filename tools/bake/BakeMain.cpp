@@ -5,11 +5,13 @@
 
 #include "BakeConfig.h"
 #include "Baker.h"
+#include "OutputPaths.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshPreview.h"
 #include "cairn/navmesh/ReplaceFile.h"
 
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -20,16 +22,39 @@ using namespace cairn;
 
 namespace
 {
+/// A whole number of digits only, to an unsigned 32-bit value; false otherwise (sscanf's %u took "-1" as
+/// 4294967295).
+bool ParseUnsigned(const char* inFirst, const char* inLast, uint32_t& outValue)
+{
+    if (inFirst == inLast || *inFirst < '0' || *inFirst > '9') return false;
+    const auto [end, error] = std::from_chars(inFirst, inLast, outValue);
+    return error == std::errc() && end == inLast;
+}
+
 /// "K/N" to (K, N); false when malformed.
 bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount)
 {
-    unsigned shard = 0, count = 0;
-    char extra = 0;
-    if (std::sscanf(inText.c_str(), "%u/%u%c", &shard, &count, &extra) != 2 || count == 0 || shard >= count)
+    const size_t slash = inText.find('/');
+    if (slash == std::string::npos) return false;
+    uint32_t shard = 0, count = 0;
+    if (!ParseUnsigned(inText.data(), inText.data() + slash, shard) ||
+        !ParseUnsigned(inText.data() + slash + 1, inText.data() + inText.size(), count) || count == 0 ||
+        shard >= count)
         return false;
     outShard = shard;
     outCount = count;
     return true;
+}
+
+/// Commits every output (each complete under its temporary name) in turn: the new navmesh never stands
+/// beside a failed summary or preview.
+Status CommitAll(std::vector<navmesh::PendingFile*> inFiles, navmesh::NavMeshFileWriter* inNavMesh)
+{
+    if (inNavMesh != nullptr)
+        if (Status committed = inNavMesh->Commit(); !committed) return committed;
+    for (navmesh::PendingFile* file : inFiles)
+        if (Status committed = file->Commit(); !committed) return committed;
+    return Status::Ok();
 }
 
 int Fail(const std::string& inMessage)
@@ -41,6 +66,8 @@ int Fail(const std::string& inMessage)
 
 int main(int argc, char** argv)
 {
+    // SIGINT and SIGTERM (a cancelled build-farm job) leave no temporary output behind
+    navmesh::RemovePendingFilesOnTermination();
     CLI::App app{"cairn-bake: bake level meshes into a tiled Detour navmesh (Recast's saved-navmesh layout)"};
     app.require_subcommand(1);
 
@@ -80,6 +107,21 @@ int main(int argc, char** argv)
     bakeCommand->add_option("--areas", areasPath,
                             "Navmesh area ids of material names, from a JSON file "
                             "({\"default\": 0, \"materials\": {\"road\": 1}})");
+    navmesh::LevelLoadLimits& limits = settings.mLoadLimits;
+    bakeCommand->add_flag("--allow-outside-files", limits.mAllowFilesOutsideFolder,
+                          "glTF buffers may come from outside the level file's folder");
+    bakeCommand
+        ->add_option("--max-file-bytes", limits.mMaxFileBytes, "Largest level file (and glTF buffer file)")
+        ->check(CLI::PositiveNumber);
+    bakeCommand->add_option("--max-triangles", limits.mMaxTriangles, "Most triangles per level file")
+        ->check(CLI::PositiveNumber);
+    bakeCommand->add_option("--max-vertices", limits.mMaxVertices, "Most vertices per level file")
+        ->check(CLI::PositiveNumber);
+    // Bounded: tinygltf's JSON conversion recurses, a level per nesting
+    bakeCommand->add_option("--max-nesting", limits.mMaxNesting, "Deepest JSON nesting of a glTF")
+        ->check(CLI::Range(1, 1000));
+    bakeCommand->add_option("--max-node-depth", limits.mMaxNodeDepth, "Deepest glTF node tree")
+        ->check(CLI::Range(1, 100000));
     CLI::Option* flags[] = {
         bakeCommand->add_option("--tile-size", flagProfile.mTileSize, "Tile side, m"),
         bakeCommand->add_option("--cell-size", flagProfile.mCellSize, "Voxel size, m"),
@@ -114,6 +156,11 @@ int main(int argc, char** argv)
 
     if (*mergeCommand)
     {
+        std::vector<bake::NamedPath> shardInputs;
+        for (const std::string& path : shards)
+            shardInputs.push_back({"shard", path});
+        if (Status usable = bake::CheckOutputPaths({{"-o", mergedOutput}}, shardInputs); !usable)
+            return Fail(usable.GetError().mMessage);
         std::vector<navmesh::NavMeshFileContents> loaded;
         for (const std::string& path : shards)
         {
@@ -129,6 +176,21 @@ int main(int argc, char** argv)
                     mergedOutput.c_str());
         return 0;
     }
+
+    // Outputs checked before any work: an unusable one was reported only after the whole bake
+    std::vector<bake::NamedPath> outputs{{"-o", output}};
+    for (const bake::NamedPath& optional :
+         {bake::NamedPath{"--summary", summaryPath}, bake::NamedPath{"--preview-obj", previewObjPath},
+          bake::NamedPath{"--preview-svg", previewSvgPath}})
+        if (!optional.mPath.empty()) outputs.push_back(optional);
+    std::vector<bake::NamedPath> inputs{{"--config", configPath},
+                                        {"--areas", areasPath},
+                                        {"--previous", previousSummaryPath},
+                                        {"--previous-navmesh", previousNavMeshPath}};
+    for (const std::string& path : settings.mInputs)
+        inputs.push_back({"input", path});
+    if (Status usable = bake::CheckOutputPaths(outputs, inputs); !usable)
+        return Fail(usable.GetError().mMessage);
 
     if (!configPath.empty())
         if (Status loaded = bake::LoadBakeConfig(configPath, settings.mProfile); !loaded)
@@ -194,31 +256,48 @@ int main(int argc, char** argv)
         settings.mPrevious = &*previous;
         settings.mPreviousNavMesh = &*previousNavMesh;
     }
-    settings.mOutputPath = output; // Tiles go to the file as they are done
+    settings.mOutputPath = output;  // Tiles go to the file as they are done
+    settings.mCommitOutput = false; // In place with the other outputs, or not at all
     Result<bake::BakeResult> result = bake::Bake(settings);
     if (terminal) std::printf("\n");
     if (!result) return Fail(result.GetError().mMessage);
+    // Every output complete under its temporary name before any is renamed into place
+    std::optional<navmesh::PendingFile> summaryFile, previewObjFile, previewSvgFile;
+    auto write = [](std::optional<navmesh::PendingFile>& outFile, const std::string& inPath,
+                    const std::string& inText) -> Status
+    {
+        outFile.emplace(inPath);
+        if (Status opened = outFile->GetOpenStatus(); !opened) return opened;
+        outFile->Stream() << inText;
+        return outFile->Complete();
+    };
     if (!summaryPath.empty())
-        if (Status saved = bake::SaveBakeSummary(summaryPath, result.Value().mSummary); !saved)
-            return Fail(saved.GetError().mMessage);
+        if (Status written =
+                write(summaryFile, summaryPath, bake::BakeSummaryToJson(result.Value().mSummary));
+            !written)
+            return Fail(written.GetError().mMessage);
     if (!previewObjPath.empty() || !previewSvgPath.empty())
     {
         // The previews show the file as a runtime loads it
-        Result<navmesh::NavMeshFileContents> written = navmesh::LoadNavMeshFile(output);
+        Result<navmesh::NavMeshFileContents> written =
+            navmesh::LoadNavMeshFile(result.Value().mOutput->GetTemporaryPath());
         if (!written) return Fail(written.GetError().mMessage);
         Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(written.Value());
         if (!navMesh) return Fail(navMesh.GetError().mMessage);
         if (!previewObjPath.empty())
-            if (Status saved =
-                    navmesh::ReplaceFileWithText(previewObjPath, navmesh::NavMeshToObj(*navMesh.Value()));
+            if (Status saved = write(previewObjFile, previewObjPath, navmesh::NavMeshToObj(*navMesh.Value()));
                 !saved)
                 return Fail(saved.GetError().mMessage);
         if (!previewSvgPath.empty())
-            if (Status saved =
-                    navmesh::ReplaceFileWithText(previewSvgPath, navmesh::NavMeshToSvg(*navMesh.Value()));
+            if (Status saved = write(previewSvgFile, previewSvgPath, navmesh::NavMeshToSvg(*navMesh.Value()));
                 !saved)
                 return Fail(saved.GetError().mMessage);
     }
+    std::vector<navmesh::PendingFile*> pending;
+    for (std::optional<navmesh::PendingFile>* file : {&summaryFile, &previewObjFile, &previewSvgFile})
+        if (file->has_value()) pending.push_back(&**file);
+    if (Status committed = CommitAll(pending, result.Value().mOutput.get()); !committed)
+        return Fail(committed.GetError().mMessage);
     const bake::BakeResult& baked = result.Value();
     std::printf("%llu bodies (at most %u at once); rebuilt %u, baked %u of %u tiles (shard %u/%u), %u with "
                 "polygons, %llu polygons, in %.1f ms (load %.1f ms) -> %s\n",

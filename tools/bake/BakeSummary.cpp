@@ -1,8 +1,11 @@
 #include "BakeSummary.h"
 
+#include "JsonFile.h"
 #include "cairn/navmesh/ReplaceFile.h"
 
 #include <algorithm>
+#include <climits>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -53,7 +56,7 @@ bool FromHex(const std::string& inText, uint64_t& outValue)
 }
 } // namespace
 
-Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary)
+std::string BakeSummaryToJson(const BakeSummary& inSummary)
 {
     nlohmann::json json;
     json["format"] = "cairn-bake-summary";
@@ -73,44 +76,105 @@ Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary)
                          {"polygons", tile.mPolygons},
                          {"bytes", tile.mBytes}});
     json["tiles"] = tiles;
-    return navmesh::ReplaceFileWithText(inPath, json.dump(1) + "\n");
+    return json.dump(1) + "\n";
+}
+
+Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary)
+{
+    return navmesh::ReplaceFileWithText(inPath, BakeSummaryToJson(inSummary));
 }
 
 Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
 {
-    std::ifstream in(inPath);
-    if (!in) return MakeError(ErrorCode::IOError, inPath + ": cannot be read");
-    nlohmann::json json = nlohmann::json::parse(in, nullptr, false);
-    if (json.is_discarded()) return MakeError(ErrorCode::ParseError, inPath + ": not valid JSON");
-    if (!json.is_object() || json.value("format", "") != "cairn-bake-summary" ||
-        json.value("version", 0) != 1)
-        return MakeError(ErrorCode::ParseError, inPath + ": not a cairn-bake summary of version 1");
-    BakeSummary summary;
-    const nlohmann::json& tiles = json["tiles"];
-    if (!tiles.is_array()) return MakeError(ErrorCode::ParseError, inPath + ": 'tiles' is not an array");
-    for (size_t i = 0; i < tiles.size(); ++i)
+    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    if (!read) return read.GetError();
+    const nlohmann::json& json = read.Value();
+    auto parseError = [&](const std::string& inWhat)
+    { return MakeError(ErrorCode::ParseError, inPath + ": " + inWhat); };
+    // Fields are looked up by type, never converted: nlohmann's value() and get() throw on a wrong type
+    auto member = [&](const nlohmann::json& inObject, const char* inKey) -> const nlohmann::json*
     {
-        const nlohmann::json& tile = tiles[i];
+        auto it = inObject.find(inKey);
+        return it != inObject.end() ? &*it : nullptr;
+    };
+    if (!json.is_object()) return parseError("not a cairn-bake summary of version 1");
+    const nlohmann::json* format = member(json, "format");
+    const nlohmann::json* version = member(json, "version");
+    if (format == nullptr || !format->is_string() || *format != "cairn-bake-summary" || version == nullptr ||
+        !version->is_number_integer() || *version != 1)
+        return parseError("not a cairn-bake summary of version 1");
+    BakeSummary summary;
+    const nlohmann::json* tiles = member(json, "tiles");
+    if (tiles == nullptr || !tiles->is_array()) return parseError("'tiles' is not an array");
+    for (size_t i = 0; i < tiles->size(); ++i)
+    {
+        const nlohmann::json& tile = (*tiles)[i];
         TileRecord record;
-        const std::string where = inPath + ": tiles[" + std::to_string(i) + "]";
-        if (!tile.is_object() || !tile.contains("x") || !tile["x"].is_number_integer() ||
-            !tile.contains("z") || !tile["z"].is_number_integer() || !tile.contains("input_hash") ||
-            !tile["input_hash"].is_string() || !tile.contains("output_hash") ||
-            !tile["output_hash"].is_string())
-            return MakeError(ErrorCode::ParseError,
-                             where + ": needs integer x, z and hex input_hash, output_hash");
-        record.mTile = {tile["x"].get<int32_t>(), tile["z"].get<int32_t>()};
-        if (!FromHex(tile["input_hash"].get<std::string>(), record.mInputHash) ||
-            !FromHex(tile["output_hash"].get<std::string>(), record.mOutputHash))
-            return MakeError(ErrorCode::ParseError, where + ": a hash is not 16 hex digits");
-        record.mPolygons = tile.value("polygons", 0);
-        record.mBytes = tile.value("bytes", 0u);
+        const std::string where = "tiles[" + std::to_string(i) + "]";
+        if (!tile.is_object()) return parseError(where + ": not an object");
+        const nlohmann::json* x = member(tile, "x");
+        const nlohmann::json* z = member(tile, "z");
+        const nlohmann::json* inputHash = member(tile, "input_hash");
+        const nlohmann::json* outputHash = member(tile, "output_hash");
+        int64_t tileX = 0, tileZ = 0;
+        if (x == nullptr || z == nullptr || !GetWholeNumber(*x, INT32_MIN, INT32_MAX, tileX) ||
+            !GetWholeNumber(*z, INT32_MIN, INT32_MAX, tileZ) || inputHash == nullptr ||
+            !inputHash->is_string() || outputHash == nullptr || !outputHash->is_string())
+            return parseError(where + ": needs integer x, z (32 bits) and hex input_hash, output_hash");
+        record.mTile = {int32_t(tileX), int32_t(tileZ)};
+        if (!FromHex(inputHash->get<std::string>(), record.mInputHash) ||
+            !FromHex(outputHash->get<std::string>(), record.mOutputHash))
+            return parseError(where + ": a hash is not 16 hex digits");
+        int64_t polygons = 0, bytes = 0;
+        const nlohmann::json* polygonsValue = member(tile, "polygons");
+        const nlohmann::json* bytesValue = member(tile, "bytes");
+        if ((polygonsValue != nullptr && !GetWholeNumber(*polygonsValue, 0, INT32_MAX, polygons)) ||
+            (bytesValue != nullptr && !GetWholeNumber(*bytesValue, 0, UINT32_MAX, bytes)))
+            return parseError(where + ": 'polygons' and 'bytes' must be whole numbers from 0");
+        record.mPolygons = int(polygons);
+        record.mBytes = uint32_t(bytes);
         summary.mTiles.push_back(record);
     }
     std::sort(summary.mTiles.begin(), summary.mTiles.end(),
               [](const TileRecord& inL, const TileRecord& inR) { return inL.mTile < inR.mTile; });
-    summary.mTilesInWorld = json.value("tiles_in_world", 0u);
+    for (size_t i = 1; i < summary.mTiles.size(); ++i)
+        if (summary.mTiles[i - 1].mTile == summary.mTiles[i].mTile)
+            return parseError("tile (" + std::to_string(summary.mTiles[i].mTile.mX) + ", " +
+                              std::to_string(summary.mTiles[i].mTile.mZ) + ") is listed twice");
+    int64_t tilesInWorld = 0;
+    if (const nlohmann::json* value = member(json, "tiles_in_world");
+        value != nullptr && !GetWholeNumber(*value, 0, UINT32_MAX, tilesInWorld))
+        return parseError("'tiles_in_world' must be a whole number from 0");
+    summary.mTilesInWorld = uint32_t(tilesInWorld);
     return summary;
+}
+
+Status CheckPreviousBake(const BakeSummary& inSummary, const navmesh::NavMeshFileContents& inNavMesh)
+{
+    auto mismatch = [](const navmesh::TileCoord& inTile, const std::string& inWhat)
+    {
+        return MakeError(ErrorCode::InvalidArgument,
+                         "the previous navmesh and summary are from different bakes: tile (" +
+                             std::to_string(inTile.mX) + ", " + std::to_string(inTile.mZ) + ") " + inWhat);
+    };
+    size_t withData = 0;
+    for (const TileRecord& record : inSummary.mTiles)
+        withData += record.mBytes > 0 ? 1 : 0;
+    for (const navmesh::NavMeshFileTile& tile : inNavMesh.mTiles)
+    {
+        const TileRecord* record = inSummary.Find(tile.mTile);
+        if (record == nullptr || record->mBytes == 0)
+            return mismatch(tile.mTile, "is in the navmesh, not in the summary");
+        if (record->mBytes != tile.mData.size() || record->mOutputHash != Hash64(tile.mData))
+            return mismatch(tile.mTile, "differs from the output the summary hashed");
+    }
+    if (withData != inNavMesh.mTiles.size())
+        return MakeError(ErrorCode::InvalidArgument,
+                         "the previous navmesh and summary are from different bakes: the "
+                         "summary has " +
+                             std::to_string(withData) + " tiles with polygons, the navmesh " +
+                             std::to_string(inNavMesh.mTiles.size()));
+    return Status::Ok();
 }
 
 } // namespace cairn::bake

@@ -6,6 +6,7 @@
 // Hashes are FNV-1a 64 over the exact bytes, the same on every machine of the same byte order.
 // Plain data and functions: any thread.
 
+#include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/TileGrid.h"
 #include "cairn/physics/math/Result.h"
 
@@ -48,9 +49,16 @@ struct BakeSummary
     const TileRecord* Find(const navmesh::TileCoord& inTile) const;
 };
 
+/// The summary as the JSON SaveBakeSummary writes.
+std::string BakeSummaryToJson(const BakeSummary& inSummary);
 /// Writes the summary as JSON (temporary file, then renamed).
 Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary);
 /// Reads a summary; errors name the file and the element that is wrong.
 Result<BakeSummary> LoadBakeSummary(const std::string& inPath);
+
+/// Ok when inNavMesh holds exactly the tiles inSummary recorded with data, each with the output hash and
+/// size recorded: an incremental bake must not take one level's summary with another level's navmesh.
+/// Errors: InvalidArgument naming the first tile that differs.
+Status CheckPreviousBake(const BakeSummary& inSummary, const navmesh::NavMeshFileContents& inNavMesh);
 
 } // namespace cairn::bake

@@ -166,6 +166,10 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     if ((inSettings.mPrevious == nullptr) != (inSettings.mPreviousNavMesh == nullptr))
         return MakeError(ErrorCode::InvalidArgument,
                          "an incremental bake needs the previous summary and navmesh");
+    if (inSettings.mPrevious != nullptr)
+        if (Status matching = CheckPreviousBake(*inSettings.mPrevious, *inSettings.mPreviousNavMesh);
+            !matching)
+            return matching.GetError();
     const AABB bounds = inSource.GetBounds();
     if (bounds.IsEmpty()) return MakeError(ErrorCode::InvalidArgument, "the level has no geometry");
 
@@ -317,7 +321,11 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     result.mPeakBodies = objects.GetPeakLive();
     result.mBodies = objects.GetNumMade();
     if (output != nullptr)
-        if (Status finished = output->Finish(); !finished) return finished.GetError();
+    {
+        if (Status completed = inSettings.mCommitOutput ? output->Commit() : output->Complete(); !completed)
+            return completed.GetError();
+        if (!inSettings.mCommitOutput) result.mOutput = std::move(output);
+    }
     result.mSummary.mBakeMs = result.mBakeMs;
     result.mSummary.mPolygons = result.mPolygons;
     return result;
@@ -329,8 +337,8 @@ Result<BakeResult> Bake(const BakeSettings& inSettings)
     // Before loading: the source's index of cells is made for the tile size
     if (Status valid = inSettings.mProfile.Validate(); !valid) return valid.GetError();
     const Clock::time_point loadStart = Clock::now();
-    Result<std::unique_ptr<FileLevelSource>> source =
-        FileLevelSource::Load(inSettings.mInputs, inSettings.mAreas, inSettings.mProfile.mTileSize);
+    Result<std::unique_ptr<FileLevelSource>> source = FileLevelSource::Load(
+        inSettings.mInputs, inSettings.mAreas, inSettings.mProfile.mTileSize, inSettings.mLoadLimits);
     if (!source) return source.GetError();
     const double loadMs = MillisecondsSince(loadStart);
     Result<BakeResult> result = BakeSource(*source.Value(), inSettings);

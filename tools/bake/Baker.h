@@ -29,14 +29,18 @@ struct BakeSettings
     /// When set, tiles are written to this navmesh file as they are done (BakeResult::mNavMesh stays empty):
     /// the bake then holds only the tiles in flight
     std::string mOutputPath;
+    /// With mOutputPath: false leaves the file complete under a temporary name in BakeResult::mOutput, for
+    /// the caller to commit with its other outputs (all in place, or none)
+    bool mCommitOutput = true;
     /// Bodies the bake's world holds at most (0: twice the objects one tile can have near it). Tiles wait to
     /// enter while their objects would not fit; a single tile with more objects near it is an error
     uint32_t mMaxBodiesInWorld = 0;
     navmesh::AgentProfile mProfile;
-    navmesh::AreaMapping mAreas; ///< Area ids of material names
-    uint32_t mThreads = 0;       ///< 0: all cores
-    uint32_t mShard = 0;         ///< This shard (0-based) ...
-    uint32_t mShardCount = 1;    ///< ... of this many
+    navmesh::AreaMapping mAreas;          ///< Area ids of material names
+    navmesh::LevelLoadLimits mLoadLimits; ///< What the level files may make the loaders do (Bake)
+    uint32_t mThreads = 0;                ///< 0: all cores
+    uint32_t mShard = 0;                  ///< This shard (0-based) ...
+    uint32_t mShardCount = 1;             ///< ... of this many
     /// Called after each tile with (tiles done, tiles in all), one call at a time; may be empty
     std::function<void(uint32_t, uint32_t)> mProgress;
     /// Incremental: the previous bake's summary and navmesh (both or neither). A tile whose input hash is
@@ -62,6 +66,8 @@ struct BakeResult
     double mBakeMs = 0.0;     ///< Tiles only (loading excluded)
     double mLoadMs = 0.0;
     BakeSummary mSummary; ///< Per tile hashes, for the next incremental bake
+    /// With mOutputPath and not mCommitOutput: the navmesh file, complete, to Commit into place
+    std::unique_ptr<navmesh::NavMeshFileWriter> mOutput;
 };
 
 /// Bakes the files of inSettings.mInputs. Errors: unreadable or malformed inputs (naming the file and line),

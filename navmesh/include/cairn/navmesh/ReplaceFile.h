@@ -16,7 +16,10 @@ namespace cairn::navmesh
 {
 
 /// A file being written: Stream() goes to "<path>.tmp-<process>-<n>"; Commit renames it to the path.
-/// Destroyed uncommitted (an error, an exception, a cancelled bake), it removes the temporary.
+/// Destroyed uncommitted (an error, an exception, a cancelled bake), it removes the temporary; so does
+/// SIGINT or SIGTERM once RemovePendingFilesOnTermination is installed. The path must not be a symbolic
+/// link or anything but a regular file (a device, a folder): a rename would replace that entry, so it is
+/// refused at creation and again at Commit.
 class PendingFile
 {
 public:
@@ -25,10 +28,15 @@ public:
     PendingFile(const PendingFile&) = delete;
     PendingFile& operator=(const PendingFile&) = delete;
 
-    /// Whether the temporary could be created (IOError naming it otherwise).
+    /// Whether the temporary could be created and the path may be replaced (IOError naming it otherwise).
     Status GetOpenStatus() const { return mOpenStatus; }
     std::ostream& Stream() { return mStream; }
-    /// Flushes, closes and renames. Errors: IOError naming the file (then nothing is left behind).
+    /// The temporary's name, to read the contents back before Commit.
+    const std::string& GetTemporaryPath() const { return mTemporary; }
+    /// Flushes and closes the temporary, keeping it for Commit: outputs that go together are all completed
+    /// before any is committed. Errors: IOError naming the file (then nothing is left behind).
+    Status Complete();
+    /// Completes (if not yet) and renames. Errors: IOError naming the file (then nothing is left behind).
     Status Commit();
 
 private:
@@ -37,8 +45,18 @@ private:
     std::string mPath, mTemporary;
     std::ofstream mStream;
     Status mOpenStatus;
+    int mSignalSlot = -1; ///< Where RemovePendingFilesOnTermination finds the temporary's name
+    bool mCompleted = false;
     bool mDone = false; ///< Committed or abandoned
 };
+
+/// Empty when inPath may be replaced by an output: it does not exist, or is a regular file and not a
+/// symbolic link; else why not.
+std::string CheckReplaceable(const std::string& inPath);
+
+/// Installs SIGINT and SIGTERM handlers that remove every PendingFile's temporary and then end the process
+/// as the signal would have. For programs (the baker): a library does not take its host's signals.
+void RemovePendingFilesOnTermination();
 
 /// inWrite streams the contents (binary); an error it returns abandons the file and is returned. Errors:
 /// IOError naming the file, or inWrite's.
