@@ -9,7 +9,10 @@
 //                  on all cores with tiles streamed to a file, each in a child process of its own so that its
 //                  peak resident memory (wait4's ru_maxrss) is its alone: time should grow with the area,
 //                  peak memory should not (target: about the same at 100x).
-// --only direct|large runs one of the two.
+//  bake_overlapping  2,000, 10,000 and 50,000 small objects over one floor, all overlapping one another's
+//                  tiles, baked on 1 thread: ms per object should stay flat (each unloaded prop once woke
+//                  every prop around it, n^2).
+// --only direct|large|overlapping runs one of the three.
 
 #include "Baker.h"
 #include "GeneratedLevel.h"
@@ -160,15 +163,57 @@ void BenchLargeWorld()
 }
 } // namespace
 
+/// A floor and inObjects one-triangle objects on a 10 x 10 pattern over the same 5 m, as an OBJ file.
+std::string WriteOverlappingLevel(int inObjects)
+{
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("cairn-bench-overlapping-" + std::to_string(getpid()) + ".obj"))
+                                 .string();
+    std::FILE* file = std::fopen(path.c_str(), "w");
+    std::fprintf(file, "v -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\no floor\nf 1 3 2\nf 1 4 3\n");
+    for (int i = 0; i < inObjects; ++i)
+    {
+        const float x = float(i % 10) * 0.5f, z = float(i / 10 % 10) * 0.5f;
+        const int base = 4 + i * 3;
+        std::fprintf(file, "o obj%d\nv %g 0.5 %g\nv %g 0.5 %g\nv %g 0.5 %g\nf %d %d %d\n", i, x, z, x + 1, z,
+                     x, z + 1, base + 1, base + 3, base + 2);
+    }
+    std::fclose(file);
+    return path;
+}
+
+void BenchOverlapping(int inRepetitions)
+{
+    for (const int objects : {2000, 10000, 50000})
+    {
+        const std::string path = WriteOverlappingLevel(objects);
+        bake::BakeSettings settings;
+        settings.mInputs = {path};
+        settings.mThreads = 1;
+        std::vector<double> ms;
+        uint64_t polygons = 0;
+        for (int rep = 0; rep < inRepetitions; ++rep)
+        {
+            const bake::BakeResult result = bake::Bake(settings).Value();
+            ms.push_back(result.mBakeMs);
+            polygons = result.mPolygons;
+        }
+        std::filesystem::remove(path);
+        std::printf("bake_overlapping %6d objects  %.1f ms  %.2f us per object  | checksum polygons %llu\n",
+                    objects, Median(ms), Median(ms) * 1000.0 / objects, (unsigned long long)polygons);
+    }
+}
+
 int main(int argc, char** argv)
 {
     tools::BenchOptions options;
     if (auto stop = tools::ParseBenchOptions(argc, argv, "cairn-bench-bake: the offline baker's figures",
-                                             {"direct", "large"}, options))
+                                             {"direct", "large", "overlapping"}, options))
         return *stop;
     const int repetitions = options.mRepetitions;
     const std::string& only = options.mOnly;
     std::printf("cairn-bench-bake: %d repetitions\n", repetitions);
+    if (only.empty() || only == "overlapping") BenchOverlapping(repetitions);
     if (only.empty() || only == "large") BenchLargeWorld();
     if (!only.empty() && only != "direct") return 0;
     for (const char* name : {"dungeon.obj", "nav_test.obj", "undulating.obj"})

@@ -106,8 +106,8 @@ private:
     template <class T, class F> Result<T> ReadBody(const BodyID& inID, F&& inRead) const;
     /// Pushes the body's new bounds to the broad phase and, for dynamic/kinematic bodies, activates them.
     void OnBodyMoved(Body& ioBody, Activation inActivation);
-    /// Activates every sleeping dynamic body whose bounds overlap inBounds (after a removal).
-    void WakeBodiesIn(const AABB& inBounds);
+    /// Activates every sleeping dynamic body of inLayers whose bounds overlap inBounds (after a removal).
+    void WakeBodiesIn(const AABB& inBounds, ObjectLayerMask inLayers);
 
     BodyManager& mBodies;
     BroadPhase& mBroadPhase;
