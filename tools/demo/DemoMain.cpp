@@ -10,9 +10,13 @@
 #include "common/MachineInfo.h"
 
 #include <CLI/CLI.hpp>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 using namespace cairn;
@@ -27,7 +31,9 @@ int main(int argc, char** argv)
     CLI::App app{"cairn-demo: the streaming open-world demo (lock-free broad phase against a global mutex)"};
     app.add_option("--frames", settings.mFrames, "Frames per mode (60 per second)")
         ->check(CLI::Range(1, 1000000));
-    app.add_option("--seed", settings.mSeed, "World and agent seed");
+    // As text: CLI11 reads "-1" into an unsigned as 2^64 - 1
+    std::string seedText = std::to_string(settings.mSeed);
+    app.add_option("--seed", seedText, "World and agent seed (0 to 2^64 - 1)");
     app.add_option("--agents", settings.mAgents, "AI agents (navmesh invokers)")->check(CLI::Range(0, 1000));
     app.add_option("--threads", settings.mThreads, "Job system threads (0: all cores)")
         ->check(CLI::Range(0, 64));
@@ -48,7 +54,30 @@ int main(int argc, char** argv)
     }
     catch (const CLI::ParseError& error)
     {
-        return app.exit(error);
+        // CLI11 prints the help or the message; a usage error exits with 1, as every other error (CLI11's
+        // own codes are 104 to 109)
+        return app.exit(error) == 0 ? 0 : 1;
+    }
+    auto usageError = [](const std::string& inMessage)
+    {
+        std::fprintf(stderr, "cairn-demo: %s\n", inMessage.c_str());
+        return 1;
+    };
+    const char* seedEnd = seedText.data() + seedText.size();
+    const auto [parsedEnd, parseError] = std::from_chars(seedText.data(), seedEnd, settings.mSeed);
+    if (seedText.empty() || seedText[0] < '0' || seedText[0] > '9' || parseError != std::errc() ||
+        parsedEnd != seedEnd)
+        return usageError("--seed " + seedText + ": expected a whole number from 0 to 2^64 - 1");
+    // CLI11's range check compares, and NaN fails no comparison: every physics update then failed
+    if (!std::isfinite(settings.mCandidateMargin))
+        return usageError("--candidate-margin: expected a finite number from 0 to 100");
+    // The report's folder is made and tried now: an unusable one was reported only after the whole run
+    if (!output.empty())
+    {
+        std::error_code error;
+        std::filesystem::create_directories(output, error);
+        if (error || !std::filesystem::is_directory(output, error) || ::access(output.c_str(), W_OK) != 0)
+            return usageError("--output " + output + ": not a folder that can be made and written");
     }
     settings.mRealTime = !fast;
 
