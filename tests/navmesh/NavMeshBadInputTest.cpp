@@ -37,6 +37,10 @@ TEST(NavMeshBadInputTest, AgentProfilesOutOfRangeAreRefused)
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mRadius = 1e9f; }));
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mRegionMinSize = std::numeric_limits<float>::infinity(); }));
     EXPECT_TRUE(refused([](AgentProfile& p) { p.mEdgeMaxLength = 1e30f; }));
+    // A radius beyond the tile: each tile's build grew with its square (1000 m: 2.3 GB for a 60 m level)
+    EXPECT_TRUE(refused([](AgentProfile& p) { p.mRadius = 1000.0f; }));
+    EXPECT_TRUE(refused([](AgentProfile& p) { p.mRadius = p.mTileSize * 1.01f; }));
+    EXPECT_FALSE(refused([](AgentProfile& p) { p.mRadius = p.mTileSize; }));
     AgentProfile bad;
     bad.mCellSize = -0.2f;
     EXPECT_FALSE(NavMeshWorld::Create(TileGrid(0, 0, 12.8f, 0, 10), bad));

@@ -63,7 +63,8 @@ struct Tally
     int mSkipped = 0;
     int mNormalMismatches = 0;
     int mDepthMismatches = 0;
-    int mMissing = 0; ///< GJK/EPA found an overlap, the dedicated routine nothing
+    int mMissing = 0;             ///< GJK/EPA found an overlap, the dedicated routine nothing
+    int mReferenceUnreliable = 0; ///< EPA's depth is not the overlap along its own normal: no oracle there
     std::string mFirstMismatch;
 };
 
@@ -93,13 +94,15 @@ void Compare(const ContactManifold& inDedicated, bool inHit, const ConvexContact
 
 void ExpectAgreement(const Tally& inTally)
 {
-    EXPECT_EQ(inTally.mCompared + inTally.mSkipped, cNumCases);
+    EXPECT_EQ(inTally.mCompared + inTally.mSkipped + inTally.mReferenceUnreliable, cNumCases);
     EXPECT_EQ(inTally.mMissing, 0);
     EXPECT_EQ(inTally.mNormalMismatches, 0) << inTally.mFirstMismatch;
     EXPECT_EQ(inTally.mDepthMismatches, 0) << inTally.mFirstMismatch;
-    // The exclusion rule must stay an exception, not a way to hide disagreement
+    // The exclusion rules must stay exceptions, not a way to hide disagreement
     EXPECT_LT(inTally.mSkipped, cNumCases / 50);
-    std::printf("compared %d, skipped %d as ambiguous\n", inTally.mCompared, inTally.mSkipped);
+    EXPECT_LT(inTally.mReferenceUnreliable, cNumCases / 200);
+    std::printf("compared %d, skipped %d as ambiguous, %d where EPA's answer contradicts itself\n",
+                inTally.mCompared, inTally.mSkipped, inTally.mReferenceUnreliable);
 }
 
 // Finds a random overlapping configuration: GJK/EPA reports penetration > 1 mm
@@ -115,13 +118,34 @@ template <class MakeCase> void RunCases(uint32_t inSeed, MakeCase inMakeCase)
     ExpectAgreement(tally);
 }
 
-/// GJK/EPA's answer for the pair; false when it does not overlap by at least 1 mm (then it is not a case).
-bool ReferenceContact(const ConvexShape& inA, const Transform& inTransformA, const ConvexShape& inB,
-                      const Transform& inTransformB, ConvexContact& outReference)
+enum class Reference
 {
-    return FindConvexContact(ConvexSupport::FromShape(inA, inTransformA),
-                             ConvexSupport::FromShape(inB, inTransformB), 0.0f, outReference) &&
-           outReference.mPenetration >= 1.0e-3f;
+    NotACase,   ///< No overlap of at least 1 mm
+    Unreliable, ///< Counted in the tally: EPA stopped where its depth is not the overlap along its normal
+    Ok,
+};
+
+/// GJK/EPA's answer for the pair. EPA's answer is checked against the exact overlap of the two shapes along
+/// its own normal (their supports): on a curved shape EPA can stop early with a depth and a normal that do
+/// not belong together (seen once in 10,000 sphere-box cases with Clang's arithmetic: depth 0.846 reported,
+/// 0.858 along its normal, the true minimum 0.8525), and then it is no oracle.
+Reference ReferenceContact(const ConvexShape& inA, const Transform& inTransformA, const ConvexShape& inB,
+                           const Transform& inTransformB, ConvexContact& outReference, Tally& ioTally)
+{
+    const ConvexSupport a = ConvexSupport::FromShape(inA, inTransformA);
+    const ConvexSupport b = ConvexSupport::FromShape(inB, inTransformB);
+    if (!FindConvexContact(a, b, 0.0f, outReference) || outReference.mPenetration < 1.0e-3f)
+        return Reference::NotACase;
+    const Vec3& n = outReference.mNormal; // From A towards B
+    const float overlap =
+        (a.GetSupport(n, a.GetRadius()) - b.GetSupport(-n, b.GetRadius())).dot(n) / n.norm();
+    const float tolerance = std::max(cDepthAbsTolerance, cDepthRelTolerance * std::abs(overlap));
+    if (std::abs(overlap - outReference.mPenetration) > tolerance)
+    {
+        ++ioTally.mReferenceUnreliable;
+        return Reference::Unreliable;
+    }
+    return Reference::Ok;
 }
 
 TEST(AgreementTest, SphereSphere)
@@ -135,7 +159,9 @@ TEST(AgreementTest, SphereSphere)
                  const Transform ta{ioRng.InBox(1.0f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.0f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
+                 if (const Reference use = ReferenceContact(*a, ta, *b, tb, ref, ioTally);
+                     use != Reference::Ok)
+                     return use == Reference::Unreliable;
                  ContactManifold m;
                  const bool hit = CollideSphereSphere(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -156,7 +182,9 @@ TEST(AgreementTest, SphereBox)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
+                 if (const Reference use = ReferenceContact(*a, ta, *b, tb, ref, ioTally);
+                     use != Reference::Ok)
+                     return use == Reference::Unreliable;
                  // Centre inside the box with two faces at nearly the same distance: either face is right
                  const Vec3 local = tb.InverseTransformPoint(ta.mPosition);
                  if ((local.cwiseAbs().array() < extent.array()).all())
@@ -188,7 +216,9 @@ TEST(AgreementTest, SphereCapsule)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
+                 if (const Reference use = ReferenceContact(*a, ta, *b, tb, ref, ioTally);
+                     use != Reference::Ok)
+                     return use == Reference::Unreliable;
                  ContactManifold m;
                  const bool hit = CollideSphereCapsule(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -209,7 +239,9 @@ TEST(AgreementTest, CapsuleCapsule)
                  const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
                  const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
                  ConvexContact ref;
-                 if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
+                 if (const Reference use = ReferenceContact(*a, ta, *b, tb, ref, ioTally);
+                     use != Reference::Ok)
+                     return use == Reference::Unreliable;
                  ContactManifold m;
                  const bool hit = CollideCapsuleCapsule(*a, ta, *b, tb, settings, m);
                  Compare(m, hit, ref, ioTally);
@@ -262,7 +294,8 @@ TEST(AgreementTest, BoxBox)
             const Transform ta{ioRng.InBox(1.5f), ioRng.Rotation()};
             const Transform tb{ioRng.InBox(1.5f), ioRng.Rotation()};
             ConvexContact ref;
-            if (!ReferenceContact(*a, ta, *b, tb, ref)) return false;
+            if (const Reference use = ReferenceContact(*a, ta, *b, tb, ref, ioTally); use != Reference::Ok)
+                return use == Reference::Unreliable;
             // Two different axes with nearly the same penetration: both answers are right
             const auto axes = BoxAxisPenetrations(ea, ta, eb, tb);
             for (size_t i = 1; i < axes.size() && axes[i].first - axes[0].first < cAmbiguityGap; ++i)
