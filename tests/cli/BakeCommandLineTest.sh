@@ -105,6 +105,21 @@ OBJ
 expect_error "from different bakes" out7.navmesh bake level.obj -o out7.navmesh --previous level.json \
     --previous-navmesh other.navmesh
 
+# merge with the shards' summaries notices a missing shard (without them it can only warn)
+for k in 0 1 2; do
+    "$bake" bake level.obj -o shard$k.navmesh --areas areas.json --summary shard$k.json --shard $k/3 >/dev/null 2>&1 ||
+        fail "shard $k/3 failed"
+done
+expect_error "the bake had 3 shards, 2 are given" merged.navmesh merge shard0.navmesh shard2.navmesh \
+    --summary shard0.json --summary shard2.json -o merged.navmesh
+expect_error "different bakes" merged.navmesh merge shard0.navmesh shard1.navmesh shard2.navmesh \
+    --summary shard0.json --summary shard2.json --summary shard1.json -o merged.navmesh
+"$bake" merge shard0.navmesh shard1.navmesh shard2.navmesh --summary shard0.json --summary shard1.json \
+    --summary shard2.json -o merged.navmesh >merge.log 2>&1 || fail "merging every shard failed: $(cat merge.log)"
+cmp -s merged.navmesh level.navmesh || fail "the merged shards differ from the one-machine bake"
+"$bake" merge shard0.navmesh shard2.navmesh -o merged2.navmesh >merge.log 2>&1 || fail "merge without summaries"
+grep -q "a missing shard cannot be noticed" merge.log || fail "merge without summaries did not warn: $(cat merge.log)"
+
 # A failed summary write leaves the previous outputs as they were: a level whose summary is far larger than
 # its navmesh (thousands of empty tiles between two small floors), under a file size limit the navmesh fits
 cat >sparse.obj <<'OBJ'

@@ -11,7 +11,6 @@
 #include "cairn/navmesh/ReplaceFile.h"
 
 #include <CLI/CLI.hpp>
-#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -22,30 +21,6 @@ using namespace cairn;
 
 namespace
 {
-/// A whole number of digits only, to an unsigned 32-bit value; false otherwise (sscanf's %u took "-1" as
-/// 4294967295).
-bool ParseUnsigned(const char* inFirst, const char* inLast, uint32_t& outValue)
-{
-    if (inFirst == inLast || *inFirst < '0' || *inFirst > '9') return false;
-    const auto [end, error] = std::from_chars(inFirst, inLast, outValue);
-    return error == std::errc() && end == inLast;
-}
-
-/// "K/N" to (K, N); false when malformed.
-bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount)
-{
-    const size_t slash = inText.find('/');
-    if (slash == std::string::npos) return false;
-    uint32_t shard = 0, count = 0;
-    if (!ParseUnsigned(inText.data(), inText.data() + slash, shard) ||
-        !ParseUnsigned(inText.data() + slash + 1, inText.data() + inText.size(), count) || count == 0 ||
-        shard >= count)
-        return false;
-    outShard = shard;
-    outCount = count;
-    return true;
-}
-
 /// Commits every output (each complete under its temporary name) in turn: the new navmesh never stands
 /// beside a failed summary or preview.
 Status CommitAll(std::vector<navmesh::PendingFile*> inFiles, navmesh::NavMeshFileWriter* inNavMesh)
@@ -143,6 +118,10 @@ int main(int argc, char** argv)
     CLI::App* mergeCommand = app.add_subcommand("merge", "Combine shard outputs into one navmesh file");
     mergeCommand->add_option("shards", shards, "Navmesh files of the shards")->required();
     mergeCommand->add_option("-o,--output", mergedOutput, "The navmesh file to write")->required();
+    std::vector<std::string> shardSummaries;
+    mergeCommand->add_option(
+        "--summary", shardSummaries,
+        "Each shard's summary, in the order of the shards: then a missing shard is an error");
 
     try
     {
@@ -159,6 +138,8 @@ int main(int argc, char** argv)
         std::vector<bake::NamedPath> shardInputs;
         for (const std::string& path : shards)
             shardInputs.push_back({"shard", path});
+        for (const std::string& path : shardSummaries)
+            shardInputs.push_back({"--summary", path});
         if (Status usable = bake::CheckOutputPaths({{"-o", mergedOutput}}, shardInputs); !usable)
             return Fail(usable.GetError().mMessage);
         std::vector<navmesh::NavMeshFileContents> loaded;
@@ -167,6 +148,22 @@ int main(int argc, char** argv)
             Result<navmesh::NavMeshFileContents> contents = navmesh::LoadNavMeshFile(path);
             if (!contents) return Fail(contents.GetError().mMessage);
             loaded.push_back(std::move(contents.Value()));
+        }
+        if (shardSummaries.empty())
+            std::fprintf(stderr,
+                         "cairn-bake: merge: without each shard's --summary, a missing shard cannot be "
+                         "noticed\n");
+        else
+        {
+            std::vector<bake::BakeSummary> summaries;
+            for (const std::string& path : shardSummaries)
+            {
+                Result<bake::BakeSummary> summary = bake::LoadBakeSummary(path);
+                if (!summary) return Fail(summary.GetError().mMessage);
+                summaries.push_back(std::move(summary.Value()));
+            }
+            if (Status complete = bake::CheckShardsComplete(summaries, loaded); !complete)
+                return Fail(complete.GetError().mMessage);
         }
         Result<navmesh::NavMeshFileContents> merged = bake::MergeShards(loaded);
         if (!merged) return Fail(merged.GetError().mMessage);
@@ -217,7 +214,7 @@ int main(int argc, char** argv)
             return Fail("--tile " + text + ": expected X,Z (whole numbers)");
         settings.mTiles.push_back({x, z});
     }
-    if (!ParseShard(shard, settings.mShard, settings.mShardCount))
+    if (!bake::ParseShard(shard, settings.mShard, settings.mShardCount))
         return Fail("--shard " + shard + ": expected K/N with 0 <= K < N");
     // A bar on a terminal, a line every tenth otherwise (logs)
     const bool terminal = isatty(fileno(stdout)) != 0;

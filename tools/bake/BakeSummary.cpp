@@ -4,6 +4,7 @@
 #include "cairn/navmesh/ReplaceFile.h"
 
 #include <algorithm>
+#include <charconv>
 #include <climits>
 #include <cstdint>
 #include <cstdio>
@@ -146,7 +147,59 @@ Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
         value != nullptr && !GetWholeNumber(*value, 0, UINT32_MAX, tilesInWorld))
         return parseError("'tiles_in_world' must be a whole number from 0");
     summary.mTilesInWorld = uint32_t(tilesInWorld);
+    if (const nlohmann::json* shard = member(json, "shard"); shard != nullptr)
+        if (!shard->is_string() ||
+            !ParseShard(shard->get<std::string>(), summary.mShard, summary.mShardCount))
+            return parseError("'shard' must be \"K/N\" with 0 <= K < N");
     return summary;
+}
+
+bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount)
+{
+    // Digits only: sscanf's %u took "-1" as 4294967295
+    auto parse = [](const char* inFirst, const char* inLast, uint32_t& outValue)
+    {
+        if (inFirst == inLast || *inFirst < '0' || *inFirst > '9') return false;
+        const auto [end, error] = std::from_chars(inFirst, inLast, outValue);
+        return error == std::errc() && end == inLast;
+    };
+    const size_t slash = inText.find('/');
+    if (slash == std::string::npos) return false;
+    uint32_t shard = 0, count = 0;
+    if (!parse(inText.data(), inText.data() + slash, shard) ||
+        !parse(inText.data() + slash + 1, inText.data() + inText.size(), count) || count == 0 ||
+        shard >= count)
+        return false;
+    outShard = shard;
+    outCount = count;
+    return true;
+}
+
+Status CheckShardsComplete(const std::vector<BakeSummary>& inSummaries,
+                           const std::vector<navmesh::NavMeshFileContents>& inShards)
+{
+    if (inSummaries.size() != inShards.size())
+        return MakeError(ErrorCode::InvalidArgument, "merge: " + std::to_string(inShards.size()) +
+                                                         " shards but " + std::to_string(inSummaries.size()) +
+                                                         " summaries");
+    std::vector<bool> seen(inSummaries.size(), false);
+    for (size_t i = 0; i < inSummaries.size(); ++i)
+    {
+        const BakeSummary& summary = inSummaries[i];
+        const std::string which = "merge: shard " + std::to_string(i) + " (" +
+                                  std::to_string(summary.mShard) + "/" + std::to_string(summary.mShardCount) +
+                                  ")";
+        if (summary.mShardCount != inSummaries.size())
+            return MakeError(ErrorCode::InvalidArgument,
+                             which + ": the bake had " + std::to_string(summary.mShardCount) + " shards, " +
+                                 std::to_string(inSummaries.size()) + " are given");
+        if (seen[summary.mShard])
+            return MakeError(ErrorCode::InvalidArgument, which + ": that shard is given twice");
+        seen[summary.mShard] = true;
+        if (Status matching = CheckPreviousBake(summary, inShards[i]); !matching)
+            return MakeError(ErrorCode::InvalidArgument, which + ": " + matching.GetError().mMessage);
+    }
+    return Status::Ok();
 }
 
 Status CheckPreviousBake(const BakeSummary& inSummary, const navmesh::NavMeshFileContents& inNavMesh)
@@ -154,7 +207,7 @@ Status CheckPreviousBake(const BakeSummary& inSummary, const navmesh::NavMeshFil
     auto mismatch = [](const navmesh::TileCoord& inTile, const std::string& inWhat)
     {
         return MakeError(ErrorCode::InvalidArgument,
-                         "the previous navmesh and summary are from different bakes: tile (" +
+                         "the navmesh and the summary are from different bakes: tile (" +
                              std::to_string(inTile.mX) + ", " + std::to_string(inTile.mZ) + ") " + inWhat);
     };
     size_t withData = 0;
@@ -170,7 +223,7 @@ Status CheckPreviousBake(const BakeSummary& inSummary, const navmesh::NavMeshFil
     }
     if (withData != inNavMesh.mTiles.size())
         return MakeError(ErrorCode::InvalidArgument,
-                         "the previous navmesh and summary are from different bakes: the "
+                         "the navmesh and the summary are from different bakes: the "
                          "summary has " +
                              std::to_string(withData) + " tiles with polygons, the navmesh " +
                              std::to_string(inNavMesh.mTiles.size()));

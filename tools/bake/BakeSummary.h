@@ -56,6 +56,15 @@ Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary);
 /// Reads a summary; errors name the file and the element that is wrong.
 Result<BakeSummary> LoadBakeSummary(const std::string& inPath);
 
+/// "K/N" (digits only, K < N) to (K, N); false when malformed.
+bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount);
+
+/// Ok when inSummaries are the summaries of shards 0 to N-1 of one bake, each once (N their shard count, all
+/// the same and equal to the number of shards), and inShards[i] is the navmesh inSummaries[i] describes.
+/// Errors: InvalidArgument naming the missing, repeated or mismatched shard.
+Status CheckShardsComplete(const std::vector<BakeSummary>& inSummaries,
+                           const std::vector<navmesh::NavMeshFileContents>& inShards);
+
 /// Ok when inNavMesh holds exactly the tiles inSummary recorded with data, each with the output hash and
 /// size recorded: an incremental bake must not take one level's summary with another level's navmesh.
 /// Errors: InvalidArgument naming the first tile that differs.
