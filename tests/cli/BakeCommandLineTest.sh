@@ -74,6 +74,22 @@ expect_error "not a box" out5.navmesh bake level.obj -o out5.navmesh --box 5,5,1
 echo "not a navmesh" >junk.navmesh
 expect_error "junk.navmesh" merged.navmesh merge junk.navmesh -o merged.navmesh
 expect_error "--shard 1/-1" out5.navmesh bake level.obj -o out5.navmesh --shard 1/-1
+# Folders and fields of the wrong type were exceptions that aborted the baker
+mkdir -p a-folder
+expect_error "a-folder: not a readable file" out5.navmesh bake level.obj -o out5.navmesh --config a-folder
+expect_error "a-folder: not a readable file" out5.navmesh bake level.obj -o out5.navmesh --areas a-folder
+expect_error "a-folder: not a readable file" out5.navmesh bake level.obj -o out5.navmesh --previous a-folder \
+    --previous-navmesh level.navmesh
+expect_error "a-folder: not a readable file" out5.navmesh bake level.obj -o out5.navmesh --previous level.json \
+    --previous-navmesh a-folder
+echo '{"format": 5, "version": "1", "tiles": {}}' >typed.json
+expect_error "typed.json: not a cairn-bake summary" out5.navmesh bake level.obj -o out5.navmesh --previous typed.json \
+    --previous-navmesh level.navmesh
+echo '{"format": "cairn-bake-summary", "version": 1, "tiles": [{"x": "0", "z": 0}]}' >typed.json
+expect_error "typed.json: tiles[0]" out5.navmesh bake level.obj -o out5.navmesh --previous typed.json \
+    --previous-navmesh level.navmesh
+echo '{"max_verts_per_poly": 4294967299}' >wrap.json
+expect_error "max_verts_per_poly" out5.navmesh bake level.obj -o out5.navmesh --config wrap.json
 
 # Outputs are checked before any work: never an input, another output's file, a link or a device
 cp level.obj level-before.obj
