@@ -5,6 +5,7 @@
 # build folder with CAIRN_FUZZ_BUILD=...). Inputs the fuzzer adds go to <build>/fuzz-work/<harness>, never
 # to the repository's seeds; an input that fails is saved as <build>/fuzz-artifacts/<harness>/crash-...
 # (or timeout-, oom-), to be added to the seeds with its fix. Harnesses run as many at once as there are cores.
+# CAIRN_FUZZ_RUNS=N stops each harness after N executions instead (SECONDS then caps the time).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${CAIRN_FUZZ_BUILD:-$root/build/asan}
@@ -29,7 +30,9 @@ run_one() {
     fi
     mkdir -p "$work" "$artifacts"
     # -timeout: one input running 10 s is a hang; the memory limits make a runaway allocation a finding
-    "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+    local runs=()
+    if [ -n "${CAIRN_FUZZ_RUNS:-}" ]; then runs=(-runs="$CAIRN_FUZZ_RUNS"); fi
+    "$binary" -max_total_time="$seconds" "${runs[@]}" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
         -print_final_stats=1 -artifact_prefix="$artifacts/" "$work" "$root/tests/fuzz/corpus/$harness" \
         >"$build/fuzz-$harness.log" 2>&1
 }
@@ -58,7 +61,8 @@ for harness in "${harnesses[@]}"; do
         grep -m 5 'ERROR\|SUMMARY\|runtime error\|Test unit written\|not built' "$log" || true
         failed=1
     else
-        echo "$harness: ${runs:-?} executions in ${seconds} s (${speed:-?}/s), corpus $(ls "$build/fuzz-work/$harness" | wc -l) new inputs, no finding"
+        took=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | grep -o 'in [0-9]*' | grep -o '[0-9]*' || true)
+        echo "$harness: ${runs:-?} executions in ${took:-?} s (${speed:-?}/s), $(ls "$build/fuzz-work/$harness" | wc -l) inputs in its working corpus, no finding"
     fi
 done
 exit $failed
