@@ -12,7 +12,9 @@
 //  bake_overlapping  2,000, 10,000 and 50,000 small objects over one floor, all overlapping one another's
 //                  tiles, baked on 1 thread: ms per object should stay flat (each unloaded prop once woke
 //                  every prop around it, n^2).
-// --only direct|large|overlapping runs one of the three.
+//  load_materials  an OBJ of 4 triangles whose materials come from 5,000 and 20,000 `mtllib`/`usemtl` line
+//                  pairs: load ms should grow with the lines (each library line once answered every name).
+// --only direct|large|overlapping|materials runs one of them.
 
 #include "Baker.h"
 #include "GeneratedLevel.h"
@@ -204,16 +206,45 @@ void BenchOverlapping(int inRepetitions)
     }
 }
 
+void BenchManyMaterials(int inRepetitions)
+{
+    for (const int materials : {5000, 20000})
+    {
+        const std::string path = (std::filesystem::temp_directory_path() /
+                                  ("cairn-bench-materials-" + std::to_string(getpid()) + ".obj"))
+                                     .string();
+        std::FILE* file = std::fopen(path.c_str(), "w");
+        std::fprintf(file, "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\n");
+        for (int i = 0; i < materials; ++i)
+            std::fprintf(file, "mtllib m%d.mtl\nusemtl m%d\n", i, i);
+        std::fprintf(file, "f 1 3 2\nf 1 4 3\n");
+        std::fclose(file);
+        std::vector<double> ms;
+        size_t loaded = 0;
+        for (int rep = 0; rep < inRepetitions; ++rep)
+        {
+            const auto start = std::chrono::steady_clock::now();
+            loaded = navmesh::LoadObjMesh(path).Value().mMaterials.size();
+            ms.push_back(
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        }
+        std::filesystem::remove(path);
+        std::printf("load_materials %6d library lines  %.1f ms  | checksum materials %zu\n", materials,
+                    Median(ms), loaded);
+    }
+}
+
 int main(int argc, char** argv)
 {
     tools::BenchOptions options;
     if (auto stop = tools::ParseBenchOptions(argc, argv, "cairn-bench-bake: the offline baker's figures",
-                                             {"direct", "large", "overlapping"}, options))
+                                             {"direct", "large", "overlapping", "materials"}, options))
         return *stop;
     const int repetitions = options.mRepetitions;
     const std::string& only = options.mOnly;
     std::printf("cairn-bench-bake: %d repetitions\n", repetitions);
     if (only.empty() || only == "overlapping") BenchOverlapping(repetitions);
+    if (only.empty() || only == "materials") BenchManyMaterials(repetitions);
     if (only.empty() || only == "large") BenchLargeWorld();
     if (!only.empty() && only != "direct") return 0;
     for (const char* name : {"dungeon.obj", "nav_test.obj", "undulating.obj"})
