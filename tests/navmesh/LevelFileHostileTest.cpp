@@ -8,6 +8,7 @@
 #include "common/TempFiles.h"
 
 #include <filesystem>
+#include <fstream>
 #include <gtest/gtest.h>
 #include <string>
 
@@ -195,6 +196,27 @@ TEST_F(LevelFileHostileTest, ObjFacesTinyobjloaderWouldReadAsOthersAreRefused)
     // Slashes with texture and normal indices, empty or not, and negative indices are OBJ
     EXPECT_TRUE(LoadLevelMesh(mFiles.Write("slashes.obj", vertices + "vt 0 0\nvn 0 1 0\nf 1/1/1 2//1 -1/1\n"))
                     .IsOk());
+}
+
+TEST_F(LevelFileHostileTest, AFileThatCannotBeReadIsAnIOErrorNotAnEmptyLevel)
+{
+    // A folder, whatever its name
+    for (const std::string name : {"folder.obj", "folder.gltf", "folder.glb"})
+    {
+        std::filesystem::create_directories(mFiles.Path(name));
+        Result<IndexedMesh> loaded = LoadLevelMesh(mFiles.Path(name));
+        ASSERT_FALSE(loaded.IsOk()) << name;
+        EXPECT_EQ(loaded.GetError().mCode, ErrorCode::IOError) << loaded.GetError().mMessage;
+    }
+    // A file this user may not read was "no triangles" (needs a user that permissions stop: not root)
+    const std::string locked = mFiles.Write("locked.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 3\n");
+    std::filesystem::permissions(locked, std::filesystem::perms::none);
+    if (std::ifstream(locked).good()) GTEST_SKIP() << "this user reads files without permission (root)";
+    Result<IndexedMesh> loaded = LoadLevelMesh(locked);
+    ASSERT_FALSE(loaded.IsOk());
+    EXPECT_EQ(loaded.GetError().mCode, ErrorCode::IOError);
+    EXPECT_NE(loaded.GetError().mMessage.find("cannot be read"), std::string::npos)
+        << loaded.GetError().mMessage;
 }
 
 TEST_F(LevelFileHostileTest, ExtensionsAreReadInAnyCase)
