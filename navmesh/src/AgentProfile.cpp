@@ -39,9 +39,9 @@ Status AgentProfile::Validate() const
     // A tile's build covers the tile and a border of the agent's radius around it: a radius beyond the tile
     // made each tile's voxels grow with the radius squared (1000 m took 2.3 GB for a 60 m level)
     if (mRadius > mTileSize)
-        return MakeError(ErrorCode::InvalidArgument, "agent profile: the agent radius (" + std::to_string(mRadius) +
-                                                         " m) must be at most the tile size (" +
-                                                         std::to_string(mTileSize) + " m)");
+        return MakeError(ErrorCode::InvalidArgument,
+                         "agent profile: the agent radius (" + std::to_string(mRadius) +
+                             " m) must be at most the tile size (" + std::to_string(mTileSize) + " m)");
     if (!inRange(mCellSize, 1e3f) || !inRange(mCellHeight, 1e3f) || mHeight / mCellHeight > 1e6f ||
         mRadius / mCellSize > 1e6f || mMaxClimb / mCellHeight > 1e6f)
         return MakeError(ErrorCode::InvalidArgument,

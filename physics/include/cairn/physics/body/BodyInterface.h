@@ -8,11 +8,11 @@
 // Locks: each call takes at most one body mutex at a time (BodyLockWrite), then the broad phase's own lock
 // (lock order body mutex < broad phase). Waking the neighbours of a removed body happens after its lock is
 // released.
-// While a physics step runs, every call here waits for it: the step holds every body mutex. With steps back to
-// back a call may wait for several (the step takes the mutexes again before the woken caller runs);
+// While a physics step runs, every call here waits for it: the step holds every body mutex. With steps back
+// to back a call may wait for several (the step takes the mutexes again before the woken caller runs);
 // cairn-bench-query-latency measures it. Queries do not wait (WorldQuery reads published poses). A write
-// publishes the body's pose under its lock, after the broad phase holds the bounds of both the old and the new
-// pose, so no reader sees a half-written pose or misses the body (PublishedPose.h).
+// publishes the body's pose under its lock, after the broad phase holds the bounds of both the old and the
+// new pose, so no reader sees a half-written pose or misses the body (PublishedPose.h).
 
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
