@@ -3,22 +3,27 @@
 // benchmark reports its figure as a counter (ms, us_per_*) and a checksum: hits for queries and rays (AABB
 // level; the test suite checks the same totals against brute force), bodies for adds and removals.
 //
-// bp_query_contended: Q query threads (1, 2) run bp_query_box for a fixed number of passes while one more
-// thread moves the 2,000 dynamic boxes by a random walk of up to 0.5 m through BodyInterface::SetPosition (a
-// body write lock plus a broad-phase AABB update per move), as fast as it can. Reported: wall-clock us per
-// query per thread, moves per second, and the same queries' time with no mover (uncontended). Wall time on
-// purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2 the mover shares a core;
-// the threads' CPU time per query is printed too, to tell time descheduled or blocked from work, and the wall
-// time less the time each thread stood runnable in the run queue (Linux schedstat): what a query costs a
-// thread with a core of its own, lock waits included (the `own_core` counters).
+// bp_query_contended: Q query threads (1, 2; CAIRN_BENCH_QUERY_THREADS) run bp_query_box passes (as many as
+// 150 ms of uncontended queries take, 30 ms for the global mutex; 5 iterations, medians and the ratio's
+// spread) while one more thread moves the 2,000 dynamic boxes by a random walk of up to 0.5 m through
+// BodyInterface::SetPosition (a body write lock plus a broad-phase AABB update per move), as fast as it can.
+// Reported: wall-clock us per query per thread, moves per second, and the same queries' time with no mover
+// (uncontended). Wall time on purpose: waiting for a lock must count. This machine has 2 cores, so with Q = 2
+// the mover shares a core; the threads' CPU time per query is printed too, to tell time descheduled or
+// blocked from work, and the wall time less the time each thread stood runnable in the run queue (Linux
+// schedstat): what a query costs a thread with a core of its own, lock waits included (the `own_core`
+// counters).
 
+#include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/BenchThreads.h"
 #include "common/FrameTimes.h"
 #include "common/SharedBenchData.h"
 
+#include <algorithm>
 #include <atomic>
 #include <benchmark/benchmark.h>
 #include <chrono>
@@ -118,7 +123,7 @@ uint64_t QueryAllBoxes(const BroadPhase& inBroadPhase)
 void BM_AddBatch(benchmark::State& ioState)
 {
     const std::vector<BroadPhaseBody> bodies = StaticBodies();
-    double addMs = 0, rebuildMs = 0, reclaimMs = 0;
+    double addMs = 0, rebuildMs = 0, reclaimMs = 0, coldAddMs = 0, coldRebuildMs = 0;
     BroadPhaseQuadTree::MemoryStats memory, settled;
     std::vector<BodyID> ids;
     for (const BroadPhaseBody& body : bodies)
@@ -163,10 +168,27 @@ void BM_AddBatch(benchmark::State& ioState)
             settled = quadTree->GetMemoryStats();
         }
         broadPhase.reset();
+        // SPEC's figure: the same add and rebuild into a broad phase that has held nothing (its memory is
+        // touched for the first time, page faults and all)
+        {
+            std::unique_ptr<BroadPhase> cold = Make(ioState.range(0), uint32_t(bodies.size()));
+            auto coldStart = Clock::now();
+            cold->AddBodiesFinalize(cold->AddBodiesPrepare(bodies));
+            coldAddMs += MillisecondsSince(coldStart);
+            coldStart = Clock::now();
+            if (auto* coldTree = dynamic_cast<BroadPhaseQuadTree*>(cold.get()))
+                coldTree->RebuildAll();
+            else
+                cold->Update();
+            coldRebuildMs += MillisecondsSince(coldStart);
+            benchmark::DoNotOptimize(cold->GetBodyCount());
+        }
         ioState.ResumeTiming();
     }
     const double iterations = double(ioState.iterations());
     ioState.counters["add_ms"] = addMs / iterations;
+    ioState.counters["cold_add_ms"] = coldAddMs / iterations;
+    ioState.counters["cold_rebuild_ms"] = coldRebuildMs / iterations;
     ioState.counters["rebuild_ms"] = rebuildMs / iterations;
     // The updates after the rebuild, with nothing changed: they free the old tree's nodes (not in the time)
     ioState.counters["reclaim_ms"] = reclaimMs / iterations;
@@ -383,6 +405,7 @@ struct QueryTiming
     double mWallMicroseconds = 0;
     double mCpuMicroseconds = 0;
     double mOwnCoreMicroseconds = 0; ///< Wall less the run-queue wait; wall where schedstat cannot be read
+    double mLockWaitMicrosecondsPerThread = 0; ///< Blocked on the engine's locks, a query thread's mean
 };
 
 /// Microseconds of CPU this thread has used.
@@ -418,8 +441,11 @@ QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPas
                 const auto start = Clock::now();
                 const double cpuStart = ThreadCpuMicroseconds();
                 const double runQueueStart = ThreadRunQueueMicroseconds();
+                const uint64_t lockWaitStart = GetThisThreadLockWaitNanoseconds();
                 for (int pass = 0; pass < inPasses; ++pass)
                     hits[t] += QueryAllBoxes(inBroadPhase);
+                timings[t].mLockWaitMicrosecondsPerThread =
+                    double(GetThisThreadLockWaitNanoseconds() - lockWaitStart) * 1.0e-3;
                 timings[t].mCpuMicroseconds = ThreadCpuMicroseconds() - cpuStart;
                 timings[t].mWallMicroseconds = 1000.0 * MillisecondsSince(start);
                 timings[t].mOwnCoreMicroseconds =
@@ -435,24 +461,37 @@ QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPas
         perQuery.mWallMicroseconds += timings[t].mWallMicroseconds / queries;
         perQuery.mCpuMicroseconds += timings[t].mCpuMicroseconds / queries;
         perQuery.mOwnCoreMicroseconds += timings[t].mOwnCoreMicroseconds / queries;
+        perQuery.mLockWaitMicrosecondsPerThread += timings[t].mLockWaitMicrosecondsPerThread / inThreads;
         outHits += hits[t];
     }
     return perQuery;
+}
+
+double Median(std::vector<double> inValues)
+{
+    std::sort(inValues.begin(), inValues.end());
+    return inValues.empty() ? 0.0 : inValues[inValues.size() / 2];
 }
 
 void BM_QueryContended(benchmark::State& ioState)
 {
     const int64_t kind = ioState.range(0);
     const int queryThreads = int(ioState.range(1));
-    const int passes = kind == cQuadTreeGlobalMutex ? 1 : 3;
     ContendedWorld world(kind);
     const BroadPhase& broadPhase = world.mSystem->GetBroadPhase();
-    QueryTiming contended, uncontended;
-    double movesPerSecond = 0;
     uint64_t hits = 0;
+    // Passes enough for a steady phase: 150 ms of uncontended queries for the lock-free tree; 30 ms for the
+    // global mutex, whose contended phase is tens of times longer (its ratio needs no finer grain than that)
+    const double targetMs = kind == cQuadTreeGlobalMutex ? 30.0 : 150.0;
+    const auto calibrationStart = Clock::now();
+    (void)TimeQueries(broadPhase, queryThreads, 1, hits);
+    const int passes =
+        std::clamp(int(targetMs / std::max(MillisecondsSince(calibrationStart), 1e-3)) + 1, 1, 1000);
+    std::vector<double> contendedUs, uncontendedUs, ratios, cpuUs, ownCoreUs, ownCoreRatios, waitsUs,
+        uncontendedWaitsUs, movesPerSecond;
     for (auto _ : ioState)
     {
-        uncontended = TimeQueries(broadPhase, queryThreads, passes, hits);
+        const QueryTiming uncontended = TimeQueries(broadPhase, queryThreads, passes, hits);
 
         std::atomic<bool> stop{false};
         std::atomic<uint64_t> moves{0};
@@ -475,24 +514,39 @@ void BM_QueryContended(benchmark::State& ioState)
             });
         const auto start = Clock::now();
         uint64_t contendedHits = 0;
-        contended = TimeQueries(broadPhase, queryThreads, passes, contendedHits);
+        const QueryTiming contended = TimeQueries(broadPhase, queryThreads, passes, contendedHits);
         const double seconds = MillisecondsSince(start) * 1e-3;
         stop.store(true, std::memory_order_relaxed);
         mover.join();
-        movesPerSecond = double(moves.load(std::memory_order_relaxed)) / seconds;
+        movesPerSecond.push_back(double(moves.load(std::memory_order_relaxed)) / seconds);
         ioState.SetIterationTime(seconds);
         hits = contendedHits;
+        contendedUs.push_back(contended.mWallMicroseconds);
+        uncontendedUs.push_back(uncontended.mWallMicroseconds);
+        ratios.push_back(contended.mWallMicroseconds / uncontended.mWallMicroseconds);
+        cpuUs.push_back(contended.mCpuMicroseconds);
+        ownCoreUs.push_back(contended.mOwnCoreMicroseconds);
+        ownCoreRatios.push_back(contended.mOwnCoreMicroseconds / uncontended.mOwnCoreMicroseconds);
+        waitsUs.push_back(contended.mLockWaitMicrosecondsPerThread);
+        uncontendedWaitsUs.push_back(uncontended.mLockWaitMicrosecondsPerThread);
         // Let the broad phase rebuild (the bounds grew) so that each iteration starts alike
         (void)world.mSystem->Update(1.0f / 60.0f, 1);
     }
-    ioState.counters["us_per_query"] = contended.mWallMicroseconds;
-    ioState.counters["us_per_query_uncontended"] = uncontended.mWallMicroseconds;
-    ioState.counters["ratio"] = contended.mWallMicroseconds / uncontended.mWallMicroseconds;
-    ioState.counters["cpu_us_per_query"] = contended.mCpuMicroseconds;
-    ioState.counters["cpu_us_per_query_uncontended"] = uncontended.mCpuMicroseconds;
-    ioState.counters["own_core_us_per_query"] = contended.mOwnCoreMicroseconds;
-    ioState.counters["own_core_ratio"] = contended.mOwnCoreMicroseconds / uncontended.mOwnCoreMicroseconds;
-    ioState.counters["moves_per_s"] = movesPerSecond;
+    // Medians of the iterations, and the ratio's spread (each iteration's contended against its own
+    // uncontended time)
+    ioState.counters["us_per_query"] = Median(contendedUs);
+    ioState.counters["us_per_query_uncontended"] = Median(uncontendedUs);
+    ioState.counters["ratio"] = Median(ratios);
+    ioState.counters["ratio_min"] = *std::min_element(ratios.begin(), ratios.end());
+    ioState.counters["ratio_max"] = *std::max_element(ratios.begin(), ratios.end());
+    ioState.counters["cpu_us_per_query"] = Median(cpuUs);
+    ioState.counters["own_core_us_per_query"] = Median(ownCoreUs);
+    ioState.counters["own_core_ratio"] = Median(ownCoreRatios);
+    // The talk's measure: how long each query thread stood blocked on the engine's locks in the phase
+    ioState.counters["lock_wait_us_per_thread"] = Median(waitsUs);
+    ioState.counters["lock_wait_us_per_thread_uncontended"] = Median(uncontendedWaitsUs);
+    ioState.counters["moves_per_s"] = Median(movesPerSecond);
+    ioState.counters["passes"] = passes;
     ioState.counters["hits"] = double(hits);
     ioState.SetLabel(std::string(KindName(kind)) + ", " + std::to_string(queryThreads) + " query thread(s)");
 }
@@ -527,14 +581,18 @@ BENCHMARK(BM_QueryBox)
     ->Arg(cSortAndSweep)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Raycast)->Name("bp_raycast")->Arg(cQuadTree)->Arg(cSortAndSweep)->Unit(benchmark::kMillisecond);
+// Query threads: CAIRN_BENCH_QUERY_THREADS (default 1,2; the 16-core run asks for 1,2,4,8,15)
 BENCHMARK(BM_QueryContended)
     ->Name("bp_query_contended")
-    ->Args({cQuadTree, 1})
-    ->Args({cQuadTree, 2})
-    ->Args({cQuadTreeGlobalMutex, 1})
-    ->Args({cQuadTreeGlobalMutex, 2})
+    ->Apply(
+        [](benchmark::internal::Benchmark* ioBenchmark)
+        {
+            for (const int64_t kind : {cQuadTree, cQuadTreeGlobalMutex})
+                for (const int threads : tools::BenchThreadCounts("CAIRN_BENCH_QUERY_THREADS", {1, 2}))
+                    ioBenchmark->Args({kind, threads});
+        })
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
-    ->Iterations(3);
+    ->Iterations(5);
 
 BENCHMARK_MAIN();

@@ -17,6 +17,7 @@
 // (each body has about 6 contact ends), whatever the algorithm.
 
 #include "cairn/physics/islands/AtomicUnionFind.h"
+#include "common/BenchThreads.h"
 
 #include <algorithm>
 #include <barrier>
@@ -190,12 +191,16 @@ void BM_Union(benchmark::State& ioState)
 
 } // namespace
 
+// Threads: CAIRN_BENCH_THREADS (default 1,2; the 16-core run asks for 1,2,4,8,16)
 BENCHMARK(BM_Union)
     ->Name("uf_union")
-    ->Args({cPiles, 1})
-    ->Args({cPiles, 2})
-    ->Args({cUniform, 1})
-    ->Args({cUniform, 2})
+    ->Apply(
+        [](benchmark::internal::Benchmark* ioBenchmark)
+        {
+            for (const int64_t graph : {cPiles, cUniform})
+                for (const int threads : tools::BenchThreadCounts("CAIRN_BENCH_THREADS", {1, 2}))
+                    ioBenchmark->Args({graph, threads});
+        })
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
+# run-all.sh): step scaling, union-find, contended broad-phase queries and the demo, with CSVs, a scaling
+# chart and a Markdown summary written to RESULTS, the summary printed last. Needs bash, awk, grep, sed and
+# /proc (no packages); pins nothing and changes no machine setting.
+# Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
+#        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,
+#        CAIRN_RUN_DEMO_FRAMES the demo's frames per mode (0: no demo).
+set -uo pipefail
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+bundle=${CAIRN_BUNDLE:-$here}
+[ -x "$bundle/run" ] || { echo "run.sh: no launcher at $bundle/run (make the bundle first)" >&2; exit 2; }
+[ $# -ge 1 ] || { echo "usage: run-all.sh RESULTS" >&2; exit 2; }
+out=$1
+mkdir -p "$out" || exit 2
+out=$(cd "$out" && pwd)
+cores=$(nproc)
+model=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
+
+# The sweeps: up to 16 threads and 15 query threads (one core for the mover), no more than the cores
+sweep() { # <list> <max>
+    echo "$1" | tr ',' '\n' | awk -v max="$2" '$1 >= 1 && $1 <= max' | paste -sd, -
+}
+threads=${CAIRN_RUN_THREADS:-$(sweep 1,2,4,8,16 "$cores")}
+queryThreads=${CAIRN_RUN_QUERY_THREADS:-$(sweep 1,2,4,8,15 "$((cores > 1 ? cores - 1 : 1))")}
+demoFrames=${CAIRN_RUN_DEMO_FRAMES:-1200}
+started=$(date -u +%Y-%m-%dT%H:%M:%SZ)
+{
+    echo "date: $started"
+    echo "nproc: $cores"
+    echo "cpu: $model"
+    echo "kernel: $(uname -r)"
+    echo "threads: $threads; query threads: $queryThreads"
+} >"$out/machine.txt"
+echo "run.sh: $cores cores ($model); threads $threads; query threads $queryThreads"
+
+# Google Benchmark's JSON (one key a line) to CSV rows: name, label, then the given counters
+json_rows() { # <file> <counters...>
+    local file=$1
+    shift
+    awk -v keys="$*" '
+        BEGIN { n = split(keys, want, " ") }
+        /"name":/ { if (name != "") emit(); name = $0; sub(/.*"name": "/, "", name); sub(/",?$/, "", name); label = ""; delete value }
+        /"label":/ { label = $0; sub(/.*"label": "/, "", label); sub(/",?$/, "", label) }
+        /^ *"[a-z_]+": [-0-9.e+]+,?$/ { key = $1; gsub(/[":]/, "", key); v = $2; sub(/,$/, "", v); value[key] = v }
+        END { if (name != "") emit() }
+        function emit(   i, row) {
+            row = name "," "\"" label "\""
+            for (i = 1; i <= n; ++i) row = row "," ((want[i] in value) ? value[want[i]] + 0 : "")
+            print row
+            name = ""
+        }' "$file"
+}
+
+echo "== step_pile2k and step_pyramid on $threads threads"
+"$bundle/run" cairn-bench-step --threads "$threads" --repetitions 3 >"$out/step.txt" 2>&1 || echo "run.sh: the step benchmark failed" >&2
+echo "scene,threads,mean_ms,p99_ms,speedup,checksum" >"$out/step.csv"
+awk '
+    / rep 0: / { scene = $1; t = $2; sub(/threads=/, "", t); c = $0; sub(/.*checksum /, "", c); sub(/ +\|.*/, "", c); checksum[scene "," t] = c }
+    / median of / { scene = $1; t = $2; sub(/threads=/, "", t)
+        for (i = 1; i <= NF; ++i) { if ($i == "mean") mean = $(i + 1); if ($i == "p99") p99 = $(i + 1) }
+        if (t == 1) base[scene] = mean
+        printf "%s,%s,%s,%s,%.2f,\"%s\"\n", scene, t, mean, p99, (scene in base) ? base[scene] / mean : 0, checksum[scene "," t] }
+' "$out/step.txt" >>"$out/step.csv"
+
+echo "== union-find on $threads threads"
+CAIRN_BENCH_THREADS=$threads "$bundle/run" cairn-bench-unionfind --benchmark_format=json \
+    --benchmark_out="$out/unionfind.json" >/dev/null 2>"$out/unionfind.err" || echo "run.sh: union-find failed" >&2
+echo "name,label,ns_per_union,wall_ns_per_union,find_loops_per_union,find_loops_per_find,retries_per_union" \
+    >"$out/unionfind.csv"
+json_rows "$out/unionfind.json" ns_per_union wall_ns_per_union find_loops_per_union find_loops_per_find \
+    retries_per_union >>"$out/unionfind.csv"
+
+echo "== contended queries, $queryThreads query threads and one mover"
+CAIRN_BENCH_QUERY_THREADS=$queryThreads "$bundle/run" cairn-bench-broadphase --benchmark_filter=bp_query_contended \
+    --benchmark_format=json --benchmark_out="$out/contended.json" >/dev/null 2>"$out/contended.err" ||
+    echo "run.sh: the contended benchmark failed" >&2
+echo "name,label,us_per_query,us_per_query_uncontended,ratio,ratio_min,ratio_max,lock_wait_us_per_thread,moves_per_s" \
+    >"$out/contended.csv"
+json_rows "$out/contended.json" us_per_query us_per_query_uncontended ratio ratio_min ratio_max \
+    lock_wait_us_per_thread moves_per_s >>"$out/contended.csv"
+
+if [ "$demoFrames" -gt 0 ]; then
+    echo "== the demo, both modes, $cores threads, $demoFrames frames each"
+    "$bundle/run" cairn-demo --threads "$cores" --game-objects 8000 --frames "$demoFrames" \
+        --output "$out/demo" >"$out/demo.txt" 2>&1 || echo "run.sh: the demo exited with an error" >&2
+fi
+
+# The scaling chart: speed-up over 1 thread against threads, per scene, with the ideal line
+awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
+    NR > 1 { scene[$1] = 1; x[$1, $2] = $2; y[$1, $2] = $5; ts[$2] = 1; if ($5 > top) top = $5 }
+    END {
+        if (maxT < 2) maxT = 2; if (top < maxT) top = maxT
+        w = 480; h = 320; l = 50; b = 40
+        printf "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" font-family=\"sans-serif\" font-size=\"12\">\n", w + 160, h + 60
+        printf "<text x=\"%d\" y=\"16\">Speed-up over 1 thread</text>\n", l
+        printf "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/>\n", l, h, l + w, h
+        printf "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"black\"/>\n", l, 30, l, h
+        printf "<polyline fill=\"none\" stroke=\"#999\" stroke-dasharray=\"4\" points=\"%d,%d %d,%d\"/>\n", l + w / maxT, h - (h - 30) / top, l + w, h - (h - 30) * maxT / top
+        printf "<text x=\"%d\" y=\"%d\" fill=\"#999\">ideal</text>\n", l + w + 5, h - (h - 30) * maxT / top
+        for (t in ts) printf "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">%s</text>\n", l + w * t / maxT, h + 16, t
+        printf "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">threads</text>\n", l + w / 2, h + 34
+        split("#1f77b4 #d62728 #2ca02c #9467bd", colour, " ")
+        k = 0
+        for (s in scene) {
+            ++k; pts = ""
+            for (t = 1; t <= maxT; ++t) if ((s, t) in y) pts = pts sprintf("%d,%d ", l + w * t / maxT, h - (h - 30) * y[s, t] / top)
+            printf "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"2\" points=\"%s\"/>\n", colour[k], pts
+            printf "<text x=\"%d\" y=\"%d\" fill=\"%s\">%s</text>\n", l + w + 5, 30 + 16 * k, colour[k], s
+        }
+        print "</svg>"
+    }' "$out/step.csv" >"$out/scaling.svg"
+
+{
+    echo "# Many-core run, $started"
+    echo
+    echo "$cores cores, $model (kernel $(uname -r)). Threads $threads; query threads $queryThreads."
+    echo
+    echo "## Step scaling (cairn-bench-step, medians of 3; chart: scaling.svg)"
+    echo
+    echo "| scene | threads | mean ms | p99 ms | speed-up | checksum |"
+    echo "|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { gsub(/"/, "", $6); printf "| %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6 }' "$out/step.csv"
+    echo
+    echo "## Union-find (cairn-bench-unionfind)"
+    echo
+    echo "| benchmark | graph | ns per union | wall ns per union | find loops per find | retries per union |"
+    echo "|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %s | %.2f | %.2f | %.3f | %.4f |\n", $1, $2 "," $3, $4, $5, $7, $8 }' "$out/unionfind.csv" | sed 's/"//g'
+    echo
+    echo "## Contended queries (bp_query_contended: Q query threads and one mover; medians of 5)"
+    echo
+    echo "| benchmark | tree, query threads | us per query | uncontended | ratio (min-max) | lock wait us per thread | moves/s |"
+    echo "|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %s | %.3f | %.3f | %.2f (%.2f-%.2f) | %.0f | %.0f |\n", $1, $2 "," $3, $4, $5, $6, $7, $8, $9, $10 }' "$out/contended.csv" | sed 's/"//g'
+    if [ -f "$out/demo.txt" ]; then
+        echo
+        echo "## Demo (cairn-demo --threads $cores --game-objects 8000 --frames $demoFrames)"
+        echo
+        echo '```'
+        grep -iE "lock|query|wait|per thread|frame" "$out/demo.txt" | tail -30
+        echo '```'
+    fi
+} >"$out/summary.md"
+cat "$out/summary.md"
