@@ -1,5 +1,5 @@
 #include "LevelFileAccess.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <Eigen/Geometry>
 #include <array>

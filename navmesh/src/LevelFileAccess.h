@@ -3,7 +3,7 @@
 // Reading a level's files within LevelLoadLimits: whole files up to the byte limit, the folders they may come
 // from, and the JSON nesting a recursive parser can take. Plain functions, any thread.
 
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <filesystem>
 #include <string_view>

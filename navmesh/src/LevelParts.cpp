@@ -1,6 +1,6 @@
-// Splitting a level file into static bodies: one per object and area (see SplitIntoParts in ObjMesh.h).
+// Splitting a level file into static bodies: one per object and area (see SplitIntoParts in LevelMesh.h).
 
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <unordered_map>
 

@@ -1,6 +1,6 @@
 #include "cairn/navmesh/NavMeshFile.h"
 
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 #include "cairn/physics/math/Math.h"
 
 #include <DetourAlloc.h>

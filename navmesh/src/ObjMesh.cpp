@@ -1,6 +1,5 @@
-#include "cairn/navmesh/ObjMesh.h"
-
 #include "LevelFileAccess.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <charconv>
 #include <cmath>

@@ -15,6 +15,7 @@
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSettings.h"
+#include "cairn/physics/StepStatistics.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
 #include "cairn/physics/islands/AtomicUnionFind.h"

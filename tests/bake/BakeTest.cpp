@@ -3,7 +3,7 @@
 // shards equal the full bake; malformed inputs get clear errors and leave no output behind.
 
 #include "Baker.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/SharedBenchData.h"
 #include "common/TempFiles.h"

@@ -1,7 +1,7 @@
 // libFuzzer: the glTF level loader, as .glb when the input starts with the binary magic, else as .gltf.
 
 #include "FuzzInputFile.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <cstring>
 

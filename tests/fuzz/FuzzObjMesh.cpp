@@ -1,7 +1,7 @@
 // libFuzzer: the OBJ level loader (tinyobjloader behind Cairn's own line checks).
 
 #include "FuzzInputFile.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* inData, size_t inSize)
 {

@@ -2,7 +2,7 @@
 // malformed files named by file and element.
 
 #include "GltfTestModel.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/TempFiles.h"
 

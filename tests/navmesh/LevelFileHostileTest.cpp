@@ -4,7 +4,7 @@
 // level's folder, OBJ lines that tinyobjloader would read as something else. LevelLoadLimits configures the
 // bounds, and the errors name them.
 
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "common/TempFiles.h"
 
 #include <filesystem>

@@ -2,7 +2,7 @@
 // material library), glTF nodes and materials, and the split into one part per object and area.
 
 #include "GltfTestModel.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "common/TempFiles.h"
 
 #include <cstring>

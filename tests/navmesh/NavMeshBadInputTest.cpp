@@ -3,7 +3,7 @@
 
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshWorld.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/TempFiles.h"
 

@@ -4,7 +4,7 @@
 // locks, the shape's triangles-in-box and the world transform; none of it may change a tile.
 
 #include "cairn/navmesh/GeometryCollector.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"

@@ -9,7 +9,7 @@
 // Every key is optional (the profile's defaults stay); an unknown key is an error, so a typo is not ignored.
 
 #include "cairn/navmesh/AgentProfile.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 
 #include <string>
 

@@ -8,7 +8,7 @@
 #include "OutputPaths.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshPreview.h"
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 
 #include <CLI/CLI.hpp>
 #include <chrono>

@@ -1,7 +1,7 @@
 #include "BakeSummary.h"
 
 #include "JsonFile.h"
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 
 #include <algorithm>
 #include <charconv>

@@ -12,8 +12,8 @@
 #include "BakeSummary.h"
 #include "LevelSource.h"
 #include "cairn/navmesh/AgentProfile.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/NavMeshFile.h"
-#include "cairn/navmesh/ObjMesh.h"
 
 #include <functional>
 #include <optional>

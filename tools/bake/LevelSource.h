@@ -5,7 +5,7 @@
 // demand (a generated or streamed world) is baked without the whole level ever being in memory.
 // Threads: a source is used by the bake's main thread only.
 
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/physics/math/AABB.h"
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/shapes/Shape.h"

@@ -1,6 +1,6 @@
 #include "OutputPaths.h"
 
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 
 #include <filesystem>
 #include <unistd.h>

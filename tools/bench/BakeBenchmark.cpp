@@ -18,7 +18,7 @@
 
 #include "Baker.h"
 #include "GeneratedLevel.h"
-#include "cairn/navmesh/ObjMesh.h"
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/BenchOptions.h"
 #include "common/SharedBenchData.h"

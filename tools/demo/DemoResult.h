@@ -3,7 +3,7 @@
 // What one run of the demo measured: plain data, filled by DemoRunner on the main thread after the run, read
 // by DemoReport to print the summary and write the Markdown report.
 
-#include "cairn/physics/PhysicsSettings.h"
+#include "cairn/physics/StepStatistics.h"
 #include "common/SpikeAttribution.h"
 
 #include <cmath>

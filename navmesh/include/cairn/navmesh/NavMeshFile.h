@@ -8,7 +8,7 @@
 // Tiles are written sorted by tile coordinate with the references a fresh dtNavMesh gives them in that order,
 // so the same tiles always give the same bytes. Plain functions over plain data: any thread.
 
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 #include "cairn/navmesh/TileGrid.h"
 #include "cairn/physics/math/Result.h"
 

@@ -66,37 +66,4 @@ struct PhysicsSettings
 /// negative distance, an iteration count over 1000, a body mutex count that is not a power of two up to 32).
 Status ValidateSettings(const PhysicsSettings& inSettings);
 
-/// What the last Update did and how long each phase took (summed over its collision steps).
-struct StepStatistics
-{
-    uint32_t mNumActiveBodies = 0;
-    uint32_t mNumBodyPairs = 0; ///< Broad-phase pairs
-    uint32_t mNumReusedBodyPairs =
-        0; ///< Pairs that took last step's manifolds over (see mPairCacheMaxDelta*)
-    uint32_t mNumManifolds = 0;
-    uint32_t mNumContactPoints = 0;
-    uint32_t mNumWarmStartedPoints = 0; ///< Contact points that took over last step's impulses
-    uint32_t mNumIslands = 0;
-    uint32_t mLargestIsland = 0;      ///< Bodies
-    uint32_t mNumColoredIslands = 0;  ///< Islands colored for the parallel or wide solver
-    uint32_t mNumColoringsReused = 0; ///< ... of which took the previous step's coloring (mReuseColorings)
-    /// Collision steps whose constraints (at least one) came with the same keys in the same order as in the
-    /// one before, so that its solve order was taken over instead of sorted (mReuseColorings)
-    uint32_t mNumSolveOrdersReused = 0;
-    /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
-    /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
-    /// to more than mTotalMs
-    double mBroadPhaseUpdateMs = 0.0;
-    double mFindPairsMs = 0.0;
-    double mNarrowPhaseMs = 0.0; ///< Forces, pairs and the narrow phase, from the step's start (see above)
-    double mIslandsMs = 0.0;
-    double mSolveMs = 0.0;  ///< Velocity and position iterations plus integration
-    double mFinishMs = 0.0; ///< Bounds update, broad-phase notify and sleeping
-    double mTotalMs = 0.0;
-    /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
-    /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex
-    /// (in the pair search and the bounds notify too). A slow step with no wait here lost its time elsewhere
-    double mLockWaitMs = 0.0;
-};
-
 } // namespace cairn

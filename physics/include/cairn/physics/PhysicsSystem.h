@@ -12,6 +12,7 @@
 // restitution, symplectic Euler integration, position iterations -> bounds to the broad phase -> sleeping.
 
 #include "cairn/physics/PhysicsSettings.h"
+#include "cairn/physics/StepStatistics.h"
 #include "cairn/physics/body/BodyInterface.h"
 #include "cairn/physics/queries/WorldQuery.h"
 

@@ -1,4 +1,4 @@
-#include "cairn/navmesh/ReplaceFile.h"
+#include "cairn/navmesh/PendingFile.h"
 
 #include <atomic>
 #include <cerrno>
