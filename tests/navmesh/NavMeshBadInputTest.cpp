@@ -1,9 +1,9 @@
 // Bad input to the navmesh pipeline gets a clear error, never a crash: agent profiles out of range, tile
 // geometry with NaN or bad indices, malformed OBJ files.
 
+#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshWorld.h"
-#include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/TempFiles.h"
 
