@@ -1,8 +1,8 @@
 // cairn-bench-bake: issue 7's baker figures on Recast's demo meshes (../shared/data/recast-meshes).
 //  bake_vs_direct  per mesh: a direct Recast build of every tile (each tile given the raw triangles that
-//  touch
-//                  its bordered box, as Recast's demo does with its chunky mesh; only the builds are timed),
-//                  against cairn-bake's tile work (query, triangle copies and builds) on 1 and 2 threads.
+//                  touch its bordered box, as Recast's demo does with its chunky mesh; only the builds are
+//                  timed), against cairn-bake's tile work (query, triangle copies and builds) on 1 and 2
+//                  threads.
 // Prints ms (medians of --repetitions), the ratio bake/direct (target <= 1.2 on 1 thread) and the 2-thread
 // speed-up (target >= 1.7), and the polygon total as a checksum (equal for all three).
 //  bake_large_world  a generated level (GeneratedLevel, made on demand) of 1x, 10x and 100x the area, baked

@@ -8,8 +8,7 @@
 //    holds every body lock); readers on any thread with no lock (a sequence lock per record, read again when
 //    a write is in progress).
 //  - Retired shapes: mRetiredMutex, taken by DestroyBody's thread and by whoever collects (the updating
-//  thread
-//    after each Update). Never taken by a reader.
+//    thread after each Update). Never taken by a reader.
 //  - The epoch: readers register in the reclaimer's stripes (never wait); it is advanced only under
 //    mRetiredMutex, so by one thread at a time as EpochReclaimer requires.
 

@@ -7,8 +7,7 @@
 //     margin and stretched ahead of its motion if it moved: MovedSlot). The objects are built into new
 //     private nodes with the same midpoint split as a batch add.
 //  2. Commit, under the exclusive side of the modification lock (so no move, remove or link runs), in
-//  O(bodies
-//     relocated + nodes kept):
+//     O(bodies relocated + nodes kept):
 //     a. kept nodes get their new parents; one that changed during phase 1 pushes its bounds up the new tree;
 //     b. each relocated body that is still where phase 1 found it gets its current exact bounds in its new
 //        slot and its new location; one that was removed meanwhile leaves an empty slot;

@@ -15,8 +15,7 @@
 //    (queued, under mQueueMutex) and read by the running thread after it pops it; mDependents is guarded by
 //    the slot's mutex, which also orders a completion (generation bump) against a registration.
 //  - mFree (free slot indices): mFreeMutex. mReady (ready ring): mQueueMutex; workers and waiting threads
-//  sleep
-//    on mWake with it.
+//    sleep on mWake with it.
 //  - Counters: atomics, each with its memory order's reason where it is used.
 //
 // Capacity: at most Settings::mMaxJobs jobs exist at once (no allocation after construction). Scheduling when

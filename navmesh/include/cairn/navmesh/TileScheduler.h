@@ -11,8 +11,7 @@
 //    retried in a later chunk while the physics step holds them, (3) Recast and Detour. No chunk waits for a
 //    lock held by the step.
 //  - Update, once a frame at the game's sync point: starts jobs, takes finished tiles, publishes them into
-//  the
-//    NavMeshWorld (NavMeshWorld::Publish), and drops tiles no invoker needed for mDropDelayFrames frames;
+//    the NavMeshWorld (NavMeshWorld::Publish), and drops tiles no invoker needed for mDropDelayFrames frames;
 //    tiles of a removed area go at once.
 //
 // Threads: Update on one thread (the game's), never inside the physics step; invokers, areas and MarkDirty

@@ -20,8 +20,7 @@
 //    level geometry without waiting for a whole step.
 //  - Every one of these mutexes that has to wait adds its wait to the thread's LockWaits total.
 //  - Published poses (PublishedPose.h): written by whoever writes the body (under its write lock, or the
-//  step),
-//    read by any thread with no lock at all.
+//    step), read by any thread with no lock at all.
 
 #include "cairn/physics/body/Body.h"
 #include "cairn/physics/body/BodyChangeListener.h"

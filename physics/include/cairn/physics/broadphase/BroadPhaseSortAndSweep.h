@@ -6,17 +6,15 @@
 //  - mEntries: the truth. Unordered array of the stored bodies; swap-remove; mLocation maps a body index to
 //    (layer, position) so every modification is O(1) with no allocation.
 //  - A snapshot built by Update(): the narrow entries split into strips along z (by min z), each strip sorted
-//  by
-//    an x key, in SoA arrays; plus a small linear list of wide entries. A query scans, in each strip its z
+//    by an x key, in SoA arrays; plus a small linear list of wide entries. A query scans, in each strip its z
 //    range reaches, only the keys in [query min x - reach, query max x]. Strips (a 2D sort rather than a
 //    plain 1D sweep) cut the candidates of a small box in the 448 m x 256 m shared world from ~300 to ~20: a
 //    1D sweep sees every body of a 6 m wide column of the world. Within a strip, a table of x cells (about
 //    one reach wide) gives the first slot to look at in O(1): binary searches over ~1,000 keys dominated the
 //    step's pair search.
 //  - Wide entries (x width or z depth above max(4 x median, 99th percentile)) would inflate the reach of
-//  every
-//    query (a 64 m ground slab would make each query scan a 64 m column), so they live in the wide list,
-//    which the percentile bounds to ~2% of the layer.
+//    every query (a 64 m ground slab would make each query scan a 64 m column), so they live in the wide
+//    list, which the percentile bounds to ~2% of the layer.
 //  - Modifications between two Update() calls are visible at once: a removed or moved body's snapshot slot is
 //    marked dead (invalid id); a moved body whose new bounds still satisfy its slot's invariants (below) is
 //    updated in place; added bodies and bodies that left their slot go to a dirty list that queries scan
@@ -26,8 +24,7 @@
 //    float rounding, and every candidate gets the exact test of BroadPhaseOverlap.h, so results equal brute
 //    force's.
 //  - A layer whose bodies moved gets x keys min x - headroom (headroom = a quarter of the median width) so
-//  that
-//    small moves in both directions stay in place.
+//    that small moves in both directions stay in place.
 //
 // Threads: as BroadPhase: any thread, except Update/FindCollidingPairs (physics step only, one at a time) and
 // AddBodiesFinalize/Abort (once per batch).
@@ -45,8 +42,7 @@
 //
 // Bad input (the BodyInterface validates before calling; these are caller bugs) is ignored, never stored:
 //  - non-finite or inverted bounds, an invalid id, an index >= inMaxBodies, an object layer the LayerSetup
-//  does
-//    not know: assert in debug, ignored in release (for NotifyBodiesAABBChanged: the old bounds stay);
+//    does not know: assert in debug, ignored in release (for NotifyBodiesAABBChanged: the old bounds stay);
 //  - adding a body index that is already present (whatever its sequence): ignored, the first add stays;
 //  - removing or moving a body that is not present (index and sequence must match): ignored.
 

@@ -8,8 +8,7 @@
 //  ContactCache);
 //  - accumulated-impulse clamping: normal >= 0, friction inside the Coulomb circle |(t1, t2)| <= mu * normal;
 //  - restitution: a separate pass after the velocity iterations (as in Box2D v3) gives points that touched
-//  and
-//    approached faster than the threshold a target velocity of -e * approach velocity;
+//    and approached faster than the threshold a target velocity of -e * approach velocity;
 //  - position correction by split impulses: no Baumgarte term in the velocity solve (it would add energy);
 //    after integration, non-linear Gauss-Seidel iterations move the bodies apart by mBaumgarte of the
 //    penetration beyond mPenetrationSlop, directly on positions.
