@@ -179,6 +179,42 @@ std::string CheckTileData(std::span<const unsigned char> inData)
         if (!boundary)
             return "the detail mesh of polygon " + std::to_string(i) + " has no triangle on its boundary";
     }
+    // Detour's raycast walks from polygon to polygon through the links until the ray leaves, with no bound: a
+    // polygon that is its own neighbour (the fuzzer: one changed byte), a neighbour that does not share the
+    // edge back, or a polygon that is not convex with an area sent it round for ever
+    auto vertex = [&](unsigned short inIndex, int inAxis)
+    { return double(ReadAt<float>(inData, verts, size_t(inIndex) * 3 + size_t(inAxis))); };
+    for (int i = 0; i < h.polyCount; ++i)
+    {
+        const dtPoly poly = ReadAt<dtPoly>(inData, polys, size_t(i));
+        if (poly.getType() == DT_POLYTYPE_OFFMESH_CONNECTION) continue;
+        const int n = poly.vertCount;
+        double area = 0.0;
+        bool turnsLeft = false, turnsRight = false;
+        for (int j = 0; j < n; ++j)
+        {
+            const unsigned short a = poly.verts[j], b = poly.verts[(j + 1) % n], c = poly.verts[(j + 2) % n];
+            const double turn = (vertex(b, 0) - vertex(a, 0)) * (vertex(c, 2) - vertex(b, 2)) -
+                                (vertex(b, 2) - vertex(a, 2)) * (vertex(c, 0) - vertex(b, 0));
+            turnsLeft = turnsLeft || turn > 0.0;
+            turnsRight = turnsRight || turn < 0.0;
+            area += vertex(a, 0) * vertex(b, 2) - vertex(b, 0) * vertex(a, 2);
+            const unsigned short neighbour = poly.neis[j];
+            if (neighbour == 0 || (neighbour & DT_EXT_LINK) != 0) continue;
+            const int other = neighbour - 1;
+            if (other == i) return "polygon " + std::to_string(i) + " is its own neighbour";
+            const dtPoly back = ReadAt<dtPoly>(inData, polys, size_t(other));
+            bool shared = false;
+            for (int k = 0; k < back.vertCount && back.getType() != DT_POLYTYPE_OFFMESH_CONNECTION; ++k)
+                shared = shared || (back.neis[k] == i + 1 && back.verts[k] == b &&
+                                    back.verts[(k + 1) % back.vertCount] == a);
+            if (!shared)
+                return "polygons " + std::to_string(i) + " and " + std::to_string(other) +
+                       " are neighbours without sharing the edge both ways";
+        }
+        if (turnsLeft && turnsRight) return "polygon " + std::to_string(i) + " is not convex";
+        if (area == 0.0) return "polygon " + std::to_string(i) + " has no area";
+    }
     for (int i = 0; i < h.bvNodeCount; ++i)
     {
         const int index = ReadAt<dtBVNode>(inData, bvNodes, size_t(i)).i;

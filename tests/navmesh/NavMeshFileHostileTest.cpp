@@ -174,5 +174,20 @@ TEST_F(NavMeshFileHostileTest, APolygonWithoutBoundaryDetailTrianglesIsRefused)
     ExpectRefused(noBoundary, "the detail mesh of polygon 0 has no triangle on its boundary");
 }
 
+TEST_F(NavMeshFileHostileTest, LinksDetoursRaycastWouldWalkForEverAreRefused)
+{
+    // Detour's raycast follows the links from polygon to polygon with no bound: a polygon that names itself
+    // as a neighbour (one changed byte, found by the fuzzer) kept it on that polygon for ever
+    const dtMeshHeader header = TileHeader();
+    ASSERT_GT(header.polyCount, 0);
+    const size_t polysAt = cFirstTileAt + cVertsAt + size_t(header.vertCount) * 12;
+    dtPoly poly;
+    std::memcpy(&poly, mBytes.data() + polysAt, sizeof(poly));
+    poly.neis[0] = 1; // Polygon 0's first edge leads to polygon 0
+    std::vector<unsigned char> selfLinked = mBytes;
+    Put(selfLinked, polysAt, poly);
+    ExpectRefused(selfLinked, "polygon 0 is its own neighbour");
+}
+
 } // namespace
 } // namespace cairn::navmesh::test
