@@ -270,9 +270,7 @@ Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles
         return MakeError(ErrorCode::InvalidArgument, "navmesh: max tiles must be 1 to 2^20");
     // A 32-bit polygon reference holds salt, tile and polygon bits: tiles take what they need, polygons get
     // the rest up to 22 (10 bits of salt, as Detour's samples leave)
-    int tileBits = 0;
-    while ((1 << tileBits) < inMaxTiles)
-        ++tileBits;
+    const int tileBits = BitsFor(unsigned(inMaxTiles));
     const int polyBits = std::min(22 - tileBits, 14);
     if (polyBits < 8)
         return MakeError(

@@ -2,9 +2,9 @@
 
 #include "JsonFile.h"
 #include "cairn/navmesh/PendingFile.h"
+#include "common/ParseWholeNumber.h"
 
 #include <algorithm>
-#include <charconv>
 #include <climits>
 #include <cstdint>
 #include <cstdio>
@@ -157,18 +157,12 @@ Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
 bool ParseShard(const std::string& inText, uint32_t& outShard, uint32_t& outCount)
 {
     // Digits only: sscanf's %u took "-1" as 4294967295
-    auto parse = [](const char* inFirst, const char* inLast, uint32_t& outValue)
-    {
-        if (inFirst == inLast || *inFirst < '0' || *inFirst > '9') return false;
-        const auto [end, error] = std::from_chars(inFirst, inLast, outValue);
-        return error == std::errc() && end == inLast;
-    };
     const size_t slash = inText.find('/');
     if (slash == std::string::npos) return false;
+    const std::string_view text(inText);
     uint32_t shard = 0, count = 0;
-    if (!parse(inText.data(), inText.data() + slash, shard) ||
-        !parse(inText.data() + slash + 1, inText.data() + inText.size(), count) || count == 0 ||
-        shard >= count)
+    if (!tools::ParseWholeNumber(text.substr(0, slash), shard) ||
+        !tools::ParseWholeNumber(text.substr(slash + 1), count) || count == 0 || shard >= count)
         return false;
     outShard = shard;
     outCount = count;

@@ -21,6 +21,7 @@
 #include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "common/BenchOptions.h"
+#include "common/FrameTimes.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -36,14 +37,10 @@
 #include <vector>
 
 using namespace cairn;
+using tools::Median;
 
 namespace
 {
-double Median(std::vector<double> inValues)
-{
-    std::sort(inValues.begin(), inValues.end());
-    return inValues[inValues.size() / 2];
-}
 
 /// Every tile of the mesh built straight from its raw triangles: ms and polygons.
 std::pair<double, uint64_t> DirectBuild(const navmesh::IndexedMesh& inMesh,
@@ -163,14 +160,19 @@ void BenchLargeWorld()
                     run.mPeakBodies, (unsigned long long)run.mBodiesMade, (unsigned long long)run.mPolygons);
     }
 }
-} // namespace
+
+/// A temporary OBJ path of this process for a generated level called inName.
+std::string TemporaryLevelPath(const std::string& inName)
+{
+    return (std::filesystem::temp_directory_path() /
+            ("cairn-bench-" + inName + "-" + std::to_string(getpid()) + ".obj"))
+        .string();
+}
 
 /// A floor and inObjects one-triangle objects on a 10 x 10 pattern over the same 5 m, as an OBJ file.
 std::string WriteOverlappingLevel(int inObjects)
 {
-    const std::string path = (std::filesystem::temp_directory_path() /
-                              ("cairn-bench-overlapping-" + std::to_string(getpid()) + ".obj"))
-                                 .string();
+    const std::string path = TemporaryLevelPath("overlapping");
     std::FILE* file = std::fopen(path.c_str(), "w");
     std::fprintf(file, "v -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\no floor\nf 1 3 2\nf 1 4 3\n");
     for (int i = 0; i < inObjects; ++i)
@@ -210,9 +212,7 @@ void BenchManyMaterials(int inRepetitions)
 {
     for (const int materials : {5000, 20000})
     {
-        const std::string path = (std::filesystem::temp_directory_path() /
-                                  ("cairn-bench-materials-" + std::to_string(getpid()) + ".obj"))
-                                     .string();
+        const std::string path = TemporaryLevelPath("materials");
         std::FILE* file = std::fopen(path.c_str(), "w");
         std::fprintf(file, "v 0 0 0\nv 10 0 0\nv 10 0 10\nv 0 0 10\n");
         for (int i = 0; i < materials; ++i)
@@ -233,6 +233,8 @@ void BenchManyMaterials(int inRepetitions)
                     Median(ms), loaded);
     }
 }
+
+} // namespace
 
 int main(int argc, char** argv)
 {

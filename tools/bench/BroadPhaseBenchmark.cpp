@@ -39,6 +39,7 @@ namespace
 {
 
 using Clock = std::chrono::steady_clock;
+using tools::Median;
 using tools::MillisecondsSince;
 
 enum Kind : int64_t
@@ -465,12 +466,6 @@ QueryTiming TimeQueries(const BroadPhase& inBroadPhase, int inThreads, int inPas
         outHits += hits[t];
     }
     return perQuery;
-}
-
-double Median(std::vector<double> inValues)
-{
-    std::sort(inValues.begin(), inValues.end());
-    return inValues.empty() ? 0.0 : inValues[inValues.size() / 2];
 }
 
 void BM_QueryContended(benchmark::State& ioState)

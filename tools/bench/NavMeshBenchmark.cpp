@@ -32,17 +32,11 @@
 using namespace cairn;
 using namespace cairn::navmesh;
 using Clock = std::chrono::steady_clock;
+using tools::Median;
 using tools::MillisecondsSince;
 
 namespace
 {
-
-double Median(std::vector<double> inValues)
-{
-    if (inValues.empty()) return 0.0;
-    std::sort(inValues.begin(), inValues.end());
-    return inValues[inValues.size() / 2];
-}
 
 BodyCreationSettings BoxSettings(const BenchBox& inBox, MotionType inMotion)
 {

@@ -136,14 +136,9 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);
     }
-    auto median = [](std::vector<double> inValues)
-    {
-        std::sort(inValues.begin(), inValues.end());
-        return inValues[inValues.size() / 2];
-    };
     std::printf("%s threads=%u median of %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms per step\n", inName,
-                inThreads, inRuns.size(), median(means), median(p99s), median(maxes));
-    return median(means);
+                inThreads, inRuns.size(), tools::Median(means), tools::Median(p99s), tools::Median(maxes));
+    return tools::Median(means);
 }
 } // namespace
 

@@ -17,6 +17,15 @@ inline double MillisecondsSince(std::chrono::steady_clock::time_point inStart)
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - inStart).count();
 }
 
+/// The middle value of inValues (the upper of the two middle ones for an even count), 0 when empty: the
+/// benchmarks' figure over their repetitions.
+inline double Median(std::vector<double> inValues)
+{
+    if (inValues.empty()) return 0.0;
+    std::sort(inValues.begin(), inValues.end());
+    return inValues[inValues.size() / 2];
+}
+
 struct TimingSummary
 {
     double mMean = 0.0;

@@ -8,9 +8,9 @@
 #include "DemoReport.h"
 #include "DemoRunner.h"
 #include "common/MachineInfo.h"
+#include "common/ParseWholeNumber.h"
 
 #include <CLI/CLI.hpp>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -63,10 +63,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "cairn-demo: %s\n", inMessage.c_str());
         return 1;
     };
-    const char* seedEnd = seedText.data() + seedText.size();
-    const auto [parsedEnd, parseError] = std::from_chars(seedText.data(), seedEnd, settings.mSeed);
-    if (seedText.empty() || seedText[0] < '0' || seedText[0] > '9' || parseError != std::errc() ||
-        parsedEnd != seedEnd)
+    if (!tools::ParseWholeNumber(seedText, settings.mSeed))
         return usageError("--seed " + seedText + ": expected a whole number from 0 to 2^64 - 1");
     // CLI11's range check compares, and NaN fails no comparison: every physics update then failed
     if (!std::isfinite(settings.mCandidateMargin))
