@@ -24,6 +24,7 @@
 // the scheduling thread wait for the prerequisite itself (helping) before it queues the new job.
 
 #include "cairn/jobs/InlineFunction.h"
+#include "cairn/jobs/JobInterface.h"
 
 #include <algorithm>
 #include <atomic>
@@ -53,7 +54,7 @@ struct JobHandle
     bool IsValid() const { return mIndex != cInvalidIndex; }
 };
 
-class JobSystem
+class JobSystem final : public JobInterface
 {
 public:
     static constexpr size_t cFunctionCapacity = 64; ///< Bytes of captures a job may carry
@@ -84,11 +85,11 @@ public:
     ~JobSystem();
 
     /// Threads that run frame jobs: the workers plus the one that waits.
-    uint32_t GetNumThreads() const { return uint32_t(mWorkers.size()) + 1; }
+    uint32_t GetNumThreads() const override { return uint32_t(mWorkers.size()) + 1; }
     /// Workers asleep for want of work (a worker spins about cSpinMicroseconds before it sleeps). A hint for
     /// a caller deciding whether a small loop is worth handing out: a sleeping worker takes tens of
     /// microseconds to wake, a spinning one a few.
-    uint32_t GetNumWorkersAsleep() const
+    uint32_t GetNumWorkersAsleep() const override
     {
         // Relaxed: a hint, stale by the time it is read
         return mNumWorkersAsleep.load(std::memory_order_relaxed);
@@ -100,7 +101,7 @@ public:
     /// length that a parallel loop follows, so that the loop does not begin by waking a worker. Does nothing
     /// when the job system has more threads than the machine has cores: a spinning worker would then take the
     /// core of the thread doing the serial work. Any thread.
-    void ExtendSpin(uint64_t inNanoseconds);
+    void ExtendSpin(uint64_t inNanoseconds) override;
     static constexpr uint64_t cMaxSpinExtensionNanoseconds = 1'000'000;
 
     /// Queues inFunction to run once every job of inPrerequisites has finished. inName must outlive the job
@@ -197,6 +198,22 @@ public:
         WaitAll({handles, parts - 1});
     }
 
+    /// JobInterface: the physics step's loops and tasks as the templates above (a task is a job; its handle
+    /// holds the JobHandle).
+    void ParallelFor(uint32_t inCount, uint32_t inGrain, RangeFunction inFunction, void* inContext) override
+    {
+        ParallelFor(inCount, inGrain,
+                    [inFunction, inContext](uint32_t inBegin, uint32_t inEnd)
+                    { inFunction(inBegin, inEnd, inContext); });
+    }
+    using JobInterface::StartTask;
+    TaskHandle StartTask(const char* inName, TaskFunction inFunction, void* inContext) override
+    {
+        return ToTask(Schedule(inName, [inFunction, inContext] { inFunction(inContext); }));
+    }
+    bool TryRunTaskHere(TaskHandle inTask) override { return TryRunHere(ToJob(inTask)); }
+    void FinishTask(TaskHandle inTask) override { Wait(ToJob(inTask)); }
+
     /// Frame jobs scheduled and not yet finished.
     uint32_t GetNumJobsInFlight() const
     {
@@ -208,6 +225,15 @@ public:
     Stats GetStats() const;
 
 private:
+    static TaskHandle ToTask(const JobHandle& inJob)
+    {
+        return {uint64_t(inJob.mIndex) << 32 | inJob.mGeneration};
+    }
+    static JobHandle ToJob(TaskHandle inTask)
+    {
+        return {uint32_t(inTask.mValue >> 32), uint32_t(inTask.mValue)};
+    }
+
     /// One ParallelFor part's chunks not yet taken, [front, back), packed in one word so that its owner (from
     /// the front) and threads that ran out of their own (from the back) claim each chunk exactly once. A
     /// cache line each: the parts' owners update theirs at once.
