@@ -71,12 +71,12 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps)
     return UpdateImpl(inDeltaTime, inCollisionSteps, nullptr);
 }
 
-Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobSystem& ioJobs)
+Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobInterface& ioJobs)
 {
     return UpdateImpl(inDeltaTime, inCollisionSteps, &ioJobs);
 }
 
-Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobSystem* ioJobs)
+Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs)
 {
     if (!mSetupStatus) return mSetupStatus;
     if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)

@@ -55,7 +55,7 @@ public:
     }
 
     /// What the physics step remembers of a body between its finishes (see
-    /// PhysicsStep::UpdateBoundsAndSleep): the displacement it last swept the body's bounds by for the broad
+    /// FinishStage::Run): the displacement it last swept the body's bounds by for the broad
     /// phase, and the body's version right after it published it. While the version is still that one nobody
     /// has given the broad phase another box since (every change of a body's box publishes it). Kept in the
     /// record's spare bytes, on the line the step writes anyway; read and written by the step only (it holds

@@ -1,5 +1,6 @@
 #include "cairn/physics/solver/SequentialImpulseSolver.h"
 
+#include "body/Integration.h"
 #include "cairn/physics/body/Body.h"
 
 #include <algorithm>
@@ -9,13 +10,6 @@
 
 namespace cairn
 {
-
-// Body's pose is private; the solver is its friend through this one accessor
-struct SolverAccess
-{
-    static Vec3& X(Body& ioBody) { return ioBody.mPosition; }
-    static Quat& Q(Body& ioBody) { return ioBody.mRotation; }
-};
 
 namespace
 {
@@ -384,9 +378,10 @@ float SequentialImpulseSolver::SolvePositions(std::span<const PositionConstraint
         for (int i = 0; i < c.mNumPoints; ++i)
         {
             // Penetration from the bodies' current poses (they moved since the manifold was made)
-            const Vec3 rA = SolverAccess::Q(a) * c.mLocalOnA[i];
-            const Vec3 rB = SolverAccess::Q(b) * c.mLocalOnB[i];
-            const float separation = c.mNormal.dot((SolverAccess::X(b) + rB) - (SolverAccess::X(a) + rA));
+            const Vec3 rA = a.GetRotation() * c.mLocalOnA[i];
+            const Vec3 rB = b.GetRotation() * c.mLocalOnB[i];
+            const float separation =
+                c.mNormal.dot((b.GetCenterOfMassPosition() + rB) - (a.GetCenterOfMassPosition() + rA));
             maxPenetration = std::max(maxPenetration, -separation - inSettings.mPenetrationSlop);
             const float correction =
                 std::clamp(inSettings.mBaumgarte * (separation + inSettings.mPenetrationSlop),
@@ -403,15 +398,11 @@ float SequentialImpulseSolver::SolvePositions(std::span<const PositionConstraint
             const float impulse = -correction * axis.mEffectiveMass;
             // Move positions directly (a pseudo-impulse): it corrects the overlap without adding velocity
             if (a.IsDynamic())
-            {
-                SolverAccess::X(a) -= (a.GetInverseMass() * impulse) * c.mNormal;
-                SolverAccess::Q(a) = IntegrateRotation(SolverAccess::Q(a), -impulse * axis.mInvIA_RAxAxis);
-            }
+                Integration::CorrectPose(a, -((a.GetInverseMass() * impulse) * c.mNormal),
+                                         -impulse * axis.mInvIA_RAxAxis);
             if (b.IsDynamic())
-            {
-                SolverAccess::X(b) += (b.GetInverseMass() * impulse) * c.mNormal;
-                SolverAccess::Q(b) = IntegrateRotation(SolverAccess::Q(b), impulse * axis.mInvIB_RBxAxis);
-            }
+                Integration::CorrectPose(b, (b.GetInverseMass() * impulse) * c.mNormal,
+                                         impulse * axis.mInvIB_RBxAxis);
         }
     }
     return maxPenetration;

@@ -1,11 +1,19 @@
 // Determinism of the parallel step: the same scene stepped 600 times gives bit-identical body states run
 // after run with the same number of threads, and the same states with no job system and with 1, 2 and 4
-// threads (pairs, contacts, waking and islands are made canonical, see PhysicsStep.h).
+// threads (pairs, contacts, waking and islands are made canonical, see PhysicsStep.h); and the same states
+// on a scheduler that is not cairn::jobs, through the step's job interface (jobs::JobInterface).
 
 #include "SimulationFixture.h"
+#include "cairn/jobs/JobInterface.h"
 #include "common/StaticFloor.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cstring>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
 #include <vector>
 
 namespace cairn::test
@@ -30,17 +38,21 @@ bool BitIdentical(const BodyState& inL, const BodyState& inR)
            same(inL.mAngularVelocity, inR.mAngularVelocity) && inL.mActive == inR.mActive;
 }
 
+/// Adds the counts of inStep that show which paths a step took to ioSum.
+void AddCounts(const StepStatistics& inStep, StepStatistics& ioSum)
+{
+    ioSum.mNumManifolds += inStep.mNumManifolds;
+    ioSum.mNumIslands += inStep.mNumIslands;
+    ioSum.mNumColoredIslands += inStep.mNumColoredIslands;
+    ioSum.mLargestIsland = std::max(ioSum.mLargestIsland, inStep.mLargestIsland);
+}
+
 /// A pile of boxes and spheres falling onto a floor and a ramp, in several heaps (several islands, some
 /// falling asleep, some woken by late arrivals), stepped 600 times.
-std::vector<BodyState> RunPile(uint32_t inThreads, bool inUpdateBesideStep = false)
+/// inJobs: null for none. outStatistics: the step statistics summed over the steps.
+std::vector<BodyState> RunPile(jobs::JobInterface* inJobs, bool inUpdateBesideStep = false,
+                               StepStatistics* outStatistics = nullptr)
 {
-    std::unique_ptr<jobs::JobSystem> jobSystem;
-    if (inThreads > 0)
-    {
-        jobs::JobSystem::Settings settings;
-        settings.mNumThreads = inThreads;
-        jobSystem = std::make_unique<jobs::JobSystem>(settings);
-    }
     PhysicsSettings physicsSettings;
     // The broad-phase rebuild beside the pair search on this small scene too (by default from 1,024 bodies)
     if (inUpdateBesideStep) physicsSettings.mUpdateBesideStepMinActiveBodies = 0;
@@ -72,9 +84,9 @@ std::vector<BodyState> RunPile(uint32_t inThreads, bool inUpdateBesideStep = fal
         }
     for (int step = 0; step < 600; ++step)
     {
-        const Status status =
-            jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f);
+        const Status status = inJobs ? system.Update(1.0f / 60.0f, 1, *inJobs) : system.Update(1.0f / 60.0f);
         EXPECT_TRUE(status.IsOk());
+        if (outStatistics != nullptr) AddCounts(system.GetLastStepStatistics(), *outStatistics);
         if (step == 400)
         {
             // A late arrival wakes a heap that may have gone to sleep
@@ -94,6 +106,16 @@ std::vector<BodyState> RunPile(uint32_t inThreads, bool inUpdateBesideStep = fal
     return states;
 }
 
+/// The pile on a job system of inThreads threads (0: no job system).
+std::vector<BodyState> RunPileOnThreads(uint32_t inThreads, bool inUpdateBesideStep = false)
+{
+    if (inThreads == 0) return RunPile(nullptr, inUpdateBesideStep);
+    jobs::JobSystem::Settings settings;
+    settings.mNumThreads = inThreads;
+    jobs::JobSystem jobSystem(settings);
+    return RunPile(&jobSystem, inUpdateBesideStep);
+}
+
 void ExpectIdentical(const std::vector<BodyState>& inExpected, const std::vector<BodyState>& inActual,
                      const char* inWhat)
 {
@@ -109,17 +131,110 @@ void ExpectIdentical(const std::vector<BodyState>& inExpected, const std::vector
 
 TEST(StepDeterminismTest, SameThreadCountGivesBitIdenticalStates)
 {
-    ExpectIdentical(RunPile(2), RunPile(2), "2 threads, two runs");
+    ExpectIdentical(RunPileOnThreads(2), RunPileOnThreads(2), "2 threads, two runs");
 }
 
 TEST(StepDeterminismTest, ThreadCountDoesNotChangeTheResult)
 {
-    const std::vector<BodyState> reference = RunPile(0);
-    ExpectIdentical(reference, RunPile(1), "1 job thread vs no job system");
-    ExpectIdentical(reference, RunPile(2), "2 threads vs no job system");
-    ExpectIdentical(reference, RunPile(4), "4 threads vs no job system");
-    ExpectIdentical(reference, RunPile(2, true),
+    const std::vector<BodyState> reference = RunPileOnThreads(0);
+    ExpectIdentical(reference, RunPileOnThreads(1), "1 job thread vs no job system");
+    ExpectIdentical(reference, RunPileOnThreads(2), "2 threads vs no job system");
+    ExpectIdentical(reference, RunPileOnThreads(4), "4 threads vs no job system");
+    ExpectIdentical(reference, RunPileOnThreads(2, true),
                     "2 threads, broad-phase update beside the step, vs no job system");
+}
+
+/// The least a scheduler can be: a thread for every task and for every part of a loop but the caller's, each
+/// joined when done. Counts what the step asked of it.
+class ThreadPerTaskJobs final : public jobs::JobInterface
+{
+public:
+    explicit ThreadPerTaskJobs(uint32_t inThreads) : mThreads(inThreads) {}
+
+    uint32_t GetNumThreads() const override { return mThreads; }
+    void ParallelFor(uint32_t inCount, uint32_t inGrain, RangeFunction inFunction, void* inContext) override
+    {
+        mNumLoops.fetch_add(1, std::memory_order_relaxed); // Relaxed: a count, read after the threads joined
+        const uint32_t grain = std::max(1u, inGrain);
+        std::atomic<uint32_t> next{0};
+        auto work = [&]
+        {
+            // Relaxed: hands out each chunk once; the join orders the chunks' writes before the caller's
+            // reads
+            for (uint32_t begin; (begin = next.fetch_add(grain, std::memory_order_relaxed)) < inCount;)
+                inFunction(begin, std::min(inCount, begin + grain), inContext);
+        };
+        std::vector<std::thread> helpers;
+        for (uint32_t t = 1; t < mThreads; ++t)
+            helpers.emplace_back(work);
+        work();
+        for (std::thread& helper : helpers)
+            helper.join();
+    }
+    jobs::TaskHandle StartTask(const char* inName, TaskFunction inFunction, void* inContext) override
+    {
+        std::lock_guard lock(mMutex);
+        const uint64_t id = ++mNumTasks;
+        ++mNumTasksNamed[inName];
+        mTasks.emplace(id, std::thread(inFunction, inContext));
+        return {id};
+    }
+    void FinishTask(jobs::TaskHandle inTask) override
+    {
+        std::thread thread;
+        {
+            std::lock_guard lock(mMutex);
+            const auto task = mTasks.find(inTask.mValue);
+            ASSERT_NE(task, mTasks.end()) << "a task finished twice or never started";
+            thread = std::move(task->second);
+            mTasks.erase(task);
+        }
+        thread.join();
+    }
+
+    uint64_t GetNumLoops() const { return mNumLoops.load(std::memory_order_relaxed); } // Relaxed: a count
+    uint64_t GetNumTasks() const
+    {
+        std::lock_guard lock(mMutex);
+        return mNumTasks;
+    }
+    /// Tasks started under this name (the step's: "broad-phase update", "stages").
+    uint64_t GetNumTasks(const std::string& inName) const
+    {
+        std::lock_guard lock(mMutex);
+        const auto named = mNumTasksNamed.find(inName);
+        return named == mNumTasksNamed.end() ? 0 : named->second;
+    }
+    size_t GetNumUnfinished() const
+    {
+        std::lock_guard lock(mMutex);
+        return mTasks.size();
+    }
+
+private:
+    const uint32_t mThreads;
+    std::atomic<uint64_t> mNumLoops{0};
+    mutable std::mutex mMutex;              ///< Guards mTasks and mNumTasks: any thread starts tasks
+    std::map<uint64_t, std::thread> mTasks; ///< Started, not yet finished
+    uint64_t mNumTasks = 0;                 ///< Started in all
+    std::map<std::string, uint64_t> mNumTasksNamed;
+};
+
+TEST(StepDeterminismTest, AnotherSchedulerThroughTheJobInterfaceGivesTheSameStates)
+{
+    StepStatistics counts;
+    const std::vector<BodyState> reference = RunPile(nullptr, false, &counts);
+    // The pile has islands the step colors, some large enough for every thread at once (the stages)
+    ASSERT_GT(counts.mNumColoredIslands, 0u);
+    for (const uint32_t threads : {2u, 3u})
+    {
+        ThreadPerTaskJobs jobs(threads);
+        ExpectIdentical(reference, RunPile(&jobs, true), "threads per task vs no job system");
+        EXPECT_GT(jobs.GetNumLoops(), 600u) << "the step's loops went to the scheduler";
+        EXPECT_EQ(jobs.GetNumTasks("broad-phase update"), 600u) << "a task beside every step";
+        EXPECT_GT(jobs.GetNumTasks("stages"), 0u) << "colored islands solved by every thread";
+        EXPECT_EQ(jobs.GetNumUnfinished(), 0u);
+    }
 }
 
 } // namespace

@@ -21,7 +21,7 @@
 
 namespace cairn::jobs
 {
-class JobSystem;
+class JobInterface;
 }
 
 namespace cairn
@@ -50,7 +50,7 @@ public:
     /// The same, with the parallel phases on ioJobs's threads (this thread takes part). Bodies end
     /// bit-identical to the single-threaded Update, whatever the number of threads. While it runs, this
     /// thread may run other queued jobs; those must not call BodyInterface (they get WrongThread).
-    Status Update(float inDeltaTime, int inCollisionSteps, jobs::JobSystem& ioJobs);
+    Status Update(float inDeltaTime, int inCollisionSteps, jobs::JobInterface& ioJobs);
 
     BodyInterface& GetBodyInterface() { return *mBodyInterface; }
     const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
@@ -87,7 +87,7 @@ private:
     std::unique_ptr<WorldQuery> mWorldQuery;
     std::unique_ptr<PhysicsStep> mStep;
 
-    Status UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobSystem* ioJobs);
+    Status UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs);
     std::atomic<bool> mUpdating{false}; ///< Guards against concurrent Update calls (acquire/release below)
     StepStatistics mLastStatistics;     ///< Written by the updating thread only
 };

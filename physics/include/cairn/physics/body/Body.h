@@ -63,9 +63,13 @@ private:
     friend class BodyManager;
     friend class BodyInterface;
     friend class PhysicsSystem;
-    friend class PhysicsStep;
     friend class PublishedPoseStore;
-    friend struct SolverAccess;
+    // The step's stages, which move and wake bodies while the step holds every body mutex
+    friend class Integration;
+    friend class ContactsStage;
+    friend class IslandSolver;
+    friend class FinishStage;
+    friend class IslandSleep;
 
     /// Sets mass properties and everything else from the settings (validated by the caller).
     void Init(const BodyID& inID, const BodyCreationSettings& inSettings);

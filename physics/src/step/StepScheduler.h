@@ -1,0 +1,180 @@
+#pragma once
+
+// StepScheduler: how the step hands its loops to a JobInterface (or runs them on its own thread when it has
+// none): loops with a cost estimate that are not worth waking a sleeping worker for, stages that every
+// thread takes part in (a colored island's colors), and the hints that keep workers spinning through a
+// serial stretch. Owned by PhysicsStep; used by the thread that runs the step (RunStages, KeepSpinning) and
+// by the step's jobs (the others; see each).
+
+#include "cairn/jobs/JobInterface.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+namespace cairn
+{
+
+class StepScheduler
+{
+public:
+    /// The most threads RunStages gives a part each (a stage's claims are one bit per part).
+    static constexpr uint32_t cMaxThreads = 64;
+
+    /// For one step: ioJobs (null: all on this thread) runs the parallel parts.
+    void BeginStep(jobs::JobInterface* ioJobs) { mJobs = ioJobs; }
+    jobs::JobInterface* GetJobs() const { return mJobs; }
+    uint32_t GetNumThreads() const
+    {
+        return mJobs == nullptr ? 1 : std::min(cMaxThreads, mJobs->GetNumThreads());
+    }
+
+    /// inBody(begin, end) over [0, inCount) in chunks of inGrain: on the job system's threads, unless a
+    /// worker sleeps and the items' estimated cost (inItemNanoseconds each, StepCosts.h) is under
+    /// cMinWakingNanoseconds; else here. Any thread.
+    template <class Body>
+    void ParallelFor(uint32_t inCount, uint32_t inGrain, uint32_t inItemNanoseconds, const Body& inBody) const
+    {
+        if (mJobs != nullptr && inCount > inGrain &&
+            (mJobs->GetNumWorkersAsleep() == 0 ||
+             uint64_t(inCount) * inItemNanoseconds >= cMinWakingNanoseconds))
+            mJobs->ParallelFor(inCount, inGrain, inBody);
+        else if (inCount > 0)
+            for (uint32_t begin = 0; begin < inCount; begin += inGrain)
+                inBody(begin, std::min(inCount, begin + inGrain));
+    }
+    /// The job system's ParallelFor, or all on this thread when inAlone (inside a job that solves its island
+    /// by itself). No cost estimate: these loops are parts of a colored island solved by every thread, whose
+    /// threads have just left the stages before (awake).
+    template <class Body>
+    void ParallelForUnlessAlone(bool inAlone, uint32_t inCount, uint32_t inGrain, const Body& inBody) const
+    {
+        if (!inAlone && mJobs != nullptr && inCount > inGrain)
+            mJobs->ParallelFor(inCount, inGrain, inBody);
+        else if (inCount > 0)
+            inBody(0u, inCount);
+    }
+
+    /// Before a serial stretch of about inNanoseconds that a parallel loop follows: the workers spinning idle
+    /// spin through it (JobInterface::ExtendSpin) instead of falling asleep halfway, so that the loop does
+    /// not begin with tens of microseconds of waking one. A stretch under half the spin is left alone (a
+    /// small step's): a worker that spins now most likely still spins at its end, and no extension is paid
+    /// for.
+    void KeepWorkersSpinningFor(uint64_t inNanoseconds) const
+    {
+        if (mJobs != nullptr && mJobs->GetNumThreads() > 1 && inNanoseconds >= cWorthExtendingNanoseconds)
+            mJobs->ExtendSpin(inNanoseconds);
+    }
+
+    /// Runs inNumStages stages in order, every thread of the job system on each: stage s has inPartsOf(s)
+    /// parts (1 to the thread count) and inRunPart(s, part, parts) does one. A stage starts only when every
+    /// part of the one before has finished: the threads wait on a counter, not on a job per part (a colored
+    /// island's velocity iterations are a stage per color per iteration, over a hundred a step). Thread t
+    /// takes part t first, so it keeps its region of the island in every color; a part whose thread has not
+    /// come yet is taken by another, so no thread waits for one that the job system has not started. Which
+    /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job;
+    /// or with inAlone, by any thread: it then runs every part itself, in order (a job that solves its island
+    /// by itself).
+    template <class PartsOf, class RunPart>
+    void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
+    {
+        const uint32_t threads = inAlone ? 1 : GetNumThreads();
+        if (threads <= 1)
+        {
+            for (uint32_t stage = 0; stage < inNumStages; ++stage)
+                for (uint32_t part = 0, parts = inPartsOf(stage); part < parts; ++part)
+                    inRunPart(stage, part, parts);
+            return;
+        }
+        ResetStages(inNumStages);
+        auto team = [&](uint32_t inThread)
+        {
+            for (uint32_t stage = 0; stage < inNumStages; ++stage)
+            {
+                const uint32_t parts = inPartsOf(stage);
+                StageCounters& counters = mStages[stage];
+                auto tryRun = [&](uint32_t inPart)
+                {
+                    const uint64_t bit = uint64_t(1) << inPart;
+                    // Relaxed: a claim only decides who runs the part; the data the part reads was ordered by
+                    // the previous stage's completion (the acquire below)
+                    if ((counters.mClaimed.load(std::memory_order_relaxed) & bit) != 0 ||
+                        (counters.mClaimed.fetch_or(bit, std::memory_order_relaxed) & bit) != 0)
+                        return;
+                    inRunPart(stage, inPart, parts);
+                    // Release: the part's writes happen before the reads of whoever sees the stage complete
+                    counters.mDone.fetch_add(1, std::memory_order_release);
+                };
+                if (inThread < parts) tryRun(inThread);
+                for (uint32_t part = 0; part < parts; ++part)
+                    if (part != inThread) tryRun(part);
+                // Acquire: pairs with every part's release, so the next stage sees all of this one's writes
+                for (uint32_t spins = 0; counters.mDone.load(std::memory_order_acquire) < parts; ++spins)
+                    WaitABit(spins);
+            }
+        };
+        struct Member
+        {
+            decltype(team)* mTeam;
+            uint32_t mThread;
+            void operator()() const { (*mTeam)(mThread); }
+        };
+        Member members[cMaxThreads];
+        jobs::TaskHandle tasks[cMaxThreads];
+        for (uint32_t thread = 1; thread < threads; ++thread)
+        {
+            members[thread] = {&team, thread};
+            tasks[thread] = mJobs->StartTask("stages", members[thread]);
+        }
+        team(0);
+        for (uint32_t thread = 1; thread < threads; ++thread)
+            mJobs->FinishTask(tasks[thread]);
+    }
+
+    /// Parts for inCount items with at least inMinPerPart in each (below that a part costs more than it
+    /// saves), at most one per thread.
+    uint32_t PartsFor(uint32_t inCount, uint32_t inMinPerPart) const
+    {
+        return std::min(GetNumThreads(), std::max(1u, inCount / inMinPerPart));
+    }
+    /// Part inPart of inItems cut into inParts contiguous parts of (nearly) equal size.
+    template <class T> static std::span<T> PartOf(std::span<T> inItems, uint32_t inPart, uint32_t inParts)
+    {
+        const size_t begin = inPart * inItems.size() / inParts, end = (inPart + 1) * inItems.size() / inParts;
+        return inItems.subspan(begin, end - begin);
+    }
+    /// inTotal spread over inItems (0 for none), saturated: a step of millions of constraints must not wrap.
+    static uint32_t PerItem(uint64_t inTotal, size_t inItems)
+    {
+        return inItems == 0 ? 0 : uint32_t(std::min<uint64_t>(inTotal / inItems, UINT32_MAX));
+    }
+
+private:
+    /// Work below which a loop does not wake a sleeping worker. A worker sleeps after about 50 us without
+    /// work (a game's worker between two frames' steps) and takes tens of microseconds to wake, while the
+    /// loop waits for its part: a small step (about 30 awake bodies, 40 pairs) spent a fifth of its time in
+    /// its two parallel loops' hand-offs. An awake worker (back-to-back loops) costs a few microseconds: any
+    /// loop of more than one chunk is handed out then.
+    static constexpr uint32_t cMinWakingNanoseconds = 50'000;
+    /// Half of JobSystem's idle spin (JobSystem::cSpinMicroseconds): see KeepWorkersSpinningFor.
+    static constexpr uint64_t cWorthExtendingNanoseconds = 25'000;
+
+    struct alignas(64) StageCounters
+    {
+        std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread
+        std::atomic<uint32_t> mDone;    ///< Parts finished
+    };
+    /// Makes room for inNumStages stages' counters and clears them. The updating thread, before the tasks.
+    void ResetStages(uint32_t inNumStages);
+    /// A pause while another thread finishes its part: a CPU hint at first, then a yield of the time slice
+    /// (two cores: the other part's thread may be waiting for this core).
+    static void WaitABit(uint32_t inSpins);
+
+    jobs::JobInterface* mJobs = nullptr;      ///< During a step only
+    std::unique_ptr<StageCounters[]> mStages; ///< RunStages' counters; threads: see RunStages
+    uint32_t mStageCapacity = 0;
+};
+
+} // namespace cairn
