@@ -151,7 +151,7 @@ void IslandSolver::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstC
             });
     };
 
-    // The constraints are where the narrow phase made them (not copied: see SolveIslands), scattered over its
+    // The constraints are where the narrow phase made them (not copied: see Solve), scattered over its
     // chunks: each batch's are fetched a batch ahead, and bound and given position constraints as they are
     // packed, while their cache lines are at hand. The range that found no color is prepared here
     const uint32_t numActive = uint32_t(mContext->mActive.size());

@@ -89,7 +89,7 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
         if (Body& body = mContext->BodyAt(index); body.IsKinematic())
             Integration::IntegratePositions(body, mContext->mDeltaTime);
 #if CAIRN_WIDE_SOLVER
-    mWideBatches.resize(mPlan->mNumWideBatches); // Each colored island's slice: see ColorIsland
+    mWideBatches.resize(mPlan->mNumWideBatches); // Each colored island's slice: see IslandStage::ColorIsland
 #endif
     // Islands share no dynamic body and no constraint. The colored islands with a quarter of the step first,
     // one at a time with every thread on each; then the others at once, the largest first so that the longest

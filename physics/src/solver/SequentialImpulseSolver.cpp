@@ -132,7 +132,7 @@ struct BodyPair
 
 /// Applies impulse inLambda along inAxis: B is pushed along +axis, A along -axis. No test for the motion
 /// type: a static or kinematic body has zero inverse mass and inertia, and a block of its own per constraint
-/// (see PhysicsStep::SolveIslands), so the write changes nothing and races with no other island
+/// (see IslandSolver::Solve), so the write changes nothing and races with no other island
 [[gnu::always_inline]] inline void ApplyImpulse(const BodyPair& ioBodies, const Vec3& inAxis,
                                                 const AxisImpulse& inPart, float inLambda)
 {
