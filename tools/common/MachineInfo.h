@@ -1,8 +1,8 @@
 #pragma once
 
 // MachineInfo: one line naming the machine a benchmark ran on (CPU model, hardware threads, L2 per core), so
-// that printed figures can be told apart when the project's machine changes (it did on 2026-12-01, and the
-// same binary ran 20-40 % faster). Linux's /proc/cpuinfo and sysfs; "unknown" parts elsewhere. Main thread.
+// that printed figures can be told apart when the project's machine changes (the same binary runs tens of per
+// cent faster on one VM than another). Linux's /proc/cpuinfo and sysfs; "unknown" parts elsewhere. Main thread.
 
 #include <fstream>
 #include <string>
