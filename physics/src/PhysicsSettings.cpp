@@ -37,7 +37,6 @@ Status ValidateSettings(const PhysicsSettings& inSettings)
     switch (inSettings.mBroadPhase)
     {
     case BroadPhaseType::BruteForce:
-    case BroadPhaseType::SortAndSweep:
     case BroadPhaseType::QuadTree:
     case BroadPhaseType::QuadTreeGlobalMutex:
         break;

@@ -4,7 +4,6 @@
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
-#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 
 namespace cairn
 {
@@ -23,8 +22,6 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, 
     {
     case BroadPhaseType::BruteForce:
         return std::make_unique<BroadPhaseBruteForce>();
-    case BroadPhaseType::SortAndSweep:
-        return std::make_unique<BroadPhaseSortAndSweep>(inSettings.mMaxBodies, inLayers);
     case BroadPhaseType::QuadTree:
         return quadTree(BroadPhaseQuadTree::LockMode::LockFree);
     case BroadPhaseType::QuadTreeGlobalMutex:

@@ -1,7 +1,7 @@
 // cairn-bench-broadphase: the broad-phase part of the shared workload (../shared/bench/SPEC.md) with Google
-// Benchmark, for the lock-free quad tree, the same trees behind one global mutex, and sort and sweep. Every
-// benchmark reports its figure as a counter (ms, us_per_*) and a checksum: hits for queries and rays (AABB
-// level; the test suite checks the same totals against brute force), bodies for adds and removals.
+// Benchmark, for the lock-free quad tree and the same trees behind one global mutex. Every benchmark reports
+// its figure as a counter (ms, us_per_*) and a checksum: hits for queries and rays (AABB level; the test
+// suite checks the same totals against brute force), bodies for adds and removals.
 //
 // bp_query_contended: Q query threads (1, 2; CAIRN_BENCH_QUERY_THREADS) run bp_query_box passes (as many as
 // 150 ms of uncontended queries take, 30 ms for the global mutex; 5 iterations, medians and the ratio's
@@ -17,7 +17,6 @@
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
-#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchThreads.h"
 #include "common/FrameTimes.h"
@@ -45,8 +44,7 @@ using tools::MillisecondsSince;
 enum Kind : int64_t
 {
     cQuadTree = 0,
-    cQuadTreeGlobalMutex = 1,
-    cSortAndSweep = 2
+    cQuadTreeGlobalMutex = 1
 };
 
 const char* KindName(int64_t inKind)
@@ -55,10 +53,8 @@ const char* KindName(int64_t inKind)
     {
     case cQuadTree:
         return "quad_tree";
-    case cQuadTreeGlobalMutex:
-        return "quad_tree_global_mutex";
     default:
-        return "sort_and_sweep";
+        return "quad_tree_global_mutex";
     }
 }
 
@@ -92,11 +88,9 @@ std::unique_ptr<BroadPhase> Make(int64_t inKind, uint32_t inMaxBodies)
     {
     case cQuadTree:
         return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers);
-    case cQuadTreeGlobalMutex:
+    default:
         return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers,
                                                     BroadPhaseQuadTree::LockMode::GlobalMutex);
-    default:
-        return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, layers);
     }
 }
 
@@ -363,9 +357,8 @@ struct ContendedWorld
     {
         PhysicsSettings settings;
         settings.mMaxBodies = uint32_t(Data().mStatic.size() + Data().mDynamic.size());
-        settings.mBroadPhase = inKind == cQuadTree              ? BroadPhaseType::QuadTree
-                               : inKind == cQuadTreeGlobalMutex ? BroadPhaseType::QuadTreeGlobalMutex
-                                                                : BroadPhaseType::SortAndSweep;
+        settings.mBroadPhase =
+            inKind == cQuadTree ? BroadPhaseType::QuadTree : BroadPhaseType::QuadTreeGlobalMutex;
         mSystem = std::make_unique<PhysicsSystem>(settings, LayerSetup::CreateDefault());
         BodyInterface& bodies = mSystem->GetBodyInterface();
         auto addAll =
@@ -551,7 +544,6 @@ void BM_QueryContended(benchmark::State& ioState)
 BENCHMARK(BM_AddBatch)
     ->Name("bp_add_batch")
     ->Arg(cQuadTree)
-    ->Arg(cSortAndSweep)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
@@ -559,23 +551,17 @@ BENCHMARK(BM_MemoryRunning)->Name("bp_memory_running")->Iterations(1)->Unit(benc
 BENCHMARK(BM_AddSingle)
     ->Name("bp_add_single")
     ->Arg(cQuadTree)
-    ->Arg(cSortAndSweep)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 BENCHMARK(BM_RemoveOne)
     ->Name("bp_remove_one")
     ->Arg(cQuadTree)
-    ->Arg(cSortAndSweep)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond)
     ->Iterations(20);
-BENCHMARK(BM_QueryBox)
-    ->Name("bp_query_box")
-    ->Arg(cQuadTree)
-    ->Arg(cSortAndSweep)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Raycast)->Name("bp_raycast")->Arg(cQuadTree)->Arg(cSortAndSweep)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_QueryBox)->Name("bp_query_box")->Arg(cQuadTree)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Raycast)->Name("bp_raycast")->Arg(cQuadTree)->Unit(benchmark::kMillisecond);
 // Query threads: CAIRN_BENCH_QUERY_THREADS (default 1,2; the 16-core run asks for 1,2,4,8,15)
 BENCHMARK(BM_QueryContended)
     ->Name("bp_query_contended")

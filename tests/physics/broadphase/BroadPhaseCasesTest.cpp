@@ -1,11 +1,9 @@
-// Hand-made cases run on both reference broad phases: closed-interval semantics (touching counts), rays along
-// axes and faces, swept boxes, layer filters, pairs reported once, aborted batches and ignored bad input.
-// Every case runs before and after Update(), so the sort-and-sweep snapshot and its dirty list both get
-// tested.
+// Hand-made cases run on every broad phase: closed-interval semantics (touching counts), rays along axes and
+// faces, swept boxes, layer filters, pairs reported once, aborted batches and ignored bad input. Every case
+// runs before and after Update(), so the quad tree's linked sub-trees and its rebuilt trees both get tested.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
-#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -22,10 +20,6 @@ template <class T> std::unique_ptr<BroadPhase> Make();
 template <> std::unique_ptr<BroadPhase> Make<BroadPhaseBruteForce>()
 {
     return std::make_unique<BroadPhaseBruteForce>();
-}
-template <> std::unique_ptr<BroadPhase> Make<BroadPhaseSortAndSweep>()
-{
-    return std::make_unique<BroadPhaseSortAndSweep>(1000, LayerSetup::CreateDefault());
 }
 
 /// The quad tree in its global-mutex mode, as its own type for the typed tests.
@@ -98,8 +92,7 @@ protected:
     std::unique_ptr<BroadPhase> mBroadPhase;
 };
 
-using Implementations =
-    ::testing::Types<BroadPhaseBruteForce, BroadPhaseSortAndSweep, BroadPhaseQuadTree, QuadTreeGlobalMutex>;
+using Implementations = ::testing::Types<BroadPhaseBruteForce, BroadPhaseQuadTree, QuadTreeGlobalMutex>;
 TYPED_TEST_SUITE(BroadPhaseCasesTest, Implementations);
 
 const AABB cUnitBox(Vec3(0, 0, 0), Vec3(1, 1, 1));

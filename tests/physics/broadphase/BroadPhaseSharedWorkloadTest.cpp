@@ -6,7 +6,6 @@
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
-#include "cairn/physics/broadphase/BroadPhaseSortAndSweep.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -36,7 +35,6 @@ constexpr int cOracleStepStride = 1;
 
 enum class Kind
 {
-    SortAndSweep,
     QuadTree,
     QuadTreeGlobalMutex
 };
@@ -45,8 +43,6 @@ std::unique_ptr<BroadPhase> MakeBroadPhase(Kind inKind, uint32_t inMaxBodies, co
 {
     switch (inKind)
     {
-    case Kind::SortAndSweep:
-        return std::make_unique<BroadPhaseSortAndSweep>(inMaxBodies, inLayers);
     case Kind::QuadTree:
         return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, inLayers);
     case Kind::QuadTreeGlobalMutex:
@@ -58,8 +54,6 @@ std::unique_ptr<BroadPhase> MakeBroadPhase(Kind inKind, uint32_t inMaxBodies, co
 
 bool Validate(const BroadPhase& inBroadPhase)
 {
-    if (auto* sortAndSweep = dynamic_cast<const BroadPhaseSortAndSweep*>(&inBroadPhase))
-        return sortAndSweep->Validate();
     if (auto* quadTree = dynamic_cast<const BroadPhaseQuadTree*>(&inBroadPhase)) return quadTree->Validate();
     return true;
 }
@@ -147,7 +141,7 @@ TEST_P(SharedWorkloadTest, BoxQueryAndRayHitCountsMatchTheOracle)
         MakeBroadPhase(GetParam(), uint32_t(bodies.size()), layers);
     broadPhase->AddBodiesFinalize(broadPhase->AddBodiesPrepare(bodies));
     EXPECT_EQ(broadPhase->GetBodyCount(), bodies.size());
-    // Before the first Update (sort and sweep: the dirty list; quad tree: the linked sub-tree)
+    // Before the first Update (the quad tree: the linked sub-tree)
     EXPECT_EQ(CountBoxHits(*broadPhase), cExpectedBoxHits);
     broadPhase->Update();
     EXPECT_TRUE(Validate(*broadPhase));
@@ -242,13 +236,11 @@ TEST_P(SharedWorkloadTest, FindCollidingPairsOfTheDynamicBoxes)
 }
 
 INSTANTIATE_TEST_SUITE_P(BroadPhases, SharedWorkloadTest,
-                         ::testing::Values(Kind::SortAndSweep, Kind::QuadTree, Kind::QuadTreeGlobalMutex),
+                         ::testing::Values(Kind::QuadTree, Kind::QuadTreeGlobalMutex),
                          [](const ::testing::TestParamInfo<Kind>& inInfo)
                          {
                              switch (inInfo.param)
                              {
-                             case Kind::SortAndSweep:
-                                 return std::string("SortAndSweep");
                              case Kind::QuadTree:
                                  return std::string("QuadTree");
                              case Kind::QuadTreeGlobalMutex:

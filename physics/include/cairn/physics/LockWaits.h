@@ -11,11 +11,11 @@
 // Counted: the body shard and static mutexes (BodyLock, StaticBodyLockRead, LockAllBodies, body creation and
 // destruction), the body manager's free-list and active-list mutexes, the global-mutex broad phase's
 // WriterFairSharedMutex (a reader that finds a writer waiting, or another reader passing its turnstile,
-// counts too), the quad tree's StripedSharedMutex, and the comparison broad phases' mutexes (brute force,
-// sort and sweep). The lock-free queries' epoch read sections never wait, so they have nothing to count.
+// counts too), the quad tree's StripedSharedMutex, and the brute-force oracle's mutex. The lock-free queries'
+// epoch read sections never wait, so they have nothing to count.
 // Two kinds are kept apart, because the reference's before and after differ in both: the broad phase's locks
-// (the global mutex, the trees' modification lock, the comparison broad phases' mutexes) and the body locks
-// (shard, static, free-list and active-list mutexes).
+// (the global mutex, the trees' modification lock, the oracle's mutex) and the body locks (shard, static,
+// free-list and active-list mutexes).
 // Threads: counters per thread (thread_local), written and read by their own thread only.
 
 #include <chrono>
@@ -30,7 +30,7 @@ namespace cairn
 /// Which of the engine's locks a wait was for.
 enum class LockKind : uint8_t
 {
-    BroadPhase, ///< The global-mutex broad phase's mutex, the trees' modification lock, the comparison ones'
+    BroadPhase, ///< The global-mutex broad phase's mutex, the trees' modification lock, the oracle's mutex
     Body,       ///< Body shard and static mutexes, the body manager's list mutexes
 };
 inline constexpr size_t cNumLockKinds = 2;

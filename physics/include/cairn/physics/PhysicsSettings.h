@@ -14,7 +14,6 @@ namespace cairn
 enum class BroadPhaseType : uint8_t
 {
     BruteForce,          ///< The reference: every query tests every body (tests only)
-    SortAndSweep,        ///< Sorted along x: the previous default, kept as a second reference
     QuadTree,            ///< Lock-free quad trees, one per broad-phase layer: the default
     QuadTreeGlobalMutex, ///< The same trees behind one global reader-writer mutex (the "before" mode)
 };

@@ -13,8 +13,15 @@
 // query is reported with either its old or its new state.
 // Visitors may run while the broad phase holds an internal lock (the reference implementations hold a shared
 // lock): a visitor must not call back into the broad phase and must not wait for a lock that a thread calling
-// a modifying method may hold (e.g. a body write lock); collect the ids and lock after the query returns. Bad
-// input (non-finite or inverted bounds, unknown ids, double adds) is ignored; see each implementation.
+// a modifying method may hold (e.g. a body write lock); collect the ids and lock after the query returns.
+// Bad input (the BodyInterface validates before calling; these are caller bugs) is ignored, never stored:
+//  - non-finite or inverted bounds, an invalid id, an index the broad phase has no room for, an object layer
+//    it does not know: assert in debug, ignored in release (for NotifyBodiesAABBChanged: the old bounds
+//    stay);
+//  - adding a body index that is already present (whatever its sequence): ignored, the first add stays;
+//  - removing or moving a body that is not present (index and sequence must match): ignored;
+//  - a cast that is not IsFiniteCast: reports nothing.
+// Each implementation says what "no room" and "does not know" mean for it.
 
 #include "cairn/physics/body/BodyID.h"
 #include "cairn/physics/body/Layers.h"

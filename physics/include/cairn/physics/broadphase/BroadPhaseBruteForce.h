@@ -11,9 +11,8 @@
 // Visitors run under the shared lock: they must not call any method of this broad phase (a modifying one
 // would deadlock) and must not wait for a lock held by a thread that may be calling a modifying method.
 //
-// Bad input is ignored (see BroadPhaseSortAndSweep for the full list): invalid bounds (asserts in debug),
-// an object layer >= cMaxObjectLayers (asserts), a second add of a present body index, the removal or move of
-// a body that is not present (the exact id, index and sequence, must match).
+// Bad input is ignored as BroadPhase.h lists it. It has no LayerSetup and no capacity: an object layer is
+// unknown when it is >= cMaxObjectLayers, and any body index has room (the index map grows on demand).
 
 #include "cairn/physics/broadphase/BroadPhase.h"
 

@@ -1,8 +1,8 @@
 #pragma once
 
 // The exact AABB-level tests every broad phase uses, in one place so that all implementations (the
-// brute-force oracle, sort and sweep, later the quad tree) agree bit for bit on touching and grazing cases:
-// an equivalence test compares their results as exact sets, so they must not each round in their own way.
+// brute-force oracle and the quad tree) agree bit for bit on touching and grazing cases: an equivalence test
+// compares their results as exact sets, so they must not each round in their own way.
 // Pure functions on values: safe from any thread.
 
 #include "cairn/physics/broadphase/BroadPhase.h"
