@@ -3,6 +3,7 @@
 #include "PhysicsStep.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 
 namespace cairn
@@ -12,9 +13,9 @@ namespace
 {
 std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
 {
-    auto quadTree = [&](BroadPhaseQuadTree::LockMode inMode)
+    auto quadTree = [&]
     {
-        auto broadPhase = std::make_unique<BroadPhaseQuadTree>(inSettings.mMaxBodies, inLayers, inMode);
+        auto broadPhase = std::make_unique<BroadPhaseQuadTree>(inSettings.mMaxBodies, inLayers);
         broadPhase->SetCandidateCacheMargin(inSettings.mBroadPhaseCandidateMargin);
         return broadPhase;
     };
@@ -23,9 +24,9 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, 
     case BroadPhaseType::BruteForce:
         return std::make_unique<BroadPhaseBruteForce>();
     case BroadPhaseType::QuadTree:
-        return quadTree(BroadPhaseQuadTree::LockMode::LockFree);
+        return quadTree();
     case BroadPhaseType::QuadTreeGlobalMutex:
-        return quadTree(BroadPhaseQuadTree::LockMode::GlobalMutex);
+        return std::make_unique<BroadPhaseGlobalMutex>(quadTree());
     }
     return nullptr;
 }

@@ -1,10 +1,12 @@
 // The quad-tree broad phase's "no missed collisions" stress, short run (see common/NoMissStress.h): part of
 // the test command and run under ThreadSanitizer in CI. The 2-million-check run is tests/long/.
 
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "common/NoMissStress.h"
 
 #include <gtest/gtest.h>
+#include <memory>
 #include <random>
 #include <thread>
 
@@ -13,28 +15,45 @@ namespace cairn
 namespace
 {
 
-void RunShort(BroadPhaseQuadTree::LockMode inMode)
+/// The short run's settings.
+test::NoMissStressConfig ShortRun()
 {
     test::NoMissStressConfig config;
     config.mTargetChecks = 50000;
     config.mMinDuration = std::chrono::milliseconds(1000);
     config.mMaxDuration = std::chrono::milliseconds(20000);
-    BroadPhaseQuadTree broadPhase(config.mNumPermanent + config.mNumChurned, LayerSetup::CreateDefault(),
-                                  inMode);
-    const test::NoMissStressResult result =
-        test::RunNoMissStress(broadPhase, config, [&] { broadPhase.RebuildAll(); });
-    test::ExpectNoMisses(result, config, broadPhase.GetBodyCount());
-    EXPECT_TRUE(broadPhase.Validate());
+    return config;
+}
+
+/// A quad tree with room for the stress's bodies.
+std::unique_ptr<BroadPhaseQuadTree> MakeQuadTree(const test::NoMissStressConfig& inConfig)
+{
+    return std::make_unique<BroadPhaseQuadTree>(inConfig.mNumPermanent + inConfig.mNumChurned,
+                                                LayerSetup::CreateDefault());
 }
 
 TEST(BroadPhaseQuadTreeNoMissTest, LockFreeShortRun)
 {
-    RunShort(BroadPhaseQuadTree::LockMode::LockFree);
+    const test::NoMissStressConfig config = ShortRun();
+    const std::unique_ptr<BroadPhaseQuadTree> broadPhase = MakeQuadTree(config);
+    const test::NoMissStressResult result =
+        test::RunNoMissStress(*broadPhase, config, [&] { broadPhase->RebuildAll(); });
+    test::ExpectNoMisses(result, config, broadPhase->GetBodyCount());
+    EXPECT_TRUE(broadPhase->Validate());
 }
 
 TEST(BroadPhaseQuadTreeNoMissTest, GlobalMutexShortRun)
 {
-    RunShort(BroadPhaseQuadTree::LockMode::GlobalMutex);
+    const test::NoMissStressConfig config = ShortRun();
+    std::unique_ptr<BroadPhaseQuadTree> owned = MakeQuadTree(config);
+    BroadPhaseQuadTree& quadTree = *owned;
+    BroadPhaseGlobalMutex broadPhase(std::move(owned));
+    // The full rebuild under the exclusive lock, where this mode's Update runs
+    const test::NoMissStressResult result = test::RunNoMissStress(
+        broadPhase, config,
+        [&] { broadPhase.WithExclusiveLock([&](BroadPhase&) { quadTree.RebuildAll(); }); });
+    test::ExpectNoMisses(result, config, broadPhase.GetBodyCount());
+    EXPECT_TRUE(quadTree.Validate());
 }
 
 } // namespace

@@ -9,6 +9,8 @@
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/body/BodyManager.h"
+#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/StripedSharedMutex.h"
 #include "cairn/physics/broadphase/WriterFairSharedMutex.h"
 #include "cairn/physics/shapes/BoxShape.h"
@@ -340,6 +342,40 @@ TEST(LockWaitsTest, GlobalMutexUpdateWaitsForAQueryAndCountsIt)
     BodyID box;
     const std::unique_ptr<PhysicsSystem> system = MakeSystem(BroadPhaseType::QuadTreeGlobalMutex, box);
     ExpectMostOfWindow(UpdateBesideASlowQuery(*system));
+}
+
+TEST(LockWaitsTest, GlobalMutexQueryWaitsForAnExclusiveHoldAndCountsIt)
+{
+    // The wrapper alone, around another broad phase: a query waits while a thread is in an exclusive section
+    // (as it would behind a modification), and the wait is a broad-phase wait
+    BroadPhaseGlobalMutex broadPhase(std::make_unique<BroadPhaseBruteForce>());
+    std::atomic<bool> inside{false}, letGo{false};
+    std::thread holder;
+    ExpectMostOfWindow(WaitBehindHolder(
+        LockKind::BroadPhase,
+        [&]
+        {
+            holder = std::thread(
+                [&]
+                {
+                    broadPhase.WithExclusiveLock(
+                        [&](BroadPhase&)
+                        {
+                            inside.store(true, std::memory_order_release); // Release: a signal only
+                            // Acquire: pairs with the store below
+                            while (!letGo.load(std::memory_order_acquire))
+                                std::this_thread::yield();
+                        });
+                });
+            while (!inside.load(std::memory_order_acquire)) // Acquire: pairs with the store above
+                std::this_thread::yield();
+            return [&]
+            {
+                letGo.store(true, std::memory_order_release); // Release: a signal only
+                holder.join();
+            };
+        },
+        [&] { broadPhase.CollideAABox(AABB(Vec3::Zero(), Vec3::Ones()), {}, [](BodyID) {}); }));
 }
 
 TEST(LockWaitsTest, LockFreeUpdateNeverWaitsForAQuery)

@@ -16,6 +16,7 @@
 
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchThreads.h"
@@ -89,8 +90,8 @@ std::unique_ptr<BroadPhase> Make(int64_t inKind, uint32_t inMaxBodies)
     case cQuadTree:
         return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers);
     default:
-        return std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers,
-                                                    BroadPhaseQuadTree::LockMode::GlobalMutex);
+        return std::make_unique<BroadPhaseGlobalMutex>(
+            std::make_unique<BroadPhaseQuadTree>(inMaxBodies, layers));
     }
 }
 

@@ -4,8 +4,6 @@
 #include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <cassert>
-#include <mutex>
-#include <shared_mutex>
 
 namespace cairn
 {
@@ -15,17 +13,6 @@ struct BroadPhaseQuadTree::Batch
 {
     std::array<QuadTree::SubTree, cMaxBroadPhaseLayers> mSubTrees;
 };
-
-namespace
-{
-
-/// Takes the global mutex in GlobalMutex mode, nothing otherwise.
-template <class Lock> Lock LockIf(bool inLock, WriterFairSharedMutex& inMutex)
-{
-    return inLock ? Lock(inMutex) : Lock(inMutex, std::defer_lock);
-}
-
-} // namespace
 
 /// Admits one call of a kind of physics-step call at a time (Update and RebuildAll share the rebuild state;
 /// FindCollidingPairs owns the active marks); a second one of the same kind that overlaps it is a caller bug
@@ -55,9 +42,9 @@ private:
     bool mOwner;
 };
 
-BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers, LockMode inMode)
-    : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mMode(inMode),
-      mBodies(mMaxBodies), mCandidateCache(std::make_unique<PairCandidateCache>())
+BroadPhaseQuadTree::BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers)
+    : mMaxBodies(std::min(inMaxBodies, QuadTree::cBodyFlag - 1)), mLayerSetup(inLayers), mBodies(mMaxBodies),
+      mCandidateCache(std::make_unique<PairCandidateCache>())
 {
     // A full rebuild needs at most ~1.4 nodes per body (4-wide, at least one body per leaf slot group);
     // batches may not take the last 2 per body, so a rebuild always finds its nodes. Storage is backed on
@@ -141,7 +128,6 @@ void BroadPhaseQuadTree::AddBodiesFinalize(AddState inState)
 {
     if (inState == nullptr) return;
     std::unique_ptr<Batch> batch(static_cast<Batch*>(inState));
-    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     for (uint32_t layer = 0; layer < mTrees.size(); ++layer)
     {
         const QuadTree::SubTree& subTree = batch->mSubTrees[layer];
@@ -179,7 +165,6 @@ uint32_t BroadPhaseQuadTree::RemoveBody(BodyID inBody)
 
 void BroadPhaseQuadTree::RemoveBodies(std::span<const BodyID> inBodies)
 {
-    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     uint32_t changed = 0;
     for (BodyID id : inBodies)
         changed |= RemoveBody(id);
@@ -220,7 +205,6 @@ uint32_t BroadPhaseQuadTree::MoveBody(const BroadPhaseBody& inBody,
 
 void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies)
 {
-    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     // A batch (the step's moved bodies) lies scattered over the body table and the tree: the table entries
     // are fetched 8 bodies ahead and the nodes 4 ahead (from the entries fetched before), so that the misses
     // of a move overlap those of the next ones instead of following each other
@@ -260,7 +244,6 @@ void BroadPhaseQuadTree::UpdateImpl(bool inFull)
 {
     const StepCallGuard guard(*this, mUpdateActive);
     if (!guard.IsOwner()) return;
-    auto lock = LockIf<std::unique_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     mLastUpdate = {};
     for (const std::unique_ptr<QuadTree>& tree : mTrees)
     {
@@ -279,7 +262,6 @@ void BroadPhaseQuadTree::UpdateImpl(bool inFull)
 void BroadPhaseQuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
                                       BodyVisitor inVisitor) const
 {
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     ForEachTree(inFilter.mObjectLayers,
                 [&](const QuadTree& inTree, ObjectLayerMask inMask)
                 {
@@ -291,7 +273,6 @@ void BroadPhaseQuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFi
 void BroadPhaseQuadTree::CollideSphere(const Vec3& inCenter, float inRadius,
                                        const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const
 {
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     ForEachTree(inFilter.mObjectLayers,
                 [&](const QuadTree& inTree, ObjectLayerMask inMask)
                 {
@@ -303,7 +284,6 @@ void BroadPhaseQuadTree::CollideSphere(const Vec3& inCenter, float inRadius,
 void BroadPhaseQuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQueryFilter& inFilter,
                                       BodyVisitor inVisitor) const
 {
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     ForEachTree(inFilter.mObjectLayers,
                 [&](const QuadTree& inTree, ObjectLayerMask inMask)
                 {
@@ -316,7 +296,6 @@ void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilt
                                  RayBodyVisitor inVisitor) const
 {
     if (!IsFiniteCast(inRay.mOrigin, inRay.mDirection)) return;
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // Shared by the trees, so a close hit in one prunes the others
     ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
                 { return inTree.CastRay(inRay, inMask, maxFraction, inVisitor); });
@@ -326,7 +305,6 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
                                    const BroadPhaseQueryFilter& inFilter, RayBodyVisitor inVisitor) const
 {
     if (!IsFiniteCast(inBox, inDisplacement)) return;
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     float maxFraction = 1.0f; // As in CastRay
     ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
                 { return inTree.CastAABox(inBox, inDisplacement, inMask, maxFraction, inVisitor); });
@@ -361,7 +339,6 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
 {
     const StepCallGuard guard(*this, mPairsActive);
     if (!guard.IsOwner()) return;
-    auto lock = LockIf<std::shared_lock<WriterFairSharedMutex>>(mMode == LockMode::GlobalMutex, mGlobalMutex);
     auto isPresent = [&](BodyID inID)
     {
         if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies) return false;

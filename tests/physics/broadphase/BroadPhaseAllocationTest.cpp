@@ -3,6 +3,7 @@
 // warm-up, 1,000 queries of each kind (and pair searches) on every broad phase must allocate nothing.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "common/AllocationCounter.h"
 
@@ -107,8 +108,7 @@ TEST(BroadPhaseAllocationTest, QuadTreeQueriesDoNotAllocate)
 
 TEST(BroadPhaseAllocationTest, QuadTreeGlobalMutexQueriesDoNotAllocate)
 {
-    BroadPhaseQuadTree broadPhase(2000, LayerSetup::CreateDefault(),
-                                  BroadPhaseQuadTree::LockMode::GlobalMutex);
+    BroadPhaseGlobalMutex broadPhase(std::make_unique<BroadPhaseQuadTree>(2000, LayerSetup::CreateDefault()));
     ExpectNoAllocations(broadPhase);
 }
 

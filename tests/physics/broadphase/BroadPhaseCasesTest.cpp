@@ -3,6 +3,7 @@
 // runs before and after Update(), so the quad tree's linked sub-trees and its rebuilt trees both get tested.
 
 #include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
 #include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
@@ -22,7 +23,8 @@ template <> std::unique_ptr<BroadPhase> Make<BroadPhaseBruteForce>()
     return std::make_unique<BroadPhaseBruteForce>();
 }
 
-/// The quad tree in its global-mutex mode, as its own type for the typed tests.
+/// The quad tree behind BroadPhaseGlobalMutex (BroadPhaseType::QuadTreeGlobalMutex), as its own type for the
+/// typed tests.
 struct QuadTreeGlobalMutex
 {
 };
@@ -32,8 +34,16 @@ template <> std::unique_ptr<BroadPhase> Make<BroadPhaseQuadTree>()
 }
 template <> std::unique_ptr<BroadPhase> Make<QuadTreeGlobalMutex>()
 {
-    return std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault(),
-                                                BroadPhaseQuadTree::LockMode::GlobalMutex);
+    return std::make_unique<BroadPhaseGlobalMutex>(
+        std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault()));
+}
+/// The oracle behind BroadPhaseGlobalMutex: the wrapper forwards to whatever it wraps.
+struct BruteForceGlobalMutex
+{
+};
+template <> std::unique_ptr<BroadPhase> Make<BruteForceGlobalMutex>()
+{
+    return std::make_unique<BroadPhaseGlobalMutex>(std::make_unique<BroadPhaseBruteForce>());
 }
 
 template <class T> class BroadPhaseCasesTest : public ::testing::Test
@@ -92,7 +102,8 @@ protected:
     std::unique_ptr<BroadPhase> mBroadPhase;
 };
 
-using Implementations = ::testing::Types<BroadPhaseBruteForce, BroadPhaseQuadTree, QuadTreeGlobalMutex>;
+using Implementations =
+    ::testing::Types<BroadPhaseBruteForce, BroadPhaseQuadTree, QuadTreeGlobalMutex, BruteForceGlobalMutex>;
 TYPED_TEST_SUITE(BroadPhaseCasesTest, Implementations);
 
 const AABB cUnitBox(Vec3(0, 0, 0), Vec3(1, 1, 1));

@@ -4,7 +4,7 @@
 // moving by default), sharing one QuadTreeBodyTable; every query is filtered by object layer and tested
 // against exact body bounds, so it returns exactly what BroadPhaseBruteForce returns.
 //
-// Threads and locks (LockMode::LockFree, the default):
+// Threads and locks:
 //  - Queries: any thread, any time, no lock (an epoch read section per tree; never waits).
 //  - AddBodiesPrepare/Abort: any thread, no lock (builds private sub-trees, one per layer of the batch).
 //  - AddBodiesFinalize (O(1) per layer: one compare-exchange), RemoveBodies, NotifyBodiesAABBChanged: any
@@ -21,9 +21,8 @@
 // while the body stays inside that box and those trees stay unchanged, its pairs with them come from the
 // cache instead of a walk, the same pairs. Each tree counts the modification calls that finished on it
 // (mTreeChanges), and a tree whose count moved between two pair searches is walked in the second.
-// LockMode::GlobalMutex puts one reader-writer mutex around everything (queries shared, every modification
-// and Update exclusive): the "before" of the reference engine, kept for the benchmarks and the demo's
-// comparison. Visitors may run under that shared lock, so the BroadPhase visitor rules apply.
+// BroadPhaseGlobalMutex wraps it in one reader-writer mutex for the "before" of the reference engine
+// (BroadPhaseType::QuadTreeGlobalMutex).
 //
 // Bad input (the BodyInterface validates first; these are caller bugs) is ignored, never stored: invalid ids,
 // indices >= inMaxBodies, unknown object layers, non-finite or inverted bounds (assert in debug), a body
@@ -32,7 +31,6 @@
 
 #include "cairn/physics/broadphase/BroadPhase.h"
 #include "cairn/physics/broadphase/QuadTree.h"
-#include "cairn/physics/broadphase/WriterFairSharedMutex.h"
 
 #include <array>
 #include <memory>
@@ -47,12 +45,6 @@ class PairCandidateCache;
 class BroadPhaseQuadTree final : public BroadPhase
 {
 public:
-    enum class LockMode : uint8_t
-    {
-        LockFree,   ///< Lock-free trees, epoch read sections (the engine's mode)
-        GlobalMutex ///< One reader-writer mutex around the whole broad phase (for comparison)
-    };
-
     /// What the last Update did, summed over the layers.
     struct UpdateStats
     {
@@ -107,8 +99,7 @@ public:
 
     /// inMaxBodies: body indices are < inMaxBodies. inLayers is copied. Node pools hold 2 * inMaxBodies +
     /// 1,024 nodes per layer (the new and old trees of a fully changed layer fit twice over).
-    BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers,
-                       LockMode inMode = LockMode::LockFree);
+    BroadPhaseQuadTree(uint32_t inMaxBodies, const LayerSetup& inLayers);
     ~BroadPhaseQuadTree() override;
     BroadPhaseQuadTree(const BroadPhaseQuadTree&) = delete;
     BroadPhaseQuadTree& operator=(const BroadPhaseQuadTree&) = delete;
@@ -126,8 +117,8 @@ public:
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
     /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
     void Update() override;
-    /// In LockMode::LockFree only: the global mutex would make the pair queries wait for the update.
-    bool CanFindPairsDuringUpdate() const override { return mMode == LockMode::LockFree; }
+    /// True: the pair queries are lock-free queries, exact whatever the trees' state.
+    bool CanFindPairsDuringUpdate() const override { return true; }
     /// Update with a full rebuild of every tree (benchmarks, level loads).
     void RebuildAll();
 
@@ -149,7 +140,6 @@ public:
 
     size_t GetBodyCount() const override;
 
-    LockMode GetLockMode() const { return mMode; }
     void SetCandidateCacheMargin(float inMargin);
     float GetCandidateCacheMargin() const { return mCandidateCacheMargin; }
     CandidateCacheStats GetCandidateCacheStats() const;
@@ -207,12 +197,10 @@ private:
 
     const uint32_t mMaxBodies;                     ///< Body indices are below this
     const LayerSetup mLayerSetup;                  ///< Copy of the constructor's setup; immutable
-    const LockMode mMode;                          ///< Chosen at construction
     QuadTreeBodyTable mBodies;                     ///< Shared by the trees
     std::vector<std::unique_ptr<QuadTree>> mTrees; ///< One per broad-phase layer; the vector is immutable
     std::array<ObjectLayerMask, cMaxBroadPhaseLayers> mObjectLayersOfTree{}; ///< Immutable
     std::atomic<int64_t> mBodyCount{0};                 ///< Bodies linked (relaxed: a statistic)
-    mutable WriterFairSharedMutex mGlobalMutex;         ///< LockMode::GlobalMutex only
     UpdateStats mLastUpdate;                            ///< Physics step only
     mutable std::atomic<bool> mUpdateActive{false};     ///< Update or RebuildAll is running (StepCallGuard)
     mutable std::atomic<bool> mPairsActive{false};      ///< FindCollidingPairs is running (StepCallGuard)
