@@ -28,4 +28,16 @@ expect_usage_error "--frames" --frames abc  # CLI11's own code for this was 105
 expect_usage_error "--mode" --mode sideways
 touch not-a-folder
 expect_usage_error "--output not-a-folder/report" --output not-a-folder/report
+# The world file: unreadable, malformed, a typo'd key, a value out of range, a world too big for the demo
+expect_usage_error "--world: missing.json" --world missing.json
+echo '{"agents": 8,' >truncated.json
+expect_usage_error "--world: truncated.json" --world truncated.json
+echo '{"agent": 8}' >typo.json
+expect_usage_error 'unknown key "agent"' --world typo.json
+echo '{"collision_radius": "far"}' >type.json
+expect_usage_error '"collision_radius": expected a number' --world type.json
+echo '{"props_per_tile": 5000, "collision_radius": 6}' >huge.json
+expect_usage_error "bodies at once" --world huge.json
+echo '{"seed": -1}' >seed.json
+expect_usage_error '"seed": expected a whole number from 0 to 2^64 - 1' --world seed.json
 echo "cairn-demo command line: all checks passed"

@@ -1,6 +1,6 @@
 #include "BakeConfig.h"
 
-#include "JsonFile.h"
+#include "common/JsonFile.h"
 
 #include <DetourNavMesh.h>
 #include <map>
@@ -11,7 +11,7 @@ namespace cairn::bake
 
 Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfile)
 {
-    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    Result<nlohmann::json> read = tools::ReadJsonFile(inPath);
     if (!read) return read.GetError();
     const nlohmann::json& json = read.Value();
     if (!json.is_object()) return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
@@ -42,7 +42,7 @@ Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfil
         else if (key == "max_verts_per_poly")
         {
             int64_t number = 0;
-            if (!GetWholeNumber(value, 3, DT_VERTS_PER_POLYGON, number))
+            if (!tools::GetWholeNumber(value, 3, DT_VERTS_PER_POLYGON, number))
                 return MakeError(ErrorCode::ParseError, inPath + ": '" + key +
                                                             "' must be a whole number from 3 to " +
                                                             std::to_string(DT_VERTS_PER_POLYGON));
@@ -72,14 +72,14 @@ Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfil
 
 Result<navmesh::AreaMapping> LoadAreaMapping(const std::string& inPath)
 {
-    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    Result<nlohmann::json> read = tools::ReadJsonFile(inPath);
     if (!read) return read.GetError();
     const nlohmann::json& json = read.Value();
     if (!json.is_object()) return MakeError(ErrorCode::ParseError, inPath + ": not a JSON object");
     auto areaId = [&](const nlohmann::json& inValue, const std::string& inWhat) -> Result<uint8_t>
     {
         int64_t id = 0;
-        if (!GetWholeNumber(inValue, 0, navmesh::cMaxAreaId, id))
+        if (!tools::GetWholeNumber(inValue, 0, navmesh::cMaxAreaId, id))
             return MakeError(ErrorCode::ParseError, inPath + ": " + inWhat +
                                                         " must be a whole number from 0 to " +
                                                         std::to_string(navmesh::cMaxAreaId));

@@ -1,7 +1,7 @@
 #include "BakeSummary.h"
 
-#include "JsonFile.h"
 #include "cairn/navmesh/PendingFile.h"
+#include "common/JsonFile.h"
 #include "common/ParseWholeNumber.h"
 
 #include <algorithm>
@@ -87,7 +87,7 @@ Status SaveBakeSummary(const std::string& inPath, const BakeSummary& inSummary)
 
 Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
 {
-    Result<nlohmann::json> read = ReadJsonFile(inPath);
+    Result<nlohmann::json> read = tools::ReadJsonFile(inPath);
     if (!read) return read.GetError();
     const nlohmann::json& json = read.Value();
     auto parseError = [&](const std::string& inWhat)
@@ -118,8 +118,8 @@ Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
         const nlohmann::json* inputHash = member(tile, "input_hash");
         const nlohmann::json* outputHash = member(tile, "output_hash");
         int64_t tileX = 0, tileZ = 0;
-        if (x == nullptr || z == nullptr || !GetWholeNumber(*x, INT32_MIN, INT32_MAX, tileX) ||
-            !GetWholeNumber(*z, INT32_MIN, INT32_MAX, tileZ) || inputHash == nullptr ||
+        if (x == nullptr || z == nullptr || !tools::GetWholeNumber(*x, INT32_MIN, INT32_MAX, tileX) ||
+            !tools::GetWholeNumber(*z, INT32_MIN, INT32_MAX, tileZ) || inputHash == nullptr ||
             !inputHash->is_string() || outputHash == nullptr || !outputHash->is_string())
             return parseError(where + ": needs integer x, z (32 bits) and hex input_hash, output_hash");
         record.mTile = {int32_t(tileX), int32_t(tileZ)};
@@ -129,8 +129,8 @@ Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
         int64_t polygons = 0, bytes = 0;
         const nlohmann::json* polygonsValue = member(tile, "polygons");
         const nlohmann::json* bytesValue = member(tile, "bytes");
-        if ((polygonsValue != nullptr && !GetWholeNumber(*polygonsValue, 0, INT32_MAX, polygons)) ||
-            (bytesValue != nullptr && !GetWholeNumber(*bytesValue, 0, UINT32_MAX, bytes)))
+        if ((polygonsValue != nullptr && !tools::GetWholeNumber(*polygonsValue, 0, INT32_MAX, polygons)) ||
+            (bytesValue != nullptr && !tools::GetWholeNumber(*bytesValue, 0, UINT32_MAX, bytes)))
             return parseError(where + ": 'polygons' and 'bytes' must be whole numbers from 0");
         record.mPolygons = int(polygons);
         record.mBytes = uint32_t(bytes);
@@ -144,7 +144,7 @@ Result<BakeSummary> LoadBakeSummary(const std::string& inPath)
                               std::to_string(summary.mTiles[i].mTile.mZ) + ") is listed twice");
     int64_t tilesInWorld = 0;
     if (const nlohmann::json* value = member(json, "tiles_in_world");
-        value != nullptr && !GetWholeNumber(*value, 0, UINT32_MAX, tilesInWorld))
+        value != nullptr && !tools::GetWholeNumber(*value, 0, UINT32_MAX, tilesInWorld))
         return parseError("'tiles_in_world' must be a whole number from 0");
     summary.mTilesInWorld = uint32_t(tilesInWorld);
     if (const nlohmann::json* shard = member(json, "shard"); shard != nullptr)

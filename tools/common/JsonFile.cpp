@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
-namespace cairn::bake
+namespace cairn::tools
 {
 
 Result<nlohmann::json> ReadJsonFile(const std::string& inPath)
@@ -44,4 +44,4 @@ bool GetWholeNumber(const nlohmann::json& inValue, int64_t inMin, int64_t inMax,
     return true;
 }
 
-} // namespace cairn::bake
+} // namespace cairn::tools

@@ -1,7 +1,8 @@
 #pragma once
 
-// The baker's JSON files (config, areas, summaries) read with nlohmann-json, whose exceptions end at this
-// boundary: a file is a Status error naming it and the parser's place, never an abort. Any thread.
+// The tools' JSON files (the baker's config, areas and summaries; the demo's world) read with nlohmann-json,
+// whose exceptions end at this boundary: a file is a Status error naming it and the parser's place, never an
+// abort. Any thread.
 
 #include "cairn/physics/math/Result.h"
 
@@ -9,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-namespace cairn::bake
+namespace cairn::tools
 {
 
 /// The JSON value of the regular file inPath. Errors: IOError when it is not a readable regular file (a
@@ -20,4 +21,4 @@ Result<nlohmann::json> ReadJsonFile(const std::string& inPath);
 /// wraps 4294967299 to 3.
 bool GetWholeNumber(const nlohmann::json& inValue, int64_t inMin, int64_t inMax, int64_t& outNumber);
 
-} // namespace cairn::bake
+} // namespace cairn::tools

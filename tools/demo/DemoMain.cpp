@@ -7,6 +7,7 @@
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
+#include "WorldFile.h"
 #include "common/MachineInfo.h"
 #include "common/ParseWholeNumber.h"
 
@@ -25,10 +26,13 @@ using namespace cairn::demo;
 int main(int argc, char** argv)
 {
     DemoSettings settings;
+    std::string world = CAIRN_DEFAULT_WORLD;
     std::string mode = "both";
     std::string output = "demo-output";
     bool fast = false;
     CLI::App app{"cairn-demo: the streaming open-world demo (lock-free broad phase against a global mutex)"};
+    app.add_option("--world", world,
+                   "The world's settings, a JSON file (see data/README.md); the flags below override it");
     app.add_option("--frames", settings.mFrames, "Frames per mode (60 per second)")
         ->check(CLI::Range(1, 1000000));
     // As text: CLI11 reads "-1" into an unsigned as 2^64 - 1
@@ -63,6 +67,27 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "cairn-demo: %s\n", inMessage.c_str());
         return 1;
     };
+    // The world file first, then the flags given: they override it
+    {
+        DemoSettings fromFile = settings;
+        if (Status loaded = LoadDemoWorld(world, fromFile); !loaded)
+            return usageError("--world: " + loaded.GetError().mMessage);
+        auto unlessGiven = [&](const char* inFlag, auto& outField, const auto& inFileValue)
+        {
+            if (app.count(inFlag) == 0) outField = inFileValue;
+        };
+        unlessGiven("--agents", settings.mAgents, fromFile.mAgents);
+        unlessGiven("--collision-steps", settings.mCollisionSteps, fromFile.mCollisionSteps);
+        unlessGiven("--candidate-margin", settings.mCandidateMargin, fromFile.mCandidateMargin);
+        unlessGiven("--game-objects", settings.mGameObjects, fromFile.mGameObjects);
+        if (app.count("--seed") == 0) seedText = std::to_string(fromFile.mSeed);
+        settings.mPropsPerTile = fromFile.mPropsPerTile;
+        settings.mDynamicPerTile = fromFile.mDynamicPerTile;
+        settings.mCollisionRadius = fromFile.mCollisionRadius;
+        settings.mPlayerSpeed = fromFile.mPlayerSpeed;
+        settings.mThrowBalls = fromFile.mThrowBalls;
+        settings.mGameObjectJobs = fromFile.mGameObjectJobs;
+    }
     if (!tools::ParseWholeNumber(seedText, settings.mSeed))
         return usageError("--seed " + seedText + ": expected a whole number from 0 to 2^64 - 1");
     // CLI11's range check compares, and NaN fails no comparison: every physics update then failed
@@ -81,8 +106,9 @@ int main(int argc, char** argv)
     std::string commandLine = "cairn-demo";
     for (int i = 1; i < argc; ++i)
         commandLine += std::string(" ") + argv[i];
-    std::printf("cairn-demo: %d frames per mode, seed %llu, %d agents; %s\n", settings.mFrames,
-                (unsigned long long)settings.mSeed, settings.mAgents, tools::DescribeMachine().c_str());
+    std::printf("cairn-demo: %d frames per mode, world %s, seed %llu, %d agents; %s\n", settings.mFrames,
+                world.c_str(), (unsigned long long)settings.mSeed, settings.mAgents,
+                tools::DescribeMachine().c_str());
 
     std::vector<DemoRunResult> runs;
     if (mode != "global-mutex") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTree, stdout));

@@ -58,7 +58,7 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
     result.mAgents = inSettings.mAgents;
 
     PhysicsSettings physicsSettings;
-    physicsSettings.mMaxBodies = 65536;
+    physicsSettings.mMaxBodies = cDemoMaxBodies;
     physicsSettings.mBroadPhase = inMode;
     physicsSettings.mBroadPhaseCandidateMargin = inSettings.mCandidateMargin;
     // The reference engine's "before": one read-write mutex around the broad phase and one for every body,

@@ -10,11 +10,17 @@
 #include "DemoResult.h"
 #include "cairn/physics/PhysicsSettings.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
 namespace cairn::demo
 {
+
+/// The demo's physics world holds this many bodies; a world file may fill it up to cDemoSpareBodies short
+/// (the balls the player throws, and tiles still leaving while new ones stream in).
+inline constexpr uint32_t cDemoMaxBodies = 65536;
+inline constexpr uint32_t cDemoSpareBodies = 4096;
 
 struct DemoSettings
 {

@@ -35,6 +35,8 @@ done
 loader=$(ldd "$out/bin/${programs[0]}" | awk '$1 ~ /^\// { print $1 }')
 [ -n "$loader" ] && [ -f "$out/lib/$(basename "$loader")" ] || { echo "bundle.sh: no dynamic loader" >&2; exit 1; }
 cp -r "$shared" "$out/shared/bench"
+# The demo's world: its default path is the source tree's, which the device's copy does not have
+mkdir -p "$out/data/demo" && cp "$root/data/demo/world.json" "$out/data/demo/"
 cp "$root/tools/manycore/run.sh" "$out/run-all.sh"
 
 # The launcher: the bundled loader runs the program with the bundled libraries only; the system's are never

@@ -82,7 +82,8 @@ json_rows "$out/contended.json" us_per_query us_per_query_uncontended ratio rati
 
 if [ "$demoFrames" -gt 0 ]; then
     echo "== the demo, both modes, $cores threads, $demoFrames frames each"
-    "$bundle/run" cairn-demo --threads "$cores" --game-objects 8000 --frames "$demoFrames" \
+    "$bundle/run" cairn-demo --world "$bundle/data/demo/world.json" --threads "$cores" --game-objects 8000 \
+        --frames "$demoFrames" \
         --output "$out/demo" >"$out/demo.txt" 2>&1 || echo "run.sh: the demo exited with an error" >&2
 fi
 
