@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
     cmake ninja-build g++ pkg-config
-    clang libclang-rt-14-dev libomp-14-dev  # the ASan+UBSan build and its libFuzzer harnesses
+    clang libclang-rt-14-dev  # the ASan+UBSan build and its libFuzzer harnesses
     libeigen3-dev         # all math
     librecast-dev         # Recast/Detour navmesh
     libtinyobjloader-dev  # OBJ level meshes

@@ -140,16 +140,6 @@ TEST(BakeTest, ThreadCountAndShardsDoNotChangeTheBytes)
     bakeTo(1, 0, 1, one);
     bakeTo(2, 0, 1, two);
     EXPECT_EQ(ReadBytes(one), ReadBytes(two));
-    // The tile loop as OpenMP windows: the same bytes on 1, 2 and 4 threads
-    settings.mTileLoop = BakeSettings::TileLoop::OpenMP;
-    for (const uint32_t threads : {1u, 2u, 4u})
-    {
-        const std::string openMP = TempPath("openmp.navmesh");
-        bakeTo(threads, 0, 1, openMP);
-        EXPECT_EQ(ReadBytes(one), ReadBytes(openMP)) << "OpenMP, " << threads << " threads";
-        std::filesystem::remove(openMP);
-    }
-    settings.mTileLoop = BakeSettings::TileLoop::Jobs;
     const navmesh::NavMeshFileContents shard0 = bakeTo(2, 0, 2, TempPath("s0.navmesh"));
     const navmesh::NavMeshFileContents shard1 = bakeTo(1, 1, 2, TempPath("s1.navmesh"));
     EXPECT_FALSE(shard0.mTiles.empty());

@@ -246,9 +246,7 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     bool nearIsNext = false; // near holds the objects of mine[next], which waits for room in the world
     while (next < mine.size() || !inFlight.empty())
     {
-        // OpenMP: a window enters only when the last one has left (see below)
-        const bool enter = inSettings.mTileLoop == BakeSettings::TileLoop::Jobs || inFlight.empty();
-        while (enter && next < mine.size() && inFlight.size() < maxInFlight)
+        while (next < mine.size() && inFlight.size() < maxInFlight)
         {
             if (!nearIsNext)
             {
@@ -264,23 +262,9 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
             Result<std::vector<TileObject>> held = objects.Acquire(near);
             if (!held) return held.GetError();
             tile.mObjects = std::move(held.Value());
-            if (inSettings.mTileLoop == BakeSettings::TileLoop::Jobs)
-            {
-                TileInFlight* job = &tile;
-                tile.mJob =
-                    jobSystem.Schedule("bake tile", [&context, job] { BuildTileInFlight(context, *job); });
-            }
-        }
-        if (inSettings.mTileLoop == BakeSettings::TileLoop::OpenMP && enter)
-        {
-            // The window built at once: nothing enters or leaves the world meanwhile, so the tiles' queries
-            // and copies read a world no thread changes. BuildTileInFlight does not throw (its errors are
-            // results), as an OpenMP region requires
-            const int count = int(inFlight.size());
-            const int threads = int(jobSystem.GetNumThreads());
-#pragma omp parallel for schedule(dynamic) num_threads(threads)
-            for (int i = 0; i < count; ++i)
-                BuildTileInFlight(context, inFlight[size_t(i)]);
+            TileInFlight* job = &tile;
+            tile.mJob =
+                jobSystem.Schedule("bake tile", [&context, job] { BuildTileInFlight(context, *job); });
         }
 
         // The front tile, written out in order

@@ -39,17 +39,8 @@ struct BakeSettings
     navmesh::AreaMapping mAreas;          ///< Area ids of material names
     navmesh::LevelLoadLimits mLoadLimits; ///< What the level files may make the loaders do (Bake)
     uint32_t mThreads = 0;                ///< 0: all cores
-    /// How the tiles in flight are built: jobs on a JobSystem, each tile entering as one leaves; or windows
-    /// of tiles as an OpenMP parallel loop (schedule(dynamic)), entered together and written out together.
-    /// The bytes are the same either way
-    enum class TileLoop : uint8_t
-    {
-        Jobs,
-        OpenMP,
-    };
-    TileLoop mTileLoop = TileLoop::Jobs;
-    uint32_t mShard = 0;      ///< This shard (0-based) ...
-    uint32_t mShardCount = 1; ///< ... of this many
+    uint32_t mShard = 0;                  ///< This shard (0-based) ...
+    uint32_t mShardCount = 1;             ///< ... of this many
     /// Called after each tile with (tiles done, tiles in all), one call at a time; may be empty
     std::function<void(uint32_t, uint32_t)> mProgress;
     /// Incremental: the previous bake's summary and navmesh (both or neither). A tile whose input hash is

@@ -260,8 +260,8 @@ int main(int argc, char** argv)
         const navmesh::IndexedMesh mesh = navmesh::LoadObjMesh(path).Value();
         bake::BakeSettings settings;
         settings.mInputs = {path};
-        std::vector<double> direct, one, two, twoOpenMP;
-        uint64_t directPolygons = 0, onePolygons = 0, twoPolygons = 0, twoOpenMPPolygons = 0;
+        std::vector<double> direct, one, two;
+        uint64_t directPolygons = 0, onePolygons = 0, twoPolygons = 0;
         for (int rep = 0; rep < repetitions; ++rep)
         {
             const auto [ms, polygons] = DirectBuild(mesh, settings.mProfile);
@@ -275,20 +275,13 @@ int main(int argc, char** argv)
             const bake::BakeResult r2 = bake::Bake(settings).Value();
             two.push_back(r2.mBakeMs);
             twoPolygons = r2.mPolygons;
-            settings.mTileLoop = bake::BakeSettings::TileLoop::OpenMP;
-            const bake::BakeResult r2OpenMP = bake::Bake(settings).Value();
-            settings.mTileLoop = bake::BakeSettings::TileLoop::Jobs;
-            twoOpenMP.push_back(r2OpenMP.mBakeMs);
-            twoOpenMPPolygons = r2OpenMP.mPolygons;
         }
         std::printf(
             "bake_vs_direct %-15s direct %.1f ms  bake 1 thread %.1f ms (%.2fx direct)  2 threads %.1f ms "
-            "(speed-up %.2fx)  2 threads OpenMP %.1f ms (%.2fx the jobs')  | checksum polygons %llu %llu "
-            "%llu %llu\n",
+            "(speed-up %.2fx)  | checksum polygons %llu %llu %llu\n",
             name, Median(direct), Median(one), Median(one) / Median(direct), Median(two),
-            Median(one) / Median(two), Median(twoOpenMP), Median(twoOpenMP) / Median(two),
-            (unsigned long long)directPolygons, (unsigned long long)onePolygons,
-            (unsigned long long)twoPolygons, (unsigned long long)twoOpenMPPolygons);
+            Median(one) / Median(two), (unsigned long long)directPolygons, (unsigned long long)onePolygons,
+            (unsigned long long)twoPolygons);
     }
     return 0;
 }
