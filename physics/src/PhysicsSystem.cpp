@@ -1,10 +1,10 @@
 #include "cairn/physics/PhysicsSystem.h"
 
 #include "PhysicsStep.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/LockWaits.h"
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 
 namespace cairn
 {

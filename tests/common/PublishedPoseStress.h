@@ -27,10 +27,10 @@
 // result is a "duplicate", and a published rotation that is not unit length (a pose torn between two
 // publications would mix two rotations' components) is a "torn pose".
 
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/body/PublishedPose.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "common/StaticFloor.h"

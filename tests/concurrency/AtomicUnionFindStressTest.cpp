@@ -8,8 +8,8 @@
 // Checked against broken Unions: with no retry after a failed compare-exchange, or a plain store instead of
 // it, the groups and clusters runs lost links in each of 12 release runs tried.
 
-#include "cairn/physics/islands/AtomicUnionFind.h"
 #include "common/SequentialIslands.h"
+#include "islands/AtomicUnionFind.h"
 
 #include <algorithm>
 #include <atomic>

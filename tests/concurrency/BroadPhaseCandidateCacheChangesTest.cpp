@@ -4,7 +4,7 @@
 // removes that overlap a search may be seen either way. Run under ThreadSanitizer in CI (the cache's entries
 // are written by the search's range threads, the change counts by the modifier).
 
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
 #include <atomic>

@@ -3,8 +3,8 @@
 // exactly the pairs of the brute-force reference: not one missed or extra because a sub-tree was being
 // rebuilt, swapped in or freed. Run under ThreadSanitizer in CI.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,8 +1,8 @@
 // The quad-tree broad phase's "no missed collisions" stress, short run (see common/NoMissStress.h): part of
 // the test command and run under ThreadSanitizer in CI. The 2-million-check run is tests/long/.
 
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/NoMissStress.h"
 
 #include <gtest/gtest.h>

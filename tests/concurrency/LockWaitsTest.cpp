@@ -6,13 +6,13 @@
 
 #include "cairn/physics/LockWaits.h"
 
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/StripedSharedMutex.h"
+#include "broadphase/WriterFairSharedMutex.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/body/BodyManager.h"
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/StripedSharedMutex.h"
-#include "cairn/physics/broadphase/WriterFairSharedMutex.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 

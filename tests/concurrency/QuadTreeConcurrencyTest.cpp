@@ -5,7 +5,7 @@
 //  - Links vs queries: adder threads link batches concurrently (filling root slots and replacing the root);
 //    once a batch's LinkSubTree has returned, every query must find its bodies.
 
-#include "cairn/physics/broadphase/QuadTree.h"
+#include "broadphase/QuadTree.h"
 
 #include <atomic>
 #include <chrono>

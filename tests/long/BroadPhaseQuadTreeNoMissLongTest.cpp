@@ -2,7 +2,7 @@
 // misses (issue 3, done-when 2). Label "long": not part of the default test command; run it with
 // `ctest --test-dir build/release -L long` (or under TSan with the tsan preset).
 
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/NoMissStress.h"
 
 #include <gtest/gtest.h>

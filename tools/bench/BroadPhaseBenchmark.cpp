@@ -14,10 +14,10 @@
 // schedstat): what a query costs a thread with a core of its own, lock waits included (the `own_core`
 // counters).
 
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchThreads.h"
 #include "common/FrameTimes.h"

@@ -2,14 +2,14 @@
 // prints ns per call and, as counters, the share of pairs that made contact and the manifolds per call: the
 // proof that the work was done.
 
-#include "cairn/physics/narrowphase/CollideBoxBox.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
-#include "cairn/physics/narrowphase/CollideSphereBox.h"
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "narrowphase/CollideBoxBox.h"
+#include "narrowphase/CollideSphereBox.h"
+#include "narrowphase/CollideSphereSphere.h"
 
 #include <array>
 #include <benchmark/benchmark.h>

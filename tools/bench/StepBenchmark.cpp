@@ -6,9 +6,9 @@
 // each thread count of --threads (default 1,2: a job system of that many threads), then the speed-up. The
 // checksum must not change with the thread count (the step is deterministic across thread counts).
 
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "common/BenchOptions.h"
 #include "common/BenchScenes.h"
 #include "common/FrameTimes.h"

@@ -16,8 +16,8 @@
 // at least the share of Union ends that are not roots: 1.66 on the piles graph and 1.60 on the uniform one
 // (each body has about 6 contact ends), whatever the algorithm.
 
-#include "cairn/physics/islands/AtomicUnionFind.h"
 #include "common/BenchThreads.h"
+#include "islands/AtomicUnionFind.h"
 
 #include <algorithm>
 #include <barrier>

@@ -5,8 +5,13 @@ namespace cairn
 {
 
 PoseReader::PoseReader(const BodyManager& inBodies)
-    : mStore(inBodies.GetPublishedPoses()), mScope(mStore.GetReclaimer())
+    : mStore(inBodies.GetPublishedPoses()), mEpochReaders(mStore.GetReclaimer().Enter())
 {
+}
+
+PoseReader::~PoseReader()
+{
+    EpochReclaimer::Exit(mEpochReaders);
 }
 
 bool PoseReader::Read(const BodyID& inID, PublishedPose& outPose) const

@@ -12,9 +12,9 @@
 //  - The epoch: readers register in the reclaimer's stripes (never wait); it is advanced only under
 //    mRetiredMutex, so by one thread at a time as EpochReclaimer requires.
 
+#include "broadphase/EpochReclaimer.h"
 #include "cairn/physics/body/Body.h"
 #include "cairn/physics/body/PublishedPose.h"
-#include "cairn/physics/broadphase/EpochReclaimer.h"
 
 #include <atomic>
 #include <memory>

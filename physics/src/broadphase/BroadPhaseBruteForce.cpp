@@ -1,7 +1,7 @@
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseBruteForce.h"
 
+#include "broadphase/BroadPhaseOverlap.h"
 #include "cairn/physics/LockWaits.h"
-#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
 
 #include <cassert>
 #include <mutex>

@@ -1,4 +1,4 @@
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
 
 #include <cassert>
 #include <mutex>

@@ -1,7 +1,7 @@
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include "PairCandidateCache.h"
-#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
+#include "broadphase/BroadPhaseOverlap.h"
 
 #include <cassert>
 

@@ -1,6 +1,6 @@
-#include "cairn/physics/broadphase/EpochReclaimer.h"
+#include "broadphase/EpochReclaimer.h"
 
-#include "cairn/physics/broadphase/ThreadStripe.h"
+#include "broadphase/ThreadStripe.h"
 
 namespace cairn
 {

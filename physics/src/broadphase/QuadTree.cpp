@@ -1,7 +1,7 @@
-#include "cairn/physics/broadphase/QuadTree.h"
+#include "broadphase/QuadTree.h"
 
 #include "QuadTreeInternal.h"
-#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
+#include "broadphase/BroadPhaseOverlap.h"
 
 #include <algorithm>
 #include <bit>

@@ -4,7 +4,7 @@
 // with each placed item is the caller's affair.
 
 #include "QuadTreeInternal.h"
-#include "cairn/physics/broadphase/QuadTree.h"
+#include "broadphase/QuadTree.h"
 
 #include <algorithm>
 #include <array>

@@ -3,8 +3,8 @@
 // Pieces shared by QuadTree.cpp (live tree) and QuadTreeRebuild.cpp (rebuild): the traversal stack, the
 // atomic min/max and the build item. Private to the physics library.
 
-#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
-#include "cairn/physics/broadphase/QuadTree.h"
+#include "broadphase/BroadPhaseOverlap.h"
+#include "broadphase/QuadTree.h"
 
 #if defined(__SSE2__)
 #include <immintrin.h>

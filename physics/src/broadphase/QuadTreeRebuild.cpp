@@ -17,7 +17,7 @@
 //  after it the new one, which already holds every modification made before the commit.
 
 #include "QuadTreeInternal.h"
-#include "cairn/physics/broadphase/QuadTree.h"
+#include "broadphase/QuadTree.h"
 
 #include <algorithm>
 #include <bit>

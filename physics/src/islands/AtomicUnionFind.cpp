@@ -1,4 +1,4 @@
-#include "cairn/physics/islands/AtomicUnionFind.h"
+#include "islands/AtomicUnionFind.h"
 
 #include <algorithm>
 

@@ -2,8 +2,8 @@
 // sharing a dynamic body, so that every thread can solve a part of each color at once. A coloring is reused
 // while the island's constraints join the same bodies in the same order (a resting pile).
 
-#include "cairn/physics/math/RadixSort.h"
 #include "islands/IslandStage.h"
+#include "math/RadixSort.h"
 #include "narrowphase/ContactsStage.h"
 #include "step/StepContext.h"
 

@@ -1,8 +1,8 @@
 // IslandStage::Order: each island's constraints in solve order, the islands by size, and how each island is
 // solved (colored by every thread, colored or whole by one thread, or in a group of small ones).
 
-#include "cairn/physics/math/RadixSort.h"
 #include "islands/IslandStage.h"
+#include "math/RadixSort.h"
 #include "narrowphase/ContactsStage.h"
 #include "solver/WideContactSolver.h"
 #include "step/StepContext.h"

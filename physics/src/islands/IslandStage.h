@@ -6,8 +6,8 @@
 // colors the large ones (IslandColoring.cpp). Serial, on the updating thread: the islands' numbering and
 // the orders do not depend on the number of threads.
 
-#include "cairn/physics/solver/ContactConstraint.h"
 #include "islands/SolvePlan.h"
+#include "solver/ContactConstraint.h"
 
 #include <array>
 #include <cstdint>

@@ -6,7 +6,7 @@
 // updating thread; read by the solver's jobs, which also rewrite mIslandConstraints' entries (each task its
 // own islands') to point at the copies they solve.
 
-#include "cairn/physics/solver/ContactConstraint.h"
+#include "solver/ContactConstraint.h"
 
 #include <cstdint>
 #include <span>

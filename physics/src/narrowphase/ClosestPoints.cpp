@@ -1,4 +1,4 @@
-#include "cairn/physics/narrowphase/ClosestPoints.h"
+#include "narrowphase/ClosestPoints.h"
 
 #include <algorithm>
 

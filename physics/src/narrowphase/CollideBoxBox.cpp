@@ -1,7 +1,7 @@
-#include "cairn/physics/narrowphase/CollideBoxBox.h"
+#include "narrowphase/CollideBoxBox.h"
 
-#include "cairn/physics/narrowphase/ClosestPoints.h"
-#include "cairn/physics/narrowphase/FaceClipping.h"
+#include "narrowphase/ClosestPoints.h"
+#include "narrowphase/FaceClipping.h"
 
 #include <utility>
 

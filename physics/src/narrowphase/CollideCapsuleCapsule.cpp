@@ -1,7 +1,7 @@
-#include "cairn/physics/narrowphase/CollideCapsuleCapsule.h"
+#include "narrowphase/CollideCapsuleCapsule.h"
 
-#include "cairn/physics/narrowphase/ClosestPoints.h"
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
+#include "narrowphase/ClosestPoints.h"
+#include "narrowphase/CollideSphereSphere.h"
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
-#include "cairn/physics/narrowphase/CollideConvexConvex.h"
+#include "narrowphase/CollideConvexConvex.h"
 
-#include "cairn/physics/narrowphase/FaceClipping.h"
+#include "narrowphase/FaceClipping.h"
 
 namespace cairn
 {

@@ -1,9 +1,9 @@
-#include "cairn/physics/narrowphase/CollideConvexTriangles.h"
+#include "narrowphase/CollideConvexTriangles.h"
 
-#include "cairn/physics/narrowphase/ClosestPoints.h"
-#include "cairn/physics/narrowphase/ConvexContact.h"
-#include "cairn/physics/narrowphase/FaceClipping.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "narrowphase/ClosestPoints.h"
+#include "narrowphase/ConvexContact.h"
+#include "narrowphase/FaceClipping.h"
 
 #include <algorithm>
 

@@ -1,13 +1,13 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 
-#include "cairn/physics/narrowphase/CollideBoxBox.h"
-#include "cairn/physics/narrowphase/CollideCapsuleCapsule.h"
-#include "cairn/physics/narrowphase/CollideConvexConvex.h"
-#include "cairn/physics/narrowphase/CollideConvexTriangles.h"
-#include "cairn/physics/narrowphase/CollideSphereBox.h"
-#include "cairn/physics/narrowphase/CollideSphereCapsule.h"
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
 #include "cairn/physics/shapes/CompoundShape.h"
+#include "narrowphase/CollideBoxBox.h"
+#include "narrowphase/CollideCapsuleCapsule.h"
+#include "narrowphase/CollideConvexConvex.h"
+#include "narrowphase/CollideConvexTriangles.h"
+#include "narrowphase/CollideSphereBox.h"
+#include "narrowphase/CollideSphereCapsule.h"
+#include "narrowphase/CollideSphereSphere.h"
 
 #include <utility>
 

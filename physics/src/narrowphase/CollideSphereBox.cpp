@@ -1,4 +1,4 @@
-#include "cairn/physics/narrowphase/CollideSphereBox.h"
+#include "narrowphase/CollideSphereBox.h"
 
 namespace cairn
 {

@@ -1,4 +1,4 @@
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
+#include "narrowphase/CollideSphereSphere.h"
 
 namespace cairn
 {

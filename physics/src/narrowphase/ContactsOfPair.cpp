@@ -4,8 +4,8 @@
 
 #include "body/Integration.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
-#include "cairn/physics/solver/SequentialImpulseSolver.h"
 #include "narrowphase/ContactsStage.h"
+#include "solver/SequentialImpulseSolver.h"
 #include "step/StepContext.h"
 
 #include <cmath>

@@ -1,7 +1,7 @@
 #include "narrowphase/ContactsStage.h"
 
 #include "cairn/physics/LockWaits.h"
-#include "cairn/physics/math/RadixSort.h"
+#include "math/RadixSort.h"
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
 

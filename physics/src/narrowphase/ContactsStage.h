@@ -11,8 +11,8 @@
 // chunk's output, the island links (lock-free) and the contact cache entries the merge gave it.
 
 #include "cairn/physics/body/Body.h"
-#include "cairn/physics/solver/ContactCache.h"
-#include "cairn/physics/solver/ContactConstraint.h"
+#include "solver/ContactCache.h"
+#include "solver/ContactConstraint.h"
 
 #include <cstdint>
 #include <optional>

@@ -1,6 +1,6 @@
-#include "cairn/physics/narrowphase/ConvexContact.h"
+#include "narrowphase/ConvexContact.h"
 
-#include "cairn/physics/narrowphase/Epa.h"
+#include "narrowphase/Epa.h"
 
 namespace cairn
 {

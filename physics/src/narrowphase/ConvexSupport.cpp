@@ -1,4 +1,4 @@
-#include "cairn/physics/narrowphase/ConvexSupport.h"
+#include "narrowphase/ConvexSupport.h"
 
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/CapsuleShape.h"

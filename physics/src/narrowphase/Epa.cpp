@@ -1,6 +1,6 @@
-#include "cairn/physics/narrowphase/Epa.h"
+#include "narrowphase/Epa.h"
 
-#include "cairn/physics/narrowphase/ClosestPoints.h"
+#include "narrowphase/ClosestPoints.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "cairn/physics/narrowphase/FaceClipping.h"
+#include "narrowphase/FaceClipping.h"
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
-#include "cairn/physics/narrowphase/Gjk.h"
+#include "narrowphase/Gjk.h"
 
-#include "cairn/physics/narrowphase/ClosestPoints.h"
+#include "narrowphase/ClosestPoints.h"
 
 #include <algorithm>
 

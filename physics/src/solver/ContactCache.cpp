@@ -1,4 +1,4 @@
-#include "cairn/physics/solver/ContactCache.h"
+#include "solver/ContactCache.h"
 
 #include <algorithm>
 

@@ -11,10 +11,10 @@
 // islands' constraints, their bodies, their solver blocks, position constraints and cache entries; a colored
 // island solved by every thread is written part by part between the stages of StepScheduler::RunStages.
 
-#include "cairn/physics/solver/ContactConstraint.h"
-#include "cairn/physics/solver/SequentialImpulseSolver.h"
-#include "cairn/physics/solver/SolverBody.h"
 #include "islands/SolvePlan.h"
+#include "solver/ContactConstraint.h"
+#include "solver/SequentialImpulseSolver.h"
+#include "solver/SolverBody.h"
 #include "solver/WideContactSolver.h"
 
 #include <cstdint>

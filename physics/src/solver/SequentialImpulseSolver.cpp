@@ -1,4 +1,4 @@
-#include "cairn/physics/solver/SequentialImpulseSolver.h"
+#include "solver/SequentialImpulseSolver.h"
 
 #include "body/Integration.h"
 #include "cairn/physics/body/Body.h"

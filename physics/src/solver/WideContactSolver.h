@@ -13,9 +13,9 @@
 // restitution pass) or stored straight into the contact cache. No locks: the batches of one color are split
 // between threads, colors in turn.
 
-#include "cairn/physics/solver/ContactCache.h"
-#include "cairn/physics/solver/ContactConstraint.h"
-#include "cairn/physics/solver/SolverBody.h"
+#include "solver/ContactCache.h"
+#include "solver/ContactConstraint.h"
+#include "solver/SolverBody.h"
 
 #include <span>
 

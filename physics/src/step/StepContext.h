@@ -9,8 +9,8 @@
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
-#include "cairn/physics/islands/AtomicUnionFind.h"
-#include "cairn/physics/solver/ContactCache.h"
+#include "islands/AtomicUnionFind.h"
+#include "solver/ContactCache.h"
 
 #include <atomic>
 #include <cstdint>

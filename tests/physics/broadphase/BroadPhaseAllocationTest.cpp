@@ -2,9 +2,9 @@
 // navmesh collector). The test program's global operator new counts (common/AllocationCounter); after a
 // warm-up, 1,000 queries of each kind (and pair searches) on every broad phase must allocate nothing.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/AllocationCounter.h"
 
 #include <gtest/gtest.h>

@@ -5,8 +5,8 @@
 // entry keeps, a full table, a body listed twice), the pairs must be exactly the brute-force reference's; and
 // the cache must really serve the queries of resting bodies, else these tests would prove nothing.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
 #include <atomic>

@@ -2,9 +2,9 @@
 // faces, swept boxes, layer filters, pairs reported once, aborted batches and ignored bad input. Every case
 // runs before and after Update(), so the quad tree's linked sub-trees and its rebuilt trees both get tested.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>

@@ -4,9 +4,9 @@
 // are the checksums that the broad-phase benchmark (tools/bench/BroadPhaseBenchmark.cpp) prints; the timings
 // are the benchmark's job.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseGlobalMutex.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseGlobalMutex.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>

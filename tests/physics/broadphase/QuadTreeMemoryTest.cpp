@@ -1,8 +1,8 @@
 // The quad tree's memory: how full its nodes are after a build, and how soon a rebuild's old nodes are freed.
 // Both set the broad phase's bytes per body (docs/BENCHMARKS.md, bp_add_batch and bp_memory_running).
 
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/body/Layers.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
 #include "common/SharedBenchData.h"
 #include "common/TestRandom.h"
 

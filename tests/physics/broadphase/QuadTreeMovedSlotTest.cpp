@@ -3,8 +3,8 @@
 // of a steady fall, write no node, so the tree is unchanged and the next update rebuilds nothing. Queries
 // must still report exactly the bodies whose own bounds match, not their grown slots.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/TestRandom.h"
 
 #include <algorithm>

@@ -25,8 +25,8 @@
 // requires it to fail, so a property that can no longer see differences does not pass silently.
 // Everything runs on one thread: this checks the sequential semantics, not the lock-free interleavings.
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 #include "common/TestRandom.h"
 
 #include <algorithm>

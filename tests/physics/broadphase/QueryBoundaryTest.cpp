@@ -3,9 +3,9 @@
 // two disagree about bodies on the query's surface (found by QuadTreePropertyTest: a squared distance summed
 // in another order was 1 ulp over the squared radius in one and equal to it in the other).
 
-#include "cairn/physics/broadphase/BroadPhaseBruteForce.h"
-#include "cairn/physics/broadphase/BroadPhaseOverlap.h"
-#include "cairn/physics/broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/BroadPhaseBruteForce.h"
+#include "broadphase/BroadPhaseOverlap.h"
+#include "broadphase/BroadPhaseQuadTree.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // their lowest body with ascending body lists, self links, empty graphs, out-of-range indices, and Reset
 // reusing its storage. The concurrent interleavings are in tests/concurrency/AtomicUnionFindStressTest.cpp.
 
-#include "cairn/physics/islands/AtomicUnionFind.h"
+#include "islands/AtomicUnionFind.h"
 
 #include "common/AllocationCounter.h"
 #include "common/SequentialIslands.h"

@@ -1,7 +1,7 @@
 // RadixSort against std::stable_sort: the same order for any keys (duplicates included), any key width and
 // any count, so the step's sorts give the results the comparison sorts gave.
 
-#include "cairn/physics/math/RadixSort.h"
+#include "math/RadixSort.h"
 
 #include <algorithm>
 #include <cstdint>

@@ -1,11 +1,11 @@
 // Each dedicated pair routine against the generic GJK/EPA answer on random overlapping configurations.
 
-#include "cairn/physics/narrowphase/CollideBoxBox.h"
-#include "cairn/physics/narrowphase/CollideCapsuleCapsule.h"
-#include "cairn/physics/narrowphase/CollideSphereBox.h"
-#include "cairn/physics/narrowphase/CollideSphereCapsule.h"
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
-#include "cairn/physics/narrowphase/ConvexContact.h"
+#include "narrowphase/CollideBoxBox.h"
+#include "narrowphase/CollideCapsuleCapsule.h"
+#include "narrowphase/CollideSphereBox.h"
+#include "narrowphase/CollideSphereCapsule.h"
+#include "narrowphase/CollideSphereSphere.h"
+#include "narrowphase/ConvexContact.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>

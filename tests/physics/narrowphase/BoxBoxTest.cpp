@@ -1,8 +1,8 @@
 // Hand-made box-box cases with analytic answers: face-face manifolds, edge-edge, rotations, touching and
 // separated boxes, and the reduction of a clipped octagon to 4 points.
 
-#include "cairn/physics/narrowphase/CollideBoxBox.h"
-#include "cairn/physics/narrowphase/ConvexContact.h"
+#include "narrowphase/CollideBoxBox.h"
+#include "narrowphase/ConvexContact.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Hand-made capsule-capsule cases with analytic answers.
 
-#include "cairn/physics/narrowphase/CollideCapsuleCapsule.h"
+#include "narrowphase/CollideCapsuleCapsule.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>

@@ -1,12 +1,12 @@
 // Convex shapes against triangle meshes and height fields: face contacts, one-sidedness, internal edges
 // (a sphere or box moving across a flat grid only ever sees up normals) and active border edges.
 
-#include "cairn/physics/narrowphase/CollideConvexTriangles.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "narrowphase/CollideConvexTriangles.h"
 
 #include <array>
 #include <gtest/gtest.h>

@@ -1,11 +1,11 @@
 // GJK distances and EPA penetrations against analytic answers, including touching and degenerate cases.
 
-#include "cairn/physics/narrowphase/ConvexContact.h"
-#include "cairn/physics/narrowphase/Epa.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "narrowphase/ConvexContact.h"
+#include "narrowphase/Epa.h"
 
 #include <gtest/gtest.h>
 #include <random>

@@ -1,8 +1,8 @@
 // Hand-made cases with analytic answers for sphere-sphere, sphere-box and sphere-capsule.
 
-#include "cairn/physics/narrowphase/CollideSphereBox.h"
-#include "cairn/physics/narrowphase/CollideSphereCapsule.h"
-#include "cairn/physics/narrowphase/CollideSphereSphere.h"
+#include "narrowphase/CollideSphereBox.h"
+#include "narrowphase/CollideSphereCapsule.h"
+#include "narrowphase/CollideSphereSphere.h"
 
 #include <gtest/gtest.h>
 

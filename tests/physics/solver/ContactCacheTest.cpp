@@ -1,6 +1,6 @@
 // ContactCache: what one step stores, the next finds, whatever order the narrow phase added it in.
 
-#include "cairn/physics/solver/ContactCache.h"
+#include "solver/ContactCache.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>

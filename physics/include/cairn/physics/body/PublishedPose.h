@@ -25,9 +25,9 @@
 #include "cairn/physics/body/BodyID.h"
 #include "cairn/physics/body/Layers.h"
 #include "cairn/physics/body/MotionType.h"
-#include "cairn/physics/broadphase/EpochReclaimer.h"
 #include "cairn/physics/math/Transform.h"
 
+#include <atomic>
 #include <cstdint>
 
 namespace cairn
@@ -59,6 +59,7 @@ class PoseReader
 {
 public:
     explicit PoseReader(const BodyManager& inBodies);
+    ~PoseReader();
     PoseReader(const PoseReader&) = delete;
     PoseReader& operator=(const PoseReader&) = delete;
 
@@ -68,7 +69,9 @@ public:
 
 private:
     const PublishedPoseStore& mStore;
-    EpochReclaimer::ReadScope mScope;
+    /// The epoch read section this reader holds open, entered by the constructor and left by the destructor:
+    /// an EpochReclaimer::ReadScope's counter, kept here so that the reclaimer stays out of installed headers
+    std::atomic<uint32_t>& mEpochReaders;
 };
 
 } // namespace cairn

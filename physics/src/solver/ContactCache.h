@@ -14,8 +14,8 @@
 // nothing writes until the next BeginStep: no locks.
 
 #include "cairn/physics/body/BodyID.h"
-#include "cairn/physics/math/UninitializedAllocator.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
+#include "math/UninitializedAllocator.h"
 
 #include <span>
 #include <type_traits>

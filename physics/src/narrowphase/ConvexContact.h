@@ -11,7 +11,7 @@
 // sitting on the boundary is ill-conditioned). The inflation is removed from the result exactly: inflating
 // both shapes by r adds exactly 2r to the penetration depth along the same normal.
 
-#include "cairn/physics/narrowphase/ConvexSupport.h"
+#include "narrowphase/ConvexSupport.h"
 
 namespace cairn
 {

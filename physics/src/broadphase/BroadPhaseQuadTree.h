@@ -29,8 +29,8 @@
 // index that is already present or prepared (the first add stays), removing or moving a body that is not
 // present.
 
+#include "broadphase/QuadTree.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
-#include "cairn/physics/broadphase/QuadTree.h"
 
 #include <array>
 #include <memory>

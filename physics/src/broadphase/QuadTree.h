@@ -32,11 +32,11 @@
 //    after a commit never touches a node that commit retired.
 // Queries allocate nothing: fixed-size traversal stack (spilling to the heap only for degenerate depths).
 
+#include "broadphase/EpochReclaimer.h"
+#include "broadphase/NodeAllocator.h"
+#include "broadphase/QuadTreeBodyTable.h"
+#include "broadphase/StripedSharedMutex.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
-#include "cairn/physics/broadphase/EpochReclaimer.h"
-#include "cairn/physics/broadphase/NodeAllocator.h"
-#include "cairn/physics/broadphase/QuadTreeBodyTable.h"
-#include "cairn/physics/broadphase/StripedSharedMutex.h"
 
 #include <atomic>
 #include <cstddef>

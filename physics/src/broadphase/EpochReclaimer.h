@@ -11,10 +11,10 @@
 // has advanced twice past r (E >= r + 2): the advance to r + 1 waited out the readers of r - 1, the one to
 // r + 2 those of r. The retired lists are tagged by epoch, so any number of tree swaps per update is safe.
 //
-// Threads: Enter/Exit (through ReadScope) from any thread, any number at once. TryAdvance and GetEpoch from
-// one updater thread at a time (the quad tree's owner of rebuilds). Stripes keep readers on different
-// threads off each other's cache lines: the reference engine's single read-write mutex cost each thread
-// 500 us per frame in contention, 32 stripes 10 us.
+// Threads: Enter/Exit (through ReadScope, or PoseReader) from any thread, any number at once. TryAdvance and
+// GetEpoch from one updater thread at a time (the quad tree's owner of rebuilds). Stripes keep readers on
+// different threads off each other's cache lines: the reference engine's single read-write mutex cost each
+// thread 500 us per frame in contention, 32 stripes 10 us.
 // Memory orders: the reader's increment and re-check and the updater's count check and advance are seq_cst,
 // because the argument above needs one total order of "reader registered" and "epoch advanced" (a
 // store-load pattern that acquire/release does not order).
@@ -34,22 +34,24 @@ public:
     class ReadScope
     {
     public:
-        explicit ReadScope(const EpochReclaimer& inReclaimer) : mReclaimer(inReclaimer)
-        {
-            mCounter = &mReclaimer.Enter();
-        }
-        ~ReadScope()
-        {
-            // Release: our reads of retired memory happen before the updater sees the count drop
-            mCounter->fetch_sub(1, std::memory_order_release);
-        }
+        explicit ReadScope(const EpochReclaimer& inReclaimer) : mCounter(inReclaimer.Enter()) {}
+        ~ReadScope() { Exit(mCounter); }
         ReadScope(const ReadScope&) = delete;
         ReadScope& operator=(const ReadScope&) = delete;
 
     private:
-        const EpochReclaimer& mReclaimer;
-        std::atomic<uint32_t>* mCounter = nullptr;
+        std::atomic<uint32_t>& mCounter;
     };
+
+    /// Enters a read section and returns the counter that Exit must be given to leave it. ReadScope pairs
+    /// them; PoseReader calls them itself, because its installed header must not name this internal class.
+    std::atomic<uint32_t>& Enter() const;
+    /// Leaves the read section that Enter returned ioCounter for.
+    static void Exit(std::atomic<uint32_t>& ioCounter)
+    {
+        // Release: our reads of retired memory happen before the updater sees the count drop
+        ioCounter.fetch_sub(1, std::memory_order_release);
+    }
 
     EpochReclaimer() = default;
     EpochReclaimer(const EpochReclaimer&) = delete;
@@ -72,9 +74,6 @@ private:
     {
         mutable std::atomic<uint32_t> mReaders[2] = {0, 0}; ///< Readers inside, by the parity of their epoch
     };
-
-    /// Registers a reader; returns the counter to decrement on exit.
-    std::atomic<uint32_t>& Enter() const;
 
     Stripe mStripes[cNumStripes];
     std::atomic<uint64_t> mEpoch = 2; ///< Starts at 2 so that "retired + 2" never wraps below zero

@@ -15,8 +15,8 @@
 // check are seq_cst (a store-load pattern in each thread that acquire/release does not order); the unlocks
 // are release and pair with the acquire of the next locker's loads.
 
+#include "broadphase/ThreadStripe.h"
 #include "cairn/physics/LockWaits.h"
-#include "cairn/physics/broadphase/ThreadStripe.h"
 
 #include <atomic>
 #include <mutex>

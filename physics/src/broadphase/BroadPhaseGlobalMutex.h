@@ -18,8 +18,8 @@
 // Two overlapping Updates (two threads stepping one world: a caller bug) queue on the exclusive lock, so the
 // wrapped broad phase never sees them overlap (the lock-free quad tree would refuse and count the second).
 
+#include "broadphase/WriterFairSharedMutex.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
-#include "cairn/physics/broadphase/WriterFairSharedMutex.h"
 
 #include <memory>
 

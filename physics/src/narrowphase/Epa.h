@@ -5,7 +5,7 @@
 // stopped with fewer points (touching or the origin on a simplex edge), then grows a polytope inside the
 // Minkowski difference towards the face closest to the origin. Fixed-capacity polytope: no allocation.
 
-#include "cairn/physics/narrowphase/Gjk.h"
+#include "narrowphase/Gjk.h"
 
 namespace cairn
 {

@@ -5,7 +5,7 @@
 // that much), which turns a core into the full shape, or the full shape into a slightly fatter one for EPA.
 // Fixed-size simplex, no allocation, at most cMaxIterations support calls per shape.
 
-#include "cairn/physics/narrowphase/ConvexSupport.h"
+#include "narrowphase/ConvexSupport.h"
 
 namespace cairn
 {

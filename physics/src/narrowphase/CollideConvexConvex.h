@@ -6,7 +6,7 @@
 // point is used.
 
 #include "cairn/physics/narrowphase/CollideShapes.h"
-#include "cairn/physics/narrowphase/ConvexContact.h"
+#include "narrowphase/ConvexContact.h"
 
 namespace cairn
 {

@@ -14,9 +14,9 @@
 //    penetration beyond mPenetrationSlop, directly on positions.
 // Runs inside the step, by the one thread that owns the island: no locks.
 
-#include "cairn/physics/solver/ContactConstraint.h"
-#include "cairn/physics/solver/SolverBody.h"
 #include "cairn/physics/solver/SolverSettings.h"
+#include "solver/ContactConstraint.h"
+#include "solver/SolverBody.h"
 
 #include <span>
 
