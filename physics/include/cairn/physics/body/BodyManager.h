@@ -110,10 +110,6 @@ public:
     /// The published poses, for PoseReader.
     const PublishedPoseStore& GetPublishedPoses() const { return *mPoses; }
 
-    /// Locks every body mutex for write, in index order. The physics step only.
-    void LockAllBodies() const;
-    void UnlockAllBodies() const;
-
     /// True on the thread that holds every body lock (inside a step): locking calls there would deadlock.
     static bool IsInsideStep();
     /// Body locks (BodyLockRead/Write) the calling thread holds now. A thread may hold one at a time: a
@@ -124,6 +120,14 @@ public:
 
 private:
     friend class PhysicsStep;
+    friend class PhysicsSystem; // Update takes every body lock for the step (LockAllBodies)
+
+    /// Locks every body mutex for write, in index order, and marks this thread as inside the step. Update
+    /// only: a caller that does not release them on every way out (an exception too) locks the world for
+    /// good.
+    void LockAllBodies() const;
+    /// Unlocks what LockAllBodies locked and clears the mark.
+    void UnlockAllBodies() const;
     struct alignas(64) PaddedMutex // one cache line each, so shards do not false-share
     {
         mutable std::shared_mutex mMutex;
