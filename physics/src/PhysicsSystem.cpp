@@ -6,6 +6,8 @@
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/LockWaits.h"
 
+#include <utility>
+
 namespace cairn
 {
 
@@ -30,6 +32,19 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, 
     }
     return nullptr;
 }
+
+/// Runs a function when it goes out of scope, whichever way: a return or an exception.
+template <class Function> class ScopeExit
+{
+public:
+    explicit ScopeExit(Function inFunction) : mFunction(std::move(inFunction)) {}
+    ~ScopeExit() { mFunction(); }
+    ScopeExit(const ScopeExit&) = delete;
+    ScopeExit& operator=(const ScopeExit&) = delete;
+
+private:
+    Function mFunction;
+};
 
 Status ValidateSetup(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
 {
@@ -90,18 +105,47 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     if (mUpdating.exchange(true, std::memory_order_acquire))
         return MakeError(ErrorCode::WrongThread, "Update is already running on another thread");
 
+    // From here on, every way out (an exception from inside the step too: a BodyChangeListener that throws,
+    // std::bad_alloc) frees the body locks and this thread's inside-step mark with them, collects the shapes
+    // of bodies destroyed meanwhile, and clears the updater flag last, so that no other Update starts before
+    // the rest is undone
+    bool locked = false;
+    const ScopeExit release(
+        [&]
+        {
+            if (locked) mBodies->UnlockAllBodies();
+            // Shapes of bodies destroyed meanwhile, once no query can hold them
+            mBodies->CollectRetiredShapes();
+            // Release: the next updater sees everything this one wrote (pairs with the acquire above)
+            mUpdating.store(false, std::memory_order_release);
+        });
+    if (mStepInterrupted)
+    {
+        // The step's state between steps is caches only (bodies, their poses and the broad phase live
+        // elsewhere), so a fresh one is a world's first step again, with nothing to warm-start from
+        mStep = std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase);
+        mStepInterrupted = false;
+    }
+
     const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
     mBodies->LockAllBodies();
+    locked = true;
     mLastStatistics = {};
     mLastStatistics.mLockWaitMs = double(GetThisThreadLockWaitNanoseconds() - waitedBefore) / 1.0e6;
     const float stepTime = inDeltaTime / float(inCollisionSteps);
-    for (int step = 0; step < inCollisionSteps; ++step)
-        mStep->Run(stepTime, mLastStatistics, ioJobs);
-    mBodies->UnlockAllBodies();
-    // Shapes of bodies destroyed meanwhile, once no query can hold them
-    mBodies->CollectRetiredShapes();
-
-    mUpdating.store(false, std::memory_order_release);
+    try
+    {
+        for (int step = 0; step < inCollisionSteps; ++step)
+            mStep->Run(stepTime, mLastStatistics, ioJobs);
+    }
+    catch (...)
+    {
+        // Stopped halfway, its caches (contact cache, pair and island reuse) possibly half updated: the next
+        // Update starts from a fresh step. The bodies are left as the step last wrote them, each whole: what
+        // can throw (a listener, told after a change; an allocation) comes between changes to a body
+        mStepInterrupted = true;
+        throw;
+    }
     return Status::Ok();
 }
 

@@ -7,6 +7,9 @@
 //    holds every body mutex for write, so BodyInterface calls and narrow-phase reads from other threads wait
 //    for the step; broad-phase queries do not.
 //  - GetBodyInterface() / GetWorldQuery(): from any thread, outside step callbacks.
+// Exceptions: what the step throws (a BodyChangeListener's exception, std::bad_alloc) leaves Update as it is,
+// with every body lock released, so that other threads go on; the next Update starts from a fresh step (the
+// warm starts and reused pairs and colorings of the interrupted one are dropped) and works.
 // The step: broad-phase update -> velocities (gravity, forces, damping) -> broad-phase pairs -> narrow phase
 // (contacts, warm-start lookup, island links) -> islands -> per island: warm start, velocity iterations,
 // restitution, symplectic Euler integration, position iterations -> bounds to the broad phase -> sleeping.
@@ -90,6 +93,9 @@ private:
     Status UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs);
     std::atomic<bool> mUpdating{false}; ///< Guards against concurrent Update calls (acquire/release below)
     StepStatistics mLastStatistics;     ///< Written by the updating thread only
+    /// The last step threw halfway: mStep's caches may be half updated, and the next Update replaces it. Read
+    /// and written by the updating thread only (ordered from one updater to the next by mUpdating)
+    bool mStepInterrupted = false;
 };
 
 } // namespace cairn
