@@ -136,10 +136,12 @@ TEST(BakeTest, ThreadCountAndShardsDoNotChangeTheBytes)
         return result.Value().mNavMesh;
     };
     const std::string one = TempPath("one.navmesh"), two = TempPath("two.navmesh"),
-                      merged = TempPath("merged.navmesh");
+                      four = TempPath("four.navmesh"), merged = TempPath("merged.navmesh");
     bakeTo(1, 0, 1, one);
     bakeTo(2, 0, 1, two);
+    bakeTo(4, 0, 1, four);
     EXPECT_EQ(ReadBytes(one), ReadBytes(two));
+    EXPECT_EQ(ReadBytes(one), ReadBytes(four));
     const navmesh::NavMeshFileContents shard0 = bakeTo(2, 0, 2, TempPath("s0.navmesh"));
     const navmesh::NavMeshFileContents shard1 = bakeTo(1, 1, 2, TempPath("s1.navmesh"));
     EXPECT_FALSE(shard0.mTiles.empty());
@@ -150,7 +152,8 @@ TEST(BakeTest, ThreadCountAndShardsDoNotChangeTheBytes)
     EXPECT_EQ(ReadBytes(one), ReadBytes(merged));
     // A shard merged twice is refused
     EXPECT_FALSE(MergeShards({shard0, shard0}));
-    for (const char* name : {"one.navmesh", "two.navmesh", "merged.navmesh", "s0.navmesh", "s1.navmesh"})
+    for (const char* name :
+         {"one.navmesh", "two.navmesh", "four.navmesh", "merged.navmesh", "s0.navmesh", "s1.navmesh"})
         std::filesystem::remove(TempPath(name));
 }
 
