@@ -136,28 +136,28 @@ NavMeshWorld::~NavMeshWorld()
     dtFreeNavMesh(mNavMesh);
 }
 
-void NavMeshWorld::SubmitTile(BuiltTile&& inTile)
-{
-    std::lock_guard lock(mPendingMutex);
-    const TileCoord tile = inTile.mTile;
-    mPending[tile] = Pending{std::move(inTile), {}};
-}
-
-void NavMeshWorld::SubmitRemoval(const TileCoord& inTile)
+BuiltTile NavMeshWorld::Removal(const TileCoord& inTile)
 {
     BuiltTile empty;
     empty.mTile = inTile;
-    SubmitTile(std::move(empty));
+    return empty;
 }
 
-int NavMeshWorld::Publish()
+int NavMeshWorld::Publish(std::vector<BuiltTile>&& inChanges)
 {
-    std::map<TileCoord, Pending> pending;
+    if (inChanges.empty()) return 0;
+    struct Pending
     {
-        std::lock_guard lock(mPendingMutex);
-        pending.swap(mPending);
+        BuiltTile mTile;      ///< mData null: remove
+        std::string mProblem; ///< Why Detour can not take mTile (CheckTile), empty when it can
+    };
+    std::map<TileCoord, Pending> pending; // By tile, the last change wins; applied in tile order
+    for (BuiltTile& change : inChanges)
+    {
+        const TileCoord tile = change.mTile;
+        pending[tile] = Pending{std::move(change), {}};
     }
-    if (pending.empty()) return 0;
+    inChanges.clear();
     // Checked before the navmesh mutex is taken (the checks walk every polygon; path queries need not wait
     // for them) and before the old tile goes: a refused tile must not leave a hole where a good one was
     for (auto& [coord, entry] : pending)

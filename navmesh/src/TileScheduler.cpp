@@ -255,7 +255,8 @@ void TileScheduler::StartJob(const TileCoord& inTile, TileState& ioState)
     ++mStats.mJobsStarted;
 }
 
-bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
+bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState,
+                                    std::vector<BuiltTile>& ioChanges)
 {
     TileJob& job = *ioState.mJob;
     if (!job.IsFinished())
@@ -292,7 +293,7 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
     else
     {
         mStats.mBuildMs += result->Value().mBuildMs;
-        mWorld.SubmitTile(std::move(result->Value()));
+        ioChanges.push_back(std::move(result->Value()));
         if (!ioState.mEverPublished)
             mStats.mFirstPublishFrames.push_back(uint32_t(mFrame - ioState.mNeededSinceFrame));
         ioState.mEverPublished = true;
@@ -306,14 +307,15 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState)
 int TileScheduler::Update()
 {
     std::unordered_map<TileCoord, float> needed;
+    std::vector<BuiltTile> changes; // The one hand-off to the navmesh: finished tiles and dropped ones
     {
         std::lock_guard lock(mMutex);
         ++mFrame;
         CollectNeeded(needed);
 
-        // Finished jobs first: their tiles go into the navmesh's queue
+        // Finished jobs first: their tiles are this frame's changes
         for (auto& [tile, state] : mTiles)
-            if (state.mJob != nullptr) CollectFinished(tile, state);
+            if (state.mJob != nullptr) CollectFinished(tile, state, changes);
 
         // Newly needed tiles; needed ones are kept
         for (const auto& [tile, distance] : needed)
@@ -345,7 +347,7 @@ int TileScheduler::Update()
                 ++it;
                 continue;
             }
-            if (state.mEverPublished) mWorld.SubmitRemoval(it->first);
+            if (state.mEverPublished) changes.push_back(NavMeshWorld::Removal(it->first));
             ++mStats.mTilesDropped;
             it = mTiles.erase(it);
         }
@@ -370,7 +372,7 @@ int TileScheduler::Update()
         }
     }
     // The sync point: outside mMutex, since it waits for path queries in progress
-    const int changed = mWorld.Publish();
+    const int changed = mWorld.Publish(std::move(changes));
     std::string reason;
     if (const uint64_t refused = mWorld.GetRefusedTiles(&reason); refused != mRefusedSeen)
     {

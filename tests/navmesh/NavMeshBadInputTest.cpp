@@ -1,6 +1,7 @@
 // Bad input to the navmesh pipeline gets a clear error, never a crash: agent profiles out of range, tile
 // geometry with NaN or bad indices, malformed OBJ files.
 
+#include "TileChanges.h"
 #include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshWorld.h"
@@ -202,16 +203,14 @@ TEST(NavMeshBadInputTest, ATileDetourCannotTakeIsRefusedAndTheOldOneStays)
     TileGeometry geometry;
     geometry.AddTriangle(Vec3(0, 0, 0), Vec3(0, 0, 10), Vec3(10, 0, 0), cDefaultArea);
     auto build = [&] { return BuildTile(profile, grid, {0, 0}, geometry).Value(); };
-    world.Value()->SubmitTile(build());
-    ASSERT_EQ(world.Value()->Publish(), 1);
+    ASSERT_EQ(world.Value()->Publish(Changes(build())), 1);
     const int polygons = world.Value()->GetTilePolygonCount({0, 0});
     ASSERT_GT(polygons, 0);
 
     // As a tile of a dense scene would be: more polygons than the 32-bit references leave room for
     BuiltTile tooMany = build();
     tooMany.mNumPolygons = 1 << 20;
-    world.Value()->SubmitTile(std::move(tooMany));
-    EXPECT_EQ(world.Value()->Publish(), 0);
+    EXPECT_EQ(world.Value()->Publish(Changes(std::move(tooMany))), 0);
     std::string reason;
     EXPECT_EQ(world.Value()->GetRefusedTiles(&reason), 1u);
     EXPECT_NE(reason.find("polygons"), std::string::npos);

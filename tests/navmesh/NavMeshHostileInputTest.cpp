@@ -7,6 +7,7 @@
 // before Detour reads it; and that BuildTile refuses a tile grid that NavMeshWorld::Create would refuse.
 
 #include "NavMeshSceneFixture.h"
+#include "TileChanges.h"
 #include "cairn/navmesh/TileBuilder.h"
 
 #include <DetourAlloc.h>
@@ -188,14 +189,12 @@ TEST(NavMeshHostileInputWorldTest, TilesDetourCanNotTakeLeaveTheOldOneInPlace)
     auto world = NavMeshWorld::Create(grid, profile);
     ASSERT_TRUE(world);
     const BuiltTile good = BuildFlatTile(grid);
-    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader&) {}));
-    ASSERT_EQ(world.Value()->Publish(), 1);
+    ASSERT_EQ(world.Value()->Publish(Changes(CopyTile(good, [](dtMeshHeader&) {}))), 1);
     const int polygons = world.Value()->GetTilePolygonCount({0, 0});
     ASSERT_GT(polygons, 0);
 
     // Not Detour data at all (its magic number is gone): Detour refuses it without reading further
-    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.magic = 0; }));
-    (void)world.Value()->Publish();
+    (void)world.Value()->Publish(Changes(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.magic = 0; })));
     EXPECT_EQ(world.Value()->GetRefusedTiles(), 1u);
     EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons)
         << "the refused tile took the good one with it: a hole in the navmesh";
@@ -203,8 +202,7 @@ TEST(NavMeshHostileInputWorldTest, TilesDetourCanNotTakeLeaveTheOldOneInPlace)
 
     // Whole and consistent but with no room for links: addTile would end its free list before the section
     // and hand out links over the detail meshes
-    world.Value()->SubmitTile(WithoutLinks(good));
-    EXPECT_EQ(world.Value()->Publish(), 0);
+    EXPECT_EQ(world.Value()->Publish(Changes(WithoutLinks(good))), 0);
     EXPECT_EQ(world.Value()->GetRefusedTiles(), 2u);
     EXPECT_EQ(world.Value()->GetTilePolygonCount({0, 0}), polygons);
     EXPECT_TRUE(world.Value()->FindNearestPoint(Vec3(5, 0, 5)).IsOk());
@@ -220,8 +218,7 @@ TEST(NavMeshHostileInputWorldTest, ATileHandedInUnderAnotherCoordinateKeepsTheBo
     // Data built for tile (0, 0), handed in as tile (3, 3)
     BuiltTile mislabelled = BuildFlatTile(grid);
     mislabelled.mTile = {3, 3};
-    navMesh.SubmitTile(std::move(mislabelled));
-    (void)navMesh.Publish();
+    (void)navMesh.Publish(Changes(std::move(mislabelled)));
     const bool navMeshAtOrigin = navMesh.FindNearestPoint(Vec3(5, 0, 5)).IsOk();
     EXPECT_FALSE(navMesh.HasTile({3, 3})) << "reported at (3, 3), where Detour has nothing";
     EXPECT_EQ(navMesh.HasTile({0, 0}), navMeshAtOrigin)
@@ -229,11 +226,31 @@ TEST(NavMeshHostileInputWorldTest, ATileHandedInUnderAnotherCoordinateKeepsTheBo
     EXPECT_EQ(navMesh.GetNumTiles(), int(navMesh.SnapshotTiles().size()));
 
     // Removing it by the coordinate it was handed in under must remove it
-    navMesh.SubmitRemoval({3, 3});
-    (void)navMesh.Publish();
+    (void)navMesh.Publish(Changes(NavMeshWorld::Removal({3, 3})));
     EXPECT_EQ(navMesh.GetNumTiles(), 0) << "the world still lists it";
     EXPECT_TRUE(navMesh.SnapshotTiles().empty()) << "Detour still holds it: it can never be removed";
     EXPECT_FALSE(navMesh.FindNearestPoint(Vec3(5, 0, 5)).IsOk()) << "paths still use it";
+}
+
+TEST(NavMeshHostileInputWorldTest, OfATileListedTwiceInOnePublishTheLastChangeWins)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -1, 10);
+    auto world = NavMeshWorld::Create(grid, profile);
+    ASSERT_TRUE(world);
+    NavMeshWorld& navMesh = *world.Value();
+    const BuiltTile good = BuildFlatTile(grid);
+    std::vector<BuiltTile> builtThenRemoved;
+    builtThenRemoved.push_back(CopyTile(good, [](dtMeshHeader&) {}));
+    builtThenRemoved.push_back(NavMeshWorld::Removal({0, 0}));
+    EXPECT_EQ(navMesh.Publish(std::move(builtThenRemoved)), 0);
+    EXPECT_FALSE(navMesh.HasTile({0, 0}));
+    std::vector<BuiltTile> removedThenBuilt;
+    removedThenBuilt.push_back(NavMeshWorld::Removal({0, 0}));
+    removedThenBuilt.push_back(CopyTile(good, [](dtMeshHeader&) {}));
+    EXPECT_EQ(navMesh.Publish(std::move(removedThenBuilt)), 1);
+    EXPECT_TRUE(navMesh.HasTile({0, 0}));
+    EXPECT_EQ(navMesh.Publish({}), 0) << "nothing to change";
 }
 
 TEST(NavMeshHostileInputWorldTest, BuildTileRefusesAGridTheWorldWouldRefuse)
@@ -267,8 +284,8 @@ TEST(NavMeshHostileInputWorldTest, BuildTileRefusesAGridTheWorldWouldRefuse)
     auto world = NavMeshWorld::Create(grid, profile);
     if (!world) std::exit(2);
     const BuiltTile good = BuildFlatTile(grid);
-    world.Value()->SubmitTile(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.vertCount += 1000; }));
-    const int changed = world.Value()->Publish();
+    const int changed = world.Value()->Publish(
+        Changes(CopyTile(good, [](dtMeshHeader& ioHeader) { ioHeader.vertCount += 1000; })));
     // Use what Detour linked, as a path query would
     (void)world.Value()->FindNearestPoint(Vec3(5, 0, 5));
     (void)world.Value()->ToObj();

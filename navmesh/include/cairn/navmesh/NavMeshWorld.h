@@ -3,12 +3,13 @@
 // NavMeshWorld: stage 4, the published navmesh. Owns a tiled Detour dtNavMesh on a TileGrid and answers path
 // queries from any thread.
 //
-// Detour's navmesh is not thread-safe, so tiles are published at a sync point: tile jobs hand finished tiles
-// in with SubmitTile (any thread, under mPendingMutex), and Publish (the game's sync point, once a frame)
-// swaps them all in under mNavMeshMutex held exclusively. Path queries hold mNavMeshMutex shared for their
-// whole length, so a query never sees a half-added tile: it sees the navmesh as of the last Publish. Each
-// thread keeps its own dtNavMeshQuery (Detour's query objects hold per-query scratch).
-// Lock order: mNavMeshMutex < mPendingMutex. Neither is ever held while a body lock is taken.
+// Detour's navmesh is not thread-safe, so tiles are published at a sync point: the finished tiles reach the
+// world in one hand-off, Publish(changes), called once a frame by the game's sync point (TileScheduler::
+// Update collects the tile jobs' results and the tiles it drops, then calls it), which swaps them all in
+// under mNavMeshMutex held exclusively. Path queries hold mNavMeshMutex shared for their whole length, so a
+// query never sees a half-added tile: it sees the navmesh as of the last Publish. Each thread keeps its own
+// dtNavMeshQuery (Detour's query objects hold per-query scratch). mNavMeshMutex is never held while a body
+// lock is taken.
 
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/navmesh/TileGrid.h"
@@ -57,17 +58,16 @@ public:
     const TileGrid& GetGrid() const { return mGrid; }
     const AgentProfile& GetProfile() const { return mProfile; }
 
-    /// Queues a built tile (an empty one removes the tile) for the next Publish. Any thread.
-    void SubmitTile(BuiltTile&& inTile);
-    /// Queues the removal of a tile for the next Publish. Any thread.
-    void SubmitRemoval(const TileCoord& inTile);
-    /// The sync point: swaps every queued tile in (or out). Returns how many tiles changed (a replaced tile
-    /// counts its removal and its addition). Any thread, but meant for one place in the frame; it waits for
-    /// path queries in progress. A tile Detour cannot take is refused: data that is not a whole, consistent
+    /// A change for Publish that removes inTile (a BuiltTile without data).
+    static BuiltTile Removal(const TileCoord& inTile);
+    /// The sync point: swaps inChanges in, each a built tile or a Removal (of tiles listed twice, the last
+    /// wins). Returns how many tiles changed (a replaced tile counts its removal and its addition). Any
+    /// thread, but meant for one place in the frame; it waits for path queries in progress. A tile Detour
+    /// cannot take is refused: data that is not a whole, consistent
     /// Detour tile (CheckTileData), data of another tile than the one it was submitted as, more polygons than
     /// a tile reference holds, or no free tile slot. The tile already there stays, and the refusal is counted
     /// (GetRefusedTiles).
-    int Publish();
+    int Publish(std::vector<BuiltTile>&& inChanges);
     /// Tiles Publish refused so far, and why the last one was. Any thread.
     uint64_t GetRefusedTiles(std::string* outLastReason = nullptr) const;
 
@@ -140,13 +140,6 @@ private:
     std::map<TileCoord, PublishedTile> mTiles;
     uint64_t mRefusedTiles = 0; ///< Guarded by mNavMeshMutex
     std::string mLastRefusal;   ///< Guarded by mNavMeshMutex
-    std::mutex mPendingMutex;
-    struct Pending
-    {
-        BuiltTile mTile;      ///< mData null: remove
-        std::string mProblem; ///< Why Detour can not take mTile (CheckTile, in Publish), empty when it can
-    };
-    std::map<TileCoord, Pending> mPending; ///< Guarded by mPendingMutex; the latest submission per tile wins
 };
 
 } // namespace cairn::navmesh

@@ -10,9 +10,9 @@
 //    several chunks: (1) broad-phase query and the static bodies' triangles, (2) the other bodies' triangles,
 //    retried in a later chunk while the physics step holds them, (3) Recast and Detour. No chunk waits for a
 //    lock held by the step.
-//  - Update, once a frame at the game's sync point: starts jobs, takes finished tiles, publishes them into
-//    the NavMeshWorld (NavMeshWorld::Publish), and drops tiles no invoker needed for mDropDelayFrames frames;
-//    tiles of a removed area go at once.
+//  - Update, once a frame at the game's sync point: starts jobs, takes finished tiles and drops tiles no
+//    invoker needed for mDropDelayFrames frames (tiles of a removed area at once), and hands both to the
+//    NavMeshWorld in one call (NavMeshWorld::Publish).
 //
 // Threads: Update on one thread (the game's), never inside the physics step; invokers, areas and MarkDirty
 // from any thread; OnBodyChanged on whatever thread changes a body (the physics listener contract).
@@ -146,8 +146,8 @@ private:
     void CollectInvokerTiles(const Invoker& inInvoker, std::unordered_map<TileCoord, float>& ioNeeded) const;
     void MarkDirtyLocked(const AABB& inBounds);
     void StartJob(const TileCoord& inTile, TileState& ioState);
-    /// Takes a finished job's tile into the navmesh's queue; false while the job still runs.
-    bool CollectFinished(const TileCoord& inTile, TileState& ioState);
+    /// Adds a finished job's tile to ioChanges (this frame's Publish); false while the job still runs.
+    bool CollectFinished(const TileCoord& inTile, TileState& ioState, std::vector<BuiltTile>& ioChanges);
 
     PhysicsSystem& mPhysics;
     NavMeshWorld& mWorld;
