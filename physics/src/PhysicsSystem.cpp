@@ -57,13 +57,12 @@ Result<std::unique_ptr<PhysicsSystem>> PhysicsSystem::Create(const PhysicsSettin
                                                              const LayerSetup& inLayers)
 {
     if (Status setup = ValidateSetup(inSettings, inLayers); !setup) return setup.GetError();
-    return std::make_unique<PhysicsSystem>(inSettings, inLayers);
+    // new rather than std::make_unique: the constructor is private
+    return std::unique_ptr<PhysicsSystem>(new PhysicsSystem(inSettings, inLayers));
 }
 
 PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup& inLayers)
-    : mSetupStatus(ValidateSetup(inSettings, inLayers)),
-      mSettings(mSetupStatus.IsOk() ? inSettings : PhysicsSettings{}),
-      mLayers(mSetupStatus.IsOk() ? inLayers : LayerSetup::CreateDefault()),
+    : mSettings(inSettings), mLayers(inLayers),
       mBodies(std::make_unique<BodyManager>(mSettings.mMaxBodies, mSettings.mNumBodyMutexes)),
       mBroadPhase(CreateBroadPhase(mSettings, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
@@ -91,7 +90,6 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobI
 
 Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs)
 {
-    if (!mSetupStatus) return mSetupStatus;
     if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)
         return MakeError(ErrorCode::InvalidArgument, "time step must be in (0, 1] s");
     if (inCollisionSteps < 1 || inCollisionSteps > 16)

@@ -33,6 +33,7 @@
 #include "cairn/physics/body/PublishedPose.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -168,13 +169,13 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
     // With a job system, the broad-phase rebuild runs beside the pairs and contacts on any scene, so the
     // queries also meet a rebuild on another thread than the step's
     settings.mUpdateBesideStepMinActiveBodies = 0;
-    PhysicsSystem system(settings, LayerSetup::CreateDefault());
-    BodyInterface& bodies = system.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
     // GetBroadPhase() is const, RebuildAll is not; the broad phase itself is not a const object (the system
     // made it), so casting the const away is well defined. It is called from the step thread between two
     // updates, where the step itself runs its rebuilds, so it never overlaps one (mRefusedStepCalls says so)
     auto& quadTree =
-        const_cast<BroadPhaseQuadTree&>(dynamic_cast<const BroadPhaseQuadTree&>(system.GetBroadPhase()));
+        const_cast<BroadPhaseQuadTree&>(dynamic_cast<const BroadPhaseQuadTree&>(system->GetBroadPhase()));
 
     std::unordered_set<BodyID> permanent; // Read-only once the threads start
     auto addPermanent = [&](const BodyCreationSettings& inSettings, Activation inActivation)
@@ -312,7 +313,7 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
         {
             stepping.store(true);
             const Status status =
-                jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f);
+                jobSystem ? system->Update(1.0f / 60.0f, 1, *jobSystem) : system->Update(1.0f / 60.0f);
             stepping.store(false);
             failed += status ? 0 : 1;
             ++count;
@@ -325,7 +326,7 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
             }
             // The pistons turn round at the ends of their stroke (read from their published pose: no lock)
             {
-                const PoseReader reader(system.GetBodyManager());
+                const PoseReader reader(system->GetBodyManager());
                 for (const Piston& piston : pistons)
                 {
                     PublishedPose pose;
@@ -459,8 +460,8 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
 
     auto queryThread = [&](uint32_t inSeed)
     {
-        const WorldQuery& query = system.GetWorldQuery();
-        const BodyManager& manager = system.GetBodyManager();
+        const WorldQuery& query = system->GetWorldQuery();
+        const BodyManager& manager = system->GetBodyManager();
         std::mt19937 random(inSeed);
         std::uniform_int_distribution<size_t> pick(0, targets.size() - 1);
         std::uniform_real_distribution<float> symmetric(-1.0f, 1.0f), probeXZ(-10.0f, 10.0f),
@@ -688,7 +689,7 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
     result.mChurnBatches = churnBatches.load();
     result.mFailedCalls = failedCalls.load();
     result.mRefusedStepCalls = quadTree.GetRefusedStepCalls();
-    result.mBodiesAfter = system.GetBodyManager().GetNumBodies();
+    result.mBodiesAfter = system->GetBodyManager().GetNumBodies();
     result.mFailures = std::move(failures);
     // The scene did what the comment at the top says: the pile stayed between the walls and was moving
     result.mPileBodies = numPile;

@@ -9,6 +9,7 @@
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -47,7 +48,7 @@ SceneWorld MakeScene(Scene inScene)
 {
     PhysicsSettings settings;
     settings.mAllowSleeping = false;
-    SceneWorld world{std::make_unique<PhysicsSystem>(settings), {}};
+    SceneWorld world{test::MakePhysicsSystem(settings), {}};
     BodyInterface& bodies = world.mSystem->GetBodyInterface();
     std::vector<BodyID>& boxes = world.mBoxes;
     const BodyCreationSettings floor = test::StaticFloorSettings(30.0f);

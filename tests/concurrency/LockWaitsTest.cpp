@@ -15,6 +15,7 @@
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 
 #include <atomic>
 #include <chrono>
@@ -258,7 +259,7 @@ std::unique_ptr<PhysicsSystem> MakeSystem(BroadPhaseType inMode, BodyID& outBox)
 {
     PhysicsSettings settings;
     settings.mBroadPhase = inMode;
-    auto system = std::make_unique<PhysicsSystem>(settings);
+    std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem(settings);
     BodyCreationSettings ground;
     ground.mShape = BoxShape::Create(Vec3(20.0f, 0.5f, 20.0f)).Value();
     ground.mPosition = Vec3(0.0f, -0.5f, 0.0f);

@@ -8,6 +8,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <atomic>
@@ -67,8 +68,8 @@ bool RunUntilIdle(PhysicsSystem& ioPhysics, TileScheduler& ioScheduler)
 
 TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromScratch)
 {
-    PhysicsSystem physics;
-    BodyInterface& bodies = physics.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> physics = cairn::test::MakePhysicsSystem();
+    BodyInterface& bodies = physics->GetBodyInterface();
     ASSERT_TRUE(bodies.CreateAndAddBody(
         BoxBodySettings(Vec3(0, -0.5f, 0), Vec3(cHalfWorld, 0.5f, cHalfWorld), MotionType::Static),
         Activation::DontActivate));
@@ -82,7 +83,7 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
     jobs::BackgroundQueue::Settings queueSettings;
     queueSettings.mNumThreads = 2;
     jobs::BackgroundQueue queue(queueSettings);
-    NavMeshUnderTest live = MakeNavMesh(physics, queue);
+    NavMeshUnderTest live = MakeNavMesh(*physics, queue);
 
     std::atomic<bool> stop{false};
     std::mutex addedMutex;
@@ -159,7 +160,7 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
     // The game thread: steps and the sync point
     for (int frame = 0; frame < 240; ++frame)
     {
-        ASSERT_TRUE(physics.Update(1.0f / 60.0f).IsOk());
+        ASSERT_TRUE(physics->Update(1.0f / 60.0f).IsOk());
         live.mScheduler->Update();
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
@@ -173,7 +174,7 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
         {
             ASSERT_TRUE(bodies.RemoveBody(body.mID).IsOk());
         }
-    ASSERT_TRUE(RunUntilIdle(physics, *live.mScheduler));
+    ASSERT_TRUE(RunUntilIdle(*physics, *live.mScheduler));
     const TileScheduler::Stats stats = live.mScheduler->GetStats();
     EXPECT_GT(stats.mRebuilds, 0u); // The world did change under the jobs
     EXPECT_EQ(stats.mJobsFailed, 0u) << stats.mLastError;
@@ -182,8 +183,8 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
     EXPECT_EQ(liveTiles.size(), 4u);
     live.mScheduler.reset();
 
-    NavMeshUnderTest fresh = MakeNavMesh(physics, queue);
-    ASSERT_TRUE(RunUntilIdle(physics, *fresh.mScheduler));
+    NavMeshUnderTest fresh = MakeNavMesh(*physics, queue);
+    ASSERT_TRUE(RunUntilIdle(*physics, *fresh.mScheduler));
     const auto freshTiles = fresh.mWorld->SnapshotTiles();
     ASSERT_EQ(freshTiles.size(), liveTiles.size());
     for (const auto& [tile, data] : freshTiles)

@@ -6,6 +6,7 @@
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <atomic>
@@ -32,8 +33,8 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
     if (GetParam() > 0) jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{GetParam()});
     PhysicsSettings settings;
     settings.mUpdateBesideStepMinActiveBodies = 0; // The broad-phase rebuild beside the pairs, on any scene
-    PhysicsSystem system(settings, LayerSetup::CreateDefault());
-    BodyInterface& bodies = system.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
     const BodyCreationSettings floor = test::StaticFloorSettings(50.0f);
     const BodyID floorID = bodies.CreateAndAddBody(floor, Activation::DontActivate).Value();
 
@@ -64,10 +65,10 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
             {
                 const Vec3 origin(coordinate(random), 20.0f, coordinate(random));
                 const Result<std::optional<RayCastResult>> hit =
-                    system.GetWorldQuery().CastRayClosest({origin, Vec3(0, -40, 0)}, onlyStatic);
+                    system->GetWorldQuery().CastRayClosest({origin, Vec3(0, -40, 0)}, onlyStatic);
                 if (!hit.IsOk() || !hit.Value() || hit.Value()->mBody != floorID)
                     floorMisses.fetch_add(1, std::memory_order_relaxed);
-                if (!system.GetWorldQuery().CollideSphere(Vec3(origin.x(), 0.0f, origin.z()), 0.5f, found))
+                if (!system->GetWorldQuery().CollideSphere(Vec3(origin.x(), 0.0f, origin.z()), 0.5f, found))
                     floorMisses.fetch_add(1, std::memory_order_relaxed); // A query must never fail here
                 queries.fetch_add(1, std::memory_order_relaxed);
             }
@@ -118,7 +119,7 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
 
     for (int step = 0; step < 240; ++step)
         ASSERT_TRUE(
-            (jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f)).IsOk());
+            (jobSystem ? system->Update(1.0f / 60.0f, 1, *jobSystem) : system->Update(1.0f / 60.0f)).IsOk());
     stop.store(true, std::memory_order_relaxed);
     querier.join();
     mover.join();
@@ -127,7 +128,7 @@ TEST_P(PhysicsSystemStepThreads, StepWhileOtherThreadsQueryMoveAddAndRemove)
     EXPECT_EQ(floorMisses.load(), 0);
     EXPECT_EQ(failedCalls.load(), 0);
     EXPECT_GT(queries.load(), 0);
-    EXPECT_EQ(system.GetBodyManager().GetNumBodies(), 61u) << "every streamed body was destroyed again";
+    EXPECT_EQ(system->GetBodyManager().GetNumBodies(), 61u) << "every streamed body was destroyed again";
 }
 
 INSTANTIATE_TEST_SUITE_P(PhysicsSystemConcurrencyTest, PhysicsSystemStepThreads, ::testing::Values(0u, 2u),
@@ -138,13 +139,13 @@ INSTANTIATE_TEST_SUITE_P(PhysicsSystemConcurrencyTest, PhysicsSystemStepThreads,
 
 TEST(PhysicsSystemConcurrencyTest, SecondConcurrentUpdateIsRefused)
 {
-    PhysicsSystem system;
+    const std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem();
     BodyCreationSettings box;
     box.mShape = BoxShape::Create(Vec3(0.4f, 0.4f, 0.4f)).Value();
     for (int i = 0; i < 200; ++i)
     {
         box.mPosition = Vec3(float(i % 20), float(i / 20), 0.0f);
-        (void)system.GetBodyInterface().CreateAndAddBody(box, Activation::Activate);
+        (void)system->GetBodyInterface().CreateAndAddBody(box, Activation::Activate);
     }
     std::atomic<int> refused{0};
     std::atomic<int> succeeded{0};
@@ -152,7 +153,7 @@ TEST(PhysicsSystemConcurrencyTest, SecondConcurrentUpdateIsRefused)
     {
         for (int i = 0; i < 100; ++i)
         {
-            Status status = system.Update(1.0f / 60.0f);
+            Status status = system->Update(1.0f / 60.0f);
             if (status)
                 succeeded.fetch_add(1, std::memory_order_relaxed);
             else if (status.GetError().mCode == ErrorCode::WrongThread)

@@ -33,6 +33,7 @@
 #include "cairn/physics/shapes/CompoundShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/PublishedPoseStress.h"
 #include "common/StaticFloor.h"
 
@@ -280,8 +281,8 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
     PhysicsSettings settings;
     settings.mMaxBodies = 1024;
     settings.mUpdateBesideStepMinActiveBodies = 0; // With a job system, the rebuild runs beside the pairs
-    PhysicsSystem system(settings, LayerSetup::CreateDefault());
-    BodyInterface& bodies = system.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
 
     // Every body's id, and every shape held here too, so that the snapshots' raw shape pointers stay valid
     // whatever happens to the bodies
@@ -398,7 +399,7 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
             add(body, Activation::Activate);
         }
     }
-    ASSERT_TRUE(system.Update(1.0f / 60.0f)); // Every body published by a step once before the run
+    ASSERT_TRUE(system->Update(1.0f / 60.0f)); // Every body published by a step once before the run
 
     // Relaxed for the stop flag and the counters; the snapshot goes through latestMutex
     std::atomic<bool> stop{false};
@@ -406,7 +407,7 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
     std::atomic<uint64_t> updates{0}, failedCalls{0}, unreadable{0};
     std::mutex latestMutex; // Guards latest
     std::shared_ptr<const Snapshot> latest;
-    const BodyManager& manager = system.GetBodyManager();
+    const BodyManager& manager = system->GetBodyManager();
 
     auto capture = [&](uint64_t inGeneration)
     {
@@ -429,7 +430,7 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
             {
                 stepping.store(true);
                 const Status status =
-                    jobSystem ? system.Update(1.0f / 60.0f, 1, *jobSystem) : system.Update(1.0f / 60.0f);
+                    jobSystem ? system->Update(1.0f / 60.0f, 1, *jobSystem) : system->Update(1.0f / 60.0f);
                 stepping.store(false);
                 failed += status ? 0 : 1;
                 capture(++generation); // Nothing publishes until the next Update: this is the world's state
@@ -461,7 +462,7 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
 
     auto queryThread = [&](uint32_t inSeed)
     {
-        const WorldQuery& world = system.GetWorldQuery();
+        const WorldQuery& world = system->GetWorldQuery();
         std::mt19937 random(inSeed);
         std::uniform_int_distribution<int> kind(0, int(QueryKind::Count) - 1);
         std::uniform_int_distribution<size_t> pickDynamic(firstDynamic, ids.size() - 1);

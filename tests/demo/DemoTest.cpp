@@ -91,8 +91,8 @@ TEST(DemoTest, LockFreeModeKeepsItsInvariantsAndLogsItsProgress)
     DemoRunResult run;
     // A file is not a terminal: the progress comes as plain lines every 300 frames, so of 240 frames the
     // first's and the last's
-    const std::string progress =
-        Printed([&](std::FILE* inFile) { run = RunDemo(SmallDemo(), BroadPhaseType::QuadTree, inFile); });
+    const std::string progress = Printed(
+        [&](std::FILE* inFile) { run = RunDemo(SmallDemo(), BroadPhaseType::QuadTree, inFile).Value(); });
     ExpectInvariants(run);
     // Its queries ran beside the step and read published poses: not one of them waited for a lock
     for (double waited : LockWaitMicrosPerThreadFrame(run))
@@ -107,7 +107,9 @@ TEST(DemoTest, LockFreeModeKeepsItsInvariantsAndLogsItsProgress)
 
 TEST(DemoTest, GlobalMutexModeKeepsItsInvariants)
 {
-    ExpectInvariants(RunDemo(SmallDemo(), BroadPhaseType::QuadTreeGlobalMutex, nullptr));
+    const Result<DemoRunResult> run = RunDemo(SmallDemo(), BroadPhaseType::QuadTreeGlobalMutex, nullptr);
+    ASSERT_TRUE(run) << run.GetError().mMessage;
+    ExpectInvariants(run.Value());
 }
 
 TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)

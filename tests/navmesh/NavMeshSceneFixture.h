@@ -8,6 +8,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/MakePhysicsSystem.h"
 
 #include <chrono>
 #include <gtest/gtest.h>
@@ -84,7 +85,7 @@ protected:
         return false;
     }
 
-    std::unique_ptr<PhysicsSystem> mPhysics = std::make_unique<PhysicsSystem>();
+    std::unique_ptr<PhysicsSystem> mPhysics = cairn::test::MakePhysicsSystem();
     std::unique_ptr<NavMeshWorld> mWorld;
     std::unique_ptr<jobs::BackgroundQueue> mQueue;
     std::unique_ptr<TileScheduler> mScheduler;

@@ -8,6 +8,7 @@
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/SharedBenchData.h"
 
 #include <cstring>
@@ -32,14 +33,14 @@ TEST_P(RecastEquivalenceTest, PhysicsWorldTilesEqualRawMeshTiles)
     const IndexedMesh& mesh = loaded.Value();
     const TileGeometry raw = mesh.ToTileGeometry();
 
-    PhysicsSystem physics;
+    const std::unique_ptr<PhysicsSystem> physics = cairn::test::MakePhysicsSystem();
     BodyCreationSettings settings;
     auto shape = TriangleMeshShape::Create(mesh.mVertices, mesh.mTriangles);
     ASSERT_TRUE(shape) << shape.GetError().mMessage;
     settings.mShape = shape.Value();
     settings.mMotionType = MotionType::Static;
     settings.mObjectLayer = Layers::cStatic;
-    ASSERT_TRUE(physics.GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate));
+    ASSERT_TRUE(physics->GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate));
 
     AgentProfile profile;
     const AABB bounds = mesh.GetBounds();
@@ -48,7 +49,7 @@ TEST_P(RecastEquivalenceTest, PhysicsWorldTilesEqualRawMeshTiles)
     std::vector<TileCoord> tiles;
     ASSERT_TRUE(grid.TilesOverlapping(bounds, 0.0f, tiles));
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
-    const GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
+    const GeometryCollector collector(physics->GetBodyManager(), physics->GetBroadPhase());
 
     int tilesWithPolygons = 0;
     for (const TileCoord& tile : tiles)

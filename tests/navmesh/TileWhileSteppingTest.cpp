@@ -26,6 +26,7 @@
 #include "cairn/physics/body/PublishedPose.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <atomic>
@@ -82,8 +83,8 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
 {
     PhysicsSettings settings;
     settings.mMaxBodies = 1024;
-    PhysicsSystem system(settings, LayerSetup::CreateDefault());
-    BodyInterface& bodies = system.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> system = cairn::test::MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
 
     const AgentProfile profile;
     const TileGrid grid(0.0f, 0.0f, profile.mTileSize, -2.0f, 10.0f);
@@ -158,7 +159,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     for (const BodyID& crate : crates)
     {
         ASSERT_FALSE(bodies.IsActive(crate).Value());
-        const PoseReader reader(system.GetBodyManager());
+        const PoseReader reader(system->GetBodyManager());
         PublishedPose pose;
         ASSERT_TRUE(reader.Read(crate, pose));
         crateVersions.push_back(pose.mVersion);
@@ -177,7 +178,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
             while (!stop.load(std::memory_order_relaxed))
             {
                 stepping.store(true);
-                failedUpdates.fetch_add(system.Update(1.0f / 60.0f) ? 0 : 1, std::memory_order_relaxed);
+                failedUpdates.fetch_add(system->Update(1.0f / 60.0f) ? 0 : 1, std::memory_order_relaxed);
                 stepping.store(false);
                 updates.store(++count);
                 // The piston turns round at the ends of its stroke (every 4 s of world time)
@@ -215,7 +216,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
             break;
         const uint64_t updatesBefore = updates.load();
         const bool steppingBefore = stepping.load();
-        TileBuild build = BuildTileNow(system, profile, grid, tile, {});
+        TileBuild build = BuildTileNow(*system, profile, grid, tile, {});
         const bool steppingAfter = stepping.load();
         const uint64_t updatesAfter = updates.load();
         Result<BuiltTile> built = BuildTile(profile, grid, tile, build.mGeometry);
@@ -241,7 +242,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
             concurrent.empty() ? between.front().mGeometry : concurrent.front().mGeometry;
         for (int i = 0; i < 32; ++i)
         {
-            const TileBuild extra = BuildTileNow(system, profile, grid, tile, {});
+            const TileBuild extra = BuildTileNow(*system, profile, grid, tile, {});
             extraDiffering += SameGeometry(extra.mGeometry, first) ? 0 : 1;
             ++extraCollections;
         }
@@ -252,7 +253,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     ASSERT_TRUE(buildError.empty()) << buildError;
 
     // The still world: the same published state of everything the tile takes
-    TileBuild still = BuildTileNow(system, profile, grid, tile, {});
+    TileBuild still = BuildTileNow(*system, profile, grid, tile, {});
     Result<BuiltTile> stillBuilt = BuildTile(profile, grid, tile, still.mGeometry);
     ASSERT_TRUE(stillBuilt) << stillBuilt.GetError().mMessage;
     still.mTile = std::move(stillBuilt.Value());
@@ -261,7 +262,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     // Without the crates (sleeping dynamic bodies left out)
     NavMeshInclusion noCrates;
     noCrates.mSleepingDynamic = false;
-    TileBuild bare = BuildTileNow(system, profile, grid, tile, noCrates);
+    TileBuild bare = BuildTileNow(*system, profile, grid, tile, noCrates);
     Result<BuiltTile> bareBuilt = BuildTile(profile, grid, tile, bare.mGeometry);
     ASSERT_TRUE(bareBuilt) << bareBuilt.GetError().mMessage;
     bare.mTile = std::move(bareBuilt.Value());
@@ -302,7 +303,7 @@ TEST(TileWhileSteppingTest, TileBuiltWhileTheWorldStepsEqualsTheStillWorldsTile)
     // The moving bodies in the tile were found and read, and left out
     EXPECT_GT(still.mBodiesFound, size_t(still.mStats.mBodies));
     // The crates slept through the run: their published pose is the one the builds were compared against
-    const PoseReader reader(system.GetBodyManager());
+    const PoseReader reader(system->GetBodyManager());
     for (size_t i = 0; i < crates.size(); ++i)
     {
         PublishedPose pose;

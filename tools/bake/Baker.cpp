@@ -222,7 +222,9 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
                   std::min(uint64_t(inSource.GetMaxObjectsNear()) * 2, inSource.GetNumObjects()), 64,
                   1u << 20));
     const size_t maxLive = physicsSettings.mMaxBodies;
-    PhysicsSystem physics(physicsSettings);
+    Result<std::unique_ptr<PhysicsSystem>> world = PhysicsSystem::Create(physicsSettings);
+    if (!world) return world.GetError();
+    PhysicsSystem& physics = *world.Value();
     LiveObjects objects(physics, inSource);
     const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;

@@ -21,6 +21,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchThreads.h"
 #include "common/FrameTimes.h"
+#include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -360,7 +361,7 @@ struct ContendedWorld
         settings.mMaxBodies = uint32_t(Data().mStatic.size() + Data().mDynamic.size());
         settings.mBroadPhase =
             inKind == cQuadTree ? BroadPhaseType::QuadTree : BroadPhaseType::QuadTreeGlobalMutex;
-        mSystem = std::make_unique<PhysicsSystem>(settings, LayerSetup::CreateDefault());
+        mSystem = tools::CreatePhysicsSystemOrExit("cairn-bench-broadphase", settings);
         BodyInterface& bodies = mSystem->GetBodyInterface();
         auto addAll =
             [&](const std::vector<BenchBox>& inBoxes, MotionType inMotion, std::vector<BodyID>& outIDs)

@@ -18,6 +18,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "common/BenchOptions.h"
 #include "common/FrameTimes.h"
+#include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -76,13 +77,14 @@ TileGrid WorldGrid(const AgentProfile& inProfile)
 
 void RunTiles(const SharedBenchData& inData, int inRepetitions)
 {
-    PhysicsSystem physics(PileSettings());
-    AddBatch(physics, inData.mStatic, MotionType::Static);
-    (void)physics.Update(1.0f / 60.0f); // The broad phase's first rebuild
+    const std::unique_ptr<PhysicsSystem> physics =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-navmesh", PileSettings());
+    AddBatch(*physics, inData.mStatic, MotionType::Static);
+    (void)physics->Update(1.0f / 60.0f); // The broad phase's first rebuild
     const AgentProfile profile;
     const TileGrid grid = WorldGrid(profile);
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
-    const GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
+    const GeometryCollector collector(physics->GetBodyManager(), physics->GetBroadPhase());
 
     std::vector<double> collectMedians, recastMedians, collectMaxes, recastMaxes;
     uint64_t polygons = 0, triangles = 0;
@@ -145,9 +147,10 @@ struct PileRun
 /// step_pile2k on one physics thread, with inBackgroundJobs tile jobs kept running (0: none).
 PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
 {
-    PhysicsSystem physics(PileSettings());
-    AddBatch(physics, inData.mStatic, MotionType::Static);
-    AddBatch(physics, inData.mDynamic, MotionType::Dynamic);
+    const std::unique_ptr<PhysicsSystem> physics =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-navmesh", PileSettings());
+    AddBatch(*physics, inData.mStatic, MotionType::Static);
+    AddBatch(*physics, inData.mDynamic, MotionType::Dynamic);
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = 1;
     jobs::JobSystem frameJobs(jobSettings);
@@ -166,7 +169,7 @@ PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
     {
         TileScheduler::Settings settings;
         settings.mMaxConcurrentJobs = inBackgroundJobs;
-        scheduler = std::make_unique<TileScheduler>(physics, *world, queue, settings);
+        scheduler = std::make_unique<TileScheduler>(*physics, *world, queue, settings);
         (void)scheduler->AddArea(area).Value(); // The shared world's tile: always inside the world
     }
     // Real-time frames at 60 Hz, as in a game: the step, the sync point, then the rest of the frame, in which
@@ -176,7 +179,7 @@ PileRun RunPile(const SharedBenchData& inData, uint32_t inBackgroundJobs)
     for (int step = 0; step < 300; ++step)
     {
         const Clock::time_point start = Clock::now();
-        (void)physics.Update(1.0f / 60.0f, 1, frameJobs);
+        (void)physics->Update(1.0f / 60.0f, 1, frameJobs);
         stepMs.push_back(MillisecondsSince(start));
         if (scheduler != nullptr)
         {
@@ -216,9 +219,10 @@ void RunPileWithJobs(const SharedBenchData& inData, int inRepetitions)
 
 void RunInvokerLatency(const SharedBenchData& inData)
 {
-    PhysicsSystem physics(PileSettings());
-    AddBatch(physics, inData.mStatic, MotionType::Static);
-    AddBatch(physics, inData.mDynamic, MotionType::Dynamic);
+    const std::unique_ptr<PhysicsSystem> physics =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-navmesh", PileSettings());
+    AddBatch(*physics, inData.mStatic, MotionType::Static);
+    AddBatch(*physics, inData.mDynamic, MotionType::Dynamic);
     const AgentProfile profile;
     std::unique_ptr<NavMeshWorld> world =
         std::move(NavMeshWorld::Create(WorldGrid(profile), profile).Value());
@@ -228,7 +232,7 @@ void RunInvokerLatency(const SharedBenchData& inData)
     TileScheduler::Settings settings;
     settings.mMaxConcurrentJobs = 2;
     settings.mDropDelayFrames = 10;
-    TileScheduler scheduler(physics, *world, queue, settings);
+    TileScheduler scheduler(*physics, *world, queue, settings);
     // Invokers one after another across the world, each asking for its own tile only, every 20 frames: the
     // budget is free each time
     TileScheduler::InvokerID invoker = 0;
@@ -245,7 +249,7 @@ void RunInvokerLatency(const SharedBenchData& inData)
                                       1.0f)
                           .Value(); // Tile centres of the shared world: always inside it
         }
-        (void)physics.Update(1.0f / 60.0f);
+        (void)physics->Update(1.0f / 60.0f);
         scheduler.Update();
         // Real-time frames: wait for the next 1/60 s tick
         std::this_thread::sleep_until(begin + std::chrono::microseconds(16667 * (frame + 1)));

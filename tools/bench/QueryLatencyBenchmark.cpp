@@ -60,6 +60,7 @@
 #include "common/FrameTimes.h"
 #include "common/MachineInfo.h"
 #include "common/Mix64.h"
+#include "common/PhysicsSystemOrExit.h"
 
 #include <algorithm>
 #include <array>
@@ -409,8 +410,9 @@ void RunOnce(QueryReads inReads, const Settings& inSettings, const std::vector<K
 {
     PhysicsSettings physicsSettings = tools::BenchSettings(tools::cPyramidAllowSleeping);
     physicsSettings.mQueryReads = inReads;
-    PhysicsSystem physics(physicsSettings);
-    BodyInterface& bodies = physics.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> physics =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-query-latency", physicsSettings);
+    BodyInterface& bodies = physics->GetBodyInterface();
     (void)tools::AddPyramid(bodies);
     const BodyID kinematic = bodies
                                  .CreateAndAddBody(tools::BoxSettings(cKinematicHome, Vec3(1, 1, 1), 0,
@@ -418,7 +420,7 @@ void RunOnce(QueryReads inReads, const Settings& inSettings, const std::vector<K
                                                    Activation::DontActivate)
                                  .Value();
     for (int step = 0; step < cWarmUpSteps; ++step)
-        (void)physics.Update(tools::cPyramidStepSeconds);
+        (void)physics->Update(tools::cPyramidStepSeconds);
 
     std::vector<Kind> queryKinds;
     std::copy_if(inKinds.begin(), inKinds.end(), std::back_inserter(queryKinds), IsQuery);
@@ -433,7 +435,7 @@ void RunOnce(QueryReads inReads, const Settings& inSettings, const std::vector<K
     std::thread queryThread, writeThread;
     if (!queryKinds.empty())
         queryThread = std::thread(
-            [&] { QueryLoop(physics, queryKinds, inSettings.mMaxWaitMicros, signals, inSeed, ioResult); });
+            [&] { QueryLoop(*physics, queryKinds, inSettings.mMaxWaitMicros, signals, inSeed, ioResult); });
     if (writes)
         writeThread = std::thread(
             [&]
@@ -452,12 +454,12 @@ void RunOnce(QueryReads inReads, const Settings& inSettings, const std::vector<K
             const ThreadTimes timesBefore = ReadThreadTimes();
             const Clock::time_point stepStart = Clock::now();
             signals.mStepping.store(true, std::memory_order_relaxed); // A label (see StepSignals)
-            const Status status = physics.Update(tools::cPyramidStepSeconds);
+            const Status status = physics->Update(tools::cPyramidStepSeconds);
             signals.mStepping.store(false, std::memory_order_relaxed); // A label (see StepSignals)
             const Clock::time_point stepEnd = Clock::now();
             const ThreadTimes timesAfter = ReadThreadTimes();
             const double wallUs = std::chrono::duration<double, std::micro>(stepEnd - stepStart).count();
-            const double lockWaitMs = physics.GetLastStepStatistics().mLockWaitMs;
+            const double lockWaitMs = physics->GetLastStepStatistics().mLockWaitMs;
             const double offCoreUs = wallUs - (timesAfter.mCpuUs - timesBefore.mCpuUs) - 1000.0 * lockWaitMs;
             stepPreempted.push_back(timesAfter.mInvoluntarySwitches != timesBefore.mInvoluntarySwitches &&
                                     offCoreUs > cPreemptedStepMicros);

@@ -13,6 +13,7 @@
 #include "common/BenchScenes.h"
 #include "common/FrameTimes.h"
 #include "common/MachineInfo.h"
+#include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
 
 #include <algorithm>
@@ -85,23 +86,25 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
 
 RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 {
-    PhysicsSystem system(BenchSettings(true, gCandidateMargin));
+    const std::unique_ptr<PhysicsSystem> system =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-step", BenchSettings(true, gCandidateMargin));
     std::vector<BodyCreationSettings> statics, dynamics;
     for (const BenchBox& box : inData.mStatic)
         statics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Static, 0.5f));
     for (const BenchBox& box : inData.mDynamic)
         dynamics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Dynamic, 0.5f));
     std::vector<BodyID> staticIDs, dynamicIDs;
-    AddBatch(system.GetBodyInterface(), statics, Activation::DontActivate, staticIDs);
-    AddBatch(system.GetBodyInterface(), dynamics, Activation::Activate, dynamicIDs);
-    return RunScene(system, dynamicIDs, 600, ioJobs);
+    AddBatch(system->GetBodyInterface(), statics, Activation::DontActivate, staticIDs);
+    AddBatch(system->GetBodyInterface(), dynamics, Activation::Activate, dynamicIDs);
+    return RunScene(*system, dynamicIDs, 600, ioJobs);
 }
 
 RunResult RunPyramid(jobs::JobSystem& ioJobs)
 {
-    PhysicsSystem system(BenchSettings(tools::cPyramidAllowSleeping, gCandidateMargin));
-    const tools::PyramidScene scene = tools::AddPyramid(system.GetBodyInterface());
-    return RunScene(system, scene.mBoxes, 500, ioJobs);
+    const std::unique_ptr<PhysicsSystem> system = tools::CreatePhysicsSystemOrExit(
+        "cairn-bench-step", BenchSettings(tools::cPyramidAllowSleeping, gCandidateMargin));
+    const tools::PyramidScene scene = tools::AddPyramid(system->GetBodyInterface());
+    return RunScene(*system, scene.mBoxes, 500, ioJobs);
 }
 
 /// Prints the repetitions and returns the median of the mean step times.

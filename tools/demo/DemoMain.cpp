@@ -18,6 +18,7 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 using namespace cairn;
@@ -111,8 +112,20 @@ int main(int argc, char** argv)
                 tools::DescribeMachine().c_str());
 
     std::vector<DemoRunResult> runs;
-    if (mode != "global-mutex") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTree, stdout));
-    if (mode != "lock-free") runs.push_back(RunDemo(settings, BroadPhaseType::QuadTreeGlobalMutex, stdout));
+    std::vector<BroadPhaseType> modes;
+    if (mode != "global-mutex") modes.push_back(BroadPhaseType::QuadTree);
+    if (mode != "lock-free") modes.push_back(BroadPhaseType::QuadTreeGlobalMutex);
+    for (BroadPhaseType runMode : modes)
+    {
+        Result<DemoRunResult> run = RunDemo(settings, runMode, stdout);
+        // Settings that the physics world refuses: no frame ran, so there is nothing to report
+        if (!run)
+        {
+            std::fprintf(stderr, "cairn-demo: %s\n", run.GetError().mMessage.c_str());
+            return 1;
+        }
+        runs.push_back(std::move(run).Value());
+    }
     for (const DemoRunResult& run : runs)
         PrintSummary(stdout, run);
     if (runs.size() == 2) PrintComparison(stdout, runs[0], runs[1]);

@@ -51,7 +51,7 @@ bool IsProgressFrame(std::FILE* inProgress, bool inLive, int inFrame, int inFram
 }
 } // namespace
 
-DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress)
+Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress)
 {
     DemoRunResult result;
     result.mModeName = inMode == BroadPhaseType::QuadTreeGlobalMutex ? "global mutex" : "lock-free";
@@ -69,7 +69,9 @@ DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std
         physicsSettings.mNumBodyMutexes = 1;
         physicsSettings.mQueryReads = QueryReads::BodyLocks;
     }
-    PhysicsSystem physics(physicsSettings);
+    Result<std::unique_ptr<PhysicsSystem>> physicsWorld = PhysicsSystem::Create(physicsSettings);
+    if (!physicsWorld) return physicsWorld.GetError();
+    PhysicsSystem& physics = *physicsWorld.Value();
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
     jobs::JobSystem frameJobs(jobSettings);

@@ -9,6 +9,7 @@
 
 #include "DemoResult.h"
 #include "cairn/physics/PhysicsSettings.h"
+#include "cairn/physics/math/Result.h"
 
 #include <cstdint>
 #include <cstdio>
@@ -42,7 +43,8 @@ struct DemoSettings
 };
 
 /// Runs the demo in inMode; inProgress (may be null) gets a live one-line display on a terminal, a line every
-/// 300 frames otherwise.
-DemoRunResult RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress);
+/// 300 frames otherwise. Errors: settings the physics world refuses (PhysicsSystem::Create's), before any
+/// frame; what goes wrong during the run is in the result's mErrors.
+Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inMode, std::FILE* inProgress);
 
 } // namespace cairn::demo

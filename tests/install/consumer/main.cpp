@@ -1,16 +1,24 @@
-// A program outside Cairn's tree that finds the installed package and links cairn::physics and cairn::navmesh:
-// a dropped sphere falls under gravity, and a navmesh tile is built from a floor body in the physics world.
-// Prints the height after one second and the tile's polygons so the test can check the libraries really ran.
+// A program outside Cairn's tree that finds the installed package and links cairn::physics and
+// cairn::navmesh: a dropped sphere falls under gravity, and a navmesh tile is built from a floor body in the
+// physics world. Prints the height after one second and the tile's polygons so the test can check the
+// libraries really ran.
 #include <cairn/navmesh/GeometryCollector.h>
 #include <cairn/navmesh/TileBuilder.h>
 #include <cairn/physics/PhysicsSystem.h>
 #include <cairn/physics/shapes/BoxShape.h>
 #include <cairn/physics/shapes/SphereShape.h>
 #include <cstdio>
+#include <memory>
 
 int main()
 {
-    cairn::PhysicsSystem system;
+    cairn::Result<std::unique_ptr<cairn::PhysicsSystem>> created = cairn::PhysicsSystem::Create();
+    if (!created)
+    {
+        std::fprintf(stderr, "PhysicsSystem::Create: %s\n", created.GetError().mMessage.c_str());
+        return 1;
+    }
+    cairn::PhysicsSystem& system = *created.Value();
     cairn::BodyCreationSettings settings;
     settings.mShape = cairn::SphereShape::Create(1.0f).Value();
     settings.mPosition = cairn::Vec3(0, 10, 0);

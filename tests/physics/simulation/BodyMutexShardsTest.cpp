@@ -4,6 +4,7 @@
 
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <gtest/gtest.h>
@@ -40,16 +41,16 @@ std::vector<Vec3> DropBoxes(uint32_t inShards, int inSteps)
     PhysicsSettings settings;
     settings.mMaxBodies = 256;
     settings.mNumBodyMutexes = inShards;
-    PhysicsSystem physics(settings);
-    (void)physics.GetBodyInterface().CreateAndAddBody(test::StaticFloorSettings(20.0f),
-                                                      Activation::DontActivate);
+    const std::unique_ptr<PhysicsSystem> physics = test::MakePhysicsSystem(settings);
+    (void)physics->GetBodyInterface().CreateAndAddBody(test::StaticFloorSettings(20.0f),
+                                                       Activation::DontActivate);
     std::vector<BodyID> boxes;
     for (int i = 0; i < 40; ++i)
     {
         BodyCreationSettings box;
         box.mShape = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
         box.mPosition = Vec3(float(i % 5) * 1.5f - 3.0f, 1.0f + float(i / 5) * 1.2f, 0.0f);
-        boxes.push_back(physics.GetBodyInterface().CreateAndAddBody(box, Activation::Activate).Value());
+        boxes.push_back(physics->GetBodyInterface().CreateAndAddBody(box, Activation::Activate).Value());
     }
     std::atomic<bool> done{false};
     std::thread reader(
@@ -58,15 +59,15 @@ std::vector<Vec3> DropBoxes(uint32_t inShards, int inSteps)
             // Relaxed: only a stop signal
             while (!done.load(std::memory_order_relaxed))
                 for (const BodyID& id : boxes)
-                    (void)physics.GetBodyInterface().GetPosition(id);
+                    (void)physics->GetBodyInterface().GetPosition(id);
         });
     for (int step = 0; step < inSteps; ++step)
-        EXPECT_TRUE(physics.Update(1.0f / 60.0f).IsOk());
+        EXPECT_TRUE(physics->Update(1.0f / 60.0f).IsOk());
     done.store(true, std::memory_order_relaxed);
     reader.join();
     std::vector<Vec3> positions;
     for (const BodyID& id : boxes)
-        positions.push_back(physics.GetBodyInterface().GetPosition(id).Value());
+        positions.push_back(physics->GetBodyInterface().GetPosition(id).Value());
     return positions;
 }
 

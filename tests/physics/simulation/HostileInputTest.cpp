@@ -15,6 +15,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/MakePhysicsSystem.h"
 
 #include <array>
 #include <cstdlib>
@@ -588,25 +589,25 @@ TEST_F(HostileInputTest, ObjectLayersPastTheTablesAreNotReadOutOfBounds)
 
 TEST(HostileInputBatchTest, ABatchFinalizedOrAbortedInAnotherWorldIsRefused)
 {
-    PhysicsSystem first, second;
+    const std::unique_ptr<PhysicsSystem> first = MakePhysicsSystem(), second = MakePhysicsSystem();
     BodyCreationSettings settings;
     settings.mShape = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
     settings.mPosition = Vec3(0, 3, 0);
     // Two bodies in the first world, so the id's slot is empty in the second
-    (void)first.GetBodyInterface().CreateBody(settings);
-    const BodyID body = first.GetBodyInterface().CreateBody(settings).Value();
-    Result<BodyInterface::AddBatch> batch = first.GetBodyInterface().AddBodiesPrepare({&body, 1});
+    (void)first->GetBodyInterface().CreateBody(settings);
+    const BodyID body = first->GetBodyInterface().CreateBody(settings).Value();
+    Result<BodyInterface::AddBatch> batch = first->GetBodyInterface().AddBodiesPrepare({&body, 1});
     ASSERT_TRUE(batch.IsOk());
     EXPECT_EQ(
-        second.GetBodyInterface().AddBodiesFinalize(batch.Value(), Activation::Activate).GetError().mCode,
+        second->GetBodyInterface().AddBodiesFinalize(batch.Value(), Activation::Activate).GetError().mCode,
         ErrorCode::InvalidArgument);
-    EXPECT_EQ(second.GetBodyInterface().AddBodiesAbort(batch.Value()).GetError().mCode,
+    EXPECT_EQ(second->GetBodyInterface().AddBodiesAbort(batch.Value()).GetError().mCode,
               ErrorCode::InvalidArgument);
-    EXPECT_EQ(second.GetBroadPhase().GetBodyCount(), 0u);
+    EXPECT_EQ(second->GetBroadPhase().GetBodyCount(), 0u);
     // The batch is still whole: its own world takes it
-    ASSERT_TRUE(first.GetBodyInterface().AddBodiesFinalize(batch.Value(), Activation::Activate).IsOk());
-    EXPECT_TRUE(first.GetBodyInterface().IsAdded(body).Value());
-    EXPECT_EQ(first.GetBroadPhase().GetBodyCount(), 1u);
+    ASSERT_TRUE(first->GetBodyInterface().AddBodiesFinalize(batch.Value(), Activation::Activate).IsOk());
+    EXPECT_TRUE(first->GetBodyInterface().IsAdded(body).Value());
+    EXPECT_EQ(first->GetBroadPhase().GetBodyCount(), 1u);
 }
 
 } // namespace cairn::test

@@ -1,8 +1,11 @@
-// Settings and layer setups out of range are refused with an error naming the field, never used: before these
-// checks, an object layer past the 64-entry tables was written out of bounds in Release builds, and NaN
-// gravity or a negative speculative distance silently broke every step.
+// Settings and layer setups out of range are refused by PhysicsSystem::Create with an error naming the field,
+// never used: before these checks, an object layer past the 64-entry tables was written out of bounds in
+// Release builds, and NaN gravity or a negative speculative distance silently broke every step. Create is the
+// only way to a world, so no world is built from a setup it refused (a constructor once built one on the
+// defaults instead, which only failed at its first Update).
 
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/shapes/SphereShape.h"
 
 #include <gtest/gtest.h>
 #include <limits>
@@ -30,7 +33,6 @@ TEST(SetupValidationTest, TheDefaultsAreValid)
     EXPECT_TRUE(LayerSetup::CreateDefault().GetStatus().IsOk());
     Result<std::unique_ptr<PhysicsSystem>> system = PhysicsSystem::Create();
     ASSERT_TRUE(system.IsOk());
-    EXPECT_TRUE(system.Value()->GetSetupStatus().IsOk());
     EXPECT_TRUE(system.Value()->Update(1.0f / 60.0f).IsOk());
 }
 
@@ -113,19 +115,68 @@ TEST(SetupValidationTest, LayerMisuseIsReportedAndWritesNothing)
 
     Result<std::unique_ptr<PhysicsSystem>> refused = PhysicsSystem::Create(PhysicsSettings{}, layers);
     ASSERT_FALSE(refused.IsOk());
+    EXPECT_EQ(refused.GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_NE(refused.GetError().mMessage.find("layer setup"), std::string::npos);
+    EXPECT_NE(refused.GetError().mMessage.find("SetBroadPhaseLayer(1, 2)"), std::string::npos)
+        << refused.GetError().mMessage;
+    for (const LayerSetup* bad : {&tooMany, &tooManyTrees, &collides})
+    {
+        Result<std::unique_ptr<PhysicsSystem>> also = PhysicsSystem::Create(PhysicsSettings{}, *bad);
+        ASSERT_FALSE(also.IsOk());
+        EXPECT_EQ(also.GetError().mCode, ErrorCode::InvalidArgument);
+        EXPECT_NE(also.GetError().mMessage.find("layer setup"), std::string::npos)
+            << also.GetError().mMessage;
+    }
 }
 
-TEST(SetupValidationTest, AWorldBuiltFromBadSettingsNeverSteps)
+TEST(SetupValidationTest, BadSettingsAndBadLayersTogetherAreRefused)
 {
     PhysicsSettings settings;
     settings.mGravity = Vec3(0, std::numeric_limits<float>::quiet_NaN(), 0);
-    PhysicsSystem system(settings);
-    ASSERT_FALSE(system.GetSetupStatus().IsOk());
-    EXPECT_TRUE(system.GetSettings().mGravity.allFinite()) << "built on the defaults instead";
-    const Status stepped = system.Update(1.0f / 60.0f);
-    ASSERT_FALSE(stepped.IsOk());
-    EXPECT_NE(stepped.GetError().mMessage.find("mGravity"), std::string::npos);
+    LayerSetup layers = LayerSetup::CreateDefault();
+    layers.SetCollides(Layers::cMoving, 70, true);
+    Result<std::unique_ptr<PhysicsSystem>> refused = PhysicsSystem::Create(settings, layers);
+    ASSERT_FALSE(refused.IsOk());
+    EXPECT_EQ(refused.GetError().mCode, ErrorCode::InvalidArgument);
+    // The settings are checked first
+    EXPECT_NE(refused.GetError().mMessage.find("mGravity"), std::string::npos) << refused.GetError().mMessage;
+}
+
+TEST(SetupValidationTest, AValidSetupCreatesAWorldOnThatSetupThatSteps)
+{
+    // Valid, and none of it the default: the world must keep every value given (no fallback to the defaults)
+    PhysicsSettings settings;
+    settings.mMaxBodies = 64;
+    settings.mGravity = Vec3(0.0f, -4.0f, 0.0f);
+    settings.mNumBodyMutexes = 4;
+    settings.mBroadPhase = BroadPhaseType::BruteForce;
+    LayerSetup layers(3, 2);
+    layers.SetBroadPhaseLayer(2, 1);
+    layers.SetCollides(2, 2, true);
+    ASSERT_TRUE(layers.GetStatus().IsOk()) << layers.GetStatus().GetError().mMessage;
+
+    Result<std::unique_ptr<PhysicsSystem>> created = PhysicsSystem::Create(settings, layers);
+    ASSERT_TRUE(created.IsOk()) << created.GetError().mMessage;
+    PhysicsSystem& system = *created.Value();
+    EXPECT_EQ(system.GetSettings().mMaxBodies, 64u);
+    EXPECT_EQ(system.GetSettings().mGravity, settings.mGravity);
+    EXPECT_EQ(system.GetSettings().mNumBodyMutexes, 4u);
+    EXPECT_EQ(system.GetSettings().mBroadPhase, BroadPhaseType::BruteForce);
+    EXPECT_EQ(system.GetLayers().GetNumObjectLayers(), 3u);
+    EXPECT_EQ(system.GetLayers().GetBroadPhaseLayer(2), 1u);
+
+    // A ball in the third layer falls under the given gravity: v = g t after one second
+    BodyCreationSettings ball;
+    ball.mShape = SphereShape::Create(0.5f).Value();
+    ball.mPosition = Vec3(0.0f, 100.0f, 0.0f);
+    ball.mObjectLayer = 2;
+    ball.mLinearDamping = 0.0f; // So that its speed is g t exactly
+    const Result<BodyID> id = system.GetBodyInterface().CreateAndAddBody(ball, Activation::Activate);
+    ASSERT_TRUE(id.IsOk()) << id.GetError().mMessage;
+    for (int i = 0; i < 60; ++i)
+        ASSERT_TRUE(system.Update(1.0f / 60.0f).IsOk());
+    EXPECT_NEAR(system.GetBodyInterface().GetLinearVelocity(id.Value()).Value().y(), -4.0f, 0.05f);
+    EXPECT_LT(system.GetBodyInterface().GetPosition(id.Value()).Value().y(), 99.0f);
 }
 
 } // namespace cairn::test

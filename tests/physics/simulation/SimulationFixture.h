@@ -8,6 +8,7 @@
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/MakePhysicsSystem.h"
 
 #include <cstdlib>
 #include <gtest/gtest.h>
@@ -22,10 +23,7 @@ protected:
     static constexpr float cDeltaTime = 1.0f / 60.0f;
 
     /// Recreates the world with non-default settings.
-    void ResetWorld(const PhysicsSettings& inSettings)
-    {
-        mSystem = std::make_unique<PhysicsSystem>(inSettings);
-    }
+    void ResetWorld(const PhysicsSettings& inSettings) { mSystem = MakePhysicsSystem(inSettings); }
 
     PhysicsSystem& System() { return *mSystem; }
     BodyInterface& Bodies() { return mSystem->GetBodyInterface(); }
@@ -105,7 +103,7 @@ protected:
     Vec3 Velocity(const BodyID& inID) { return Bodies().GetLinearVelocity(inID).Value(); }
     bool IsActive(const BodyID& inID) { return Bodies().IsActive(inID).Value(); }
 
-    std::unique_ptr<PhysicsSystem> mSystem = std::make_unique<PhysicsSystem>();
+    std::unique_ptr<PhysicsSystem> mSystem = MakePhysicsSystem();
 };
 
 } // namespace cairn::test

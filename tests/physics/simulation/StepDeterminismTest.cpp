@@ -5,6 +5,7 @@
 
 #include "SimulationFixture.h"
 #include "cairn/jobs/JobInterface.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -56,8 +57,8 @@ std::vector<BodyState> RunPile(jobs::JobInterface* inJobs, bool inUpdateBesideSt
     PhysicsSettings physicsSettings;
     // The broad-phase rebuild beside the pair search on this small scene too (by default from 1,024 bodies)
     if (inUpdateBesideStep) physicsSettings.mUpdateBesideStepMinActiveBodies = 0;
-    PhysicsSystem system(physicsSettings);
-    BodyInterface& bodies = system.GetBodyInterface();
+    const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem(physicsSettings);
+    BodyInterface& bodies = system->GetBodyInterface();
     const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
     BodyCreationSettings ramp = floor;
@@ -84,9 +85,10 @@ std::vector<BodyState> RunPile(jobs::JobInterface* inJobs, bool inUpdateBesideSt
         }
     for (int step = 0; step < 600; ++step)
     {
-        const Status status = inJobs ? system.Update(1.0f / 60.0f, 1, *inJobs) : system.Update(1.0f / 60.0f);
+        const Status status =
+            inJobs ? system->Update(1.0f / 60.0f, 1, *inJobs) : system->Update(1.0f / 60.0f);
         EXPECT_TRUE(status.IsOk());
-        if (outStatistics != nullptr) AddCounts(system.GetLastStepStatistics(), *outStatistics);
+        if (outStatistics != nullptr) AddCounts(system->GetLastStepStatistics(), *outStatistics);
         if (step == 400)
         {
             // A late arrival wakes a heap that may have gone to sleep

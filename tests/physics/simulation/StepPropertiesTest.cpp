@@ -1,5 +1,6 @@
 #include "SimulationFixture.h"
 #include "common/AllocationCounter.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 namespace cairn::test
@@ -46,8 +47,8 @@ TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
 {
     auto run = [](std::vector<Vec3>& outPositions)
     {
-        PhysicsSystem system;
-        BodyInterface& bodies = system.GetBodyInterface();
+        const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem();
+        BodyInterface& bodies = system->GetBodyInterface();
         const BodyCreationSettings floor = test::StaticFloorSettings(20.0f);
         (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
         std::vector<BodyID> ids;
@@ -60,7 +61,7 @@ TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
             ids.push_back(bodies.CreateAndAddBody(box, Activation::Activate).Value());
         }
         for (int step = 0; step < 300; ++step)
-            (void)UpdateWorld(system, 1.0f / 60.0f);
+            (void)UpdateWorld(*system, 1.0f / 60.0f);
         for (const BodyID& id : ids)
             outPositions.push_back(bodies.GetPosition(id).Value());
     };

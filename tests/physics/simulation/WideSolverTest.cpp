@@ -4,6 +4,7 @@
 // ones made anew.
 
 #include "SimulationFixture.h"
+#include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -28,7 +29,7 @@ PyramidRun MakeWorldWithFloor(bool inWide, bool inReuseColorings = true)
     settings.mAllowSleeping = false;
     settings.mSolver.mWideColoredIslands = inWide;
     settings.mSolver.mReuseColorings = inReuseColorings;
-    PyramidRun run{std::make_unique<PhysicsSystem>(settings), {}};
+    PyramidRun run{MakePhysicsSystem(settings), {}};
     const BodyCreationSettings floor = test::StaticFloorSettings(40.0f);
     (void)run.mSystem->GetBodyInterface().CreateAndAddBody(floor, Activation::DontActivate);
     return run;

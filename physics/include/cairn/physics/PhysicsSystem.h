@@ -36,14 +36,9 @@ class PhysicsSystem
 {
 public:
     /// A world, or the error of settings or layers that are out of range (ValidateSettings,
-    /// LayerSetup::GetStatus).
+    /// LayerSetup::GetStatus). The only way to make one: a world that exists was made from a valid setup.
     static Result<std::unique_ptr<PhysicsSystem>>
     Create(const PhysicsSettings& inSettings = {}, const LayerSetup& inLayers = LayerSetup::CreateDefault());
-    /// The same without the check up front: a world made from settings or layers that are not valid is built
-    /// on the defaults instead, never steps (every Update returns the error) and reports it in
-    /// GetSetupStatus.
-    explicit PhysicsSystem(const PhysicsSettings& inSettings = {},
-                           const LayerSetup& inLayers = LayerSetup::CreateDefault());
     ~PhysicsSystem();
     PhysicsSystem(const PhysicsSystem&) = delete;
     PhysicsSystem& operator=(const PhysicsSystem&) = delete;
@@ -72,8 +67,6 @@ public:
     }
     const LayerSetup& GetLayers() const { return mLayers; }
     const PhysicsSettings& GetSettings() const { return mSettings; }
-    /// Ok, or why the settings or layers given at construction were refused.
-    const Status& GetSetupStatus() const { return mSetupStatus; }
     /// Figures of the last Update. Read it from the thread that calls Update.
     const StepStatistics& GetLastStepStatistics() const { return mLastStatistics; }
     /// A self-check for tests, between updates: the contact cache that the next step warm-starts from is in
@@ -81,7 +74,10 @@ public:
     bool IsContactCacheConsistent() const;
 
 private:
-    Status mSetupStatus; ///< Set at construction, constant afterwards
+    /// Create's, after it has checked inSettings and inLayers: private, so that no world is built from a
+    /// setup that was not checked (a public one once fell back to the defaults on a bad setup, silently).
+    PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup& inLayers);
+
     PhysicsSettings mSettings;
     LayerSetup mLayers;
     std::unique_ptr<BodyManager> mBodies;

@@ -5,7 +5,8 @@
 // broad-phase layer (one broad-phase tree per broad-phase layer, e.g. static vs moving).
 // LayerSetup is configured once before the world is created and read-only afterwards: any thread may read it.
 // Misuse (a count or a layer id out of range) never writes out of bounds: the count is clamped or the call is
-// ignored, and GetStatus reports the first such error (PhysicsSystem refuses a setup whose status is not Ok).
+// ignored, and GetStatus reports the first such error (PhysicsSystem::Create refuses a setup whose status is
+// not Ok).
 
 #include "cairn/physics/math/Result.h"
 
