@@ -1,11 +1,11 @@
-# `cmake --install` exports cairn::jobs, cairn::physics and cairn::navmesh so that another project can
+# `cmake --install` exports cairn::jobs, cairn::physics, cairn::navmesh and cairn::navmesh_io so that another project can
 # find_package(Cairn). The navmesh's Recast/Detour are found by the FindRecast module installed next to the
 # package config (Debian's librecast-dev has no CMake config of its own).
 
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-install(TARGETS cairn_jobs cairn_physics cairn_navmesh EXPORT CairnTargets
+install(TARGETS cairn_jobs cairn_physics cairn_navmesh cairn_navmesh_io EXPORT CairnTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})

@@ -1,7 +1,6 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 
-#include "cairn/navmesh/NavMeshFile.h"
-#include "cairn/navmesh/NavMeshPreview.h"
+#include "cairn/navmesh/TileData.h"
 
 #include <DetourNavMesh.h>
 #include <DetourNavMeshQuery.h>
@@ -427,10 +426,10 @@ int NavMeshWorld::GetTilePolygonCount(const TileCoord& inTile) const
     return it == mTiles.end() ? 0 : it->second.mNumPolygons;
 }
 
-std::string NavMeshWorld::ToObj() const
+void NavMeshWorld::Read(FunctionRef<void(const dtNavMesh&)> inRead) const
 {
     std::shared_lock lock(mNavMeshMutex);
-    return NavMeshToObj(*mNavMesh);
+    inRead(*mNavMesh);
 }
 
 std::map<TileCoord, std::vector<unsigned char>> NavMeshWorld::SnapshotTiles() const

@@ -7,6 +7,7 @@
 #include "WorldGenerator.h"
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/jobs/JobSystem.h"
+#include "cairn/navmesh/NavMeshPreview.h"
 #include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
@@ -194,7 +195,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
 
     const navmesh::TileScheduler::Stats navStats = scheduler->GetStats();
     result.mNavTilesBuilt = navStats.mTilesPublished;
-    result.mNavMeshObj = navMesh->ToObj();
+    navMesh->Read([&](const dtNavMesh& inNavMesh) { result.mNavMeshObj = navmesh::NavMeshToObj(inNavMesh); });
     result.mNavTileLatencyFrames = navStats.mFirstPublishFrames;
     if (navStats.mJobsFailed > 0) result.mErrors.push_back("navmesh: " + navStats.mLastError);
     const Agents::Stats& agentStats = agents->GetStats();

@@ -13,6 +13,7 @@
 
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/navmesh/TileGrid.h"
+#include "cairn/physics/math/FunctionRef.h"
 #include "cairn/physics/math/Result.h"
 
 #include <array>
@@ -103,8 +104,10 @@ public:
     bool HasTile(const TileCoord& inTile) const;
     /// Polygons of a published tile (0 when absent).
     int GetTilePolygonCount(const TileCoord& inTile) const;
-    /// The published navmesh's surface (each polygon's detail triangles) as Wavefront OBJ text.
-    std::string ToObj() const;
+    /// Calls inRead with the published Detour navmesh, under the navmesh mutex held shared (a Publish waits
+    /// for it): to draw or export it (NavMeshPreview's NavMeshToObj, NavMeshToSvg). inRead must not call
+    /// this world. Any thread.
+    void Read(FunctionRef<void(const dtNavMesh&)> inRead) const;
     /// A copy of every published tile's Detour data, by tile: to compare two navmeshes.
     std::map<TileCoord, std::vector<unsigned char>> SnapshotTiles() const;
 
