@@ -8,6 +8,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -9,6 +9,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 namespace
 {

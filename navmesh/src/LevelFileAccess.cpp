@@ -6,6 +6,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 Result<std::vector<unsigned char>> ReadLevelFile(const std::string& inPath, uint64_t inMaxBytes)
 {

@@ -11,6 +11,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// The bytes of the regular file inPath. Errors: IOError when it is not a readable regular file, ParseError
 /// when it is over inMaxBytes (named with the limit).

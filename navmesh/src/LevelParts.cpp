@@ -6,6 +6,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 IndexedMesh IndexedMesh::ExtractTriangles(std::span<const uint32_t> inTriangles) const
 {

@@ -19,6 +19,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 namespace
 {

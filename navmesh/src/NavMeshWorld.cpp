@@ -12,6 +12,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 namespace
 {

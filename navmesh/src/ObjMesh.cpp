@@ -13,6 +13,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 AABB IndexedMesh::GetBounds() const
 {

@@ -10,6 +10,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 void DetourFree::operator()(unsigned char* inData) const
 {

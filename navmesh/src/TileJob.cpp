@@ -2,6 +2,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 jobs::BackgroundStep TileJob::Finish(std::optional<Result<BuiltTile>> inResult, jobs::BackgroundStep inStep)
 {

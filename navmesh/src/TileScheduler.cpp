@@ -7,6 +7,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -71,4 +71,4 @@ Status ValidateSettings(const PhysicsSettings& inSettings)
     return Status::Ok();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <chrono>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -108,4 +108,4 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
     ioStatistics.mLockWaitMs += double(mLockWaitNanoseconds.load(std::memory_order_relaxed)) / 1.0e6;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

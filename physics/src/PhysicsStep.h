@@ -37,7 +37,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PhysicsStep
@@ -74,4 +74,4 @@ private:
     IslandSleep mSleep;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -147,4 +147,4 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     return Status::Ok();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -13,6 +13,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -15,6 +15,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 
@@ -105,6 +106,7 @@ TEST(BakeSelectionTest, ALevelTooLargeForTheReferenceBitsIsRefusedBeforeBaking)
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -14,6 +14,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -18,6 +18,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 
@@ -192,6 +193,7 @@ TEST(BakeTest, BadInputGetsClearErrorsAndNoOutput)
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 
@@ -269,6 +271,7 @@ TEST(BakeTest, AnIncrementalBakeRebuildsOnlyTheTilesAMovedObjectTouches)
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 namespace
 {
 

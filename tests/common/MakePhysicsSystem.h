@@ -11,6 +11,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 /// A world from inSettings and inLayers. When Create refuses them, the test fails with Create's error: as an
 /// exception, which gtest reports with its message and which ends the test, since a helper that returns a

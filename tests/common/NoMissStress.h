@@ -25,6 +25,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 struct NoMissStressConfig
 {

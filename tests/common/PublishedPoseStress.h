@@ -54,6 +54,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 /// A build whose checks run many times slower than an optimised one (sanitizers, no optimisation): the runs
 /// keep their time caps there and require a lower floor of checks instead of the full target.

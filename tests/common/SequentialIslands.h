@@ -11,6 +11,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 using Edge = std::pair<uint32_t, uint32_t>;
 

@@ -8,6 +8,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -13,6 +13,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 
 /// A box of world20k_static.csv or world20k_dynamic.csv: rotated by mYaw about +Y.
 struct BenchBox

@@ -9,6 +9,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 /// Settings of a static floor 2 m thick whose top is at y = 0, reaching inHalfWidth metres from the origin
 /// along x and z.

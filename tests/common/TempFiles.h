@@ -15,6 +15,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 class TempFiles
 {

@@ -10,6 +10,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 class TestRandom
 {

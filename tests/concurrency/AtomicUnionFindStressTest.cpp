@@ -23,6 +23,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -12,6 +12,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 
@@ -61,6 +62,7 @@ TEST(BroadPhaseQuadTreeNoMissTest, GlobalMutexShortRun)
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -25,6 +25,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -54,6 +54,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

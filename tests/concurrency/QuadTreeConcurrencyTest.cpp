@@ -16,6 +16,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

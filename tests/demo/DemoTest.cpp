@@ -15,6 +15,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -10,6 +10,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -9,6 +9,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -15,6 +15,7 @@
 
 namespace cairn::jobs
 {
+using namespace cairn::physics;
 namespace
 {
 

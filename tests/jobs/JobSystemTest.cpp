@@ -14,6 +14,7 @@
 
 namespace cairn::jobs
 {
+using namespace cairn::physics;
 namespace
 {
 

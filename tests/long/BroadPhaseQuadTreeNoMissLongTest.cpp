@@ -9,6 +9,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

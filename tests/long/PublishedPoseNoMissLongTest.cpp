@@ -10,6 +10,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

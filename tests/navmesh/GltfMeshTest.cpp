@@ -14,6 +14,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 namespace
 {
 

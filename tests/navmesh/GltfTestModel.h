@@ -9,6 +9,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 
 inline tinygltf::Model SquareModel(float inSide)
 {

@@ -16,6 +16,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 namespace
 {
 

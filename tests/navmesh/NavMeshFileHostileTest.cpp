@@ -15,6 +15,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 namespace
 {
 using cairn::test::ReadBytes;

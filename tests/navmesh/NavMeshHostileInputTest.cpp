@@ -22,6 +22,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -11,6 +11,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 namespace
 {
 

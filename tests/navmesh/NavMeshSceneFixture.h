@@ -17,6 +17,7 @@
 
 namespace cairn::navmesh::test
 {
+using namespace cairn::physics;
 
 class NavMeshSceneFixture : public ::testing::Test
 {

@@ -40,6 +40,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -8,6 +8,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 Status LoadBakeConfig(const std::string& inPath, navmesh::AgentProfile& ioProfile)
 {

@@ -15,6 +15,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 /// Reads inPath into ioProfile (keys it does not name keep their values) and validates the result. Errors
 /// name the file and the key.

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

@@ -14,6 +14,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 uint64_t Hash64(std::span<const unsigned char> inBytes, uint64_t inHash)
 {

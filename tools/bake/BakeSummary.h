@@ -17,6 +17,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 /// FNV-1a, 64 bits, continuing from inHash.
 uint64_t Hash64(std::span<const unsigned char> inBytes, uint64_t inHash = 14695981039346656037ull);

@@ -15,6 +15,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 namespace
 {

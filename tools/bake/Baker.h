@@ -22,6 +22,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 struct BakeSettings
 {

@@ -21,6 +21,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -18,6 +18,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 struct GeneratedLevelSettings
 {

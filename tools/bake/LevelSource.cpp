@@ -7,6 +7,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 Result<std::unique_ptr<FileLevelSource>> FileLevelSource::Load(const std::vector<std::string>& inPaths,
                                                                const navmesh::AreaMapping& inAreas,

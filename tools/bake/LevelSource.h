@@ -18,6 +18,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 /// What a body of an object is made of.
 struct SourceBody

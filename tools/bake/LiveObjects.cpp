@@ -4,6 +4,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 Result<std::vector<TileObject>> LiveObjects::Acquire(std::vector<SourceObject>& ioObjects)
 {

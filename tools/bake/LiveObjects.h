@@ -15,6 +15,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 /// A body of a tile's object.
 struct TileObject

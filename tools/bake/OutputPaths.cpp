@@ -7,6 +7,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -11,6 +11,7 @@
 
 namespace cairn::bake
 {
+using namespace cairn::physics;
 
 struct NamedPath
 {

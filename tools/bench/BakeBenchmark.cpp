@@ -37,6 +37,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 using tools::Median;
 
 namespace

@@ -35,6 +35,7 @@
 #include <thread>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

@@ -18,6 +18,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

@@ -31,6 +31,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 using namespace cairn::navmesh;
 using Clock = std::chrono::steady_clock;
 using tools::Median;

@@ -78,6 +78,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 using Clock = std::chrono::steady_clock;
 
 namespace

@@ -25,6 +25,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 using tools::AddBatch;
 using tools::BenchSettings;
 using tools::BoxSettings;

@@ -30,6 +30,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

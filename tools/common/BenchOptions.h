@@ -13,6 +13,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 struct BenchOptions
 {

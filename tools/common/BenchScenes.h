@@ -13,6 +13,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 /// A box body as the shared workload describes them: density 1000, no restitution, turned inYaw about +Y;
 /// static boxes in the static layer, the others in the moving one.

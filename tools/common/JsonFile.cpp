@@ -5,6 +5,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 Result<nlohmann::json> ReadJsonFile(const std::string& inPath)
 {

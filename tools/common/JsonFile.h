@@ -12,6 +12,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 /// The JSON value of the regular file inPath. Errors: IOError when it is not a readable regular file (a
 /// folder, a device), ParseError with the parser's message (line, column, what) otherwise.

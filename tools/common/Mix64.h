@@ -8,6 +8,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 inline uint64_t Mix64(uint64_t inValue)
 {

@@ -10,6 +10,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 template <class T> bool ParseWholeNumber(std::string_view inText, T& outValue)
 {

@@ -12,6 +12,7 @@
 
 namespace cairn::tools
 {
+using namespace cairn::physics;
 
 /// A world from inSettings and inLayers; when Create refuses them, "inProgram: PhysicsSystem::Create: <the
 /// error>" on stderr and exit status 1.

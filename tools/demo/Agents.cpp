@@ -4,6 +4,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -22,6 +22,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// The goal of an agent that follows the player: the navmesh point nearest the player, or, while the player's
 /// tiles are not built yet, the one nearest the point inReach metres the player's way from the agent, on the

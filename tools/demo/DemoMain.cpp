@@ -22,6 +22,7 @@
 #include <vector>
 
 using namespace cairn;
+using namespace cairn::physics;
 using namespace cairn::demo;
 
 int main(int argc, char** argv)

@@ -17,6 +17,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 namespace
 {
 

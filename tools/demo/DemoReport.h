@@ -13,6 +13,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// Compact human summary of one run (one locking mode) written to inOut.
 void PrintSummary(std::FILE* inOut, const DemoRunResult& inRun);

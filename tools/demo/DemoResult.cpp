@@ -10,6 +10,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 SampleSummary Summarize(std::vector<double> inSamples)
 {

@@ -13,6 +13,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// Summary of a series of samples (milliseconds unless said otherwise).
 struct SampleSummary

@@ -20,6 +20,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 namespace
 {

@@ -17,6 +17,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// The demo's physics world holds this many bodies; a world file may fill it up to cDemoSpareBodies short
 /// (the balls the player throws, and tiles still leaving while new ones stream in).

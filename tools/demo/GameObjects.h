@@ -25,6 +25,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 class WorldGenerator;
 

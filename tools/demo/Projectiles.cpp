@@ -7,6 +7,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 namespace
 {

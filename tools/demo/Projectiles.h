@@ -11,6 +11,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 class WorldGenerator;
 

@@ -8,6 +8,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 uint64_t EstimateMaxBodies(const DemoSettings& inSettings)
 {

@@ -15,6 +15,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// Reads inPath into ioSettings and checks the world fits the demo's physics world (cDemoMaxBodies with the
 /// tiles streaming in). Errors name the file and the key.

@@ -18,6 +18,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 namespace
 {

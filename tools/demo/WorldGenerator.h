@@ -19,6 +19,7 @@
 
 namespace cairn::demo
 {
+using namespace cairn::physics;
 
 /// A world tile of the open world (64 m by default), on the x-z plane:
 /// tile (x, z) covers [x*size, (x+1)*size).

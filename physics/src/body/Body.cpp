@@ -2,7 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
@@ -75,4 +75,4 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     UpdateBounds();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include "cairn/physics/body/BodyLock.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -449,4 +449,4 @@ Result<bool> BodyInterface::IsAdded(const BodyID& inID) const
     return ReadBody<bool>(inID, [](const Body& inBody) { return inBody.IsInWorld(); });
 }
 
-} // namespace cairn
+} // namespace cairn::physics

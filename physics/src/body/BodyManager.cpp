@@ -8,7 +8,7 @@
 #include <cassert>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -266,4 +266,4 @@ void BodyManager::NoteBodyLockHeld(int inDelta)
     tBodyLocksHeld = uint32_t(int(tBodyLocksHeld) + inDelta);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

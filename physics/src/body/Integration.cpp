@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -72,4 +72,4 @@ void Integration::CorrectPose(Body& ioBody, const Vec3& inTranslation, const Vec
     ioBody.mRotation = IntegrateRotation(ioBody.mRotation, inRotation);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -17,7 +17,7 @@
 #include <span>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -43,4 +43,4 @@ private:
         mInverseInertia; ///< Per active dynamic body: world inverse inertia, from the velocities
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 LayerSetup::LayerSetup(uint32_t inNumObjectLayers, uint32_t inNumBroadPhaseLayers)
@@ -84,4 +84,4 @@ ObjectLayerMask LayerSetup::GetObjectLayersIn(BroadPhaseLayer inLayer) const
     return mask;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -1,7 +1,7 @@
 #include "PublishedPoseStore.h"
 #include "cairn/physics/body/BodyManager.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 PoseReader::PoseReader(const BodyManager& inBodies)
@@ -20,4 +20,4 @@ bool PoseReader::Read(const BodyID& inID, PublishedPose& outPose) const
     return mStore.Read(inID.GetIndex(), outPose) && outPose.mID == inID;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

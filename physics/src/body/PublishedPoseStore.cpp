@@ -8,7 +8,7 @@
 #include <immintrin.h>
 #endif
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -116,4 +116,4 @@ void PublishedPoseStore::FreeUnreachable()
     mRetired.erase(mRetired.begin(), mRetired.begin() + std::ptrdiff_t(freed));
 }
 
-} // namespace cairn
+} // namespace cairn::physics

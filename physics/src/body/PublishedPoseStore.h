@@ -21,7 +21,7 @@
 #include <mutex>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PublishedPoseStore
@@ -143,4 +143,4 @@ private:
     std::vector<RetiredShape> mRetired; ///< Guarded by mRetiredMutex; in epoch order
 };
 
-} // namespace cairn
+} // namespace cairn::physics

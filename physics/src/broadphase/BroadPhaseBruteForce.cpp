@@ -6,7 +6,7 @@
 #include <cassert>
 #include <mutex>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -192,4 +192,4 @@ size_t BroadPhaseBruteForce::GetBodyCount() const
     return mBodies.size();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -19,7 +19,7 @@
 #include <shared_mutex>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BroadPhaseBruteForce final : public BroadPhase
@@ -78,4 +78,4 @@ private:
         mActiveScratch; ///< Per position: 1 while FindCollidingPairs runs and the body is active
 };
 
-} // namespace cairn
+} // namespace cairn::physics

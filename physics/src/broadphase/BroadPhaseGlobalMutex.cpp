@@ -5,7 +5,7 @@
 #include <shared_mutex>
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 // The locks below are plain std::unique_lock/std::shared_lock: WriterFairSharedMutex tries first and counts
@@ -110,4 +110,4 @@ void BroadPhaseGlobalMutex::WithExclusiveLock(FunctionRef<void(BroadPhase&)> inF
     inFunction(*mWrapped);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

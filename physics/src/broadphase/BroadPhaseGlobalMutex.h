@@ -23,7 +23,7 @@
 
 #include <memory>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BroadPhaseGlobalMutex final : public BroadPhase
@@ -85,4 +85,4 @@ private:
     mutable WriterFairSharedMutex mMutex;       ///< See the header comment
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Bounds a broad phase accepts: finite and not inverted (min <= max on every axis). Anything else is a
@@ -77,4 +77,4 @@ struct SweptAABox
     Vec3 mInvDisplacement; ///< SafeReciprocal of the displacement
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -5,7 +5,7 @@
 
 #include <cassert>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// A prepared batch: one private sub-tree per broad-phase layer. Owned by the caller until finalized/aborted.
@@ -527,4 +527,4 @@ bool BroadPhaseQuadTree::Validate() const
     return total == mBodyCount.load(std::memory_order_relaxed); // Single-threaded: any order
 }
 
-} // namespace cairn
+} // namespace cairn::physics

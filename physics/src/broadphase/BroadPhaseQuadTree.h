@@ -37,7 +37,7 @@
 #include <optional>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PairCandidateCache;
@@ -221,4 +221,4 @@ private:
         mCandidateCacheRefilled{0}, mCandidateCacheUncached{0};
 };
 
-} // namespace cairn
+} // namespace cairn::physics

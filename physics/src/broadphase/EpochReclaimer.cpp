@@ -2,7 +2,7 @@
 
 #include "broadphase/ThreadStripe.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 std::atomic<uint32_t>& EpochReclaimer::Enter() const
@@ -33,4 +33,4 @@ bool EpochReclaimer::TryAdvance()
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -22,7 +22,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class EpochReclaimer
@@ -79,4 +79,4 @@ private:
     std::atomic<uint64_t> mEpoch = 2; ///< Starts at 2 so that "retired + 2" never wraps below zero
 };
 
-} // namespace cairn
+} // namespace cairn::physics

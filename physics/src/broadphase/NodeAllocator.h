@@ -20,7 +20,7 @@
 #include <cstdint>
 #include <memory>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class NodeAllocator
@@ -129,4 +129,4 @@ private:
     std::atomic<uint32_t> mNumAllocated;            ///< Statistic
 };
 
-} // namespace cairn
+} // namespace cairn::physics

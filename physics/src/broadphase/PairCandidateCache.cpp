@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <bit>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void PairCandidateCache::Prepare(uint32_t inNumActive)
@@ -50,4 +50,4 @@ PairCandidateCache::Entry* PairCandidateCache::FindOrClaim(uint32_t inIndex)
     return nullptr;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -25,7 +25,7 @@
 #include <cstdint>
 #include <memory>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PairCandidateCache
@@ -89,4 +89,4 @@ private:
     std::atomic<uint32_t> mUsed{0};
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -9,7 +9,7 @@
 #include <cstddef>
 #include <type_traits>
 
-namespace cairn
+namespace cairn::physics
 {
 
 using quadtree::BuildItem;
@@ -640,4 +640,4 @@ int64_t QuadTree::Validate() const
     return bodies;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

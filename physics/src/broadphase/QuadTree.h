@@ -44,7 +44,7 @@
 #include <span>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace quadtree
@@ -331,4 +331,4 @@ private:
     float mMovedSlotReach = 0.0f;                              ///< Update thread only (SetMovedSlotReach)
 };
 
-} // namespace cairn
+} // namespace cairn::physics

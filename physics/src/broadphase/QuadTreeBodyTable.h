@@ -20,7 +20,7 @@
 #include <cstdint>
 #include <memory>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class QuadTreeBodyTable
@@ -114,4 +114,4 @@ private:
     std::unique_ptr<std::atomic<uint32_t>[]> mSequences;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

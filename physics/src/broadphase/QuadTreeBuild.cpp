@@ -16,7 +16,7 @@
 #include <emmintrin.h>
 #endif
 
-namespace cairn
+namespace cairn::physics
 {
 
 using quadtree::BuildItem;
@@ -237,4 +237,4 @@ QuadTree::SubTree QuadTree::BuildRange(BuildItem* inBegin, BuildItem* inEnd, uin
     return result;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -12,7 +12,7 @@
 
 #include <vector>
 
-namespace cairn::quadtree
+namespace cairn::physics::quadtree
 {
 
 /// Lowers ioValue to inValue if smaller. Release on success: see GrowSlot.
@@ -315,4 +315,4 @@ struct RebuildScratch
     std::vector<uint32_t> mNewNodes;
 };
 
-} // namespace cairn::quadtree
+} // namespace cairn::physics::quadtree

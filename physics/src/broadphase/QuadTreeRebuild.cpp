@@ -24,7 +24,7 @@
 #include <chrono>
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 using quadtree::BuildItem;
@@ -409,4 +409,4 @@ void QuadTree::FreeReclaimableNodes()
     mNumRetired.fetch_sub(numFreed, std::memory_order_relaxed); // Statistic only
 }
 
-} // namespace cairn
+} // namespace cairn::physics

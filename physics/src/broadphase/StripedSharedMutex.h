@@ -22,7 +22,7 @@
 #include <mutex>
 #include <thread>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class StripedSharedMutex
@@ -98,4 +98,4 @@ private:
     std::mutex mWriterMutex;          ///< Serialises exclusive lockers
 };
 
-} // namespace cairn
+} // namespace cairn::physics

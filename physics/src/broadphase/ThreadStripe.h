@@ -7,7 +7,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// This thread's stripe in [0, inNumStripes); inNumStripes must be a power of two.
@@ -19,4 +19,4 @@ inline uint32_t GetThreadStripe(uint32_t inNumStripes)
     return tThread & (inNumStripes - 1);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

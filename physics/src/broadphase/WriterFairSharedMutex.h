@@ -17,7 +17,7 @@
 #include <mutex>
 #include <shared_mutex>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class WriterFairSharedMutex
@@ -67,4 +67,4 @@ private:
     std::shared_mutex mMutex; ///< The lock proper
 };
 
-} // namespace cairn
+} // namespace cairn::physics

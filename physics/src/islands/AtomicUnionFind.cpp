@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void AtomicUnionFind::Reset(uint32_t inNumBodies)
@@ -75,4 +75,4 @@ void AtomicUnionFind::Finalize()
         mBodies[mCursor[mIslandOfBody[i]]++] = i;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -41,7 +41,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class AtomicUnionFind
@@ -165,4 +165,4 @@ private:
     std::vector<uint32_t> mCursor;                   ///< Scratch for the counting sort, kept across steps
 };
 
-} // namespace cairn
+} // namespace cairn::physics

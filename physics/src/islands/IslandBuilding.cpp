@@ -4,7 +4,7 @@
 #include "narrowphase/ContactsStage.h"
 #include "step/StepContext.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandStage::Build(const StepContext& inContext, std::span<const ConstraintInfo> inInfo)
@@ -42,4 +42,4 @@ uint32_t IslandStage::GetLargestIslandSize(const StepContext& inContext) const
     return mIslandOrder.empty() ? 0 : uint32_t(inContext.mIslands.GetBodies(mIslandOrder[0]).size());
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <bit>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandStage::ColorIsland(const StepContext& inContext, std::span<const ConstraintInfo> inInfo,
@@ -131,4 +131,4 @@ void IslandStage::ComputeColoring(const StepContext& inContext, ColoringRecord& 
         ioRecord.mOrder[i] = mColorItems[i].mPosition;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -9,7 +9,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandStage::Order(const StepContext& inContext, std::span<ContactConstraint* const> inConstraints,
@@ -133,4 +133,4 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
     }
 }
 
-} // namespace cairn
+} // namespace cairn::physics

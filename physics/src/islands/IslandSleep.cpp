@@ -2,7 +2,7 @@
 
 #include "step/StepContext.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandSleep::WakeIslandsOfWokenBodies(const StepContext& inContext)
@@ -53,4 +53,4 @@ void IslandSleep::PutRestingIslandsToSleep(const StepContext& inContext)
         inContext.mBodies.DeactivateBody(inContext.BodyAt(bodyIndex));
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -26,4 +26,4 @@ private:
     std::vector<uint32_t> mSleepingBodies; ///< Scratch: body indices
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -104,4 +104,4 @@ private:
     uint32_t mNumColoringsReused = 0; ///< This step's (statistics; colored islands: its records)
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -12,7 +12,7 @@
 #include <span>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct SolvePlan
@@ -70,4 +70,4 @@ struct SolvePlan
     bool IsColored(uint32_t inIsland) const { return mIslandFirstColor[inIsland] != UINT32_MAX; }
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Sorts ioItems by inKeyOf(item) (a uint64_t below 2^inKeyBits), using ioScratch as the second buffer.
@@ -73,4 +73,4 @@ void RadixSortByHighHalf(std::span<Item> ioItems, std::vector<Item>& ioScratch, 
     }
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -1,6 +1,6 @@
 #include "cairn/physics/math/Result.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 const char* ToString(ErrorCode inCode)
@@ -29,4 +29,4 @@ const char* ToString(ErrorCode inCode)
     return "unknown error";
 }
 
-} // namespace cairn
+} // namespace cairn::physics

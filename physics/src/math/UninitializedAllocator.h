@@ -14,7 +14,7 @@
 #include <type_traits>
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 template <class T> class UninitializedAllocator : public std::allocator<T>
@@ -37,4 +37,4 @@ public:
     }
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 Vec3 ClosestPointOnSegment(const Vec3& inP, const Vec3& inA, const Vec3& inB, float& outT)
@@ -158,4 +158,4 @@ Vec3 ClosestPointOnTriangle(const Vec3& inP, const Vec3& inA, const Vec3& inB, c
     return inA + v * ab + w * ac;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

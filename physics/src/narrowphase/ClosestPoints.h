@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Closest point to inP on the segment [inA, inB]; outT in [0, 1] is its parameter from inA.
@@ -24,4 +24,4 @@ float ClosestPointsSegmentSegment(const Vec3& inP1, const Vec3& inQ1, const Vec3
 Vec3 ClosestPointOnTriangle(const Vec3& inP, const Vec3& inA, const Vec3& inB, const Vec3& inC, Vec3& outBary,
                             uint32_t& outFeature);
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -5,7 +5,7 @@
 
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -272,4 +272,4 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -9,7 +9,7 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/BoxShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Which kind of axis the separating axis test picked.
@@ -31,4 +31,4 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
                    const Transform& inTransformB, const CollideSettings& inSettings,
                    ContactManifold& outManifold, BoxBoxAxis* outAxis = nullptr);
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -77,4 +77,4 @@ bool CollideCapsuleCapsule(const CapsuleShape& inA, const Transform& inTransform
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Capsule A against capsule B. Returns false when further apart than inSettings.mMaxSeparation.
@@ -15,4 +15,4 @@ bool CollideCapsuleCapsule(const CapsuleShape& inA, const Transform& inTransform
                            const Transform& inTransformB, const CollideSettings& inSettings,
                            ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

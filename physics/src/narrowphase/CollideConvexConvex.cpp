@@ -2,7 +2,7 @@
 
 #include "narrowphase/FaceClipping.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -51,4 +51,4 @@ bool CollideConvexConvex(const ConvexShape& inA, const Transform& inTransformA, 
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

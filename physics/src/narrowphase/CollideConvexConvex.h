@@ -8,7 +8,7 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "narrowphase/ConvexContact.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Builds the manifold along inContact.mNormal from the supporting faces of A and B; falls back to the single
@@ -23,4 +23,4 @@ bool CollideConvexConvex(const ConvexShape& inA, const Transform& inTransformA, 
                          const Transform& inTransformB, const CollideSettings& inSettings,
                          ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -166,4 +166,4 @@ int CollideConvexTriangles(const ConvexShape& inA, const Transform& inTransformA
     return count;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -21,7 +21,7 @@
 
 #include "cairn/physics/narrowphase/CollideShapes.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// A contact normal whose dot product with the triangle's face normal is above this counts as the face
@@ -40,4 +40,4 @@ int CollideConvexTriangles(const ConvexShape& inA, const Transform& inTransformA
                            const Transform& inTransformB, const CollideSettings& inSettings,
                            ManifoldVisitor inVisitor);
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -11,7 +11,7 @@
 
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -158,4 +158,4 @@ int CollideShapes(const Shape& inShapeA, const Transform& inTransformA, const Sh
     return 1;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -1,6 +1,6 @@
 #include "narrowphase/CollideSphereBox.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 bool CollideSphereBox(const SphereShape& inA, const Transform& inTransformA, const BoxShape& inB,
@@ -50,4 +50,4 @@ bool CollideSphereBox(const SphereShape& inA, const Transform& inTransformA, con
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Sphere A against box B. Returns false when further apart than inSettings.mMaxSeparation.
@@ -15,4 +15,4 @@ bool CollideSphereBox(const SphereShape& inA, const Transform& inTransformA, con
                       const Transform& inTransformB, const CollideSettings& inSettings,
                       ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -3,7 +3,7 @@
 #include "narrowphase/ClosestPoints.h"
 #include "narrowphase/CollideSphereSphere.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 bool CollideSphereCapsule(const SphereShape& inA, const Transform& inTransformA, const CapsuleShape& inB,
@@ -20,4 +20,4 @@ bool CollideSphereCapsule(const SphereShape& inA, const Transform& inTransformA,
                         inSettings.mMaxSeparation, outManifold);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

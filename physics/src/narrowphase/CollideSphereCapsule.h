@@ -7,7 +7,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Sphere A against capsule B. Returns false when further apart than inSettings.mMaxSeparation.
@@ -15,4 +15,4 @@ bool CollideSphereCapsule(const SphereShape& inA, const Transform& inTransformA,
                           const Transform& inTransformB, const CollideSettings& inSettings,
                           ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

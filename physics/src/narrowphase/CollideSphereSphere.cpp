@@ -1,6 +1,6 @@
 #include "narrowphase/CollideSphereSphere.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 bool CollideBalls(const Vec3& inCenterA, float inRadiusA, const Vec3& inCenterB, float inRadiusB,
@@ -30,4 +30,4 @@ bool CollideSphereSphere(const SphereShape& inA, const Transform& inTransformA, 
                         Vec3::UnitY(), inSettings.mMaxSeparation, outManifold);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

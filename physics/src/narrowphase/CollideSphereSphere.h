@@ -6,7 +6,7 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Contact between ball (inCenterA, inRadiusA) and ball (inCenterB, inRadiusB) as a one-point manifold.
@@ -20,4 +20,4 @@ bool CollideSphereSphere(const SphereShape& inA, const Transform& inTransformA, 
                          const Transform& inTransformB, const CollideSettings& inSettings,
                          ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

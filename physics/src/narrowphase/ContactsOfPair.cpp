@@ -10,7 +10,7 @@
 
 #include <cmath>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -165,4 +165,4 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
                           (uint64_t(inManifold.mSubShapeA) << 40) ^ inManifold.mSubShapeB);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

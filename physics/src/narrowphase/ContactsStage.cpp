@@ -9,7 +9,7 @@
 #include <bit>
 #include <cmath>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -215,4 +215,4 @@ void ContactsStage::Merge(const StepContext& inContext)
                                      inContext.BodyAt(link.mB).GetActiveIndex());
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -148,4 +148,4 @@ private:
     std::optional<ContactKey> mLastCachedKey;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include "narrowphase/Epa.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 bool FindConvexContact(const ConvexSupport& inA, const ConvexSupport& inB, float inMaxSeparation,
@@ -46,4 +46,4 @@ bool FindConvexContact(const ConvexSupport& inA, const ConvexSupport& inB, float
     return outContact.mPenetration >= -inMaxSeparation;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -13,7 +13,7 @@
 
 #include "narrowphase/ConvexSupport.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct ConvexContact
@@ -33,4 +33,4 @@ inline constexpr float cEpaInflation = 1.0e-3f;
 bool FindConvexContact(const ConvexSupport& inA, const ConvexSupport& inB, float inMaxSeparation,
                        ConvexContact& outContact);
 
-} // namespace cairn
+} // namespace cairn::physics

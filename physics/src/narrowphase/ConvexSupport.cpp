@@ -4,7 +4,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 ConvexSupport ConvexSupport::FromShape(const ConvexShape& inShape, const Transform& inTransform)
@@ -93,4 +93,4 @@ Vec3 ConvexSupport::GetCoreSupport(const Vec3& inDirection) const
     return mRotation * mShape->GetSupport(mRotation.transpose() * inDirection) + mTranslation;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

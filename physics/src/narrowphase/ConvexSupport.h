@@ -8,7 +8,7 @@
 
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 class ConvexSupport
@@ -57,4 +57,4 @@ private:
     float mRadius = 0.0f;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -267,4 +267,4 @@ bool Epa::Penetration(const ConvexSupport& inA, float inInflationA, const Convex
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 
 #include "narrowphase/Gjk.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct PenetrationResult
@@ -33,4 +33,4 @@ public:
                             float inInflationB, const GjkSimplex& inSimplex, PenetrationResult& outResult);
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -220,4 +220,4 @@ int ManifoldFromFaces(const Vec3* inFaceA, int inCountA, const Vec3* inFaceB, in
     return ReduceContactPoints(points, count, inNormal, outManifold);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

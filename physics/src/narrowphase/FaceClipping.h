@@ -8,7 +8,7 @@
 
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Most points a clipped polygon can have (two faces of SupportingFace::cMaxVertices each).
@@ -26,4 +26,4 @@ int ManifoldFromFaces(const Vec3* inFaceA, int inCountA, const Vec3* inFaceB, in
 int ReduceContactPoints(const ContactPoint* inPoints, int inCount, const Vec3& inNormal,
                         ContactManifold& outManifold);
 
-} // namespace cairn
+} // namespace cairn::physics

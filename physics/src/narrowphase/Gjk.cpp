@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -218,4 +218,4 @@ GjkResult Gjk::ClosestPoints(const ConvexSupport& inA, float inInflationA, const
     return result;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 
 #include "narrowphase/ConvexSupport.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// The simplex GJK ends with: up to 4 points of the Minkowski difference with the support points they came
@@ -46,4 +46,4 @@ public:
                                    float inInflationB, float inMaxDistance);
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -282,4 +282,4 @@ Status WorldQuery::CollidePoint(const Vec3& inPoint, std::vector<BodyID>& outBod
     return Status::Ok();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -2,7 +2,7 @@
 
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -129,4 +129,4 @@ void BoxShape::GetSupportingFace(const Vec3& inDirection, SupportingFace& outFac
     GetBoxFace(mHalfExtent, axis, inDirection[axis] < 0.0f ? -1.0f : 1.0f, outFace.mVertices);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -3,7 +3,7 @@
 #include <array>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -202,4 +202,4 @@ void CapsuleShape::GetSupportingFace(const Vec3& inDirection, SupportingFace& ou
     outFace.mVertices[1] = Vec3(0.0f, -mHalfHeight, 0.0f) + side;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

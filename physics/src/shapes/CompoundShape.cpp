@@ -3,7 +3,7 @@
 #include <bit>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 Result<std::shared_ptr<const CompoundShape>> CompoundShape::Create(std::vector<SubShape> inSubShapes)
@@ -148,4 +148,4 @@ void CompoundShape::VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVis
     }
 }
 
-} // namespace cairn
+} // namespace cairn::physics

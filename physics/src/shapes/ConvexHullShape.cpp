@@ -5,7 +5,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -580,4 +580,4 @@ void ConvexHullShape::GetSupportingFace(const Vec3& inDirection, SupportingFace&
         outFace.mVertices[i] = mVertices[best->mIndices[i * count / kept]];
 }
 
-} // namespace cairn
+} // namespace cairn::physics

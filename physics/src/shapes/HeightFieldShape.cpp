@@ -5,7 +5,7 @@
 #include <cassert>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -318,4 +318,4 @@ bool HeightFieldShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
     return true;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

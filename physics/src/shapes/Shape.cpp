@@ -1,6 +1,6 @@
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 const char* ToString(ShapeType inType)
@@ -116,4 +116,4 @@ AABB TriangleBounds(const Vec3& inV0, const Vec3& inV1, const Vec3& inV2)
 
 } // namespace ShapeHelpers
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -4,7 +4,7 @@
 
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 Result<std::shared_ptr<const SphereShape>> SphereShape::Create(float inRadius)
@@ -66,4 +66,4 @@ Vec3 SphereShape::GetSupport(const Vec3& inDirection) const
     return mRadius * ShapeHelpers::SafeNormalized(inDirection, Vec3::UnitX());
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -6,7 +6,7 @@
 #include <string>
 #include <unordered_map>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -298,4 +298,4 @@ void TriangleMeshShape::VisitTriangles(const AABB& inLocalBox, TriangleVisitor i
         });
 }
 
-} // namespace cairn
+} // namespace cairn::physics

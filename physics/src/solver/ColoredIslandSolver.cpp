@@ -9,7 +9,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
@@ -219,4 +219,4 @@ void IslandSolver::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstC
 #endif
 }
 
-} // namespace cairn
+} // namespace cairn::physics

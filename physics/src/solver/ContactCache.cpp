@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void ContactCache::BeginStep()
@@ -133,4 +133,4 @@ void ContactCache::Clear()
     mCurrentPairs.clear();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct ContactKey
@@ -132,4 +132,4 @@ private:
     std::vector<std::pair<std::pair<BodyID, BodyID>, uint32_t>> mPairOrder;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

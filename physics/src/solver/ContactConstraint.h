@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class Body;
@@ -88,4 +88,4 @@ struct alignas(64) PositionConstraint
 };
 static_assert(sizeof(PositionConstraint) == 128, "two cache lines");
 
-} // namespace cairn
+} // namespace cairn::physics

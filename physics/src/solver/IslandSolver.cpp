@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <array>
 
-namespace cairn
+namespace cairn::physics
 {
 
 void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints)
@@ -244,4 +244,4 @@ void IslandSolver::StoreImpulses(std::span<ContactConstraint* const> inConstrain
     }
 }
 
-} // namespace cairn
+} // namespace cairn::physics

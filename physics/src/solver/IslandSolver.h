@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -93,4 +93,4 @@ private:
     uint32_t mPaddingBlocksFirst = 0; ///< In mSolverBodies: WideContactSolver::cPaddingBlocks per color
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 #include <emmintrin.h>
 #endif
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace
@@ -408,4 +408,4 @@ float SequentialImpulseSolver::SolvePositions(std::span<const PositionConstraint
     return maxPenetration;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

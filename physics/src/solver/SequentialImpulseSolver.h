@@ -20,7 +20,7 @@
 
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace SequentialImpulseSolver
@@ -57,4 +57,4 @@ void MakePositionConstraint(const ContactConstraint& inConstraint, PositionConst
 float SolvePositions(std::span<const PositionConstraint> inConstraints, const SolverSettings& inSettings);
 } // namespace SequentialImpulseSolver
 
-} // namespace cairn
+} // namespace cairn::physics

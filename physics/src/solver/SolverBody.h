@@ -7,7 +7,7 @@
 
 #include "cairn/physics/math/Math.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct alignas(32) SolverBody
@@ -18,4 +18,4 @@ struct alignas(32) SolverBody
     float mPadding;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

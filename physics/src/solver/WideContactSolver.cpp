@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstring>
 
-namespace cairn
+namespace cairn::physics
 {
 namespace
 {
@@ -358,6 +358,6 @@ void WideContactSolver::StoreImpulses(const WideContactBatch& inBatch, ContactCa
     }
 }
 
-} // namespace cairn
+} // namespace cairn::physics
 
 #endif

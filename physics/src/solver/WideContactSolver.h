@@ -26,7 +26,7 @@
 #define CAIRN_WIDE_SOLVER 0
 #endif
 
-namespace cairn
+namespace cairn::physics
 {
 
 namespace WideContactSolver
@@ -93,4 +93,4 @@ void StoreImpulses(const WideContactBatch& inBatch, ContactCache& ioCache);
 
 #endif
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -4,7 +4,7 @@
 
 #include <chrono>
 
-namespace cairn
+namespace cairn::physics
 {
 
 BroadPhaseUpdate::BroadPhaseUpdate(BroadPhase& ioBroadPhase, jobs::JobInterface* ioJobs, bool inBeside)
@@ -66,4 +66,4 @@ double BroadPhaseUpdate::Finish()
     return mMilliseconds;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

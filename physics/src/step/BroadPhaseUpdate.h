@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <exception>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BroadPhaseUpdate
@@ -53,4 +53,4 @@ private:
     std::exception_ptr mError;         ///< The same
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -5,7 +5,7 @@
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 void FinishStage::Run(const StepContext& inContext)
@@ -101,4 +101,4 @@ void FinishStage::Run(const StepContext& inContext)
         });
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct StepContext;
@@ -35,4 +35,4 @@ private:
     std::vector<PublishOrder> mPublishOrders; ///< Scratch, by active index
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -16,7 +16,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PublishedPoseStore;
@@ -47,4 +47,4 @@ struct StepContext
     Body& ActiveBody(uint32_t inActiveIndex) const { return BodyAt(mActive[inActiveIndex]); }
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-namespace cairn::StepCosts
+namespace cairn::physics::StepCosts
 {
 
 /// A loop over items cut into chunks of mGrain, each item costing about mItemNanoseconds.
@@ -51,4 +51,4 @@ inline constexpr uint32_t cColoredIslandGrain = 256;
 inline constexpr uint32_t cMinConstraintsPerPart = 32;
 inline constexpr uint32_t cMinBatchesPerPart = 8;
 
-} // namespace cairn::StepCosts
+} // namespace cairn::physics::StepCosts

@@ -5,7 +5,7 @@
 #include <immintrin.h>
 #endif
 
-namespace cairn
+namespace cairn::physics
 {
 
 void StepScheduler::ResetStages(uint32_t inNumStages)
@@ -35,4 +35,4 @@ void StepScheduler::WaitABit(uint32_t inSpins)
         std::this_thread::yield();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

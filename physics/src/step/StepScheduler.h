@@ -14,7 +14,7 @@
 #include <memory>
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class StepScheduler
@@ -177,4 +177,4 @@ private:
     uint32_t mStageCapacity = 0;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -20,6 +20,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -17,6 +17,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

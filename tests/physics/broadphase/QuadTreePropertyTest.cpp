@@ -44,6 +44,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -11,6 +11,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 struct Keyed

@@ -7,6 +7,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -19,6 +19,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -14,6 +14,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

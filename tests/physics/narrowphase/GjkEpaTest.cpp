@@ -13,6 +13,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

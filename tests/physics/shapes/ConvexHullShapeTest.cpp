@@ -8,6 +8,7 @@
 #include <random>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

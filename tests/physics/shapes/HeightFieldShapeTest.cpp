@@ -13,6 +13,7 @@
 #include <tuple>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

@@ -7,6 +7,7 @@
 #include <limits>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

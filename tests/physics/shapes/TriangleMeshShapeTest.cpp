@@ -7,6 +7,7 @@
 #include <set>
 
 using namespace cairn;
+using namespace cairn::physics;
 
 namespace
 {

@@ -9,6 +9,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

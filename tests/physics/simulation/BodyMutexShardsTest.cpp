@@ -12,6 +12,7 @@
 
 namespace cairn
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -8,6 +8,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

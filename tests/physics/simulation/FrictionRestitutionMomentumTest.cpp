@@ -2,6 +2,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 class FrictionTest : public SimulationFixture
 {

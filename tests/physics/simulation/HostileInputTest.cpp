@@ -27,6 +27,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

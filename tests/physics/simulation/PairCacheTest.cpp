@@ -6,6 +6,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

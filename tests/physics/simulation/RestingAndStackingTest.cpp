@@ -5,6 +5,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 using RestingTest = SimulationFixture;
 

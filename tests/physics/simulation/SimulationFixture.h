@@ -16,6 +16,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 class SimulationFixture : public ::testing::Test
 {

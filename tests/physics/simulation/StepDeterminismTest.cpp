@@ -19,6 +19,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

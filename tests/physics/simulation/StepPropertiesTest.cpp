@@ -5,6 +5,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 TEST(BodyLayout, BodyFitsIn256Bytes)
 {

@@ -13,6 +13,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 namespace
 {
 

@@ -7,6 +7,7 @@
 
 namespace cairn::test
 {
+using namespace cairn::physics;
 
 class WorldQueryTest : public SimulationFixture
 {

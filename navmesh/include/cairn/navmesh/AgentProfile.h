@@ -12,6 +12,7 @@ struct rcConfig;
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// How Recast splits the walkable area into regions (see Recast's Sample_TileMesh for the trade-offs).
 enum class RegionPartition : uint8_t

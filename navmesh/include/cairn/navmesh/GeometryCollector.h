@@ -16,6 +16,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// Which bodies make the navmesh.
 struct NavMeshInclusion

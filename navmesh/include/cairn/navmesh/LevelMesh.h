@@ -16,6 +16,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// A named part of a level file: an OBJ object or group (`o`, `g`), a glTF node with a mesh.
 struct MeshObject

@@ -21,6 +21,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 struct NavMeshFileTile
 {

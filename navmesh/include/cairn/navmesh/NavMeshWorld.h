@@ -30,6 +30,7 @@ class dtNavMesh;
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// Which areas a path may cross and what each costs (a multiplier on distance).
 struct PathFilter

@@ -14,6 +14,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// A file being written: Stream() goes to "<path>.tmp-<process>-<n>"; Commit renames it to the path.
 /// Destroyed uncommitted (an error, an exception, a cancelled bake), it removes the temporary; so does

@@ -14,6 +14,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// Detour tile data (dtAlloc'ed), freed with dtFree by whoever holds it last (NavMeshWorld keeps the data of
 /// the tiles it hands to Detour, and frees it after Detour lets go).

@@ -13,6 +13,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// Empty when inData is a Detour tile whose sections fit its size, whose indices stay inside their arrays and
 /// whose coordinates are finite and within the world's range, else what is wrong. Detour's addTile trusts

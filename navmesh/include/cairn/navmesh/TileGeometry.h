@@ -11,6 +11,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 /// Area ids as bodies carry them (Body::GetNavMeshArea): 0 is the default walkable ground; other values up
 /// to cMaxAreaId are the game's own (road, water...), priced by the path query's filter.

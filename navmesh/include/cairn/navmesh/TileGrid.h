@@ -14,6 +14,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 struct TileCoord
 {

@@ -33,6 +33,7 @@
 
 namespace cairn::navmesh
 {
+using namespace cairn::physics;
 
 class TileJob;
 

@@ -24,7 +24,7 @@
 #include <mutex>
 #include <shared_mutex>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// Which of the engine's locks a wait was for.
@@ -111,4 +111,4 @@ template <class SharedMutex>
     return std::shared_lock<SharedMutex>(ioMutex, std::adopt_lock);
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 enum class BroadPhaseType : uint8_t
@@ -65,4 +65,4 @@ struct PhysicsSettings
 /// negative distance, an iteration count over 1000, a body mutex count that is not a power of two up to 32).
 Status ValidateSettings(const PhysicsSettings& inSettings);
 
-} // namespace cairn
+} // namespace cairn::physics

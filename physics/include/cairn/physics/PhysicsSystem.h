@@ -27,7 +27,7 @@ namespace cairn::jobs
 class JobInterface;
 }
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PhysicsStep;
@@ -94,4 +94,4 @@ private:
     bool mStepInterrupted = false;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

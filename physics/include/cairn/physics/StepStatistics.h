@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// What the last Update did and how long each phase took (summed over its collision steps).
@@ -40,4 +40,4 @@ struct StepStatistics
     double mLockWaitMs = 0.0;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

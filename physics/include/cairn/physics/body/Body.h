@@ -10,7 +10,7 @@
 #include <atomic>
 #include <cassert>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class Body
@@ -117,4 +117,4 @@ private:
     bool mWakeIsland = false; ///< Woken from outside the step: the step wakes its sleeping island too
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -16,7 +16,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 enum class BodyChangeKind : uint8_t
@@ -46,4 +46,4 @@ public:
     virtual void OnBodyChanged(const BodyChange& inChange) = 0;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -6,7 +6,7 @@
 #include "cairn/physics/body/MotionType.h"
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// The heaviest dynamic body CreateBody takes, kg (a rock cube of about 700 m). Contact impulses are mass
@@ -35,4 +35,4 @@ struct BodyCreationSettings
     uint64_t mUserData = 0;   ///< Free for the game
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <functional>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BodyID
@@ -30,11 +30,11 @@ private:
     uint32_t mSequence = 0;
 };
 
-} // namespace cairn
+} // namespace cairn::physics
 
-template <> struct std::hash<cairn::BodyID>
+template <> struct std::hash<cairn::physics::BodyID>
 {
-    size_t operator()(const cairn::BodyID& inID) const noexcept
+    size_t operator()(const cairn::physics::BodyID& inID) const noexcept
     {
         return std::hash<uint64_t>()((uint64_t(inID.GetSequence()) << 32) | inID.GetIndex());
     }

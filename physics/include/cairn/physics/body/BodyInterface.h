@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BodyInterface
@@ -114,4 +114,4 @@ private:
     const LayerSetup& mLayers;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -15,7 +15,7 @@
 #include <mutex>
 #include <shared_mutex>
 
-namespace cairn
+namespace cairn::physics
 {
 
 template <bool Write> class BodyLock
@@ -146,4 +146,4 @@ private:
     MotionType mMotionType = MotionType::Static;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

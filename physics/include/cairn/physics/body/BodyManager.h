@@ -34,7 +34,7 @@
 #include <span>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class PublishedPoseStore;
@@ -155,4 +155,4 @@ private:
     std::vector<uint32_t> mActiveBodies; ///< Guarded by mActiveListMutex (or all body mutexes)
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <string>
 
-namespace cairn
+namespace cairn::physics
 {
 
 using ObjectLayer = uint8_t;
@@ -91,4 +91,4 @@ private:
     void RecordError(std::string inMessage);
 };
 
-} // namespace cairn
+} // namespace cairn::physics

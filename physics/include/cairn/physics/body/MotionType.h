@@ -2,7 +2,7 @@
 
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 enum class MotionType : uint8_t
@@ -19,4 +19,4 @@ enum class Activation : uint8_t
     DontActivate,
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -30,7 +30,7 @@
 #include <atomic>
 #include <cstdint>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BodyManager;
@@ -74,4 +74,4 @@ private:
     std::atomic<uint32_t>& mEpochReaders;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -31,7 +31,7 @@
 
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 /// What the broad phase stores of a body.
@@ -130,4 +130,4 @@ public:
     virtual size_t GetBodyCount() const = 0;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

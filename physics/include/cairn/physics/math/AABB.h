@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct AABB
@@ -25,7 +25,7 @@ struct AABB
 
     /// An empty box has min > max on some axis; it overlaps nothing.
     bool IsEmpty() const { return (mMin.array() > mMax.array()).any(); }
-    bool IsFinite() const { return cairn::IsFinite(mMin) && cairn::IsFinite(mMax); }
+    bool IsFinite() const { return physics::IsFinite(mMin) && physics::IsFinite(mMax); }
 
     Vec3 Center() const { return 0.5f * (mMin + mMax); }
     Vec3 HalfExtent() const { return 0.5f * (mMax - mMin); }
@@ -101,4 +101,4 @@ inline Vec3 SafeReciprocal(const Vec3& inV)
     return r;
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -6,7 +6,7 @@
 #include <type_traits>
 #include <utility>
 
-namespace cairn
+namespace cairn::physics
 {
 
 template <class Signature> class FunctionRef;
@@ -32,4 +32,4 @@ private:
     R (*mInvoke)(void*, Args...);
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <limits>
 
-namespace cairn
+namespace cairn::physics
 {
 
 using Vec3 = Eigen::Vector3f;
@@ -79,4 +79,4 @@ inline Quat IntegrateRotation(const Quat& inQ, const Vec3& inAngle)
     return result.normalized();
 }
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -8,7 +8,7 @@
 #include <utility>
 #include <variant>
 
-namespace cairn
+namespace cairn::physics
 {
 
 enum class ErrorCode
@@ -92,4 +92,4 @@ inline Error MakeError(ErrorCode inCode, std::string inMessage)
     return Error{inCode, std::move(inMessage)};
 }
 
-} // namespace cairn
+} // namespace cairn::physics

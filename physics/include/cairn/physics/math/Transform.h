@@ -4,7 +4,7 @@
 
 #include "cairn/physics/math/Math.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct Transform
@@ -42,4 +42,4 @@ struct Transform
     Vec3 InverseRotateVector(const Vec3& inDir) const { return mRotation.conjugate() * inDir; }
 };
 
-} // namespace cairn
+} // namespace cairn::physics

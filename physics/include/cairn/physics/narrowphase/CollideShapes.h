@@ -14,7 +14,7 @@
 
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct CollideSettings
@@ -31,4 +31,4 @@ int CollideShapes(const Shape& inShapeA, const Transform& inTransformA, const Sh
                   const Transform& inTransformB, const CollideSettings& inSettings,
                   ManifoldVisitor inVisitor);
 
-} // namespace cairn
+} // namespace cairn::physics

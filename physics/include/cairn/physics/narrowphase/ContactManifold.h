@@ -4,7 +4,7 @@
 
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct ContactPoint
@@ -30,4 +30,4 @@ struct ContactManifold
 /// Receives the manifolds of one shape pair (a mesh or compound can give several).
 using ManifoldVisitor = FunctionRef<void(const ContactManifold&)>;
 
-} // namespace cairn
+} // namespace cairn::physics

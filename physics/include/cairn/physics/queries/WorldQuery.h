@@ -24,7 +24,7 @@
 #include <optional>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct QueryFilter
@@ -98,4 +98,4 @@ private:
     QueryReads mReads;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -5,7 +5,7 @@
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 class BoxShape final : public ConvexShape
@@ -29,4 +29,4 @@ private:
     Vec3 mHalfExtent; ///< Metres, each > 0
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -6,7 +6,7 @@
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 class CapsuleShape final : public ConvexShape
@@ -34,4 +34,4 @@ private:
     float mRadius;     ///< > 0
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -11,7 +11,7 @@
 
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class CompoundShape final : public Shape
@@ -49,4 +49,4 @@ private:
     AABB mBounds;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -7,7 +7,7 @@
 
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class ConvexHullShape final : public ConvexShape
@@ -44,4 +44,4 @@ private:
     AABB mBounds;                ///< Local bounds of mVertices
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -11,7 +11,7 @@
 
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class HeightFieldShape final : public Shape
@@ -66,4 +66,4 @@ private:
     AABB mBounds;
 };
 
-} // namespace cairn
+} // namespace cairn::physics

@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-namespace cairn
+namespace cairn::physics
 {
 
 enum class ShapeType : uint8_t
@@ -185,4 +185,4 @@ AABB TriangleBounds(const Vec3& inV0, const Vec3& inV1, const Vec3& inV2);
 
 } // namespace ShapeHelpers
 
-} // namespace cairn
+} // namespace cairn::physics

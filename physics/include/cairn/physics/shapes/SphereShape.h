@@ -5,7 +5,7 @@
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/shapes/Shape.h"
 
-namespace cairn
+namespace cairn::physics
 {
 
 class SphereShape final : public ConvexShape
@@ -28,4 +28,4 @@ private:
     float mRadius; ///< Metres, > 0
 };
 
-} // namespace cairn
+} // namespace cairn::physics

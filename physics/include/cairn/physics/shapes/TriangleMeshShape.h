@@ -14,7 +14,7 @@
 #include <array>
 #include <span>
 
-namespace cairn
+namespace cairn::physics
 {
 
 class TriangleMeshShape final : public Shape
@@ -43,4 +43,4 @@ private:
     std::unique_ptr<Impl> mImpl; ///< Vertices, triangles with edge flags, BVH nodes
 };
 
-} // namespace cairn
+} // namespace cairn::physics

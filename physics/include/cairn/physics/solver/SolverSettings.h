@@ -2,7 +2,7 @@
 
 // Solver tuning, shared by every island of a step. Plain value type.
 
-namespace cairn
+namespace cairn::physics
 {
 
 struct SolverSettings
@@ -23,4 +23,4 @@ struct SolverSettings
     bool mReuseColorings = true;
 };
 
-} // namespace cairn
+} // namespace cairn::physics
