@@ -11,7 +11,6 @@
 
 namespace cairn::fuzz
 {
-using namespace cairn::physics;
 
 /// Writes inData to <tmp>/cairn-fuzz-<pid>/input<inExtension> and returns that path (the folder is the
 /// level's folder for loaders that read files beside it; it holds nothing else).

@@ -77,9 +77,9 @@ void QueryNavMesh(const dtNavMesh& inNavMesh)
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* inData, size_t inSize)
 {
     const std::string path = cairn::fuzz::WriteInputFile(inData, inSize, ".bin");
-    cairn::Result<cairn::navmesh::NavMeshFileContents> contents = cairn::navmesh::LoadNavMeshFile(path);
+    cairn::physics::Result<cairn::navmesh::NavMeshFileContents> contents = cairn::navmesh::LoadNavMeshFile(path);
     if (!contents) return 0;
-    cairn::Result<cairn::navmesh::DetourNavMeshPtr> navMesh =
+    cairn::physics::Result<cairn::navmesh::DetourNavMeshPtr> navMesh =
         cairn::navmesh::CreateDetourNavMesh(contents.Value());
     if (navMesh) QueryNavMesh(*navMesh.Value());
     return 0;
