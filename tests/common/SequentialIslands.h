@@ -11,7 +11,6 @@
 
 namespace cairn::test
 {
-using namespace cairn::physics;
 
 using Edge = std::pair<uint32_t, uint32_t>;
 

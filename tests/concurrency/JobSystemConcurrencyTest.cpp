@@ -15,7 +15,6 @@
 
 namespace cairn::jobs
 {
-using namespace cairn::physics;
 namespace
 {
 

@@ -10,7 +10,6 @@
 
 namespace cairn::tools
 {
-using namespace cairn::physics;
 namespace
 {
 

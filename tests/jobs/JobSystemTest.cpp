@@ -14,7 +14,6 @@
 
 namespace cairn::jobs
 {
-using namespace cairn::physics;
 namespace
 {
 

@@ -9,7 +9,6 @@
 
 namespace cairn::navmesh::test
 {
-using namespace cairn::physics;
 
 inline tinygltf::Model SquareModel(float inSide)
 {
