@@ -40,16 +40,17 @@ int main(int argc, char** argv)
     // As text: CLI11 reads "-1" into an unsigned as 2^64 - 1
     std::string seedText = std::to_string(settings.mSeed);
     app.add_option("--seed", seedText, "World and agent seed (0 to 2^64 - 1)");
-    app.add_option("--agents", settings.mAgents, "AI agents (navmesh invokers)")->check(CLI::Range(0, 1000));
+    app.add_option("--agents", settings.mAgents, "AI agents (navmesh invokers)")
+        ->check(CLI::Range(0, cDemoMaxAgents));
     app.add_option("--threads", settings.mThreads, "Job system threads (0: all cores)")
         ->check(CLI::Range(0, 64));
     app.add_option("--collision-steps", settings.mCollisionSteps, "Physics collision steps per frame")
-        ->check(CLI::Range(1, 8));
+        ->check(CLI::Range(1, cDemoMaxCollisionSteps));
     app.add_option("--candidate-margin", settings.mCandidateMargin,
                    "Broad-phase static candidate margin (m), 0 turns the cache off")
-        ->check(CLI::Range(0.0f, 100.0f));
+        ->check(CLI::Range(0.0f, cDemoMaxCandidateMargin));
     app.add_option("--game-objects", settings.mGameObjects, "Game objects updated by jobs each frame")
-        ->check(CLI::Range(0, 20000));
+        ->check(CLI::Range(0u, cDemoMaxGameObjects));
     app.add_option("--mode", mode, "lock-free, global-mutex or both")
         ->check(CLI::IsMember({"lock-free", "global-mutex", "both"}));
     app.add_option("--output", output, "Folder for report.md, the SVG charts and navmesh.obj ('' for none)");

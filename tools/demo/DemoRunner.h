@@ -23,6 +23,11 @@ using namespace cairn::physics;
 /// (the balls the player throws, and tiles still leaving while new ones stream in).
 inline constexpr uint32_t cDemoMaxBodies = 65536;
 inline constexpr uint32_t cDemoSpareBodies = 4096;
+/// The largest values the demo takes, from its flags and its world file alike.
+inline constexpr int cDemoMaxAgents = 1000;
+inline constexpr int cDemoMaxCollisionSteps = 8;
+inline constexpr float cDemoMaxCandidateMargin = 100.0f;
+inline constexpr uint32_t cDemoMaxGameObjects = 20000;
 
 struct DemoSettings
 {

@@ -88,11 +88,11 @@ Status LoadDemoWorld(const std::string& inPath, DemoSettings& ioSettings)
              settings.mThrowBalls = inValue.get<bool>();
              return true;
          }},
-        {"agents", whole(0, 1000, settings.mAgents)},
-        {"game_objects", whole(0, 20000, settings.mGameObjects)},
+        {"agents", whole(0, cDemoMaxAgents, settings.mAgents)},
+        {"game_objects", whole(0, cDemoMaxGameObjects, settings.mGameObjects)},
         {"game_object_jobs", whole(1, 64, settings.mGameObjectJobs)},
-        {"collision_steps", whole(1, 8, settings.mCollisionSteps)},
-        {"candidate_margin", real(0.0f, 100.0f, settings.mCandidateMargin)},
+        {"collision_steps", whole(1, cDemoMaxCollisionSteps, settings.mCollisionSteps)},
+        {"candidate_margin", real(0.0f, cDemoMaxCandidateMargin, settings.mCandidateMargin)},
     };
     for (const auto& [key, value] : json.items())
     {
