@@ -3,6 +3,7 @@
 #include "step/BroadPhaseUpdate.h"
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
+#include "step/SweptBoxes.h"
 
 #include <algorithm>
 #include <chrono>
@@ -31,15 +32,24 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 {
 }
 
-void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobInterface* ioJobs)
+void PhysicsStep::Run(float inDeltaTime, bool inLastCollisionStep, StepStatistics& ioStatistics,
+                      jobs::JobInterface* ioJobs)
 {
     mScheduler.BeginStep(ioJobs);
     mLockWaitNanoseconds.store(0, std::memory_order_relaxed); // Relaxed: no job of this step runs yet
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
-    const StepContext context{
-        mSettings,   mLayers,       mBodies,  active,     mBodies.GetPublishedPosesForStep(),
-        mBroadPhase, mContactCache, mIslands, mScheduler, mLockWaitNanoseconds,
-        inDeltaTime};
+    const StepContext context{mSettings,
+                              mLayers,
+                              mBodies,
+                              active,
+                              mBodies.GetPublishedPosesForStep(),
+                              mBroadPhase,
+                              mContactCache,
+                              mIslands,
+                              mScheduler,
+                              mLockWaitNanoseconds,
+                              inDeltaTime,
+                              inLastCollisionStep};
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
 
@@ -61,7 +71,11 @@ void PhysicsStep::Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::Job
         mScheduler.ParallelFor(
             uint32_t(round.size()), StepCosts::cVelocities.mGrain, StepCosts::cVelocities.mItemNanoseconds,
             [&](uint32_t inBegin, uint32_t inEnd)
-            { mIntegration.IntegrateVelocities(context, round.subspan(inBegin, inEnd - inBegin)); });
+            {
+                const std::span<const uint32_t> bodies = round.subspan(inBegin, inEnd - inBegin);
+                mIntegration.IntegrateVelocities(context, bodies);
+                SweptBoxes::CoverThisStep(context, bodies);
+            });
         mContacts.FindPairs(context, begin);
         mContacts.CollidePairs(context, mIntegration);
         mContacts.Merge(context);

@@ -48,7 +48,8 @@ public:
 
     /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics. ioJobs (may be null: all
     /// on this thread) runs the parallel parts.
-    void Run(float inDeltaTime, StepStatistics& ioStatistics, jobs::JobInterface* ioJobs);
+    void Run(float inDeltaTime, bool inLastCollisionStep, StepStatistics& ioStatistics,
+             jobs::JobInterface* ioJobs);
     /// See PhysicsSystem::IsContactCacheConsistent.
     bool IsContactCacheConsistent() const { return mContactCache.IsConsistent(); }
 

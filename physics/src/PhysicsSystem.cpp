@@ -134,7 +134,7 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     try
     {
         for (int step = 0; step < inCollisionSteps; ++step)
-            mStep->Run(stepTime, mLastStatistics, ioJobs);
+            mStep->Run(stepTime, step + 1 == inCollisionSteps, mLastStatistics, ioJobs);
     }
     catch (...)
     {

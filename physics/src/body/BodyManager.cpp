@@ -181,6 +181,10 @@ void BodyManager::DeactivateBody(Body& ioBody)
     ioBody.SetActiveIndex(Body::cInactive);
     ioBody.mLinearVelocity.setZero();
     ioBody.mAngularVelocity.setZero();
+    // A sleeping body's forces are not kept for when it wakes: they belonged to the Update that put it to
+    // sleep
+    ioBody.mForce.setZero();
+    ioBody.mTorque.setZero();
     ioBody.mSleepTimer = 0.0f;
     mPoses->Publish(ioBody);
     NotifyChange(BodyChangeKind::FellAsleep, ioBody, ioBody.mBounds);

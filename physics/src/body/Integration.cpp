@@ -47,8 +47,6 @@ void Integration::IntegrateVelocities(const StepContext& inContext, std::span<co
         body.mAngularVelocity *= std::max(0.0f, 1.0f - body.mAngularDamping * deltaTime);
         body.mLinearVelocity = ClampLength(body.mLinearVelocity, body.mMaxLinearVelocity);
         body.mAngularVelocity = ClampLength(body.mAngularVelocity, body.mMaxAngularVelocity);
-        body.mForce.setZero();
-        body.mTorque.setZero();
     }
 }
 
@@ -57,6 +55,15 @@ Mat3 Integration::InverseInertiaOf(const Body& inBody) const
     if (!inBody.IsDynamic()) return Mat3::Zero();
     // A body still asleep (woken by this contact at the merge) had no forces applied: nothing kept for it
     return inBody.IsActive() ? mInverseInertia[inBody.GetActiveIndex()] : inBody.GetInverseInertiaWorld();
+}
+
+VelocityChange Integration::ForceVelocityChangeOf(const StepContext& inContext, const Body& inBody) const
+{
+    if (!inBody.IsDynamic() || !inBody.IsActive()) return {Vec3::Zero(), Vec3::Zero()};
+    const float deltaTime = inContext.mDeltaTime;
+    return {deltaTime *
+                (inBody.mGravityFactor * inContext.mSettings.mGravity + inBody.mInvMass * inBody.mForce),
+            deltaTime * (mInverseInertia[inBody.GetActiveIndex()] * inBody.mTorque)};
 }
 
 void Integration::IntegratePositions(Body& ioBody, float inDeltaTime)

@@ -22,6 +22,13 @@ namespace cairn::physics
 
 struct StepContext;
 
+/// What a body's velocity half added to its velocities: gravity's and the forces' share of this step.
+struct VelocityChange
+{
+    Vec3 mLinear;
+    Vec3 mAngular;
+};
+
 class Integration
 {
 public:
@@ -31,6 +38,9 @@ public:
     void IntegrateVelocities(const StepContext& inContext, std::span<const uint32_t> inBodies);
     /// World inverse inertia of a body at the start of the step: zero unless dynamic.
     Mat3 InverseInertiaOf(const Body& inBody) const;
+    /// The velocity change that gravity, force and torque gave inBody this step (damping and the limits left
+    /// out): zero for a body that is not dynamic or was asleep at the velocity half.
+    VelocityChange ForceVelocityChangeOf(const StepContext& inContext, const Body& inBody) const;
 
     /// The position half: uses the velocity after gravity and contacts.
     static void IntegratePositions(Body& ioBody, float inDeltaTime);

@@ -121,6 +121,10 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
         ioA, ioB, inIntegration.InverseInertiaOf(ioA), inIntegration.InverseInertiaOf(ioB), inManifold,
         inContext.mDeltaTime, c, inTakenOver ? inPrevious->mLocalOnA : nullptr,
         inTakenOver ? inPrevious->mLocalOnB : nullptr);
+    if (c.mRestitution > 0.0f)
+        SequentialImpulseSolver::InitBounces(inIntegration.ForceVelocityChangeOf(inContext, ioA),
+                                             inIntegration.ForceVelocityChangeOf(inContext, ioB),
+                                             inContext.mDeltaTime, inContext.mSettings.mSolver, c);
 
     CachedManifold& cached = ioOut.mCached.emplace_back();
     cached.mKey = {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB};
@@ -139,12 +143,10 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
         cached.mLocalOnA[i] = p.mLocalOnA;
         cached.mLocalOnB[i] = p.mLocalOnB;
         cached.mNormalImpulse[i] = 0.0f;
-        cached.mDeferredBounce[i] = 0.0f;
         if (previous == nullptr) continue;
         if (inTakenOver)
         {
             p.mNormal.mAccumulated = previous->mNormalImpulse[i];
-            p.mApproachVelocity = std::min(p.mApproachVelocity, previous->mDeferredBounce[i]); // As below
             ++ioOut.mNumWarmStartedPoints;
             continue;
         }
@@ -154,8 +156,6 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
                 ContactCache::cPointMatchDistance * ContactCache::cPointMatchDistance)
             {
                 p.mNormal.mAccumulated = previous->mNormalImpulse[j];
-                // A bounce deferred by last step (its point was still a gap away) happens now
-                p.mApproachVelocity = std::min(p.mApproachVelocity, previous->mDeferredBounce[j]);
                 ++ioOut.mNumWarmStartedPoints;
                 break;
             }

@@ -69,7 +69,7 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
     if (bounces)
         colorPasses(1, constraints,
                     [&](int, std::span<ContactConstraint* const> inC)
-                    { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies, solver); });
+                    { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies); });
 
     const std::vector<uint32_t>& active = mContext->mActive;
     const std::span<const uint32_t> bodies = mContext->mIslands.GetBodies(inIsland);

@@ -42,8 +42,6 @@ struct CachedManifold
     Vec3 mLocalOnA[ContactManifold::cMaxPoints]; ///< In A's centre-of-mass frame
     Vec3 mLocalOnB[ContactManifold::cMaxPoints]; ///< In B's centre-of-mass frame
     float mNormalImpulse[ContactManifold::cMaxPoints];
-    float mDeferredBounce[ContactManifold::cMaxPoints]; ///< Approach velocity of a bounce that happens next
-                                                        ///< step
     Vec3 mFrictionImpulse =
         Vec3::Zero();           ///< Patch friction as a world vector, so a new tangent basis can take it over
     float mTwistImpulse = 0.0f; ///< Patch twist friction about the normal

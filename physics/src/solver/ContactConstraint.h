@@ -29,12 +29,12 @@ struct ContactConstraintPoint
     Vec3 mLocalOnA; ///< Contact point in A's centre-of-mass frame, for position correction
     Vec3 mLocalOnB;
     AxisImpulse mNormal;
-    float mSeparation;   ///< Gap at the start of the step (negative: penetration)
-    float mVelocityBias; ///< Minimum normal relative velocity (negative: a speculative gap may close)
-    float
-        mApproachVelocity; ///< Normal relative velocity before solving (or a bounce deferred from last step)
+    float mSeparation;       ///< Gap at the start of the step (negative: penetration)
+    float mVelocityBias;     ///< Minimum normal relative velocity (negative: a speculative gap may close)
+    float mApproachVelocity; ///< Normal relative velocity before solving, after this step's forces
     float mMaxNormalImpulse; ///< Largest normal impulse applied this step: > 0 means the point really touched
-    float mDeferredBounce;   ///< Approach velocity to bounce with next step (0: none), see ApplyRestitution
+    float
+        mBounceVelocity; ///< The restitution pass's target normal velocity (> 0), 0: no bounce (InitBounces)
 };
 
 /// Friction for a whole manifold ("patch friction"): a 2D impulse at the centroid of the contact points and a

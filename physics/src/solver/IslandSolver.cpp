@@ -216,7 +216,7 @@ void IslandSolver::FinishIsland(uint32_t inIsland)
 {
     const std::span<ContactConstraint* const> constraints = mPlan->ConstraintsOf(inIsland);
     const SolverSettings& solver = mContext->mSettings.mSolver;
-    SequentialImpulseSolver::ApplyRestitution(constraints, std::span<SolverBody>(mSolverBodies), solver);
+    SequentialImpulseSolver::ApplyRestitution(constraints, std::span<SolverBody>(mSolverBodies));
 
     const std::vector<uint32_t>& active = mContext->mActive;
     for (uint32_t activeIndex : mContext->mIslands.GetBodies(inIsland))
@@ -234,10 +234,7 @@ void IslandSolver::StoreImpulses(std::span<ContactConstraint* const> inConstrain
     {
         CachedManifold& cached = mContext->mContactCache.Get(c->mCacheIndex);
         for (int i = 0; i < c->mNumPoints; ++i)
-        {
             cached.mNormalImpulse[i] = c->mPoints[i].mNormal.mAccumulated;
-            cached.mDeferredBounce[i] = c->mPoints[i].mDeferredBounce;
-        }
         cached.mFrictionImpulse = c->mPatch.mTangent[0].mAccumulated * c->mTangent[0] +
                                   c->mPatch.mTangent[1].mAccumulated * c->mTangent[1];
         cached.mTwistImpulse = c->mPatch.mTwistAccumulated;

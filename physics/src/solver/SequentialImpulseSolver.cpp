@@ -13,9 +13,6 @@ namespace cairn::physics
 
 namespace
 {
-/// A speculative point further apart than this at the start of the step does not bounce in this step.
-constexpr float cTouchingTolerance = 1.0e-3f;
-
 void InitAxis(const Vec3& inAxis, const Vec3& inRA, const Vec3& inRB, const Mat3& inInvIA,
               const Mat3& inInvIB, float inInvMassA, float inInvMassB, AxisImpulse& outAxis)
 {
@@ -245,7 +242,7 @@ void SequentialImpulseSolver::InitConstraint(Body& ioA, Body& ioB, const Mat3& i
         p.mSeparation = -mp.mPenetration;
         p.mVelocityBias = p.mSeparation > 0.0f ? -p.mSeparation / inDeltaTime : 0.0f;
         p.mMaxNormalImpulse = 0.0f;
-        p.mDeferredBounce = 0.0f;
+        p.mBounceVelocity = 0.0f;
         centroid += 0.5f * (mp.mPositionOnA + mp.mPositionOnB);
     }
     // Each point's normal axis, and its normal velocity before solving
@@ -317,9 +314,44 @@ void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const
     }
 }
 
+void SequentialImpulseSolver::InitBounces(const VelocityChange& inA, const VelocityChange& inB,
+                                          float inDeltaTime, const SolverSettings& inSettings,
+                                          ContactConstraint& ioC)
+{
+    const float linearChange = ioC.mNormal.dot(inB.mLinear - inA.mLinear);
+    for (int i = 0; i < ioC.mNumPoints; ++i)
+    {
+        ContactConstraintPoint& p = ioC.mPoints[i];
+        // The point bounces in the step it would reach the surface in: a gap it closes this step, or a touch
+        const float gap = std::max(p.mSeparation, 0.0f);
+        const float velocity = p.mApproachVelocity; // Before the contacts, after the step's forces
+        if (!(gap + velocity * inDeltaTime < 0.0f)) continue;
+        // Along the normal the point moves as a body under constant acceleration a (the forces' and gravity's
+        // share of the relative velocity). Symplectic Euler's positions lie on the parabola whose velocity at
+        // the step's start is s = v_before + a dt / 2; it reaches the surface at speed sqrt(s^2 - 2 a gap),
+        // leaves it e times as fast, and is back at the gap with speed sqrt(e^2 v_hit^2 + 2 a gap). Starting
+        // from there now, the velocity the position half needs is that plus a dt / 2. So the bounce is the
+        // analytic one from wherever in the step the surface is met: with e = 1 the velocity is exactly
+        // reversed (the parabola mirrored), so no bounce gains or loses height, and gravity acting during the
+        // impact step adds nothing to the rebound
+        const float change =
+            linearChange + p.mNormal.mRBxAxis.dot(inB.mAngular) - p.mNormal.mRAxAxis.dot(inA.mAngular);
+        const float acceleration = change / inDeltaTime;
+        const float startVelocity =
+            velocity - 0.5f * change; // The velocity before the step: velocity - change
+        const float hitSpeedSq = startVelocity * startVelocity - 2.0f * acceleration * gap;
+        if (!(hitSpeedSq >= inSettings.mRestitutionThreshold * inSettings.mRestitutionThreshold)) continue;
+        const float leaveSpeedSq =
+            ioC.mRestitution * ioC.mRestitution * hitSpeedSq + 2.0f * acceleration * gap;
+        p.mBounceVelocity = std::max(std::sqrt(std::max(leaveSpeedSq, 0.0f)) + 0.5f * change, 0.0f);
+        // The target of every velocity iteration, not of a pass after them: the contacts behind the other
+        // body (a box on a stack) then push back while it bounces, as the stack would
+        p.mVelocityBias = std::max(p.mVelocityBias, p.mBounceVelocity);
+    }
+}
+
 void SequentialImpulseSolver::ApplyRestitution(std::span<ContactConstraint* const> ioConstraints,
-                                               std::span<SolverBody> ioBodies,
-                                               const SolverSettings& inSettings)
+                                               std::span<SolverBody> ioBodies)
 {
     for (ContactConstraint* c : ioConstraints)
     {
@@ -328,19 +360,10 @@ void SequentialImpulseSolver::ApplyRestitution(std::span<ContactConstraint* cons
         for (int i = 0; i < c->mNumPoints; ++i)
         {
             ContactConstraintPoint& p = c->mPoints[i];
-            // Only points that touched (received an impulse) and hit hard enough bounce
-            if (p.mApproachVelocity > -inSettings.mRestitutionThreshold || p.mMaxNormalImpulse == 0.0f)
-                continue;
-            // A speculative point that only closed its gap this step bounces next step, from where it
-            // touches: bouncing now would launch it from the far side of the gap, too high (up to a step's
-            // travel)
-            if (p.mSeparation > cTouchingTolerance)
-            {
-                p.mDeferredBounce = p.mApproachVelocity;
-                continue;
-            }
+            // Only points that touched (received an impulse: another contact may have stopped the body short)
+            if (p.mBounceVelocity == 0.0f || p.mMaxNormalImpulse == 0.0f) continue;
             const float vn = RelativeVelocity(bodies, c->mNormal, p.mNormal);
-            const float lambda = -p.mNormal.mEffectiveMass * (vn + c->mRestitution * p.mApproachVelocity);
+            const float lambda = -p.mNormal.mEffectiveMass * (vn - p.mBounceVelocity);
             const float total = std::max(p.mNormal.mAccumulated + lambda, 0.0f);
             const float applied = total - p.mNormal.mAccumulated;
             p.mNormal.mAccumulated = total;

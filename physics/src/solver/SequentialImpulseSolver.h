@@ -8,12 +8,14 @@
 //  ContactCache);
 //  - accumulated-impulse clamping: normal >= 0, friction inside the Coulomb circle |(t1, t2)| <= mu * normal;
 //  - restitution: a separate pass after the velocity iterations (as in Box2D v3) gives points that touched
-//    and approached faster than the threshold a target velocity of -e * approach velocity;
+//    and hit faster than the threshold the analytic rebound, from wherever in the step the surface is met
+//    (InitBounces);
 //  - position correction by split impulses: no Baumgarte term in the velocity solve (it would add energy);
 //    after integration, non-linear Gauss-Seidel iterations move the bodies apart by mBaumgarte of the
 //    penetration beyond mPenetrationSlop, directly on positions.
 // Runs inside the step, by the one thread that owns the island: no locks.
 
+#include "body/Integration.h"
 #include "cairn/physics/solver/SolverSettings.h"
 #include "solver/ContactConstraint.h"
 #include "solver/SolverBody.h"
@@ -48,9 +50,14 @@ void WarmStart(std::span<ContactConstraint* const> ioConstraints, std::span<Solv
 /// turns at starting backwards), so nothing evens it out.
 void SolveVelocities(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies,
                      int inIteration);
-/// The restitution pass, after the velocity iterations.
-void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies,
-                      const SolverSettings& inSettings);
+/// Gives the points of a constraint with restitution their bounce (mBounceVelocity): those that meet the
+/// surface this step, faster than the threshold. inA/inB: the bodies' velocity change from this step's
+/// gravity and forces (Integration::ForceVelocityChangeOf).
+void InitBounces(const VelocityChange& inA, const VelocityChange& inB, float inDeltaTime,
+                 const SolverSettings& inSettings, ContactConstraint& ioC);
+/// The restitution pass, after the velocity iterations: the points InitBounces chose, that touched, leave at
+/// their bounce velocity.
+void ApplyRestitution(std::span<ContactConstraint* const> ioConstraints, std::span<SolverBody> ioBodies);
 /// The part of inConstraint that the position iterations need.
 void MakePositionConstraint(const ContactConstraint& inConstraint, PositionConstraint& outConstraint);
 /// One position iteration; returns the largest remaining penetration beyond the slop.

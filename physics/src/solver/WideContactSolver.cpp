@@ -345,10 +345,7 @@ void WideContactSolver::StoreImpulses(const WideContactBatch& inBatch, ContactCa
         const int l = int(lane);
         // Points beyond the lane's count hold zeros, and the cache never reads past its count
         for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
-        {
             cached.mNormalImpulse[i] = GetLane(inBatch.mPoint[i].mAccumulated, l);
-            cached.mDeferredBounce[i] = 0.0f;
-        }
         const float friction[2] = {GetLane(inBatch.mTangentAxis[0].mAccumulated, l),
                                    GetLane(inBatch.mTangentAxis[1].mAccumulated, l)};
         for (int k = 0; k < 3; ++k)

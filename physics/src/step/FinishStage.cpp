@@ -4,6 +4,7 @@
 #include "cairn/physics/LockWaits.h"
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
+#include "step/SweptBoxes.h"
 
 namespace cairn::physics
 {
@@ -21,11 +22,7 @@ void FinishStage::Run(const StepContext& inContext)
     // The broad phase gets the bounds swept over the next step (by inSweep: the step's velocity times its
     // time) plus the speculative distance, so the next step finds the pairs this body can reach
     auto sweptBounds = [&](const AABB& inBounds, const Vec3& inSweep)
-    {
-        AABB swept = inBounds;
-        swept.Encapsulate(AABB(inBounds.mMin + inSweep, inBounds.mMax + inSweep));
-        return swept.Expanded(settings.mSpeculativeDistance);
-    };
+    { return SweptBoxes::Of(inBounds, inSweep, settings.mSpeculativeDistance); };
     PublishedPoseStore& poses = inContext.mPoses;
     mPublishOrders.resize(active.size());
     inContext.mScheduler.ParallelFor(
@@ -45,6 +42,13 @@ void FinishStage::Run(const StepContext& inContext)
                 Body& body = inContext.BodyAt(index);
                 poses.Prefetch(index);
                 const AABB published = body.mBounds;
+                // Forces act over the whole Update (each collision step's velocity half and bounces read
+                // them)
+                if (inContext.mLastCollisionStep)
+                {
+                    body.mForce.setZero();
+                    body.mTorque.setZero();
+                }
                 body.UpdateBounds();
                 const Vec3 sweep = deltaTime * body.mLinearVelocity;
                 const AABB swept = sweptBounds(body.mBounds, sweep);

@@ -41,6 +41,9 @@ struct StepContext
     /// read by the stepping thread after it waited for every job that adds to it
     std::atomic<uint64_t>& mLockWaitNanoseconds;
     float mDeltaTime;
+    /// The last collision step of an Update: the forces and torques added before the Update act in each of
+    /// its collision steps, and are cleared by this one's velocity half
+    bool mLastCollisionStep;
 
     Body& BodyAt(uint32_t inIndex) const { return *mBodies.TryGetBodyAtIndex(inIndex); }
     /// The body at active index inActiveIndex.

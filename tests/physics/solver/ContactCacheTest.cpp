@@ -39,7 +39,7 @@ StepContent MakeStep(int inNumPairs, uint32_t inSeed)
             for (int i = 0; i < ContactManifold::cMaxPoints; ++i)
             {
                 manifold.mLocalOnA[i] = manifold.mLocalOnB[i] = Vec3::Zero();
-                manifold.mNormalImpulse[i] = manifold.mDeferredBounce[i] = 0.0f;
+                manifold.mNormalImpulse[i] = 0.0f;
             }
             manifold.mKey = {pair.mBodyA, pair.mBodyB, SubShapeID(7 - m), SubShapeID(m)};
             manifold.mNumPoints = 1;

@@ -85,8 +85,8 @@ private:
     Quat mRotation;           ///< World rotation
     Vec3 mLinearVelocity;     ///< m/s
     Vec3 mAngularVelocity;    ///< rad/s, world
-    Vec3 mForce;              ///< Accumulated until the next step, N
-    Vec3 mTorque;             ///< Accumulated until the next step, N m
+    Vec3 mForce;              ///< Accumulated until the next Update, acting over all its collision steps, N
+    Vec3 mTorque;             ///< As mForce, N m
     Quat mInertiaRotation;    ///< Rotates the principal axes of inertia into body space
     Vec3 mInvInertiaDiagonal; ///< Inverse principal moments (0 for static/kinematic)
     float mInvMass;           ///< 0 for static/kinematic

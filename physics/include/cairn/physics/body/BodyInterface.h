@@ -78,8 +78,9 @@ public:
                                   Activation inActivation);
     Status SetLinearVelocity(const BodyID& inID, const Vec3& inVelocity);
     Status SetAngularVelocity(const BodyID& inID, const Vec3& inVelocity);
-    /// Force through the centre of mass until the next step, N.
+    /// Force through the centre of mass over the whole next Update (each of its collision steps), N.
     Status AddForce(const BodyID& inID, const Vec3& inForce);
+    /// Torque over the whole next Update, as AddForce, N m.
     Status AddTorque(const BodyID& inID, const Vec3& inTorque);
     /// Impulse at the centre of mass, N s.
     Status AddImpulse(const BodyID& inID, const Vec3& inImpulse);
