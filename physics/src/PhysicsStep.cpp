@@ -32,24 +32,16 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 {
 }
 
-void PhysicsStep::Run(float inDeltaTime, bool inLastCollisionStep, StepStatistics& ioStatistics,
+void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepStatistics& ioStatistics,
                       jobs::JobInterface* ioJobs)
 {
     mScheduler.BeginStep(ioJobs);
     mLockWaitNanoseconds.store(0, std::memory_order_relaxed); // Relaxed: no job of this step runs yet
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
-    const StepContext context{mSettings,
-                              mLayers,
-                              mBodies,
-                              active,
-                              mBodies.GetPublishedPosesForStep(),
-                              mBroadPhase,
-                              mContactCache,
-                              mIslands,
-                              mScheduler,
-                              mLockWaitNanoseconds,
-                              inDeltaTime,
-                              inLastCollisionStep};
+    const StepContext context{
+        mSettings,        mLayers,       mBodies,       active,     mBodies.GetPublishedPosesForStep(),
+        mBroadPhase,      mContactCache, mIslands,      mScheduler, mLockWaitNanoseconds,
+        inStep.mListener, inDeltaTime,   inStep.mIsLast};
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
 
@@ -115,6 +107,16 @@ void PhysicsStep::Run(float inDeltaTime, bool inLastCollisionStep, StepStatistic
     // 8. Finish: bounds, broad-phase moves and published poses; then the resting islands sleep
     mFinish.Run(context);
     mSleep.PutRestingIslandsToSleep(context);
+    // 9. Contact events, from the contact cache (the solver's impulses are in it) and the sensor overlaps
+    if (inStep.mEvents != nullptr)
+    {
+        const size_t first = inStep.mEvents->size();
+        mEvents.Record(mBodies, mContactCache, mContacts.GetSensorOverlaps(), inStep.mIndex, *inStep.mEvents);
+        if (inStep.mListener != nullptr)
+            inStep.mListener->OnContactEvents(std::span<const ContactEvent>(*inStep.mEvents).subspan(first));
+    }
+    else
+        mEvents.Forget();
     ioStatistics.mFinishMs += MillisecondsSince(phase);
     ioStatistics.mNumActiveBodies = uint32_t(active.size());
     ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();

@@ -28,6 +28,7 @@
 #include "islands/AtomicUnionFind.h"
 #include "islands/IslandSleep.h"
 #include "islands/IslandStage.h"
+#include "narrowphase/ContactEventRecorder.h"
 #include "narrowphase/ContactsStage.h"
 #include "solver/ContactCache.h"
 #include "solver/IslandSolver.h"
@@ -36,9 +37,19 @@
 
 #include <atomic>
 #include <cstdint>
+#include <vector>
 
 namespace cairn::physics
 {
+
+/// Which collision step of an Update a step is, and who hears of its contacts.
+struct CollisionStepInfo
+{
+    uint8_t mIndex = 0;
+    bool mIsLast = true;
+    ContactListener* mListener = nullptr;         ///< ContactListener.h; null: none
+    std::vector<ContactEvent>* mEvents = nullptr; ///< Where its contact events go; null: none recorded
+};
 
 class PhysicsStep
 {
@@ -48,7 +59,7 @@ public:
 
     /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics. ioJobs (may be null: all
     /// on this thread) runs the parallel parts.
-    void Run(float inDeltaTime, bool inLastCollisionStep, StepStatistics& ioStatistics,
+    void Run(float inDeltaTime, const CollisionStepInfo& inStep, StepStatistics& ioStatistics,
              jobs::JobInterface* ioJobs);
     /// See PhysicsSystem::IsContactCacheConsistent.
     bool IsContactCacheConsistent() const { return mContactCache.IsConsistent(); }
@@ -73,6 +84,7 @@ private:
     IslandSolver mSolver;
     FinishStage mFinish;
     IslandSleep mSleep;
+    ContactEventRecorder mEvents;
 };
 
 } // namespace cairn::physics

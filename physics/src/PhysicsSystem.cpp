@@ -131,10 +131,16 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     mLastStatistics = {};
     mLastStatistics.mLockWaitMs = double(GetThisThreadLockWaitNanoseconds() - waitedBefore) / 1.0e6;
     const float stepTime = inDeltaTime / float(inCollisionSteps);
+    const bool recordEvents = mRecordContactEvents || mContactListener != nullptr;
+    mContactEvents.clear();
     try
     {
         for (int step = 0; step < inCollisionSteps; ++step)
-            mStep->Run(stepTime, step + 1 == inCollisionSteps, mLastStatistics, ioJobs);
+        {
+            const CollisionStepInfo info{uint8_t(step), step + 1 == inCollisionSteps, mContactListener,
+                                         recordEvents ? &mContactEvents : nullptr};
+            mStep->Run(stepTime, info, mLastStatistics, ioJobs);
+        }
     }
     catch (...)
     {

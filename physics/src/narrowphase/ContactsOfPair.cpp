@@ -31,6 +31,14 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
                                 Body& ioB, NarrowPhaseChunk& ioOut) const
 {
     if (!ioA.IsDynamic() && !ioB.IsDynamic()) return;
+    if (inContext.mListener != nullptr &&
+        inContext.mListener->OnContactValidate(ioA, ioB) == ContactValidation::Reject)
+        return; // No record either: the pair is validated again next step
+    if (ioA.IsSensor() || ioB.IsSensor())
+    {
+        CollideSensor(ioA, ioB, ioOut);
+        return;
+    }
     // Look ahead by how far the bodies can close in this step, so fast bodies get speculative contacts before
     // they tunnel
     CollideSettings settings;
@@ -67,6 +75,23 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
     // Touching an active body wakes a sleeping one: at the merge, in pair order (the active list is shared)
     if (!ioA.IsActive() && ioA.IsDynamic()) ioOut.mToWake.push_back(ioA.GetID().GetIndex());
     if (!ioB.IsActive() && ioB.IsDynamic()) ioOut.mToWake.push_back(ioB.GetID().GetIndex());
+}
+
+void ContactsStage::CollideSensor(Body& ioA, Body& ioB, NarrowPhaseChunk& ioOut) const
+{
+    const Body& other = ioA.IsSensor() ? ioB : ioA;
+    if (other.IsSensor() || !other.IsDynamic()) return;
+    // Touching counts as inside: a body resting on a sensor's face is in it
+    CollideSettings settings;
+    settings.mMaxSeparation = 0.0f;
+    bool overlap = false;
+    CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
+                  [&](const ContactManifold& inManifold)
+                  {
+                      for (int i = 0; i < inManifold.mNumPoints; ++i)
+                          overlap |= inManifold.mPoints[i].mPenetration >= 0.0f;
+                  });
+    if (overlap) ioOut.mSensorOverlaps.push_back({ioA.GetID(), ioB.GetID()});
 }
 
 bool ContactsStage::ReuseManifolds(const StepContext& inContext, const Integration& inIntegration, Body& ioA,
@@ -121,6 +146,19 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
         ioA, ioB, inIntegration.InverseInertiaOf(ioA), inIntegration.InverseInertiaOf(ioB), inManifold,
         inContext.mDeltaTime, c, inTakenOver ? inPrevious->mLocalOnA : nullptr,
         inTakenOver ? inPrevious->mLocalOnB : nullptr);
+    if (inContext.mListener != nullptr)
+    {
+        ContactSettings settings{c.mFriction, c.mRestitution};
+        if (inPrevious == nullptr)
+            inContext.mListener->OnContactAdded(ioA, ioB, inManifold, settings);
+        else
+            inContext.mListener->OnContactPersisted(ioA, ioB, inManifold, settings);
+        // A listener's NaN or out-of-range value keeps the combined one: the step cannot report an error,
+        // and a NaN friction would spread to every body of the island
+        if (settings.mFriction >= 0.0f && settings.mFriction < cLargeFloat) c.mFriction = settings.mFriction;
+        if (settings.mRestitution >= 0.0f && settings.mRestitution <= 1.0f)
+            c.mRestitution = settings.mRestitution;
+    }
     if (c.mRestitution > 0.0f)
         SequentialImpulseSolver::InitBounces(inIntegration.ForceVelocityChangeOf(inContext, ioA),
                                              inIntegration.ForceVelocityChangeOf(inContext, ioB),

@@ -29,6 +29,7 @@ void ContactsStage::BeginStep()
     mConstraintInfo.clear();
     mNumChunksUsed = 0;
     mCounts = {};
+    mSensorOverlaps.clear();
     mCacheInOrder = true;
     mLastCachedPair.reset();
     mLastCachedKey.reset();
@@ -158,6 +159,7 @@ void ContactsStage::Merge(const StepContext& inContext)
         mCounts.mNumWarmStartedPoints += out.mNumWarmStartedPoints;
         mCounts.mNumReusedPairs += out.mNumReusedPairs;
         mCounts.mNumContactPoints += out.mNumContactPoints;
+        mSensorOverlaps.insert(mSensorOverlaps.end(), out.mSensorOverlaps.begin(), out.mSensorOverlaps.end());
         // The contact cache's order across chunks (and rounds); within each chunk the copies check it
         continuesInOrder(out.mCachedPairs, PairKeyOf, mLastCachedPair);
         continuesInOrder(

@@ -11,6 +11,7 @@
 // chunk's output, the island links (lock-free) and the contact cache entries the merge gave it.
 
 #include "cairn/physics/body/Body.h"
+#include "narrowphase/ContactEventRecorder.h"
 #include "solver/ContactCache.h"
 #include "solver/ContactConstraint.h"
 
@@ -68,6 +69,8 @@ public:
     /// Whether this step's contact-cache entries are in key order (ContactCache::EndStep).
     bool IsCacheInOrder() const { return mCacheInOrder; }
     const Counts& GetCounts() const { return mCounts; }
+    /// This step's sensor overlaps (ContactEventRecorder), in pair order within each round.
+    std::span<const SensorOverlap> GetSensorOverlaps() const { return mSensorOverlaps; }
 
 private:
     struct BodyPair
@@ -85,6 +88,7 @@ private:
         std::vector<CachedBodyPair> mCachedPairs;    ///< One per pair collided, with its count of constraints
         std::vector<uint32_t> mToWake;               ///< Sleeping dynamic bodies touched, in pair order
         std::vector<BodyPair> mDeferredLinks;        ///< Island links with a body woken at the merge
+        std::vector<SensorOverlap> mSensorOverlaps;  ///< Dynamic bodies overlapping sensors, in pair order
         uint32_t mNumWarmStartedPoints = 0;
         uint32_t mNumReusedPairs = 0;
         uint32_t mNumContactPoints = 0;
@@ -101,6 +105,7 @@ private:
             mNumReusedPairs = 0;
             mToWake.clear();
             mDeferredLinks.clear();
+            mSensorOverlaps.clear();
             mNumWarmStartedPoints = 0;
             mNumContactPoints = 0;
         }
@@ -114,6 +119,8 @@ private:
     /// The pair's manifolds (reused or collided) into ioOut, its island link and the bodies it wakes.
     void CollidePair(const StepContext& inContext, const Integration& inIntegration, Body& ioA, Body& ioB,
                      NarrowPhaseChunk& ioOut) const;
+    /// A pair with a sensor: whether the two overlap (no constraints).
+    void CollideSensor(Body& ioA, Body& ioB, NarrowPhaseChunk& ioOut) const;
     /// Adds last step's manifolds of the pair if its relative pose has barely changed since they were made;
     /// false if the shapes must be collided. ioRecord: the pose recorded with them.
     bool ReuseManifolds(const StepContext& inContext, const Integration& inIntegration, Body& ioA, Body& ioB,
@@ -140,6 +147,7 @@ private:
     std::vector<ContactConstraint*> mConstraints; ///< This step's contacts, in the narrow phase's chunks
     std::vector<ConstraintInfo> mConstraintInfo;  ///< Per entry of mConstraints
     Counts mCounts;
+    std::vector<SensorOverlap> mSensorOverlaps; ///< This step's, from the merges
     /// Whether this step's contact-cache entries are in key order, as they nearly always are (the pairs are
     /// collided in sorted order): then ContactCache::EndStep has nothing to do. Checked by the merge, the
     /// chunks' own entries in parallel and where chunks (and rounds) meet here, from the last entry so far.

@@ -89,6 +89,10 @@ public:
     {
         return {mPrevious.data() + inPair.mFirstManifold, inPair.mNumManifolds};
     }
+    /// Last step's manifolds, all of them, in key order (between BeginStep and the next one).
+    std::span<const CachedManifold> GetAllPreviousManifolds() const { return mPrevious; }
+    /// This step's manifolds: in key order after EndStep.
+    std::span<const CachedManifold> GetManifolds() const { return mCurrent; }
     /// Stores a body pair of this step: its manifolds are the next inPair.mNumManifolds given to Add().
     void AddPair(const CachedBodyPair& inPair) { mCurrentPairs.push_back(inPair); }
     /// Makes room for inCount more body pairs of this step (unset: each to be filled through GetPair) and

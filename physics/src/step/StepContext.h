@@ -9,6 +9,7 @@
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
+#include "cairn/physics/narrowphase/ContactListener.h"
 #include "islands/AtomicUnionFind.h"
 #include "solver/ContactCache.h"
 
@@ -40,6 +41,8 @@ struct StepContext
     /// This step's waits for locks (LockWaits), added by whichever of its threads waited. Relaxed: a sum,
     /// read by the stepping thread after it waited for every job that adds to it
     std::atomic<uint64_t>& mLockWaitNanoseconds;
+    /// Told of each contact the narrow phase makes (ContactListener.h), on its job threads; null: none
+    ContactListener* mListener;
     float mDeltaTime;
     /// The last collision step of an Update: the forces and torques added before the Update act in each of
     /// its collision steps, and are cleared by this one's velocity half

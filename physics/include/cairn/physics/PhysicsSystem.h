@@ -17,10 +17,13 @@
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/StepStatistics.h"
 #include "cairn/physics/body/BodyInterface.h"
+#include "cairn/physics/narrowphase/ContactListener.h"
 #include "cairn/physics/queries/WorldQuery.h"
 
 #include <atomic>
 #include <memory>
+#include <span>
+#include <vector>
 
 namespace cairn::jobs
 {
@@ -69,6 +72,14 @@ public:
     const PhysicsSettings& GetSettings() const { return mSettings; }
     /// Figures of the last Update. Read it from the thread that calls Update.
     const StepStatistics& GetLastStepStatistics() const { return mLastStatistics; }
+    /// The contact listener (ContactListener.h), or null for none. Between Updates, from the thread that
+    /// calls Update; it must outlive its use.
+    void SetContactListener(ContactListener* inListener) { mContactListener = inListener; }
+    /// Records contact events without a listener. Between Updates, from the thread that calls Update.
+    void SetRecordContactEvents(bool inRecord) { mRecordContactEvents = inRecord; }
+    /// The last Update's contact events, in the order ContactListener.h states; empty when none were
+    /// recorded. Read it from the thread that calls Update, until the next Update.
+    std::span<const ContactEvent> GetContactEvents() const { return mContactEvents; }
     /// A self-check for tests, between updates: the contact cache that the next step warm-starts from is in
     /// key order and every body pair in it finds its manifolds. O(contacts).
     bool IsContactCacheConsistent() const;
@@ -89,6 +100,10 @@ private:
     Status UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs);
     std::atomic<bool> mUpdating{false}; ///< Guards against concurrent Update calls (acquire/release below)
     StepStatistics mLastStatistics;     ///< Written by the updating thread only
+    // The updating thread's only, like mLastStatistics
+    ContactListener* mContactListener = nullptr;
+    bool mRecordContactEvents = false;
+    std::vector<ContactEvent> mContactEvents;
     /// The last step threw halfway: mStep's caches may be half updated, and the next Update replaces it. Read
     /// and written by the updating thread only (ordered from one updater to the next by mUpdating)
     bool mStepInterrupted = false;

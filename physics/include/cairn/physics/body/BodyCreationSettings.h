@@ -31,6 +31,9 @@ struct BodyCreationSettings
     float mMaxLinearVelocity = 500.0f; ///< m/s, clamped each step
     float mMaxAngularVelocity = 0.25f * 3.14159265f * 60.0f; ///< rad/s: a quarter turn per 1/60 s step
     bool mAllowSleeping = true;
+    /// A sensor makes no contacts that push: it reports the dynamic bodies that enter and leave it
+    /// (ContactListener.h)
+    bool mIsSensor = false;
     uint8_t mNavMeshArea = 0; ///< Navmesh area type (0 = default walkable); the navmesh reads it
     uint64_t mUserData = 0;   ///< Free for the game
 };
