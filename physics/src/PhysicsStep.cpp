@@ -48,6 +48,7 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     // 1. The broad-phase update: beside the rounds below when it may, else now
     BroadPhaseUpdate update(mBroadPhase, ioJobs, active.size() >= mSettings.mUpdateBesideStepMinActiveBodies);
     mContactCache.BeginStep();
+    mContinuous.BeginStep();
     mContacts.BeginStep();
     IslandSleep::WakeIslandsOfWokenBodies(context);
     mIslands.Reset(uint32_t(active.size()));
@@ -67,6 +68,7 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
                 const std::span<const uint32_t> bodies = round.subspan(inBegin, inEnd - inBegin);
                 mIntegration.IntegrateVelocities(context, bodies);
                 SweptBoxes::CoverThisStep(context, bodies);
+                mContinuous.Count(context, bodies);
             });
         mContacts.FindPairs(context, begin);
         mContacts.CollidePairs(context, mIntegration);
@@ -90,6 +92,10 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     mSolver.Solve(context, mIslandStage.GetPlan(), uint32_t(mContacts.GetConstraints().size()));
     mContactCache.EndStep(mContacts.IsCacheInOrder());
     ioStatistics.mSolveMs += MillisecondsSince(phase);
+
+    // 7b. Linear casts: fast bodies stopped short of what they would have passed through
+    ioStatistics.mNumLinearCastsMovedBack += mContinuous.Run(context);
+    ioStatistics.mContinuousMs += MillisecondsSince(phase);
 
     const ContactsStage::Counts& counts = mContacts.GetCounts();
     ioStatistics.mNumBodyPairs += counts.mNumBodyPairs;

@@ -32,6 +32,7 @@
 #include "narrowphase/ContactsStage.h"
 #include "solver/ContactCache.h"
 #include "solver/IslandSolver.h"
+#include "step/ContinuousCollision.h"
 #include "step/FinishStage.h"
 #include "step/StepScheduler.h"
 
@@ -82,6 +83,7 @@ private:
     ContactsStage mContacts;
     IslandStage mIslandStage;
     IslandSolver mSolver;
+    ContinuousCollision mContinuous;
     FinishStage mFinish;
     IslandSleep mSleep;
     ContactEventRecorder mEvents;

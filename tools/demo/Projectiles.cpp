@@ -47,6 +47,8 @@ void Projectiles::Update(int inFrame, const Vec3& inPlayer)
     settings.mDensity = 3000.0f;
     settings.mObjectLayer = Layers::cMoving;
     settings.mFriction = 0.5f;
+    // Fast and small: swept from where each step starts, so a ball never passes through a thin crate or wall
+    settings.mMotionQuality = MotionQuality::LinearCast;
     Result<BodyID> id = bodies.CreateAndAddBody(settings, Activation::Activate);
     if (!id) return;
     mBalls.push_back({id.Value(), inFrame});

@@ -24,6 +24,7 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     mMaxAngularVelocity = inSettings.mMaxAngularVelocity;
     mAllowSleeping = inSettings.mAllowSleeping;
     mIsSensor = inSettings.mIsSensor;
+    mMotionQuality = inSettings.mMotionQuality;
     mNavMeshArea = inSettings.mNavMeshArea;
     mUserData = inSettings.mUserData;
     mForce.setZero();
@@ -58,8 +59,8 @@ Status Body::CheckDynamicMass(const Shape& inShape, float inDensity)
     // The volume first, at unit density, so a density that overflows the mass is not blamed on the shape
     const MassProperties unit = inShape.GetMassProperties(1.0f);
     if (!(unit.mMass > 0.0f) || !std::isfinite(unit.mMass) || !unit.mInertia.allFinite())
-        return invalid(std::string("a dynamic body needs a shape with volume; a ") + ToString(inShape.GetType()) +
-                       " has none");
+        return invalid(std::string("a dynamic body needs a shape with volume; a ") +
+                       ToString(inShape.GetType()) + " has none");
     // Beyond cMaxBodyMass a landing body's contact impulses overflow a float and turn it and its neighbours
     // to NaN
     static_assert(cMaxBodyMass == 1.0e12f, "the message below names it");
@@ -67,7 +68,8 @@ Status Body::CheckDynamicMass(const Shape& inShape, float inDensity)
     if (!(mass.mMass <= cMaxBodyMass) || !mass.mInertia.allFinite())
         return invalid("the body's mass (density times volume) is over 1e12 kg (cMaxBodyMass)");
     // A mass in the denormals (a density of 1e-40) has an infinite inverse: the first step would make NaN
-    if (!std::isfinite(1.0f / mass.mMass)) return invalid("the body's mass (density times volume) is too small to invert");
+    if (!std::isfinite(1.0f / mass.mMass))
+        return invalid("the body's mass (density times volume) is too small to invert");
     return Status::Ok();
 }
 

@@ -42,29 +42,14 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (!(inSettings.mMaxLinearVelocity > 0.0f && inSettings.mMaxLinearVelocity <= 1e5f) ||
         !(inSettings.mMaxAngularVelocity > 0.0f && inSettings.mMaxAngularVelocity <= 1e5f))
         return invalid("velocity limits must be in (0, 1e5] m/s and rad/s");
+    if (inSettings.mMotionQuality != MotionQuality::Discrete && inSettings.mMotionQuality != MotionQuality::LinearCast)
+        return invalid("motion quality is not a MotionQuality");
     const AABB bounds = inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation});
     if (!bounds.IsFinite()) return invalid("body bounds are not finite");
     // An empty or inverted box (a shape built around its checked Create) would be dropped by the broad phase
     if (bounds.IsEmpty()) return invalid("body bounds are empty: the shape has no extent");
     if (inSettings.mMotionType == MotionType::Dynamic)
-    {
-        if (!std::isfinite(inSettings.mDensity) || inSettings.mDensity <= 0.0f)
-            return invalid("density must be finite and > 0");
-        // The volume first, at unit density, so a density that overflows the mass is not blamed on the shape
-        const MassProperties unit = inSettings.mShape->GetMassProperties(1.0f);
-        if (!(unit.mMass > 0.0f) || !std::isfinite(unit.mMass) || !unit.mInertia.allFinite())
-            return invalid(std::string("a dynamic body needs a shape with volume; a ") +
-                           ToString(inSettings.mShape->GetType()) + " has none");
-        // Beyond cMaxBodyMass a landing body's contact impulses overflow a float and turn it and its
-        // neighbours to NaN
-        static_assert(cMaxBodyMass == 1.0e12f, "the message below names it");
-        const MassProperties mass = inSettings.mShape->GetMassProperties(inSettings.mDensity);
-        if (!(mass.mMass <= cMaxBodyMass) || !mass.mInertia.allFinite())
-            return invalid("the body's mass (density times volume) is over 1e12 kg (cMaxBodyMass)");
-        // A mass in the denormals (a density of 1e-40) has an infinite inverse: the first step would make NaN
-        if (!std::isfinite(1.0f / mass.mMass))
-            return invalid("the body's mass (density times volume) is too small to invert");
-    }
+        return Body::CheckDynamicMass(*inSettings.mShape, inSettings.mDensity);
     return Status::Ok();
 }
 } // namespace

@@ -25,14 +25,16 @@ struct StepStatistics
     /// Collision steps whose constraints (at least one) came with the same keys in the same order as in the
     /// one before, so that its solve order was taken over instead of sorted (mReuseColorings)
     uint32_t mNumSolveOrdersReused = 0;
+    uint32_t mNumLinearCastsMovedBack = 0; ///< LinearCast bodies stopped short of what they would touch
     /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
     /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
     /// to more than mTotalMs
     double mBroadPhaseUpdateMs = 0.0;
     double mNarrowPhaseMs = 0.0; ///< Forces, pairs and the narrow phase, from the step's start (see above)
     double mIslandsMs = 0.0;
-    double mSolveMs = 0.0;  ///< Velocity and position iterations plus integration
-    double mFinishMs = 0.0; ///< Bounds update, broad-phase notify and sleeping
+    double mSolveMs = 0.0;      ///< Velocity and position iterations plus integration
+    double mContinuousMs = 0.0; ///< The linear casts (MotionQuality::LinearCast bodies)
+    double mFinishMs = 0.0;     ///< Bounds update, broad-phase notify and sleeping
     double mTotalMs = 0.0;
     /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
     /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex

@@ -58,10 +58,11 @@ public:
     uint8_t GetNavMeshArea() const { return mNavMeshArea; }
     uint64_t GetUserData() const { return mUserData; }
     bool GetAllowSleeping() const { return mAllowSleeping; }
-    /// Whether inShape can carry a dynamic body of density inDensity (a volume, a mass in range): CreateBody's
-    /// checks, which a change of shape or motion type repeats.
+    /// Whether inShape can carry a dynamic body of density inDensity (a volume, a mass in range):
+    /// CreateBody's checks, which a change of shape or motion type repeats.
     static Status CheckDynamicMass(const Shape& inShape, float inDensity);
     bool IsSensor() const { return mIsSensor; }
+    MotionQuality GetMotionQuality() const { return mMotionQuality; }
 
 private:
     friend class BodyManager;
@@ -79,7 +80,8 @@ private:
     void Init(const BodyID& inID, const BodyCreationSettings& inSettings);
     /// Sets the centre of mass offset for the shape and motion type (the shape's centre of mass; zero for a
     /// static body) and, with inRecomputeMass, the mass and inertia (the shape's at mDensity for a dynamic
-    /// body, none for the others). mPosition is left alone: the caller puts it where the shape's origin stays.
+    /// body, none for the others). mPosition is left alone: the caller puts it where the shape's origin
+    /// stays.
     void SetMassProperties(bool inRecomputeMass);
     void UpdateBounds() { mBounds = mShape->GetWorldBounds(GetTransform()); }
     // Relaxed: the index is only changed under the active-list mutex (or by the step, which holds
@@ -106,7 +108,7 @@ private:
     float mLinearDamping;
     float mAngularDamping;
     float mGravityFactor;
-    float mDensity; ///< kg/m^3, from the settings: a body made dynamic later (or given a new shape) gets its mass
+    float mDensity; ///< kg/m^3: the mass of a body made dynamic later or given a new shape
     float mMaxLinearVelocity;
     float mMaxAngularVelocity;
     float mSleepTimer = 0.0f; ///< Seconds this body has been slow enough to sleep
@@ -122,6 +124,7 @@ private:
     uint8_t mNavMeshArea;
     bool mAllowSleeping;
     bool mIsSensor;
+    MotionQuality mMotionQuality;
     bool mInWorld = false;    ///< Added to the broad phase and simulated
     bool mAddPending = false; ///< In a prepared add batch that is not finalized yet
     bool mWakeIsland = false; ///< Woken from outside the step: the step wakes its sleeping island too

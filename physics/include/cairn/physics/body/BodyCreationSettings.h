@@ -34,6 +34,7 @@ struct BodyCreationSettings
     /// A sensor makes no contacts that push: it reports the dynamic bodies that enter and leave it
     /// (ContactListener.h)
     bool mIsSensor = false;
+    MotionQuality mMotionQuality = MotionQuality::Discrete; ///< Dynamic bodies: see MotionQuality
     uint8_t mNavMeshArea = 0; ///< Navmesh area type (0 = default walkable); the navmesh reads it
     uint64_t mUserData = 0;   ///< Free for the game
 };

@@ -12,6 +12,18 @@ enum class MotionType : uint8_t
     Dynamic,   ///< Moved by forces and contacts
 };
 
+/// How a dynamic body's motion is checked against what it could pass through in one step.
+enum class MotionQuality : uint8_t
+{
+    /// Speculative contacts only: a body meets what it heads for, found from where it starts the step (enough
+    /// for nearly every body, and the cheapest)
+    Discrete,
+    /// Also swept from where it started the step to where the solver put it, and stopped at the first thing
+    /// it would touch (a time-of-impact cast, translation only, at its final rotation): fast small bodies
+    /// (projectiles) never pass through a thin wall. The contact itself is then the next step's
+    LinearCast,
+};
+
 /// Whether AddBody makes a dynamic or kinematic body active (simulated) right away.
 enum class Activation : uint8_t
 {
