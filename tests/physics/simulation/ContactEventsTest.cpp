@@ -21,6 +21,18 @@ class ContactEventsTest : public SimulationFixture
 protected:
     ContactEventsTest() { System().SetRecordContactEvents(true); }
 
+    /// A static sensor box of 6 x 2 x 6 m.
+    BodyID AddSensorBox(const Vec3& inCenter)
+    {
+        BodyCreationSettings sensor;
+        sensor.mShape = Box(Vec3(3, 1, 3));
+        sensor.mPosition = inCenter;
+        sensor.mMotionType = MotionType::Static;
+        sensor.mObjectLayer = Layers::cStatic;
+        sensor.mIsSensor = true;
+        return Bodies().CreateAndAddBody(sensor, Activation::DontActivate).Value();
+    }
+
     /// The events of one Update that involve inBody.
     std::vector<ContactEvent> EventsOf(const BodyID& inBody) const
     {
@@ -269,13 +281,7 @@ TEST(ContactEventsOrderTest, TheSameEventsInTheSameOrderForAnyThreadCount)
 // not there (free fall, to float rounding)
 TEST_F(ContactEventsTest, ASensorReportsEachBodyEnteringAndLeavingOnce)
 {
-    BodyCreationSettings sensor;
-    sensor.mShape = Box(Vec3(3, 1, 3));
-    sensor.mPosition = Vec3(0, 5, 0);
-    sensor.mMotionType = MotionType::Static;
-    sensor.mObjectLayer = Layers::cStatic;
-    sensor.mIsSensor = true;
-    const BodyID sensorID = Bodies().CreateAndAddBody(sensor, Activation::DontActivate).Value();
+    const BodyID sensorID = AddSensorBox(Vec3(0, 5, 0));
     std::vector<BodyID> balls;
     for (int i = 0; i < 5; ++i)
     {
@@ -319,13 +325,7 @@ TEST_F(ContactEventsTest, ASensorReportsEachBodyEnteringAndLeavingOnce)
 TEST_F(ContactEventsTest, ABodyAsleepInASensorStaysInside)
 {
     AddFloor();
-    BodyCreationSettings sensor;
-    sensor.mShape = Box(Vec3(3, 1, 3));
-    sensor.mPosition = Vec3(0, 0.5f, 0);
-    sensor.mMotionType = MotionType::Static;
-    sensor.mObjectLayer = Layers::cStatic;
-    sensor.mIsSensor = true;
-    Bodies().CreateAndAddBody(sensor, Activation::DontActivate).Value();
+    AddSensorBox(Vec3(0, 0.5f, 0));
     const BodyID box = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0, 0.5f, 0)));
     int entered = 0, left = 0;
     for (int update = 0; update < 180; ++update)
