@@ -2,6 +2,9 @@
 
 #include "cairn/physics/body/BodyLock.h"
 
+#include <cmath>
+#include <string>
+
 namespace cairn::physics
 {
 
@@ -27,6 +30,23 @@ Error InvalidVector(const char* inWhat)
 BroadPhaseBody ToBroadPhase(const Body& inBody)
 {
     return {inBody.GetID(), inBody.GetWorldBounds(), inBody.GetObjectLayer()};
+}
+const char* MotionTypeName(MotionType inType)
+{
+    switch (inType)
+    {
+    case MotionType::Static:
+        return "static";
+    case MotionType::Kinematic:
+        return "kinematic";
+    case MotionType::Dynamic:
+        return "dynamic";
+    }
+    return "unknown";
+}
+bool IsMotionType(MotionType inType)
+{
+    return inType == MotionType::Static || inType == MotionType::Kinematic || inType == MotionType::Dynamic;
 }
 } // namespace
 
@@ -418,6 +438,197 @@ Status BodyInterface::DeactivateBody(const BodyID& inID)
                           mBodies.DeactivateBody(ioBody);
                           return Status::Ok();
                       });
+}
+
+Status BodyInterface::SetMotionType(const BodyID& inID, MotionType inMotionType, Activation inActivation)
+{
+    if (!IsMotionType(inMotionType))
+        return MakeError(ErrorCode::InvalidArgument, "motion type " + std::to_string(int(inMotionType)) +
+                                                         " is not static, kinematic or dynamic");
+    return ModifyBody(
+        inID, false,
+        [&](Body& ioBody)
+        {
+            // ActivateBody leaves static bodies and bodies outside the world alone
+            auto activate = [&]
+            {
+                if (inActivation == Activation::Activate) mBodies.ActivateBody(ioBody);
+            };
+            if (ioBody.mMotionType == inMotionType)
+            {
+                activate();
+                return Status::Ok();
+            }
+            if (inMotionType == MotionType::Dynamic)
+                if (Status mass = Body::CheckDynamicMass(*ioBody.mShape, ioBody.mDensity); !mass)
+                    return Status(MakeError(ErrorCode::InvalidArgument,
+                                            "the body can not be made dynamic: " + mass.GetError().mMessage));
+            const AABB bounds = ioBody.mBounds;
+            // Under the old motion type: a listener that follows bodies of that type only lets it go
+            if (ioBody.mInWorld) mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, bounds);
+            const Vec3 origin = ioBody.GetPosition();
+            if (inMotionType == MotionType::Static)
+            {
+                // Out of the active list first (a static body never is in it): velocities and forces go too
+                mBodies.DeactivateBody(ioBody);
+                ioBody.mLinearVelocity.setZero();
+                ioBody.mAngularVelocity.setZero();
+            }
+            if (inMotionType != MotionType::Dynamic)
+            {
+                // Forces move dynamic bodies only; a kinematic body would carry them to a later change
+                ioBody.mForce.setZero();
+                ioBody.mTorque.setZero();
+            }
+            ioBody.mMotionType = inMotionType;
+            ioBody.SetMassProperties(true);
+            ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+            ioBody.mSleepTimer = 0.0f;
+            mBodies.PublishPose(ioBody); // The new motion type in the flags; the pose is the same
+            if (ioBody.mInWorld)
+            {
+                // An active body's box is the swept one the step gave it: a static body's is its own bounds,
+                // which hold its published pose's (it did not move)
+                if (inMotionType == MotionType::Static)
+                {
+                    const BroadPhaseBody entry = ToBroadPhase(ioBody);
+                    mBroadPhase.NotifyBodiesAABBChanged({&entry, 1});
+                }
+                mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, bounds);
+            }
+            activate();
+            return Status::Ok();
+        });
+}
+
+Status BodyInterface::SetObjectLayer(const BodyID& inID, ObjectLayer inLayer)
+{
+    if (!mLayers.IsValid(inLayer))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "object layer " + std::to_string(inLayer) + " is not in the layer setup");
+    return ModifyBody(
+        inID, false,
+        [&](Body& ioBody)
+        {
+            if (ioBody.mObjectLayer == inLayer) return Status::Ok();
+            if (ioBody.mAddPending)
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        "the body is in an add batch that is not finalized (which holds its "
+                                        "layer): finalize or abort the batch first"));
+            auto setLayer = [&]
+            {
+                ioBody.mObjectLayer = inLayer;
+                mBodies.PublishPose(ioBody);
+            };
+            if (!ioBody.mInWorld)
+            {
+                setLayer();
+                return Status::Ok();
+            }
+            const AABB bounds = ioBody.mBounds;
+            mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, bounds); // Under the old layer, as above
+            // The broad phase runs setLayer while the body is found under both layers: the published layer
+            // changes while a query of either finds it
+            if (!mBroadPhase.ChangeBodyLayer(ioBody.GetID(), inLayer, setLayer))
+                return Status(
+                    MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room to move the body to "
+                                                        "object layer " +
+                                                            std::to_string(inLayer)));
+            mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, bounds);
+            return Status::Ok();
+        });
+}
+
+Status BodyInterface::SetShape(const BodyID& inID, ShapeRef inShape, bool inUpdateMassProperties,
+                               Activation inActivation)
+{
+    if (inShape == nullptr) return MakeError(ErrorCode::InvalidArgument, "the new shape is null");
+    ShapeRef old; // Retired once the body's lock is released
+    const Status status = ModifyBody(
+        inID, false,
+        [&](Body& ioBody)
+        {
+            // CreateBody's checks of the shape, at the body's pose
+            const AABB bounds = inShape->GetWorldBounds(ioBody.GetTransform());
+            if (!bounds.IsFinite())
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        "the new shape's bounds at the body's pose are not finite"));
+            if (bounds.IsEmpty())
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        "the new shape's bounds are empty: the shape has no extent"));
+            if (ioBody.IsDynamic())
+                if (Status mass = Body::CheckDynamicMass(*inShape, ioBody.mDensity); !mass) return mass;
+            const Vec3 origin = ioBody.GetPosition();
+            const Vec3 oldCenterOfMass = ioBody.mPosition;
+            old = std::move(ioBody.mShape);
+            ioBody.mShape = std::move(inShape);
+            ioBody.SetMassProperties(inUpdateMassProperties);
+            ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
+            // The same rigid motion, now about the new centre of mass: v(p) = v + w x (p - c) at the new c
+            if (!ioBody.IsStatic())
+                ioBody.mLinearVelocity += ioBody.mAngularVelocity.cross(ioBody.mPosition - oldCenterOfMass);
+            // Grows the broad phase over both shapes' bounds, publishes the new shape, shrinks to its bounds
+            OnBodyMoved(ioBody, inActivation);
+            return Status::Ok();
+        });
+    // The published pose names the new shape now; a query may still hold the old one (as after DestroyBody)
+    mBodies.RetireShape(std::move(old));
+    return status;
+}
+
+Status BodyInterface::MoveKinematic(const BodyID& inID, const Vec3& inTargetPosition,
+                                    const Quat& inTargetRotation, float inDeltaTime)
+{
+    if (!IsValidWorldPosition(inTargetPosition)) return InvalidVector("target position");
+    if (!IsValidRotation(inTargetRotation))
+        return MakeError(ErrorCode::InvalidArgument, "target rotation is not a finite unit quaternion");
+    if (!std::isfinite(inDeltaTime) || !(inDeltaTime > 0.0f))
+        return MakeError(ErrorCode::InvalidArgument, "delta time must be finite and > 0");
+    return ModifyBody(
+        inID, false,
+        [&](Body& ioBody)
+        {
+            if (!ioBody.IsKinematic())
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        std::string("MoveKinematic moves kinematic bodies; this one is ") +
+                                            MotionTypeName(ioBody.mMotionType)));
+            if (!ioBody.mInWorld)
+                return Status(
+                    MakeError(ErrorCode::NotAdded, "only a body in the world moves by its velocity"));
+            const Quat target = inTargetRotation.normalized();
+            // The centre of mass moves in a straight line (the step moves it by its velocity)
+            const Vec3 linear =
+                (inTargetPosition + target * ioBody.mCenterOfMassOffset - ioBody.mPosition) / inDeltaTime;
+            // The turn from the rotation now to the target, the short way round; the step turns a body by
+            // exp(w dt), so w is the turn's rotation vector over the time
+            Quat turn = target * ioBody.mRotation.conjugate();
+            if (turn.w() < 0.0f) turn.coeffs() = -turn.coeffs();
+            const float sinHalf = turn.vec().norm();
+            const float angle = 2.0f * std::atan2(sinHalf, turn.w());
+            // Near zero, angle / sin(angle / 2) tends to 2
+            const Vec3 rotation =
+                sinHalf > 1.0e-6f ? Vec3(turn.vec() * (angle / sinHalf)) : Vec3(2.0f * turn.vec());
+            const Vec3 angular = rotation / inDeltaTime;
+            if (!IsFiniteLength(linear) || !IsFiniteLength(angular))
+                return Status(
+                    MakeError(ErrorCode::InvalidArgument,
+                              "the move needs a velocity too large to represent (delta time too small)"));
+            // The step clamps a kinematic body's velocities to its limits: it would stop short of the target
+            if (linear.norm() > ioBody.mMaxLinearVelocity)
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        "the move needs " + std::to_string(linear.norm()) +
+                                            " m/s, over the body's limit of " +
+                                            std::to_string(ioBody.mMaxLinearVelocity) + " m/s"));
+            if (angular.norm() > ioBody.mMaxAngularVelocity)
+                return Status(MakeError(ErrorCode::InvalidArgument,
+                                        "the move needs " + std::to_string(angular.norm()) +
+                                            " rad/s, over the body's limit of " +
+                                            std::to_string(ioBody.mMaxAngularVelocity) + " rad/s"));
+            ioBody.mLinearVelocity = linear;
+            ioBody.mAngularVelocity = angular;
+            if (linear.squaredNorm() > 0.0f || angular.squaredNorm() > 0.0f) mBodies.ActivateBody(ioBody);
+            return Status::Ok();
+        });
 }
 
 Result<Vec3> BodyInterface::GetPosition(const BodyID& inID) const

@@ -220,6 +220,11 @@ void BodyManager::PublishPose(const Body& inBody)
     mPoses->Publish(inBody);
 }
 
+void BodyManager::RetireShape(ShapeRef&& ioShape)
+{
+    mPoses->Retire(std::move(ioShape));
+}
+
 void BodyManager::CollectRetiredShapes()
 {
     mPoses->CollectRetired();

@@ -93,6 +93,22 @@ void BroadPhaseBruteForce::NotifyBodiesAABBChanged(std::span<const BroadPhaseBod
     }
 }
 
+bool BroadPhaseBruteForce::ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer,
+                                           FunctionRef<void()> inWhileInBoth)
+{
+    const bool known = inLayer < cMaxObjectLayers;
+    assert(known && "BroadPhase: invalid object layer");
+    if (!known) return false;
+    const auto lock = LockedCountingWait(mMutex, LockKind::BroadPhase);
+    const uint32_t position = FindPosition(inBody);
+    if (position == cNotPresent) return false;
+    // Queries hold the lock shared, so each finds the body under one layer or the other, never neither: the
+    // callback runs before any query sees the change, and it is found under the new layer meanwhile
+    mBodies[position].mLayer = inLayer;
+    inWhileInBoth();
+    return true;
+}
+
 void BroadPhaseBruteForce::CollideAABox(const AABB& inBox, const BroadPhaseQueryFilter& inFilter,
                                         BodyVisitor inVisitor) const
 {

@@ -5,11 +5,12 @@
 //
 // Threads: as BroadPhase (any thread; FindCollidingPairs/Update from the physics step only).
 // Locking: mMutex guards every member. Queries and FindCollidingPairs take it shared; AddBodiesFinalize,
-// RemoveBodies and NotifyBodiesAABBChanged take it exclusive. AddBodiesPrepare/Abort take no lock (they only
-// touch the batch they own). mActiveScratch is written under the shared lock, which is safe because only the
-// physics step calls FindCollidingPairs, one call at a time.
-// Visitors run under the shared lock: they must not call any method of this broad phase (a modifying one
-// would deadlock) and must not wait for a lock held by a thread that may be calling a modifying method.
+// RemoveBodies, NotifyBodiesAABBChanged and ChangeBodyLayer take it exclusive (ChangeBodyLayer runs its
+// callback under it: a query sees the body in its old layer or its new one, whole). AddBodiesPrepare/Abort
+// take no lock (they only touch the batch they own). mActiveScratch is written under the shared lock, which
+// is safe because only the physics step calls FindCollidingPairs, one call at a time. Visitors run under the
+// shared lock: they must not call any method of this broad phase (a modifying one would deadlock) and must
+// not wait for a lock held by a thread that may be calling a modifying method.
 //
 // Bad input is ignored as BroadPhase.h lists it. It has no LayerSetup and no capacity: an object layer is
 // unknown when it is >= cMaxObjectLayers, and any body index has room (the index map grows on demand).
@@ -39,6 +40,8 @@ public:
     void RemoveBodies(std::span<const BodyID> inBodies) override;
     /// Overwrites the stored bounds (and object layer) of each present body.
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
+    /// Overwrites the stored object layer and runs inWhileInBoth, both under the exclusive lock.
+    bool ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer, FunctionRef<void()> inWhileInBoth) override;
     /// Nothing to optimise.
     void Update() override {}
 

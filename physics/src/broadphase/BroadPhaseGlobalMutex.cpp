@@ -47,6 +47,13 @@ void BroadPhaseGlobalMutex::NotifyBodiesAABBChanged(std::span<const BroadPhaseBo
     mWrapped->NotifyBodiesAABBChanged(inBodies);
 }
 
+bool BroadPhaseGlobalMutex::ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer,
+                                            FunctionRef<void()> inWhileInBoth)
+{
+    const ExclusiveLock lock(mMutex);
+    return mWrapped->ChangeBodyLayer(inBody, inLayer, inWhileInBoth);
+}
+
 void BroadPhaseGlobalMutex::Update()
 {
     const ExclusiveLock lock(mMutex);

@@ -7,7 +7,8 @@
 //
 // Threads and locks: every method may be called as BroadPhase says. mMutex, a WriterFairSharedMutex (glibc's
 // shared mutex let a stream of queries starve the mover and the step's Update), is taken
-//  - exclusive by AddBodiesFinalize, RemoveBodies, NotifyBodiesAABBChanged, Update and WithExclusiveLock;
+//  - exclusive by AddBodiesFinalize, RemoveBodies, NotifyBodiesAABBChanged, ChangeBodyLayer (its callback
+//    included), Update and WithExclusiveLock;
 //  - shared by the five queries and FindCollidingPairs;
 //  - not at all by AddBodiesPrepare/Abort, which build or free the caller's own batch off the live structure
 //    (so the loading thread's work stays outside the lock), nor by GetBodyCount, a statistic.
@@ -44,6 +45,9 @@ public:
     void RemoveBodies(std::span<const BodyID> inBodies) override;
     /// Exclusive.
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
+    /// Exclusive, for the whole change: no query runs in the wrapped broad phase meanwhile, so the quad
+    /// tree's change waits for none.
+    bool ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer, FunctionRef<void()> inWhileInBoth) override;
     /// Exclusive. Physics step only.
     void Update() override;
     /// False: the search takes the lock shared and would only wait for the update's exclusive hold, so the

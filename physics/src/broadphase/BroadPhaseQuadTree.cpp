@@ -4,9 +4,25 @@
 #include "broadphase/BroadPhaseOverlap.h"
 
 #include <cassert>
+#include <thread>
+
+#if defined(__x86_64__) || defined(_M_X64)
+#include <immintrin.h>
+#endif
 
 namespace cairn::physics
 {
+
+namespace
+{
+/// A spin-wait hint to the core (and to its hyper-thread sibling).
+void Pause()
+{
+#if defined(__x86_64__) || defined(_M_X64)
+    _mm_pause();
+#endif
+}
+} // namespace
 
 /// A prepared batch: one private sub-tree per broad-phase layer. Owned by the caller until finalized/aborted.
 struct BroadPhaseQuadTree::Batch
@@ -230,6 +246,108 @@ void BroadPhaseQuadTree::NotifyBodiesAABBChanged(std::span<const BroadPhaseBody>
     CountTreeChanges(changed);
 }
 
+void BroadPhaseQuadTree::WaitForEpoch(uint64_t inEpoch)
+{
+    if (mBodies.GetReclaimer().GetEpoch() >= inEpoch) return;
+    // The queries of the previous epoch are leaving (a query lasts microseconds): pause between tries, and
+    // yield now and then, for a query thread that lost its core inside its section holds the epoch back. The
+    // wait a layer change may have, counted like the broad phase's other lock waits
+    const ScopedLockWait wait(LockKind::BroadPhase);
+    for (uint32_t attempt = 1; mBodies.GetReclaimer().GetEpoch() < inEpoch; ++attempt)
+    {
+        if (mBodies.TryAdvanceEpoch()) continue;
+        if (attempt % 64 == 0)
+            std::this_thread::yield();
+        else
+            Pause();
+    }
+}
+
+// Why no query misses the body or reports it twice (cross-tree change; QuadTreeBodyTable has the record):
+//  1. The body's second leaf is linked in the new tree with the record already stored, and the flip epoch f
+//     is the current epoch + 1, all under the table's advance mutex: so every query that enters its section
+//     at f or later sees the new leaf and the record, and a query that entered before (at f - 1 or earlier)
+//     sees the record whenever it sees the new leaf (the record is stored first, the link publishes both).
+//  2. A query over both trees takes the new leaf if its entry epoch is f or later, the old one otherwise:
+//     exactly one of the two leaves, while both exist. A query over one of them takes the leaf it finds.
+//  3. The old leaf is removed only once the epoch is f + 1: no query that entered before f is left, so none
+//     that takes the old leaf can still be looking for it.
+//  4. The record is cleared only once the epoch is two past its value g right after the removal (read under
+//     the advance mutex, so every advance after g follows the removal): a query still in flight that could
+//     have seen the old leaf (it entered at g or earlier) is gone, so none meets a leaf it cannot tell.
+//  5. The object layer the table holds changes while the record stands, and the record lets either layer
+//     through a query's filter; inWhileInBoth (the published layer) runs between 1 and 3, so a query filtered
+//     to either layer finds the body in the tree it walks for as long as that layer is published.
+// Same-tree change: one leaf; the record stands while the table's layer changes and inWhileInBoth runs, so a
+// filtered query lets the body through under either layer meanwhile.
+bool BroadPhaseQuadTree::ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer,
+                                         FunctionRef<void()> inWhileInBoth)
+{
+    const uint32_t index = inBody.GetIndex();
+    const bool ok = !inBody.IsInvalid() && index < mMaxBodies && mLayerSetup.IsValid(inLayer);
+    assert(ok && "BroadPhaseQuadTree: invalid body id or object layer");
+    if (!ok) return false;
+    QuadTreeBodyTable::Entry& entry = mBodies[index];
+    // Relaxed: the caller serialises operations on this body, so its layer is stable
+    const ObjectLayer oldLayer = entry.mLayer.load(std::memory_order_relaxed);
+    if (!mLayerSetup.IsValid(oldLayer) || !TreeOf(oldLayer).Contains(inBody)) return false;
+    if (oldLayer == inLayer)
+    {
+        inWhileInBoth();
+        return true;
+    }
+    const auto lock = LockedCountingWait(mLayerChangeMutex, LockKind::BroadPhase);
+    const uint32_t oldTree = TreeIndexOf(oldLayer), newTree = TreeIndexOf(inLayer);
+    QuadTreeBodyTable::Transit transit{index, uint8_t(oldTree), uint8_t(newTree), oldLayer, inLayer, 0};
+    if (oldTree == newTree)
+    {
+        mBodies.StoreTransit(QuadTreeBodyTable::PackTransit(transit));
+        // Release: a query that reads the new layer reads the record after it (see QuadTree's walk)
+        entry.mLayer.store(inLayer, std::memory_order_release);
+        inWhileInBoth();
+        mBodies.StoreTransit(QuadTreeBodyTable::cNoTransit);
+        CountTreeChanges(1u << oldTree);
+        return true;
+    }
+    {
+        QuadTree& from = *mTrees[oldTree];
+        QuadTree& to = *mTrees[newTree];
+        // Both modification locks for the whole change, in tree order (a rebuild takes one at a time)
+        const QuadTree::MoveScope lowScope(oldTree < newTree ? from : to);
+        const QuadTree::MoveScope highScope(oldTree < newTree ? to : from);
+        const QuadTree::MoveScope& fromScope = oldTree < newTree ? lowScope : highScope;
+        const QuadTree::MoveScope& toScope = oldTree < newTree ? highScope : lowScope;
+        uint32_t newLocation = QuadTreeBodyTable::cInvalidLocation;
+        const QuadTree::SubTree leaf = to.BuildSecondLeaf(index, from.GetBodyBounds(inBody), newLocation);
+        if (leaf.mChild == QuadTree::cInvalidChild) return false; // Out of nodes: nothing changed
+        uint64_t flip;
+        {
+            // 1. above: the epoch stands still from its read to the link
+            const std::lock_guard epochLock(mBodies.GetAdvanceMutex());
+            flip = mBodies.GetReclaimer().GetEpoch() + 1;
+            transit.mFlip = QuadTreeBodyTable::FlipBits(flip);
+            mBodies.StoreTransit(QuadTreeBodyTable::PackTransit(transit));
+            to.LinkSubTreeHeld(toScope, leaf);
+            mBodies.TryAdvanceEpochHeld();
+        }
+        // Release: as in the same-tree case (5. above)
+        entry.mLayer.store(inLayer, std::memory_order_release);
+        inWhileInBoth();
+        WaitForEpoch(flip + 1); // 3.
+        from.RemoveBodyHeld(fromScope, inBody);
+        to.AdoptSecondLeaf(toScope, index, newLocation);
+        uint64_t removedAt;
+        {
+            const std::lock_guard epochLock(mBodies.GetAdvanceMutex()); // 4.
+            removedAt = mBodies.GetReclaimer().GetEpoch();
+        }
+        WaitForEpoch(removedAt + 2);
+        mBodies.StoreTransit(QuadTreeBodyTable::cNoTransit);
+    }
+    CountTreeChanges(1u << oldTree | 1u << newTree); // After the locks: see NotifyBodiesAABBChanged
+    return true;
+}
+
 void BroadPhaseQuadTree::Update()
 {
     UpdateImpl(false);
@@ -263,9 +381,9 @@ void BroadPhaseQuadTree::CollideAABox(const AABB& inBox, const BroadPhaseQueryFi
                                       BodyVisitor inVisitor) const
 {
     ForEachTree(inFilter.mObjectLayers,
-                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                [&](const QuadTree& inTree, ObjectLayerMask inMask, const QuadTree::MultiTreeQuery* inMulti)
                 {
-                    inTree.CollideAABox(inBox, inMask, inVisitor);
+                    inTree.CollideAABox(inBox, inMask, inVisitor, inMulti);
                     return true;
                 });
 }
@@ -274,9 +392,9 @@ void BroadPhaseQuadTree::CollideSphere(const Vec3& inCenter, float inRadius,
                                        const BroadPhaseQueryFilter& inFilter, BodyVisitor inVisitor) const
 {
     ForEachTree(inFilter.mObjectLayers,
-                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                [&](const QuadTree& inTree, ObjectLayerMask inMask, const QuadTree::MultiTreeQuery* inMulti)
                 {
-                    inTree.CollideSphere(inCenter, inRadius, inMask, inVisitor);
+                    inTree.CollideSphere(inCenter, inRadius, inMask, inVisitor, inMulti);
                     return true;
                 });
 }
@@ -285,9 +403,9 @@ void BroadPhaseQuadTree::CollidePoint(const Vec3& inPoint, const BroadPhaseQuery
                                       BodyVisitor inVisitor) const
 {
     ForEachTree(inFilter.mObjectLayers,
-                [&](const QuadTree& inTree, ObjectLayerMask inMask)
+                [&](const QuadTree& inTree, ObjectLayerMask inMask, const QuadTree::MultiTreeQuery* inMulti)
                 {
-                    inTree.CollidePoint(inPoint, inMask, inVisitor);
+                    inTree.CollidePoint(inPoint, inMask, inVisitor, inMulti);
                     return true;
                 });
 }
@@ -297,8 +415,9 @@ void BroadPhaseQuadTree::CastRay(const RayCast& inRay, const BroadPhaseQueryFilt
 {
     if (!IsFiniteCast(inRay.mOrigin, inRay.mDirection)) return;
     float maxFraction = 1.0f; // Shared by the trees, so a close hit in one prunes the others
-    ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
-                { return inTree.CastRay(inRay, inMask, maxFraction, inVisitor); });
+    ForEachTree(inFilter.mObjectLayers,
+                [&](const QuadTree& inTree, ObjectLayerMask inMask, const QuadTree::MultiTreeQuery* inMulti)
+                { return inTree.CastRay(inRay, inMask, maxFraction, inVisitor, inMulti); });
 }
 
 void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement,
@@ -306,8 +425,9 @@ void BroadPhaseQuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement
 {
     if (!IsFiniteCast(inBox, inDisplacement)) return;
     float maxFraction = 1.0f; // As in CastRay
-    ForEachTree(inFilter.mObjectLayers, [&](const QuadTree& inTree, ObjectLayerMask inMask)
-                { return inTree.CastAABox(inBox, inDisplacement, inMask, maxFraction, inVisitor); });
+    ForEachTree(inFilter.mObjectLayers,
+                [&](const QuadTree& inTree, ObjectLayerMask inMask, const QuadTree::MultiTreeQuery* inMulti)
+                { return inTree.CastAABox(inBox, inDisplacement, inMask, maxFraction, inVisitor, inMulti); });
 }
 
 uint32_t BroadPhaseQuadTree::PrepareCachedTrees(uint32_t inNumActive) const

@@ -5,17 +5,27 @@
 // against exact body bounds, so it returns exactly what BroadPhaseBruteForce returns.
 //
 // Threads and locks:
-//  - Queries: any thread, any time, no lock (an epoch read section per tree; never waits).
+//  - Queries: any thread, any time, no lock (one epoch read section of the trees' shared reclaimer for all
+//    the trees a query walks; never waits).
 //  - AddBodiesPrepare/Abort: any thread, no lock (builds private sub-trees, one per layer of the batch).
 //  - AddBodiesFinalize (O(1) per layer: one compare-exchange), RemoveBodies, NotifyBodiesAABBChanged: any
 //    thread; each tree's modification lock is taken shared (per-thread stripe) only to stay out of a
 //    rebuild's commit. The caller serialises operations on one body.
+//  - ChangeBodyLayer: any thread, one at a time (mLayerChangeMutex), not inside a query's visitor (it waits
+//    for the queries running when it starts). To another tree: the body gets a leaf in the new tree while it
+//    keeps the old one, the transit record (QuadTreeBodyTable) tells each query which leaf is the body, the
+//    shared epoch is advanced past the queries that take the old leaf, and only then is the old leaf removed
+//    (the no-miss argument is at ChangeBodyLayer in the .cpp). Both trees' modification locks are held shared
+//    meanwhile, so a rebuild commit of either waits for the change. Lock order: body mutex (the caller's) <
+//    mLayerChangeMutex < the trees' modification locks, in tree order < the table's epoch advance mutex.
 //  - Update (rebuild of changed parts + freeing of old nodes) and FindCollidingPairs: the physics step only.
 //    The two may run at once on two threads (CanFindPairsDuringUpdate): the pair queries are queries like any
 //    other, exact whatever the tree's state, and the table's mActiveInStep bytes belong to FindCollidingPairs
 //    alone. A second Update (or RebuildAll) that overlaps a running one, or a second FindCollidingPairs that
 //    overlaps a running one (two threads stepping one world), is refused and counted (GetRefusedStepCalls),
-//    never run concurrently.
+//    never run concurrently. FindCollidingPairs walks each tree in a section of its own: a layer change
+//    running beside it may give the changing body's pairs twice or not at all (the engine never runs the
+//    two at once: the step holds every body lock, and ChangeBodyLayer's caller holds one).
 // FindCollidingPairs keeps, per active body, the bodies of the trees that did not change since its last call
 // (the static layer) near the body's bounds grown by a margin (PairCandidateCache, physics/src/broadphase):
 // while the body stays inside that box and those trees stay unchanged, its pairs with them come from the
@@ -33,7 +43,9 @@
 #include "cairn/physics/broadphase/BroadPhase.h"
 
 #include <array>
+#include <bit>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -113,8 +125,11 @@ public:
     /// Empties each body's slot and marks its path changed.
     void RemoveBodies(std::span<const BodyID> inBodies) override;
     /// Stores the exact bounds and grows the slots up to the root. A body whose object layer moved it to
-    /// another broad-phase layer is moved to that tree.
+    /// another broad-phase layer is moved to that tree (removed, then added: a query may miss it meanwhile).
     void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) override;
+    /// See BroadPhase, and the top of this file. False when the new tree's node pool has no room for the
+    /// body's second leaf.
+    bool ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer, FunctionRef<void()> inWhileInBoth) override;
     /// Frees old nodes no query can reach, then rebuilds the changed parts of every tree. Physics step only.
     void Update() override;
     /// True: the pair queries are lock-free queries, exact whatever the trees' state.
@@ -165,13 +180,27 @@ private:
     /// Object-layer mask to pass to tree inTree for a query filtered by inMask (all layers when the filter
     /// lets every layer of the tree through, so the tree skips the per-body layer check); 0 to skip the tree.
     ObjectLayerMask MaskForTree(uint32_t inTree, ObjectLayerMask inMask) const;
-    /// Calls inQuery(tree, mask) for every tree that a query filtered by inMask must walk, until it returns
-    /// false.
+    /// Calls inQuery(tree, mask, multi) for every tree that a query filtered by inMask must walk, until it
+    /// returns false. A query of several trees walks them all in one read section of the shared reclaimer
+    /// (multi names it; null for a query of one tree, whose walk enters its own): one section instead of one
+    /// a tree, and the section's epoch picks one leaf of a body moving between two of them.
     template <class Query> void ForEachTree(ObjectLayerMask inMask, Query&& inQuery) const
     {
+        std::array<ObjectLayerMask, cMaxBroadPhaseLayers> masks{};
+        uint32_t trees = 0;
         for (uint32_t tree = 0; tree < mTrees.size(); ++tree)
-            if (const ObjectLayerMask mask = MaskForTree(tree, inMask); mask != 0)
-                if (!inQuery(*mTrees[tree], mask)) return;
+            if ((masks[tree] = MaskForTree(tree, inMask)) != 0) trees |= 1u << tree;
+        auto walk = [&](const QuadTree::MultiTreeQuery* inMulti)
+        {
+            for (uint32_t left = trees; left != 0; left &= left - 1)
+                if (const uint32_t tree = uint32_t(std::countr_zero(left));
+                    !inQuery(*mTrees[tree], masks[tree], inMulti))
+                    return;
+        };
+        if (std::popcount(trees) < 2) return walk(nullptr);
+        const EpochReclaimer::ReadScope section(mBodies.GetReclaimer());
+        const QuadTree::MultiTreeQuery multi{section.GetEpoch(), trees};
+        walk(&multi);
     }
     /// As ForEachTree, with the tree's index; the query returns nothing (visits every tree).
     template <class Query> void ForEachTreeIndexed(ObjectLayerMask inMask, Query&& inQuery) const
@@ -190,6 +219,9 @@ private:
     /// ioScope: the move scope of the tree of the body before, kept for the next body when it is that body's
     /// tree too (a batch takes each tree's lock once), released before any other modification.
     uint32_t MoveBody(const BroadPhaseBody& inBody, std::optional<QuadTree::MoveScope>& ioScope);
+    /// Waits (yielding, counted as a broad-phase lock wait) until the shared epoch is inEpoch or more,
+    /// advancing it as soon as no reader of the previous one is left.
+    void WaitForEpoch(uint64_t inEpoch);
     /// Trees FindCollidingPairs may serve from the pair cache in this call (a bit per tree): those whose
     /// change count is the one the last call saw, with cMinCachedTreeBodies or more. Starts a new cache
     /// generation when that set differs from the last call's. FindCollidingPairs only.
@@ -200,8 +232,9 @@ private:
     QuadTreeBodyTable mBodies;                     ///< Shared by the trees
     std::vector<std::unique_ptr<QuadTree>> mTrees; ///< One per broad-phase layer; the vector is immutable
     std::array<ObjectLayerMask, cMaxBroadPhaseLayers> mObjectLayersOfTree{}; ///< Immutable
-    std::atomic<int64_t> mBodyCount{0};                 ///< Bodies linked (relaxed: a statistic)
-    UpdateStats mLastUpdate;                            ///< Physics step only
+    std::atomic<int64_t> mBodyCount{0}; ///< Bodies linked (relaxed: a statistic)
+    std::mutex mLayerChangeMutex; ///< ChangeBodyLayer, one at a time: the table holds one transit record
+    UpdateStats mLastUpdate;      ///< Physics step only
     mutable std::atomic<bool> mUpdateActive{false};     ///< Update or RebuildAll is running (StepCallGuard)
     mutable std::atomic<bool> mPairsActive{false};      ///< FindCollidingPairs is running (StepCallGuard)
     mutable std::atomic<uint64_t> mRefusedStepCalls{0}; ///< Statistic

@@ -5,7 +5,7 @@
 namespace cairn::physics
 {
 
-std::atomic<uint32_t>& EpochReclaimer::Enter() const
+std::atomic<uint32_t>& EpochReclaimer::Enter(uint64_t* outEpoch) const
 {
     Stripe& stripe = const_cast<Stripe&>(mStripes[GetThreadStripe(cNumStripes)]);
     for (;;)
@@ -15,7 +15,11 @@ std::atomic<uint32_t>& EpochReclaimer::Enter() const
         const uint64_t epoch = mEpoch.load(std::memory_order_seq_cst);
         std::atomic<uint32_t>& counter = stripe.mReaders[epoch & 1];
         counter.fetch_add(1, std::memory_order_seq_cst);
-        if (mEpoch.load(std::memory_order_seq_cst) == epoch) return counter;
+        if (mEpoch.load(std::memory_order_seq_cst) == epoch)
+        {
+            if (outEpoch != nullptr) *outEpoch = epoch;
+            return counter;
+        }
         // The epoch moved between the two loads: our count may be in a parity the updater already checked
         // Relaxed: we read nothing under this registration
         counter.fetch_sub(1, std::memory_order_relaxed);

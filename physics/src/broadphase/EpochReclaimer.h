@@ -11,13 +11,14 @@
 // has advanced twice past r (E >= r + 2): the advance to r + 1 waited out the readers of r - 1, the one to
 // r + 2 those of r. The retired lists are tagged by epoch, so any number of tree swaps per update is safe.
 //
-// Threads: Enter/Exit (through ReadScope, or PoseReader) from any thread, any number at once. TryAdvance and
-// GetEpoch from one updater thread at a time (the quad tree's owner of rebuilds). Stripes keep readers on
-// different threads off each other's cache lines: the reference engine's single read-write mutex cost each
-// thread 500 us per frame in contention, 32 stripes 10 us.
-// Memory orders: the reader's increment and re-check and the updater's count check and advance are seq_cst,
-// because the argument above needs one total order of "reader registered" and "epoch advanced" (a
-// store-load pattern that acquire/release does not order).
+// Threads: Enter/Exit (through ReadScope, or PoseReader) from any thread, any number at once. TryAdvance from
+// one thread at a time: the callers serialise it (the quad trees' body table under a mutex, since rebuilds
+// and layer changes both advance its epoch; the published poses under their retired-list mutex). GetEpoch
+// from any thread. Stripes keep readers on different threads off each other's cache lines: the reference
+// engine's single read-write mutex cost each thread 500 us per frame in contention, 32 stripes 10 us. Memory
+// orders: the reader's increment and re-check and the updater's count check and advance are seq_cst, because
+// the argument above needs one total order of "reader registered" and "epoch advanced" (a store-load pattern
+// that acquire/release does not order).
 
 #include <atomic>
 #include <cstdint>
@@ -34,18 +35,22 @@ public:
     class ReadScope
     {
     public:
-        explicit ReadScope(const EpochReclaimer& inReclaimer) : mCounter(inReclaimer.Enter()) {}
+        explicit ReadScope(const EpochReclaimer& inReclaimer) : mCounter(inReclaimer.Enter(&mEpoch)) {}
         ~ReadScope() { Exit(mCounter); }
         ReadScope(const ReadScope&) = delete;
         ReadScope& operator=(const ReadScope&) = delete;
+        /// The epoch the section was entered at: while the section lasts, the epoch is at most one past it.
+        uint64_t GetEpoch() const { return mEpoch; }
 
     private:
+        uint64_t mEpoch = 0; ///< Set by Enter, before mCounter (declared first: initialised first)
         std::atomic<uint32_t>& mCounter;
     };
 
-    /// Enters a read section and returns the counter that Exit must be given to leave it. ReadScope pairs
-    /// them; PoseReader calls them itself, because its installed header must not name this internal class.
-    std::atomic<uint32_t>& Enter() const;
+    /// Enters a read section and returns the counter that Exit must be given to leave it; outEpoch (if not
+    /// null) gets the epoch it was entered at. ReadScope pairs them; PoseReader calls them itself, because
+    /// its installed header must not name this internal class.
+    std::atomic<uint32_t>& Enter(uint64_t* outEpoch = nullptr) const;
     /// Leaves the read section that Enter returned ioCounter for.
     static void Exit(std::atomic<uint32_t>& ioCounter)
     {
@@ -57,13 +62,13 @@ public:
     EpochReclaimer(const EpochReclaimer&) = delete;
     EpochReclaimer& operator=(const EpochReclaimer&) = delete;
 
-    /// Current epoch. Updater thread only (others may call it for statistics).
+    /// Current epoch. Any thread.
     uint64_t GetEpoch() const
     {
         return mEpoch.load(std::memory_order_seq_cst); // Part of the total order, see the header comment
     }
 
-    /// Advances the epoch when no reader of the previous one is left; never waits. Updater thread only.
+    /// Advances the epoch when no reader of the previous one is left; never waits. One caller at a time.
     bool TryAdvance();
 
     /// True when memory retired at inRetiredEpoch can no longer be reached by any reader.

@@ -197,11 +197,60 @@ void QuadTree::FreeSubTree(const SubTree& inSubTree)
     }
 }
 
+QuadTree::SubTree QuadTree::BuildSecondLeaf(uint32_t inIndex, const AABB& inBounds, uint32_t& outLocation)
+{
+    outLocation = QuadTreeBodyTable::cInvalidLocation;
+    if (inIndex >= mBodies.GetMaxBodies() || inIndex >= cBodyFlag || !IsValidBroadPhaseBounds(inBounds))
+    {
+        assert(false && "QuadTree: invalid body");
+        return {};
+    }
+    // No claim of the table entry: the body stays where the entry says until AdoptSecondLeaf
+    BuildItem item{cBodyFlag | inIndex, inBounds, QuadTreeBodyTable::cInvalidLocation};
+    std::vector<uint32_t> newNodes;
+    // The spare root first, as BuildSubTree does: rebuilds keep a reserve that this may not take
+    const uint32_t spareRoot = AllocateNode(cInvalidNode, mRebuildReserve);
+    if (spareRoot == cInvalidNode) return {};
+    newNodes.push_back(spareRoot);
+    SubTree tree = BuildNodes(std::span(&item, 1), mRebuildReserve, newNodes,
+                              [&](const BuildItem&, uint32_t inNode, int inSlot)
+                              { outLocation = inNode << 2 | uint32_t(inSlot); });
+    if (tree.mChild == cInvalidChild)
+    {
+        for (uint32_t node : newNodes)
+            mAllocator.Free(node); // Never published
+        outLocation = QuadTreeBodyTable::cInvalidLocation;
+        return {};
+    }
+    tree.mNumBodies = 1;
+    tree.mSpareRoot = spareRoot;
+    return tree;
+}
+
+void QuadTree::AdoptSecondLeaf([[maybe_unused]] const MoveScope& inScope, uint32_t inIndex,
+                               uint32_t inLocation)
+{
+    assert(&inScope.GetTree() == this);
+    if (inIndex >= mBodies.GetMaxBodies()) return;
+    QuadTreeBodyTable::Entry& entry = mBodies[inIndex];
+    // Relaxed: read with the location by this body's serialised operations, after its release below
+    entry.mTree.store(mTreeId, std::memory_order_relaxed);
+    // Release: a later operation on the body (acquire, FindLocation) sees the leaf's node, and the tree id
+    entry.mLocation.store(inLocation, std::memory_order_release);
+}
+
 void QuadTree::LinkSubTree(const SubTree& inSubTree)
 {
     if (inSubTree.mChild == cInvalidChild) return;
+    const MoveScope scope(*this); // Keeps out of a rebuild commit only
+    LinkSubTreeHeld(scope, inSubTree);
+}
+
+void QuadTree::LinkSubTreeHeld([[maybe_unused]] const MoveScope& inScope, const SubTree& inSubTree)
+{
+    assert(&inScope.GetTree() == this);
+    if (inSubTree.mChild == cInvalidChild) return;
     mNumBodies.fetch_add(inSubTree.mNumBodies, std::memory_order_relaxed); // Before the link: see mNumBodies
-    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     const uint32_t subNode = inSubTree.mChild;
     for (;;)
     {
@@ -293,9 +342,16 @@ void QuadTree::MarkChangedUp(uint32_t inNode)
 
 bool QuadTree::RemoveBody(BodyID inBody)
 {
+    if (inBody.GetIndex() >= mBodies.GetMaxBodies()) return false;
+    const MoveScope scope(*this); // Keeps out of a rebuild commit only
+    return RemoveBodyHeld(scope, inBody);
+}
+
+bool QuadTree::RemoveBodyHeld([[maybe_unused]] const MoveScope& inScope, BodyID inBody)
+{
+    assert(&inScope.GetTree() == this);
     const uint32_t index = inBody.GetIndex();
     if (index >= mBodies.GetMaxBodies()) return false;
-    StripedSharedMutex::SharedLock lock(mModificationLock); // Keeps out of a rebuild commit only
     QuadTreeBodyTable::Entry& entry = mBodies[index];
     const uint32_t location = FindLocation(inBody);
     if (location == QuadTreeBodyTable::cInvalidLocation) return false;
@@ -401,7 +457,7 @@ void QuadTree::PrefetchNodeOf(uint32_t inIndex) const
 
 AABB QuadTree::GetBodySlotBounds(BodyID inBody) const
 {
-    EpochReclaimer::ReadScope scope(mReclaimer);
+    EpochReclaimer::ReadScope scope(mBodies.GetReclaimer());
     const uint32_t location = FindLocation(inBody);
     if (location == QuadTreeBodyTable::cInvalidLocation) return AABB::Empty();
     return LoadSlot(GetNode(location >> 2), int(location & 3));
@@ -415,11 +471,37 @@ AABB QuadTree::GetBodyBounds(BodyID inBody) const
     return GetBodySlotBounds(inBody); // A move is being written: its slot contains the old bounds
 }
 
+bool QuadTree::ReportsTransitLeaf(uint64_t inTransit, const MultiTreeQuery* inMulti, ObjectLayerMask inMask,
+                                  bool inCheckLayers) const
+{
+    const QuadTreeBodyTable::Transit transit = QuadTreeBodyTable::UnpackTransit(inTransit);
+    // Either layer passes the filter: queries that run while the body's published layer changes find it
+    if (inCheckLayers && !IsInLayerMask(inMask, transit.mOldLayer) &&
+        !IsInLayerMask(inMask, transit.mNewLayer))
+        return false;
+    // One leaf, or a walk that cannot meet the other leaf in this query: this leaf is the body
+    const uint32_t both = 1u << transit.mOldTree | 1u << transit.mNewTree;
+    if (transit.mOldTree == transit.mNewTree || inMulti == nullptr || (inMulti->mTrees & both) != both)
+        return true;
+    // The query walks both trees: the leaf its entry epoch picks, so that it reports the body once
+    const bool takesNew = QuadTreeBodyTable::IsAtOrPastFlip(inMulti->mEpoch, transit.mFlip);
+    return (mTreeId == transit.mNewTree) == takesNew;
+}
+
 template <class Test4, class Test, class LeafVisit>
-bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const
+bool QuadTree::Walk(ObjectLayerMask inMask, const MultiTreeQuery* inMulti, Test4&& inTest4, Test&& inTest,
+                    LeafVisit&& inLeaf) const
 {
     if (mNumBodies.load(std::memory_order_relaxed) == 0) return true; // See mNumBodies
-    EpochReclaimer::ReadScope scope(mReclaimer);
+    if (inMulti != nullptr) return WalkInSection(inMask, inMulti, inTest4, inTest, inLeaf);
+    EpochReclaimer::ReadScope scope(mBodies.GetReclaimer());
+    return WalkInSection(inMask, inMulti, inTest4, inTest, inLeaf);
+}
+
+template <class Test4, class Test, class LeafVisit>
+bool QuadTree::WalkInSection(ObjectLayerMask inMask, const MultiTreeQuery* inMulti, Test4&& inTest4,
+                             Test&& inTest, LeafVisit&& inLeaf) const
+{
     const bool checkLayers = inMask != cAllObjectLayers;
     NodeStack stack;
     // Acquire: pairs with the release exchange or store that published the root and everything below it
@@ -460,10 +542,21 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, Leaf
                 haveExact = QuadTreeBodyTable::LoadBounds(entry, exact);
                 if (haveExact && !inTest(exact, fraction)) continue;
             }
-            // Relaxed: written before the sub-tree was published (acquired above); a concurrent re-add of
-            // the index is reported with its old or new id, both allowed
-            if (checkLayers && !IsInLayerMask(inMask, entry.mLayer.load(std::memory_order_relaxed))) continue;
-            const BodyID id(index, mBodies.Sequence(index).load(std::memory_order_relaxed)); // As above
+            // Acquire: a layer that a change stored (release) before it publishes the body comes with the
+            // transit record stored before it (read below); else written before the sub-tree was published
+            // (acquired above). A concurrent re-add of the index is reported with its old or new id, both
+            // allowed
+            const ObjectLayer layer = checkLayers ? entry.mLayer.load(std::memory_order_acquire) : 0;
+            // The body changing layers, if any (one at a time): a load of a word that changes only then
+            if (const uint64_t transit = mBodies.LoadTransit();
+                QuadTreeBodyTable::TransitBody(transit) == index) [[unlikely]]
+            {
+                if (!ReportsTransitLeaf(transit, inMulti, inMask, checkLayers)) continue;
+            }
+            else if (checkLayers && !IsInLayerMask(inMask, layer))
+                continue;
+            // Relaxed: written before the sub-tree was published (acquired above)
+            const BodyID id(index, mBodies.Sequence(index).load(std::memory_order_relaxed));
             if constexpr (std::is_invocable_v<LeafVisit&, BodyID, float, const AABB&>)
             {
                 // A slot that is not loose holds the body's exact bounds
@@ -476,10 +569,11 @@ bool QuadTree::Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, Leaf
     return true;
 }
 
-void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const
+void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor,
+                            const MultiTreeQuery* inMulti) const
 {
     Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::OverlapMask(inSlots, inBox); },
         [&](const AABB& inBody, float&) { return AABBsOverlap(inBody, inBox); },
@@ -491,10 +585,11 @@ void QuadTree::CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisit
 }
 
 void QuadTree::CollideAABoxWithBounds(const AABB& inBox, ObjectLayerMask inMask,
-                                      FunctionRef<void(BodyID, const AABB&)> inVisitor) const
+                                      FunctionRef<void(BodyID, const AABB&)> inVisitor,
+                                      const MultiTreeQuery* inMulti) const
 {
     Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::OverlapMask(inSlots, inBox); },
         [&](const AABB& inBody, float&) { return AABBsOverlap(inBody, inBox); },
@@ -506,10 +601,10 @@ void QuadTree::CollideAABoxWithBounds(const AABB& inBox, ObjectLayerMask inMask,
 }
 
 void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask,
-                             BodyVisitor inVisitor) const
+                             BodyVisitor inVisitor, const MultiTreeQuery* inMulti) const
 {
     Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::SphereMask(inSlots, inCenter, inRadius); },
         [&](const AABB& inBody, float&) { return SphereOverlapsAABB(inCenter, inRadius, inBody); },
@@ -520,11 +615,12 @@ void QuadTree::CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMa
         });
 }
 
-void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor) const
+void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor,
+                            const MultiTreeQuery* inMulti) const
 {
     const AABB point(inPoint, inPoint);
     Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&)[4])
         { return quadtree::OverlapMask(inSlots, point); },
         [&](const AABB& inBody, float&) { return AABBContains(inBody, inPoint); },
@@ -536,11 +632,11 @@ void QuadTree::CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVis
 }
 
 bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMaxFraction,
-                       RayBodyVisitor inVisitor) const
+                       RayBodyVisitor inVisitor, const MultiTreeQuery* inMulti) const
 {
     const Vec3 invDirection = SafeReciprocal(inRay.mDirection);
     return Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&outFractions)[4])
         { return quadtree::RayMask(inSlots, inRay.mOrigin, invDirection, ioMaxFraction, outFractions); },
         [&](const AABB& inBody, float& outFraction)
@@ -559,12 +655,12 @@ bool QuadTree::CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMa
 }
 
 bool QuadTree::CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
-                         float& ioMaxFraction, RayBodyVisitor inVisitor) const
+                         float& ioMaxFraction, RayBodyVisitor inVisitor, const MultiTreeQuery* inMulti) const
 {
     // The box centre is cast against slots grown by the box half extents (see SweptAABox)
     const SweptAABox sweep(inBox, inDisplacement);
     return Walk(
-        inMask,
+        inMask, inMulti,
         [&](const quadtree::SlotBounds4& inSlots, float(&outFractions)[4])
         {
             // Empty slots stay empty when grown (min > max by about 2 * cLargeFloat)

@@ -5,12 +5,17 @@
 //
 // Threads and locks:
 //  - Queries (CollideAABox, CollideSphere, CollidePoint, CastRay, CastAABox, GetBodyBounds): any thread, any
-//    time, no lock. A query runs inside an EpochReclaimer read section, so no node it can reach is freed
-//    under it; it never waits.
+//    time, no lock. A query runs inside a read section of the EpochReclaimer that the trees of one body table
+//    share (its own, or, with a MultiTreeQuery, the section of the caller that walks several trees), so no
+//    node it can reach is freed under it; it never waits.
 //  - BuildSubTree / FreeSubTree: any thread, no lock; they only touch nodes not reachable from the root.
 //  - LinkSubTree, RemoveBody, MoveBody: any thread, concurrently with each other and with queries. They take
 //    this tree's StripedSharedMutex shared (their own stripe: no contention between them) only to keep out of
-//    the rebuild's short commit. The caller serialises operations on one body.
+//    the rebuild's short commit; their *Held forms run under a MoveScope the caller holds. The caller
+//    serialises operations on one body.
+//  - A body changing trees (BroadPhaseQuadTree::ChangeBodyLayer, see QuadTreeBodyTable's transit record):
+//    BuildSecondLeaf, LinkSubTreeHeld, RemoveBodyHeld and AdoptSecondLeaf, under MoveScopes of both trees
+//    for the whole change, so that no rebuild commit of either sees the body with two leaves.
 //  - Rebuild and CollectGarbage: one thread at a time (the physics update) across all the trees that share a
 //    QuadTreeBodyTable (its mSlotReachSides is the rebuilds' own), concurrently with the rest. A
 //    rebuild builds the new tree off the live one with no lock, then commits (relocates the bodies it moved,
@@ -27,6 +32,10 @@
 //    that grew is marked loose and queries then test the body's exact bounds from the QuadTreeBodyTable.
 //  - Removal empties the slot; a concurrent query reports the body or not.
 //  - Nodes are freed only after every read section that might reach them has ended (EpochReclaimer).
+//  - A body in transit between two trees (one at a time, QuadTreeBodyTable) has a leaf in each for a while: a
+//    walk with a MultiTreeQuery over both reports the leaf its entry epoch picks, any other walk reports
+//    the leaf it finds (it cannot find the other). A body in transit passes a layer filter with either of
+//    its two object layers.
 //    Modifiers need no read section: they reach nodes only through body locations and parent links, which
 //    the commit points at the new tree before it releases the exclusive lock, so a modification that starts
 //    after a commit never touches a node that commit retired.
@@ -80,6 +89,16 @@ public:
     // The bound rows are 16-byte aligned: queries read each as one SIMD load (QuadTreeInternal.h)
     static_assert(offsetof(Node, mMinY) % 16 == 0 && offsetof(Node, mMaxZ) % 16 == 0 &&
                   alignof(Node) % 16 == 0);
+
+    /// A query that walks several trees of one body table under one read section of the table's reclaimer,
+    /// which the caller holds for all of them (BroadPhaseQuadTree): the section's entry epoch, and the trees
+    /// it walks (a bit per tree id). With it a body in transit between two of them is reported by one walk
+    /// only.
+    struct MultiTreeQuery
+    {
+        uint64_t mEpoch = 0; ///< EpochReclaimer::ReadScope::GetEpoch of the caller's section
+        uint32_t mTrees = 0; ///< Bit t: the query walks tree id t
+    };
 
     /// A prepared, not yet linked sub-tree.
     struct SubTree
@@ -137,7 +156,8 @@ public:
     /// Stores the body's new exact bounds and grows its slot (and the parents') to contain them.
     void MoveBody(BodyID inBody, const AABB& inBounds);
     /// A shared hold of the tree's modification lock over several moves (a batch pays for the lock once; a
-    /// rebuild commit waits for the whole batch). The holder calls no other modifying method of the tree.
+    /// rebuild commit waits for the whole batch), or over a body's change of trees. The holder calls only the
+    /// *Held modifying methods of the tree (the lock is not recursive).
     class MoveScope
     {
     public:
@@ -152,6 +172,18 @@ public:
     bool MoveBodyHeld(const MoveScope& inScope, BodyID inBody, const AABB& inBounds);
     /// Sets the object layer of a linked body (same broad-phase layer).
     void SetBodyLayer(BodyID inBody, ObjectLayer inLayer);
+
+    /// A body changing trees (see the top of this file), in the order the change calls them:
+    /// A private one-body sub-tree for body index inIndex, which is linked in another tree of the table: the
+    /// table entry is left alone. outLocation: the leaf's location. An empty SubTree when out of nodes.
+    SubTree BuildSecondLeaf(uint32_t inIndex, const AABB& inBounds, uint32_t& outLocation);
+    /// LinkSubTree under a MoveScope of this tree.
+    void LinkSubTreeHeld(const MoveScope& inScope, const SubTree& inSubTree);
+    /// RemoveBody under a MoveScope of this tree.
+    bool RemoveBodyHeld(const MoveScope& inScope, BodyID inBody);
+    /// Makes the leaf that BuildSecondLeaf made (at inLocation, linked since) the body's location in the
+    /// table, once the body's leaf in its old tree is removed.
+    void AdoptSecondLeaf(const MoveScope& inScope, uint32_t inIndex, uint32_t inLocation);
 
     /// Margin (m) by which a rebuild grows the slot of a body that moved since the previous rebuild (0: exact
     /// slots). A body then moves inside its slot for a while without writing to any node (no cache line taken
@@ -180,23 +212,27 @@ public:
     void CollectGarbage();
 
     /// Bodies whose exact bounds overlap inBox. inMask: object layers to report.
-    void CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor) const;
+    void CollideAABox(const AABB& inBox, ObjectLayerMask inMask, BodyVisitor inVisitor,
+                      const MultiTreeQuery* inMulti = nullptr) const;
     /// As CollideAABox, with each body's bounds as the query saw them: exact, or, while a move of the body is
     /// being written, its slot's (which contain the old bounds).
     void CollideAABoxWithBounds(const AABB& inBox, ObjectLayerMask inMask,
-                                FunctionRef<void(BodyID, const AABB&)> inVisitor) const;
+                                FunctionRef<void(BodyID, const AABB&)> inVisitor,
+                                const MultiTreeQuery* inMulti = nullptr) const;
     /// Bodies whose exact bounds are within inRadius of inCenter.
-    void CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask,
-                       BodyVisitor inVisitor) const;
+    void CollideSphere(const Vec3& inCenter, float inRadius, ObjectLayerMask inMask, BodyVisitor inVisitor,
+                       const MultiTreeQuery* inMulti = nullptr) const;
     /// Bodies whose exact bounds contain inPoint.
-    void CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor) const;
+    void CollidePoint(const Vec3& inPoint, ObjectLayerMask inMask, BodyVisitor inVisitor,
+                      const MultiTreeQuery* inMulti = nullptr) const;
     /// Bodies whose exact bounds the segment enters before ioMaxFraction (which the visitor can lower; a
     /// negative value stops). Returns false when the visitor stopped the cast.
-    bool CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMaxFraction,
-                 RayBodyVisitor inVisitor) const;
+    bool CastRay(const RayCast& inRay, ObjectLayerMask inMask, float& ioMaxFraction, RayBodyVisitor inVisitor,
+                 const MultiTreeQuery* inMulti = nullptr) const;
     /// Bodies whose exact bounds the swept box touches before ioMaxFraction; as CastRay.
     bool CastAABox(const AABB& inBox, const Vec3& inDisplacement, ObjectLayerMask inMask,
-                   float& ioMaxFraction, RayBodyVisitor inVisitor) const;
+                   float& ioMaxFraction, RayBodyVisitor inVisitor,
+                   const MultiTreeQuery* inMulti = nullptr) const;
 
     /// Bodies linked (a snapshot: others may be adding and removing).
     uint32_t GetNumBodies() const
@@ -287,12 +323,21 @@ private:
     void PropagateUp(uint32_t inNode, const AABB& inBounds);
     /// Marks inNode and its ancestors changed.
     void MarkChangedUp(uint32_t inNode);
-    /// Depth-first walk under a read section. inTest4(SlotBounds4, Array4f& fractions) -> slot mask decides
-    /// which slots to descend or report; inTest(exact AABB, float& fraction) -> bool re-tests a body whose
-    /// slot is loose; inLeaf(BodyID, fraction) -> bool returns false to stop (or inLeaf(BodyID, fraction,
-    /// bounds) to get the bounds tested too). Returns false when stopped.
+    /// Depth-first walk under a read section (its own, or inMulti's). inTest4(SlotBounds4, Array4f&
+    /// fractions)
+    /// -> slot mask decides which slots to descend or report; inTest(exact AABB, float& fraction) -> bool
+    /// re-tests a body whose slot is loose; inLeaf(BodyID, fraction) -> bool returns false to stop (or
+    /// inLeaf(BodyID, fraction, bounds) to get the bounds tested too). Returns false when stopped.
     template <class Test4, class Test, class LeafVisit>
-    bool Walk(ObjectLayerMask inMask, Test4&& inTest4, Test&& inTest, LeafVisit&& inLeaf) const;
+    bool Walk(ObjectLayerMask inMask, const MultiTreeQuery* inMulti, Test4&& inTest4, Test&& inTest,
+              LeafVisit&& inLeaf) const;
+    template <class Test4, class Test, class LeafVisit>
+    bool WalkInSection(ObjectLayerMask inMask, const MultiTreeQuery* inMulti, Test4&& inTest4, Test&& inTest,
+                       LeafVisit&& inLeaf) const;
+    /// Whether a walk reports the leaf of body index inIndex, which the transit record inTransit names, in
+    /// this tree, for a query filtered by inMask (checked when inCheckLayers).
+    bool ReportsTransitLeaf(uint64_t inTransit, const MultiTreeQuery* inMulti, ObjectLayerMask inMask,
+                            bool inCheckLayers) const;
 
     /// The body's location when this exact id (index and sequence) is linked in this tree or in a sub-tree
     /// built for it (acquire), else cInvalidLocation.
@@ -315,7 +360,6 @@ private:
     std::unique_ptr<std::atomic<Node*>[]> mChunks; ///< Node storage, allocated on demand
     std::atomic<uint32_t> mRoot;                   ///< Current root node
     StripedSharedMutex mModificationLock;          ///< Shared: modifiers; exclusive: rebuild commit
-    EpochReclaimer mReclaimer;                     ///< Read sections of queries
     std::vector<RetiredBatch> mRetired;            ///< Update thread only: nodes waiting to be freed
     std::atomic<uint32_t> mNumRetired{0};          ///< Statistic: nodes in mRetired
     std::vector<uint64_t>

@@ -289,7 +289,7 @@ QuadTree::RebuildStats QuadTree::Rebuild(bool inFull)
     stats.mNewNodes = uint32_t(newNodes.size());
     stats.mRetiredNodes = uint32_t(replaced.size());
     mNumRetired.fetch_add(uint32_t(replaced.size()), std::memory_order_relaxed); // Statistic only
-    mRetired.push_back({mReclaimer.GetEpoch(), std::move(replaced)});
+    mRetired.push_back({mBodies.GetReclaimer().GetEpoch(), std::move(replaced)});
     return stats;
 }
 
@@ -358,10 +358,12 @@ uint32_t QuadTree::LinkLateSubTrees(uint32_t inOldRoot, uint32_t inNewRoot, std:
 void QuadTree::CollectGarbage()
 {
     // Two steps of the epoch, each followed by freeing what became safe: the last update's retirees (stamped
-    // with the epoch after its second step) are then freed here, one update later, when no reader lags
+    // with the epoch after its second step) are then freed here, one update later, when no reader lags. The
+    // epoch is the trees' shared one (QuadTreeBodyTable): the other trees' collections and layer changes
+    // advance it too, which only frees sooner what is safe to free
     for (int step = 0; step < 2; ++step)
     {
-        mReclaimer.TryAdvance();
+        mBodies.TryAdvanceEpoch();
         FreeReclaimableNodes();
     }
 }
@@ -378,7 +380,7 @@ void QuadTree::FreeReclaimableNodes()
     for (size_t i = 0; i < mRetired.size(); ++i)
     {
         RetiredBatch& batch = mRetired[i];
-        if (!mReclaimer.IsSafeToFree(batch.mEpoch))
+        if (!mBodies.GetReclaimer().IsSafeToFree(batch.mEpoch))
         {
             if (kept != i) mRetired[kept] = std::move(batch); // A self-move would empty the list
             ++kept;

@@ -1050,6 +1050,10 @@ public:
             body.mLayer = mLayerOfAdd[body.mID.GetIndex()];
         mInner.NotifyBodiesAABBChanged(bodies);
     }
+    bool ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer, FunctionRef<void()> inWhileInBoth) override
+    {
+        return mInner.ChangeBodyLayer(inBody, inLayer, inWhileInBoth);
+    }
     void Update() override { mInner.Update(); }
     void RebuildAll() { mInner.RebuildAll(); }
     bool Validate() const { return mInner.Validate(); }

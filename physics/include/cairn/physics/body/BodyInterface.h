@@ -1,9 +1,9 @@
 #pragma once
 
-// BodyInterface: the locking API to create, add, remove, move and push bodies, callable from any thread
-// outside the physics step. Every call validates its input and returns an error without changing anything
-// when the input is bad (stale id, NaN, body in the wrong state). Calls made from inside the step (a step
-// callback) return ErrorCode::WrongThread instead of deadlocking.
+// BodyInterface: the locking API to create, add, remove, move, push and change bodies (motion type, object
+// layer, shape), callable from any thread outside the physics step. Every call validates its input and
+// returns an error without changing anything when the input is bad (stale id, NaN, body in the wrong state).
+// Calls made from inside the step (a step callback) return ErrorCode::WrongThread instead of deadlocking.
 //
 // Locks: each call takes at most one body mutex at a time (BodyLockWrite), then the broad phase's own lock
 // (lock order body mutex < broad phase). Waking the neighbours of a removed body happens after its lock is
@@ -89,6 +89,53 @@ public:
     Status AddAngularImpulse(const BodyID& inID, const Vec3& inImpulse);
     Status ActivateBody(const BodyID& inID);
     Status DeactivateBody(const BodyID& inID);
+
+    // Changing a live body. Each works on a body in the world or not, from any thread outside the step
+    // (inside it, or while this thread holds a body lock: WrongThread), under the body's write lock like the
+    // calls above; bad input (a stale id, NaN, a value out of range) is an error that changes nothing.
+
+    /// Makes a body static, kinematic or dynamic, its shape's origin staying where it is. To dynamic: the
+    /// shape's mass and inertia at the density the body was created with, after CreateBody's checks (a shape
+    /// with volume, a mass in range); the velocities are kept (a kinematic door let go swings on). To
+    /// kinematic: no mass, velocities kept, forces dropped. To static: deactivated, velocities and forces
+    /// zeroed, and its broad-phase box back to its own bounds (the step gave an active body a swept one); a
+    /// static body is never in the active list. Activation::Activate activates a dynamic or kinematic body in
+    /// the world (the same motion type again only does that). The published pose names the new motion type at
+    /// once. The object layer stays: a body made dynamic in a static layer collides as that layer says (see
+    /// SetObjectLayer). Body change listeners hear an in-place move under the old motion type, then one under
+    /// the new (a listener that keeps bodies of one type only sees both sides). A sleeping body made static
+    /// stays in its island's ring, where it ends the ring's wake walk: the bodies after it wake by contact.
+    /// Locks: the body's mutex; the broad phase for a body made static in the world.
+    Status SetMotionType(const BodyID& inID, MotionType inMotionType, Activation inActivation);
+    /// Moves a body to another object layer (one of the layer setup, as CreateBody requires), and so to that
+    /// layer's broad-phase structure, without a moment where a query on another thread misses it: a query
+    /// running meanwhile finds it once under the old layer or the new one, and under the layer its published
+    /// pose shows at every moment (BroadPhase::ChangeBodyLayer). Refused for a body in an add batch that is
+    /// not finalized (its batch holds the old layer); OutOfCapacity, with nothing changed, when the new
+    /// broad-phase structure has no room. Listeners hear an in-place move under each layer, as for
+    /// SetMotionType. Locks: the body's mutex, then the broad phase's; it may wait, holding the body's lock,
+    /// for the queries running on other threads when it starts to finish (microseconds; longer only when such
+    /// a thread lost its core).
+    Status SetObjectLayer(const BodyID& inID, ObjectLayer inLayer);
+    /// Gives a body another shape, the shape's origin staying where it is. A dynamic body's new shape must
+    /// have volume (CreateBody's checks at the body's density); with inUpdateMassProperties it gets the new
+    /// shape's mass and inertia, otherwise it keeps its own. The centre of mass follows the new shape either
+    /// way (the velocities stay those of the same rigid motion). As a move by hand: the broad phase holds
+    /// both shapes' bounds while the new shape is published, then the new bounds only, so no query misses the
+    /// body; listeners hear a move from the old bounds; inActivation as SetPosition's. The old shape is
+    /// retired as DestroyBody retires one: freed once no query can still hold it. Locks: the body's mutex,
+    /// then the broad phase's; the retired shapes' mutex after the body's lock is released.
+    Status SetShape(const BodyID& inID, ShapeRef inShape, bool inUpdateMassProperties,
+                    Activation inActivation);
+    /// Sets the velocities of a kinematic body in the world so that it reaches the target pose (the shape's
+    /// origin and rotation, the turn taken the short way round) in inDeltaTime seconds, and activates it: an
+    /// Update of inDeltaTime (in any number of collision steps) moves it there. The velocities stay
+    /// afterwards: call it again each frame with the next target, or set them to zero. Refused, with nothing
+    /// changed: a body that is not kinematic or not in the world, a target that is not finite or beyond the
+    /// world, a rotation that is not a unit quaternion, inDeltaTime not finite and > 0, and a move faster
+    /// than the body's velocity limits (the step would clamp it and stop short). Locks: the body's mutex.
+    Status MoveKinematic(const BodyID& inID, const Vec3& inTargetPosition, const Quat& inTargetRotation,
+                         float inDeltaTime);
 
     Result<Vec3> GetPosition(const BodyID& inID) const;
     Result<Quat> GetRotation(const BodyID& inID) const;

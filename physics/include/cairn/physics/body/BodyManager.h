@@ -104,6 +104,10 @@ public:
 
     /// Publishes inBody's pose (PublishedPose.h). The caller holds the body's write lock, or is the step.
     void PublishPose(const Body& inBody);
+    /// Keeps a shape that a published pose named until no PoseReader can hold it (a destroyed body's, or one
+    /// a body's shape was replaced by): the body must be published without it first. Any thread; not under a
+    /// body lock (freeing a shape may take long).
+    void RetireShape(ShapeRef&& ioShape);
     /// Frees the shapes of destroyed bodies that no PoseReader can hold any more. Any thread (the updating
     /// thread calls it after each Update).
     void CollectRetiredShapes();

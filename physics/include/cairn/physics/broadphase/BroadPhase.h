@@ -10,7 +10,10 @@
 //  - AddBodiesFinalize / AddBodiesAbort: exactly once per AddState, from any one thread.
 // A body id is added at most once; the caller (BodyInterface) serialises add/remove of the same body.
 // Queries report every body whose stored AABB overlaps; a body added, moved or removed concurrently with a
-// query is reported with either its old or its new state.
+// query is reported with either its old or its new state. A body whose object layer ChangeBodyLayer changes
+// is reported by every query that runs meanwhile whose filter takes either layer, once (not by
+// FindCollidingPairs, which the engine never runs beside a layer change: BodyInterface calls wait for the
+// step).
 // Visitors may run while the broad phase holds an internal lock (the reference implementations hold a shared
 // lock): a visitor must not call back into the broad phase and must not wait for a lock that a thread calling
 // a modifying method may hold (e.g. a body write lock); collect the ids and lock after the query returns.
@@ -91,8 +94,21 @@ public:
     /// Removes added bodies.
     virtual void RemoveBodies(std::span<const BodyID> inBodies) = 0;
 
-    /// New world AABBs for added bodies (after a move).
+    /// New world AABBs for added bodies (after a move). A new object layer is taken too, but a query running
+    /// meanwhile may miss a body that it moves to another broad-phase layer: ChangeBodyLayer does not.
     virtual void NotifyBodiesAABBChanged(std::span<const BroadPhaseBody> inBodies) = 0;
+
+    /// Moves an added body to object layer inLayer (another broad-phase layer's structure, perhaps) without a
+    /// moment where a query could miss it: from the start of the call to its end, a query whose filter takes
+    /// either layer reports the body exactly once (as the filter of a query that starts after the call sees
+    /// it, only in the new layer). inWhileInBoth runs in the middle, while the body is found under both
+    /// layers: the body interface publishes the new layer there, so a query that reads the body's published
+    /// layer finds the body under it at every moment. It must not call the broad phase (it may run under its
+    /// lock). Returns false, with nothing changed and inWhileInBoth not run, for a body that is not present,
+    /// an object layer the broad phase does not know, or no room for the body in the new structure. Any
+    /// thread, not from inside a visitor; the caller serialises it with the body's other operations. It may
+    /// wait for the queries running when it starts to finish (microseconds, unless one lost its core).
+    virtual bool ChangeBodyLayer(BodyID inBody, ObjectLayer inLayer, FunctionRef<void()> inWhileInBoth) = 0;
 
     /// Optimises the structure after moves, adds and removes (re-sort, rebuild). Physics step only.
     virtual void Update() = 0;
