@@ -25,6 +25,7 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     mAllowSleeping = inSettings.mAllowSleeping;
     mIsSensor = inSettings.mIsSensor;
     mMotionQuality = inSettings.mMotionQuality;
+    mShapeGeneration = 0;
     mNavMeshArea = inSettings.mNavMeshArea;
     mUserData = inSettings.mUserData;
     mForce.setZero();

@@ -562,6 +562,7 @@ Status BodyInterface::SetShape(const BodyID& inID, ShapeRef inShape, bool inUpda
             const Vec3 oldCenterOfMass = ioBody.mPosition;
             old = std::move(ioBody.mShape);
             ioBody.mShape = std::move(inShape);
+            ++ioBody.mShapeGeneration; // The step's pair cache must collide the new shape, not reuse the old
             ioBody.SetMassProperties(inUpdateMassProperties);
             ioBody.mPosition = origin + ioBody.mRotation * ioBody.mCenterOfMassOffset;
             // The same rigid motion, now about the new centre of mass: v(p) = v + w x (p - c) at the new c

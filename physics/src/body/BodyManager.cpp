@@ -42,7 +42,8 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (!(inSettings.mMaxLinearVelocity > 0.0f && inSettings.mMaxLinearVelocity <= 1e5f) ||
         !(inSettings.mMaxAngularVelocity > 0.0f && inSettings.mMaxAngularVelocity <= 1e5f))
         return invalid("velocity limits must be in (0, 1e5] m/s and rad/s");
-    if (inSettings.mMotionQuality != MotionQuality::Discrete && inSettings.mMotionQuality != MotionQuality::LinearCast)
+    if (inSettings.mMotionQuality != MotionQuality::Discrete &&
+        inSettings.mMotionQuality != MotionQuality::LinearCast)
         return invalid("motion quality is not a MotionQuality");
     const AABB bounds = inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation});
     if (!bounds.IsFinite()) return invalid("body bounds are not finite");

@@ -48,6 +48,8 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
     const Quat inverseRotationA = ioA.mRotation.conjugate();
     CachedBodyPair record{ioA.GetID(), ioB.GetID(), inverseRotationA * (ioB.mPosition - ioA.mPosition),
                           inverseRotationA * ioB.mRotation, settings.mMaxSeparation};
+    record.mShapeGenerationA = ioA.mShapeGeneration;
+    record.mShapeGenerationB = ioB.mShapeGeneration;
     if (!ReuseManifolds(inContext, inIntegration, ioA, ioB, record, ioOut))
         CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
                       [&](const ContactManifold& inManifold)
@@ -109,7 +111,9 @@ bool ContactsStage::ReuseManifolds(const StepContext& inContext, const Integrati
     const float maxDelta = settings.mPairCacheMaxDeltaPosition;
     if ((ioRecord.mDeltaPosition - previous->mDeltaPosition).squaredNorm() > maxDelta * maxDelta ||
         std::abs(ioRecord.mDeltaRotation.dot(previous->mDeltaRotation)) < mPairCacheCosHalfMaxAngle ||
-        ioRecord.mMaxSeparation > previous->mMaxSeparation + maxDelta)
+        ioRecord.mMaxSeparation > previous->mMaxSeparation + maxDelta ||
+        ioRecord.mShapeGenerationA != previous->mShapeGenerationA ||
+        ioRecord.mShapeGenerationB != previous->mShapeGenerationB)
         return false;
     ioRecord = *previous;
     // The points stay fixed on both bodies; where they are now, and how far apart, follows from the poses

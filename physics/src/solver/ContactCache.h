@@ -57,7 +57,12 @@ struct CachedBodyPair
     float mMaxSeparation;        ///< How far apart the shapes could be and still make contact points, then
     uint32_t mFirstManifold = 0; ///< Into the same step's manifolds (valid after EndStep)
     uint32_t mNumManifolds = 0;
+    /// The bodies' Body::mShapeGeneration then: a new shape at the same pose is collided again. In what was
+    /// padding (the record stays 64 bytes)
+    uint16_t mShapeGenerationA = 0;
+    uint16_t mShapeGenerationB = 0;
 };
+static_assert(sizeof(CachedBodyPair) == 64, "one cache line");
 
 class ContactCache
 {

@@ -325,12 +325,11 @@ TEST_F(LiveBodyChangeTest, SetShapeMovesTheBoundsThePublishedShapeAndRetiresTheO
     EXPECT_TRUE(oldShape.expired());
 }
 
-// Disabled until the narrow phase tells a new shape from an old one: its body-pair cache takes last step's
-// manifolds over for a pair whose relative pose did not change (ContactsStage::ReuseManifolds), so a resting
-// body given a larger shape keeps the contacts of the old one and stays sunk in the floor (y 0.5 here). The
-// fix belongs in narrowphase/ContactsOfPair.cpp and the contact cache (a shape generation per body, kept
-// with each cached pair and compared before a takeover), not in the body interface.
-TEST_F(LiveBodyChangeTest, DISABLED_ABodyGivenALargerShapeRestsOnItsNewSurface)
+// The narrow phase's body-pair cache takes last step's manifolds over for a pair whose relative pose did not
+// change (ContactsStage::ReuseManifolds): it must tell a new shape from the old (a shape generation per body,
+// kept with each cached pair), or a resting body given a larger shape keeps the old contacts and stays sunk
+// in the floor (y 0.5 here, before the generation)
+TEST_F(LiveBodyChangeTest, ABodyGivenALargerShapeRestsOnItsNewSurface)
 {
     AddFloor();
     const BodyID ball = AddDynamic(DynamicSettings(Sphere(0.5f), Vec3(0, 0.5f, 0)));

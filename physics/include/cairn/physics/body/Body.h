@@ -125,6 +125,9 @@ private:
     bool mAllowSleeping;
     bool mIsSensor;
     MotionQuality mMotionQuality;
+    /// Counts SetShape calls (wrapping): the narrow phase's body-pair cache takes manifolds over only from
+    /// the same shapes
+    uint16_t mShapeGeneration;
     bool mInWorld = false;    ///< Added to the broad phase and simulated
     bool mAddPending = false; ///< In a prepared add batch that is not finalized yet
     bool mWakeIsland = false; ///< Woken from outside the step: the step wakes its sleeping island too
