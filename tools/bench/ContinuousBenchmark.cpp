@@ -1,6 +1,7 @@
 // cairn-bench-continuous: what a MotionQuality::LinearCast body costs against a discrete one, in the same
 // scene (issue 31's target: at most 3x a discrete body's narrow phase).
-//  step_projectiles  the shared world's 20,020 static boxes; 256 balls (radius 0.35 m, as the demo throws)
+//  step_projectiles  the shared world's 20,020 static boxes on a floor; 256 balls (radius 0.35 m, as the demo
+//  throws)
 //                    shot down into it at 100-300 m/s from 10-30 m up, 240 steps of 1/60 s, one thread. The
 //                    same balls (same seed) run once discrete and once linear-cast, alternating, per
 //                    repetition.
@@ -17,6 +18,7 @@
 #include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
 
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -37,6 +39,7 @@ struct RunResult
     uint64_t mMovedBack = 0;    ///< Casts that stopped a ball, over the run
     double mMeanHeight = 0.0;   ///< Of the balls at the end
     double mLowestHeight = 0.0;
+    int mBelowFloor = 0; ///< Balls whose centre ended below the floor's top, over it: passed through it
 };
 
 RunResult Run(const SharedBenchData& inData, MotionQuality inQuality)
@@ -53,6 +56,15 @@ RunResult Run(const SharedBenchData& inData, MotionQuality inQuality)
     AABB world;
     for (const BenchBox& box : inData.mStatic)
         world.Encapsulate(AABB::FromCenterExtent(box.mCenter, box.mHalfExtent));
+
+    // A floor under it all, so that balls falling between the boxes land and roll into them
+    const Vec3 worldCenter = 0.5f * (world.mMin + world.mMax);
+    const Vec3 worldHalf = world.HalfExtent();
+    const Vec3 floorHalf(worldHalf.x() + 100.0f, 1.0f, worldHalf.z() + 100.0f);
+    BodyCreationSettings floor =
+        tools::BoxSettings(Vec3(worldCenter.x(), world.mMin.y() - 1.0f, worldCenter.z()), floorHalf, 0.0f,
+                           MotionType::Static, 0.5f);
+    (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
 
     std::mt19937 random(7);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -93,6 +105,11 @@ RunResult Run(const SharedBenchData& inData, MotionQuality inQuality)
         const double y = bodies.GetPosition(id).Value().y();
         result.mMeanHeight += y / cBalls;
         result.mLowestHeight = std::min(result.mLowestHeight, y);
+        // Under the floor's top and over the floor (some roll off its edges and fall past it)
+        const Vec3 at = bodies.GetPosition(id).Value();
+        const bool overFloor = std::abs(at.x() - worldCenter.x()) < floorHalf.x() &&
+                               std::abs(at.z() - worldCenter.z()) < floorHalf.z();
+        result.mBelowFloor += y < world.mMin.y() && overFloor ? 1 : 0;
     }
     return result;
 }
@@ -101,9 +118,10 @@ void Print(const char* inQuality, int inRepetition, const RunResult& inRun)
 {
     std::printf(
         "step_projectiles %s rep %d: step %.3f ms  narrow(+pairs) %.3f ms  casts %.3f ms  | casts that "
-        "stopped a ball %llu  | ball heights mean %.3f lowest %.3f m\n",
+        "stopped a ball %llu  | ball heights mean %.3f lowest %.3f m, %d below the floor\n",
         inQuality, inRepetition, inRun.mStepMs, inRun.mNarrowMs, inRun.mContinuousMs,
-        static_cast<unsigned long long>(inRun.mMovedBack), inRun.mMeanHeight, inRun.mLowestHeight);
+        static_cast<unsigned long long>(inRun.mMovedBack), inRun.mMeanHeight, inRun.mLowestHeight,
+        inRun.mBelowFloor);
 }
 } // namespace
 
