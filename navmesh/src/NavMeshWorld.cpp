@@ -1,5 +1,6 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 
+#include "DetourPaths.h"
 #include "cairn/navmesh/TileData.h"
 
 #include <DetourNavMesh.h>
@@ -17,15 +18,6 @@ using namespace cairn::physics;
 namespace
 {
 std::atomic<uint64_t> sNextSerial{1}; // Relaxed: only uniqueness matters
-
-constexpr int cMaxQueryNodes = 4096;
-constexpr int cMaxPathPolygons = 1024;
-constexpr int cMaxStraightPoints = 256;
-
-unsigned char ToDetourArea(int inArea)
-{
-    return inArea == cDefaultArea ? 63 : (unsigned char)inArea; // RC_WALKABLE_AREA is 63
-}
 
 /// This thread's query object for a world, made on first use.
 dtNavMeshQuery* QueryFor(uint64_t inSerial, const dtNavMesh* inNavMesh)
@@ -48,52 +40,6 @@ dtNavMeshQuery* QueryFor(uint64_t inSerial, const dtNavMesh* inNavMesh)
         perThread.mSerial = inSerial;
     }
     return perThread.mQuery.get();
-}
-
-/// Detour's filter for a PathFilter. Detour excludes by polygon flags, not areas: an excluded area gets a
-/// prohibitive cost, and callers check the areas of what they find (IsExcluded).
-Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat)
-{
-    dtQueryFilter filter;
-    filter.setIncludeFlags(cPolyFlagWalk);
-    filter.setExcludeFlags(0);
-    for (int area = 0; area <= cMaxAreaId; ++area)
-    {
-        const bool excluded = (inFilter.mExcludedAreas >> area) & 1u;
-        const float cost = inFilter.mAreaCost[size_t(area)];
-        if (!std::isfinite(cost) || cost < 0.0f)
-            return MakeError(ErrorCode::InvalidArgument,
-                             std::string(inWhat) + ": area costs must be finite and >= 0");
-        filter.setAreaCost(ToDetourArea(area), excluded ? 1.0e30f : cost);
-    }
-    return filter;
-}
-
-/// True if the polygon's Cairn area is one inFilter excludes.
-bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilter& inFilter)
-{
-    const dtMeshTile* tile = nullptr;
-    const dtPoly* poly = nullptr;
-    inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
-    const int area = poly->getArea() == 63 ? cDefaultArea : poly->getArea();
-    return area <= cMaxAreaId && ((inFilter.mExcludedAreas >> area) & 1u) != 0;
-}
-
-/// Checks a search extent against the grid's limit (see FindPath).
-Status CheckSearchExtent(const Vec3& inSearchExtent, float inTileSize, const char* inWhat)
-{
-    if (!IsFinite(inSearchExtent) || (inSearchExtent.array() <= 0.0f).any())
-        return MakeError(ErrorCode::InvalidArgument,
-                         std::string(inWhat) + ": the search extent must be finite and positive");
-    // Detour visits every tile cell under the extent while the navmesh is locked: a huge one would stall
-    // Publish (and the frame) for minutes
-    const float maxExtent = NavMeshWorld::cMaxSearchExtentTiles * inTileSize;
-    if (inSearchExtent.x() > maxExtent || inSearchExtent.z() > maxExtent)
-        return MakeError(ErrorCode::InvalidArgument,
-                         std::string(inWhat) + ": the search extent may span at most " +
-                             std::to_string(int(NavMeshWorld::cMaxSearchExtentTiles)) +
-                             " tiles across (x and z)");
-    return {};
 }
 
 /// Detour takes its random numbers from a plain function: this thread's generator state while a query runs.
@@ -299,30 +245,7 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
                                        &numPolygons, cMaxPathPolygons)) ||
         numPolygons == 0)
         return MakeError(ErrorCode::InvalidArgument, "path: no path");
-    // Cut the corridor before the first polygon of an excluded area
-    for (int i = 0; i < numPolygons; ++i)
-    {
-        if (IsExcluded(*mNavMesh, corridor[i], inFilter))
-        {
-            if (i == 0)
-                return MakeError(ErrorCode::InvalidArgument, "path: the start is in an excluded area");
-            numPolygons = i;
-            break;
-        }
-    }
-    PathResult result;
-    result.mNumPolygons = numPolygons;
-    result.mReachedEnd = corridor[numPolygons - 1] == endRef;
-    // A partial path ends at the point of its last polygon nearest the end
-    float target[3] = {endPoint[0], endPoint[1], endPoint[2]};
-    if (!result.mReachedEnd) query->closestPointOnPoly(corridor[numPolygons - 1], endPoint, target, nullptr);
-    float points[cMaxStraightPoints * 3];
-    int numPoints = 0;
-    query->findStraightPath(startPoint, target, corridor, numPolygons, points, nullptr, nullptr, &numPoints,
-                            cMaxStraightPoints);
-    for (int i = 0; i < numPoints; ++i)
-        result.mStraightPath.emplace_back(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
-    return result;
+    return FinishPath(*query, *mNavMesh, corridor, numPolygons, endRef, startPoint, endPoint, inFilter);
 }
 
 Result<Vec3> NavMeshWorld::FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter,
