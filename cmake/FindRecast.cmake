@@ -1,12 +1,14 @@
 # FindRecast: Debian's librecast-dev ships headers under recastnavigation/ and no CMake config.
-# Defines Recast::Recast and Recast::Detour (imported, SYSTEM headers) and Recast_FOUND.
+# Defines Recast::Recast, Recast::Detour and Recast::DetourCrowd (imported, SYSTEM headers) and Recast_FOUND.
 
 find_path(Recast_INCLUDE_DIR NAMES Recast.h PATH_SUFFIXES recastnavigation)
 find_library(Recast_LIBRARY NAMES Recast)
 find_library(Detour_LIBRARY NAMES Detour)
+find_library(DetourCrowd_LIBRARY NAMES DetourCrowd)
 
 include(FindPackageHandleStandardArgs)
-find_package_handle_standard_args(Recast REQUIRED_VARS Recast_LIBRARY Detour_LIBRARY Recast_INCLUDE_DIR)
+find_package_handle_standard_args(Recast REQUIRED_VARS Recast_LIBRARY Detour_LIBRARY DetourCrowd_LIBRARY
+                                                        Recast_INCLUDE_DIR)
 
 if(Recast_FOUND)
     if(NOT TARGET Recast::Recast)
@@ -19,5 +21,11 @@ if(Recast_FOUND)
         set_target_properties(Recast::Detour PROPERTIES IMPORTED_LOCATION "${Detour_LIBRARY}"
                                                         INTERFACE_INCLUDE_DIRECTORIES "${Recast_INCLUDE_DIR}")
     endif()
+    if(NOT TARGET Recast::DetourCrowd)
+        add_library(Recast::DetourCrowd UNKNOWN IMPORTED)
+        set_target_properties(Recast::DetourCrowd PROPERTIES IMPORTED_LOCATION "${DetourCrowd_LIBRARY}"
+                                                             INTERFACE_INCLUDE_DIRECTORIES "${Recast_INCLUDE_DIR}"
+                                                             INTERFACE_LINK_LIBRARIES Recast::Detour)
+    endif()
 endif()
-mark_as_advanced(Recast_INCLUDE_DIR Recast_LIBRARY Detour_LIBRARY)
+mark_as_advanced(Recast_INCLUDE_DIR Recast_LIBRARY Detour_LIBRARY DetourCrowd_LIBRARY)

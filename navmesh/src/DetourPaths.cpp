@@ -74,6 +74,7 @@ Result<PathResult> FinishPath(const dtNavMeshQuery& inQuery, const dtNavMesh& in
     int numPoints = 0;
     inQuery.findStraightPath(inStartPoint, target, inCorridor, inNumPolygons, points, nullptr, nullptr,
                              &numPoints, cMaxStraightPoints);
+    result.mPolygons.assign(inCorridor, inCorridor + inNumPolygons);
     for (int i = 0; i < numPoints; ++i)
         result.mStraightPath.emplace_back(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
     return result;

@@ -45,6 +45,9 @@ struct PathResult
     bool mReachedEnd = false;        ///< False: the path ends at the reachable point nearest the end
     int mNumPolygons = 0;            ///< Length of the polygon corridor
     std::vector<Vec3> mStraightPath; ///< Corner points from start to (reachable) end
+    /// The polygon corridor, Detour polygon references from the start's polygon on: valid until a Publish
+    /// changes a tile they are in (a crowd follows them; anyone else may ignore them)
+    std::vector<uint64_t> mPolygons;
 };
 
 class NavMeshWorld

@@ -1,0 +1,492 @@
+#include "cairn/navmesh/Crowd.h"
+
+#include "DetourPaths.h"
+
+#include <DetourCommon.h>
+#include <DetourLocalBoundary.h>
+#include <DetourObstacleAvoidance.h>
+#include <DetourPathCorridor.h>
+#include <algorithm>
+#include <cmath>
+
+namespace cairn::navmesh
+{
+
+namespace
+{
+/// Where AddAgent looks for navmesh under a position (half extents), as FindPath snaps its ends.
+const Vec3 cSnapExtent(2.0f, 4.0f, 2.0f);
+/// Agents in a ParallelFor chunk: steering one costs a few microseconds.
+constexpr uint32_t cAgentsPerChunk = 64;
+/// The neighbours and walls an agent avoids: within this many of its radii (DetourCrowd's choice)
+constexpr float cCollisionRangeRadii = 12.0f;
+/// At most this many neighbours, the nearest
+constexpr int cMaxNeighbours = 6;
+/// The wall segments a dtLocalBoundary keeps (its MAX_LOCAL_SEGS, private there)
+constexpr int cMaxWallSegments = 8;
+
+/// DetourCrowd's defaults for good quality ("adaptive" sampling, 7 divisions, 2 rings, depth 5).
+dtObstacleAvoidanceParams AvoidanceParams()
+{
+    dtObstacleAvoidanceParams params;
+    params.velBias = 0.4f;
+    params.weightDesVel = 2.0f;
+    params.weightCurVel = 0.75f;
+    params.weightSide = 0.75f;
+    params.weightToi = 2.5f;
+    params.horizTime = 2.5f;
+    params.gridSize = 33;
+    params.adaptiveDivs = 7;
+    params.adaptiveRings = 2;
+    params.adaptiveDepth = 5;
+    return params;
+}
+
+uint64_t CellKey(int32_t inX, int32_t inZ)
+{
+    return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ);
+}
+
+Vec3 Flat(const Vec3& inV)
+{
+    return Vec3(inV.x(), 0.0f, inV.z());
+}
+} // namespace
+
+struct Crowd::Agent
+{
+    AgentParams mParams;
+    dtPathCorridor mCorridor;
+    dtLocalBoundary mBoundary; ///< The walls near it, for its avoidance
+    Vec3 mVelocity = Vec3::Zero();
+    Vec3 mTarget = Vec3::Zero();
+    bool mHasTarget = false;
+    PathTicket mTicket;
+    AgentState mState = AgentState::Idle;
+    float mStuckSeconds = 0.0f; ///< Moving but hardly: how long, for the way out of a jam
+
+    Vec3 Position() const
+    {
+        return Vec3(mCorridor.getPos()[0], mCorridor.getPos()[1], mCorridor.getPos()[2]);
+    }
+};
+
+Crowd::Crowd(const NavMeshWorld& inWorld, const Settings& inSettings) : mWorld(inWorld), mSettings(inSettings)
+{
+}
+
+Crowd::~Crowd()
+{
+    for (dtNavMeshQuery* query : mQueries)
+        dtFreeNavMeshQuery(query);
+}
+
+Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const Settings& inSettings)
+{
+    if (!(inSettings.mMaxAgents >= 1 && inSettings.mMaxAgents <= 1 << 20))
+        return MakeError(ErrorCode::InvalidArgument, "crowd: max agents must be in [1, 2^20]");
+    if (!(inSettings.mMaxAgentRadius > 0.0f && inSettings.mMaxAgentRadius <= inWorld.GetGrid().GetTileSize()))
+        return MakeError(ErrorCode::InvalidArgument, "crowd: the max agent radius must be in (0, a tile]");
+    if (!(inSettings.mMaxCorridorPolygons >= 2 && inSettings.mMaxCorridorPolygons <= cMaxPathPolygons))
+        return MakeError(ErrorCode::InvalidArgument, "crowd: corridor polygons must be in [2, 1024]");
+    std::unique_ptr<Crowd> crowd(new Crowd(inWorld, inSettings));
+    Result<std::unique_ptr<PathRequestQueue>> paths = PathRequestQueue::Create(inWorld, inSettings.mPaths);
+    if (!paths) return paths.GetError();
+    crowd->mPaths = std::move(paths).Value();
+    crowd->mFilter = std::make_unique<dtQueryFilter>(MakeDetourFilter(PathFilter{}, "crowd").Value());
+    return crowd;
+}
+
+Crowd::Agent* Crowd::Find(AgentID inAgent) const
+{
+    return inAgent < mAgents.size() ? mAgents[inAgent].get() : nullptr;
+}
+
+Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams& inParams)
+{
+    if (!IsValidWorldPosition(inPosition))
+        return MakeError(ErrorCode::InvalidArgument, "agent: bad position");
+    if (!(inParams.mRadius > 0.0f && inParams.mRadius <= mSettings.mMaxAgentRadius) ||
+        !(inParams.mMaxSpeed > 0.0f && inParams.mMaxSpeed <= 100.0f) ||
+        !(inParams.mMaxAcceleration > 0.0f && inParams.mMaxAcceleration <= 1000.0f))
+        return MakeError(
+            ErrorCode::InvalidArgument,
+            "agent: radius in (0, the crowd's max], speed in (0, 100], acceleration in (0, 1000]");
+    if (GetAgents().size() >= size_t(mSettings.mMaxAgents))
+        return MakeError(ErrorCode::OutOfCapacity, "agent: the crowd is full");
+    auto agent = std::make_unique<Agent>();
+    agent->mParams = inParams;
+    if (!agent->mCorridor.init(mSettings.mMaxCorridorPolygons))
+        return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not allocate its corridor");
+    bool onNavMesh = false;
+    mWorld.Read(
+        [&](const dtNavMesh& inNavMesh)
+        {
+            if (mQueries.empty())
+            {
+                mQueries.push_back(dtAllocNavMeshQuery());
+                if (mQueries.back() == nullptr ||
+                    dtStatusFailed(mQueries.back()->init(&inNavMesh, cMaxQueryNodes)))
+                    return;
+            }
+            dtPolyRef polygon = 0;
+            float nearest[3];
+            mQueries[0]->findNearestPoly(inPosition.data(), cSnapExtent.data(), mFilter.get(), &polygon,
+                                         nearest);
+            if (polygon == 0) return;
+            agent->mCorridor.reset(polygon, nearest);
+            onNavMesh = true;
+        });
+    if (!onNavMesh) return MakeError(ErrorCode::InvalidArgument, "agent: no navmesh under the position");
+    // The lowest free id: ids are reused, and the order of updates is the order of ids
+    AgentID id = 0;
+    while (id < mAgents.size() && mAgents[id] != nullptr)
+        ++id;
+    if (id == mAgents.size()) mAgents.emplace_back();
+    mAgents[id] = std::move(agent);
+    return id;
+}
+
+Status Crowd::RemoveAgent(AgentID inAgent)
+{
+    Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
+    mAgents[inAgent].reset();
+    return Status::Ok();
+}
+
+Status Crowd::SetTarget(AgentID inAgent, const Vec3& inTarget)
+{
+    Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    if (!IsValidWorldPosition(inTarget)) return MakeError(ErrorCode::InvalidArgument, "agent: bad target");
+    if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
+    agent->mTicket = {};
+    Result<PathTicket> ticket = mPaths->Request(agent->Position(), inTarget);
+    if (!ticket) return ticket.GetError();
+    agent->mTicket = ticket.Value();
+    agent->mTarget = inTarget;
+    agent->mHasTarget = true;
+    if (agent->mState != AgentState::OffNavMesh) agent->mState = AgentState::WaitingForPath;
+    return Status::Ok();
+}
+
+Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
+{
+    if (!(inDeltaTime > 0.0f && inDeltaTime <= 1.0f))
+        return MakeError(ErrorCode::InvalidArgument, "crowd: the time step must be in (0, 1] s");
+    mPaths->Update(); // Before the navmesh is held below: the queue holds it for its own budget
+    mOrder = GetAgents();
+    const uint32_t count = uint32_t(mOrder.size());
+    const uint32_t chunks = (count + cAgentsPerChunk - 1) / cAgentsPerChunk;
+    mWorld.Read(
+        [&](const dtNavMesh& inNavMesh)
+        {
+            while (mQueries.size() < std::max<size_t>(chunks, 1))
+            {
+                dtNavMeshQuery* query = dtAllocNavMeshQuery();
+                if (query == nullptr || dtStatusFailed(query->init(&inNavMesh, cMaxQueryNodes))) return;
+                mQueries.push_back(query);
+            }
+            while (mAvoidance.size() < std::max<size_t>(chunks, 1))
+            {
+                mAvoidance.push_back(std::make_unique<dtObstacleAvoidanceQuery>());
+                if (!mAvoidance.back()->init(cMaxNeighbours, cMaxWallSegments)) return;
+            }
+            UpdatePaths(*mQueries[0]);
+            // The snapshot and its neighbour grid
+            mSnapshotPositions.resize(count);
+            mSnapshotVelocities.resize(count);
+            mSnapshotRadii.resize(count);
+            mCellAgents.clear();
+            const float cell = cCollisionRangeRadii * mSettings.mMaxAgentRadius;
+            for (uint32_t i = 0; i < count; ++i)
+            {
+                const Agent& agent = *mAgents[mOrder[i]];
+                mSnapshotPositions[i] = agent.Position();
+                mSnapshotVelocities[i] = agent.mVelocity;
+                mSnapshotRadii[i] = agent.mParams.mRadius;
+                mCellAgents.push_back({CellKey(int32_t(std::floor(mSnapshotPositions[i].x() / cell)),
+                                               int32_t(std::floor(mSnapshotPositions[i].z() / cell))),
+                                       i});
+            }
+            std::sort(mCellAgents.begin(), mCellAgents.end());
+            auto move = [&](uint32_t inBegin, uint32_t inEnd)
+            {
+                const uint32_t chunk = inBegin / cAgentsPerChunk;
+                MoveAgents(inBegin, inEnd, inDeltaTime, *mQueries[chunk], *mAvoidance[chunk]);
+            };
+            if (ioJobs != nullptr && chunks > 1)
+                ioJobs->ParallelFor(count, cAgentsPerChunk, move);
+            else
+                for (uint32_t begin = 0; begin < count; begin += cAgentsPerChunk)
+                    move(begin, std::min(count, begin + cAgentsPerChunk));
+        });
+    return Status::Ok();
+}
+
+void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
+{
+    const dtNavMesh& navMesh = *ioQuery.getAttachedNavMesh();
+    for (AgentID id : mOrder)
+    {
+        Agent& agent = *mAgents[id];
+        dtPathCorridor& corridor = agent.mCorridor;
+        if (!navMesh.isValidPolyRef(corridor.getFirstPoly()))
+        {
+            // Its tile went away under it: wait in place until navmesh is published there again
+            dtPolyRef polygon = 0;
+            float nearest[3];
+            const Vec3 extent(agent.mParams.mRadius, 2.0f, agent.mParams.mRadius);
+            ioQuery.findNearestPoly(corridor.getPos(), extent.data(), mFilter.get(), &polygon, nearest);
+            if (polygon == 0)
+            {
+                corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
+                agent.mState = AgentState::OffNavMesh;
+                agent.mVelocity.setZero();
+                ++mStatistics.mOffNavMeshFrames;
+                continue;
+            }
+            corridor.reset(polygon, nearest);
+            if (agent.mState == AgentState::OffNavMesh || agent.mState == AgentState::Moving)
+            {
+                agent.mState = agent.mHasTarget ? AgentState::WaitingForPath : AgentState::Idle;
+            }
+        }
+        if (agent.mTicket.mValue != 0)
+        {
+            if (std::optional<Result<PathResult>> result = mPaths->TakeResult(agent.mTicket))
+            {
+                agent.mTicket = {};
+                const std::vector<uint64_t>* polygons = *result ? &result->Value().mPolygons : nullptr;
+                // The path starts where the agent was when it asked; it has been standing since, so its
+                // polygon is normally the first. Else the path from its polygon on, if it is in it
+                size_t from = 0;
+                while (polygons != nullptr && from < polygons->size() &&
+                       (*polygons)[from] != corridor.getFirstPoly())
+                    ++from;
+                if (polygons == nullptr || from == polygons->size() || result->Value().mStraightPath.empty())
+                {
+                    ++mStatistics.mPathsFailed;
+                    agent.mState = AgentState::NoPath;
+                }
+                else
+                {
+                    std::vector<dtPolyRef> path(polygons->begin() + long(from), polygons->end());
+                    if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
+                        path.resize(size_t(mSettings.mMaxCorridorPolygons));
+                    corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(),
+                                         int(path.size()));
+                    agent.mState = AgentState::Moving;
+                    ++mStatistics.mPathsApplied;
+                }
+            }
+        }
+        if (corridor.getPathCount() > 1 &&
+            !corridor.isValid(corridor.getPathCount(), &ioQuery, mFilter.get()))
+        {
+            // A polygon of its corridor went away (also one just handed over, searched before a Publish):
+            // it keeps its own polygon and, if it was on its way, asks again from here
+            corridor.reset(corridor.getFirstPoly(), corridor.getPos());
+            if (agent.mState == AgentState::Moving)
+            {
+                agent.mState = AgentState::WaitingForPath;
+                ++mStatistics.mReplans;
+            }
+        }
+        // An agent that needs a path and has no request (a replan, back on navmesh, or a full queue last
+        // time) asks now; a full queue is asked again next Update
+        if (agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue == 0)
+        {
+            Result<PathTicket> ticket = mPaths->Request(agent.Position(), agent.mTarget);
+            if (ticket) agent.mTicket = ticket.Value();
+        }
+    }
+}
+
+void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNavMeshQuery& ioQuery,
+                       dtObstacleAvoidanceQuery& ioAvoidance)
+{
+    const float cell = cCollisionRangeRadii * mSettings.mMaxAgentRadius;
+    static const dtObstacleAvoidanceParams params = AvoidanceParams();
+    for (uint32_t i = inBegin; i < inEnd; ++i)
+    {
+        Agent& agent = *mAgents[mOrder[i]];
+        if (agent.mState == AgentState::OffNavMesh) continue;
+        const Vec3 position = mSnapshotPositions[i];
+        const float radius = agent.mParams.mRadius, maxSpeed = agent.mParams.mMaxSpeed;
+        const float range = cCollisionRangeRadii * radius;
+        // The walls near it, again once it has moved a quarter of the range from where they were gathered
+        const Vec3 boundaryCentre(agent.mBoundary.getCenter()[0], agent.mBoundary.getCenter()[1],
+                                  agent.mBoundary.getCenter()[2]);
+        if (Flat(position - boundaryCentre).norm() > 0.25f * range ||
+            !agent.mBoundary.isValid(&ioQuery, mFilter.get()))
+            agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
+                                   mFilter.get());
+
+        Vec3 desired = Vec3::Zero();
+        if (agent.mState == AgentState::Moving)
+        {
+            float corners[3 * 3];
+            unsigned char flags[3];
+            dtPolyRef polygons[3];
+            const int numCorners =
+                agent.mCorridor.findCorners(corners, flags, polygons, 3, &ioQuery, mFilter.get());
+            const Vec3 end(agent.mCorridor.getTarget()[0], agent.mCorridor.getTarget()[1],
+                           agent.mCorridor.getTarget()[2]);
+            if (numCorners == 0 || Flat(end - position).norm() < radius)
+                agent.mState = AgentState::Arrived;
+            else
+            {
+                const Vec3 toCorner = Flat(Vec3(corners[0], corners[1], corners[2]) - position);
+                const float distance = toCorner.norm();
+                // Slow down within two radii of the last corner, so the agent stops on its target
+                const bool last = (flags[0] & DT_STRAIGHTPATH_END) != 0;
+                const float speed = last ? maxSpeed * std::min(1.0f, distance / (2.0f * radius)) : maxSpeed;
+                if (distance > 1.0e-4f) desired = toCorner * (speed / distance);
+                // A jam (agents wanting through each other, each waiting for the other) dissolves when the
+                // stuck ones step aside for a moment: to the left or the right by the parity of their ids
+                agent.mStuckSeconds = Flat(mSnapshotVelocities[i]).norm() < 0.1f * maxSpeed
+                                          ? agent.mStuckSeconds + inDeltaTime
+                                          : 0.0f;
+                if (agent.mStuckSeconds > 1.0f)
+                {
+                    const float side = (mOrder[i] & 1u) != 0 ? 1.0f : -1.0f;
+                    desired = 0.5f * desired + side * Vec3(-desired.z(), 0.0f, desired.x());
+                    if (agent.mStuckSeconds > 2.0f) agent.mStuckSeconds = 0.0f;
+                }
+            }
+        }
+
+        // The nearest neighbours in range, as the snapshot has them (ties by order: deterministic)
+        std::pair<float, uint32_t> neighbours[cMaxNeighbours];
+        int numNeighbours = 0;
+        const int32_t cx = int32_t(std::floor(position.x() / cell)),
+                      cz = int32_t(std::floor(position.z() / cell));
+        for (int32_t dx = -1; dx <= 1; ++dx)
+            for (int32_t dz = -1; dz <= 1; ++dz)
+            {
+                const uint64_t key = CellKey(cx + dx, cz + dz);
+                auto it = std::lower_bound(mCellAgents.begin(), mCellAgents.end(),
+                                           std::pair<uint64_t, uint32_t>(key, 0));
+                for (; it != mCellAgents.end() && it->first == key; ++it)
+                {
+                    const uint32_t j = it->second;
+                    if (j == i) continue;
+                    const float distance = Flat(position - mSnapshotPositions[j]).norm();
+                    if (distance >= range) continue;
+                    // Kept sorted by insertion: at most cMaxNeighbours, the nearest
+                    const std::pair<float, uint32_t> entry(distance, j);
+                    if (numNeighbours == cMaxNeighbours && !(entry < neighbours[cMaxNeighbours - 1]))
+                        continue;
+                    int at = numNeighbours < cMaxNeighbours ? numNeighbours++ : cMaxNeighbours - 1;
+                    while (at > 0 && entry < neighbours[at - 1])
+                    {
+                        neighbours[at] = neighbours[at - 1];
+                        --at;
+                    }
+                    neighbours[at] = entry;
+                }
+            }
+
+        // Velocity obstacles (DetourCrowd's sampling): the velocity nearest the desired one that meets no
+        // neighbour and no wall within the time horizon
+        Vec3 velocity = desired;
+        if (agent.mState != AgentState::OffNavMesh &&
+            (numNeighbours > 0 || agent.mBoundary.getSegmentCount() > 0))
+        {
+            ioAvoidance.reset();
+            for (int n = 0; n < numNeighbours; ++n)
+            {
+                const uint32_t j = neighbours[n].second;
+                ioAvoidance.addCircle(mSnapshotPositions[j].data(), mSnapshotRadii[j],
+                                      mSnapshotVelocities[j].data(), mSnapshotVelocities[j].data());
+            }
+            for (int w = 0; w < agent.mBoundary.getSegmentCount(); ++w)
+            {
+                const float* segment = agent.mBoundary.getSegment(w);
+                // Walls the agent is behind do not matter (DetourCrowd skips them too)
+                if (dtTriArea2D(position.data(), segment, segment + 3) < 0.0f) continue;
+                ioAvoidance.addSegment(segment, segment + 3);
+            }
+            Vec3 chosen = Vec3::Zero();
+            ioAvoidance.sampleVelocityAdaptive(position.data(), radius, maxSpeed,
+                                               mSnapshotVelocities[i].data(), desired.data(), chosen.data(),
+                                               &params);
+            velocity = Flat(chosen);
+        }
+        // The acceleration limit
+        Vec3 change = velocity - mSnapshotVelocities[i];
+        const float maxChange = agent.mParams.mMaxAcceleration * inDeltaTime;
+        if (change.norm() > maxChange) change *= maxChange / change.norm();
+        velocity = mSnapshotVelocities[i] + change;
+        // Agents already overlapping part, and neither moves into the other meanwhile (DetourCrowd moves
+        // them apart after integrating, in passes that need every agent; here each from the snapshot)
+        for (int n = 0; n < numNeighbours; ++n)
+        {
+            const uint32_t j = neighbours[n].second;
+            const float touching = radius + mSnapshotRadii[j];
+            if (neighbours[n].first >= touching) break; // Sorted by distance
+            const Vec3 away = Flat(position - mSnapshotPositions[j]);
+            const Vec3 direction = neighbours[n].first > 1.0e-4f ? Vec3(away / neighbours[n].first)
+                                                                 : Vec3(j < i ? 1.0f : -1.0f, 0.0f, 0.0f);
+            const float into = velocity.dot(direction);
+            if (into < 0.0f) velocity -= into * direction;
+            // Half the overlap each (the other does the same), within this step
+            velocity += direction * (0.5f * (touching - neighbours[n].first) / inDeltaTime);
+        }
+        if (velocity.norm() > 2.0f * maxSpeed) velocity *= 2.0f * maxSpeed / velocity.norm();
+        const Vec3 wanted = position + velocity * inDeltaTime;
+        // Along the navmesh surface, inside the corridor: never off it
+        agent.mCorridor.movePosition(wanted.data(), &ioQuery, mFilter.get());
+        agent.mVelocity = Flat(agent.Position() - position) / inDeltaTime;
+    }
+}
+
+std::vector<Crowd::AgentID> Crowd::GetAgents() const
+{
+    std::vector<AgentID> ids;
+    for (AgentID id = 0; id < mAgents.size(); ++id)
+        if (mAgents[id] != nullptr) ids.push_back(id);
+    return ids;
+}
+
+Result<Vec3> Crowd::GetPosition(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    return agent->Position();
+}
+
+Result<Vec3> Crowd::GetVelocity(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    return agent->mVelocity;
+}
+
+Result<AgentState> Crowd::GetState(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    return agent->mState;
+}
+
+Result<float> Crowd::GetRadius(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    return agent->mParams.mRadius;
+}
+
+Result<std::vector<uint64_t>> Crowd::GetCorridor(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    const dtPathCorridor& corridor = agent->mCorridor;
+    if (corridor.getFirstPoly() == 0) return std::vector<uint64_t>(); // Off the navmesh
+    return std::vector<uint64_t>(corridor.getPath(), corridor.getPath() + corridor.getPathCount());
+}
+
+} // namespace cairn::navmesh

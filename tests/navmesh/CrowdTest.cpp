@@ -1,0 +1,231 @@
+// A crowd on the navmesh: agents reach their goals keeping apart and on the navmesh; the same positions for
+// any number of job threads; tiles rebuilt and removed under walking agents leave no corridor through a
+// polygon that is gone; clear errors.
+
+#include "cairn/navmesh/Crowd.h"
+
+#include "NavMeshSceneFixture.h"
+#include "TileChanges.h"
+#include "cairn/jobs/JobSystem.h"
+
+#include <DetourNavMesh.h>
+#include <random>
+
+namespace cairn::navmesh::test
+{
+using namespace cairn::physics;
+namespace
+{
+
+class CrowdTest : public NavMeshSceneFixture
+{
+protected:
+    /// Ground over 2 x 2 tiles each side of the origin with walls to walk around.
+    void BuildWalledGround()
+    {
+        AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25, 0.5f, 25));
+        for (int i = -1; i <= 1; ++i)
+            AddStaticBox(Vec3(float(i) * 12.0f, 1.0f, float(i == 0 ? 5 : -5)), Vec3(0.5f, 1.5f, 15.0f));
+        MakeNavMesh(2);
+        ASSERT_TRUE(RunUntilIdle());
+    }
+
+    /// inCount agents at random places with random goals (a fixed seed), the goals at least inGoalSpacing
+    /// apart; the ids.
+    std::vector<Crowd::AgentID> AddAgentsWithGoals(Crowd& ioCrowd, int inCount, float inGoalSpacing = 3.0f)
+    {
+        std::mt19937 random(5);
+        std::uniform_real_distribution<float> coordinate(-22.0f, 22.0f);
+        std::vector<Crowd::AgentID> agents;
+        while (int(agents.size()) < inCount)
+        {
+            const Vec3 start(coordinate(random), 0, coordinate(random));
+            const Vec3 goal(coordinate(random), 0, coordinate(random));
+            // Goals apart: an agent standing on its goal is not a way through for another (an occupied goal
+            // is no goal to reach)
+            bool taken = false;
+            for (const Vec3& other : mGoals)
+                taken |= (Vec3(goal.x(), 0, goal.z()) - Vec3(other.x(), 0, other.z())).norm() < inGoalSpacing;
+            if (taken) continue;
+            // Not on a wall, and a goal FindPath reaches
+            const Result<PathResult> path = mWorld->FindPath(start, goal);
+            if (!path || !path.Value().mReachedEnd ||
+                std::abs(path.Value().mStraightPath.front().y()) > 0.3f ||
+                std::abs(path.Value().mStraightPath.back().y()) > 0.3f)
+                continue;
+            Result<Crowd::AgentID> agent = ioCrowd.AddAgent(start);
+            if (!agent) continue;
+            EXPECT_TRUE(ioCrowd.SetTarget(agent.Value(), goal).IsOk());
+            agents.push_back(agent.Value());
+            mGoals.push_back(path.Value().mStraightPath.back());
+        }
+        return agents;
+    }
+
+    /// Agent-frames in which two agents overlap by more than 10 % of the smaller radius.
+    static int CountOverlaps(const Crowd& inCrowd, const std::vector<Crowd::AgentID>& inAgents)
+    {
+        int overlapping = 0;
+        for (size_t i = 0; i < inAgents.size(); ++i)
+            for (size_t j = i + 1; j < inAgents.size(); ++j)
+            {
+                Vec3 d = inCrowd.GetPosition(inAgents[i]).Value() - inCrowd.GetPosition(inAgents[j]).Value();
+                d.y() = 0.0f;
+                const float ri = inCrowd.GetRadius(inAgents[i]).Value(),
+                            rj = inCrowd.GetRadius(inAgents[j]).Value();
+                if (ri + rj - d.norm() > 0.1f * std::min(ri, rj))
+                {
+                    overlapping += 2;
+                }
+            }
+        return overlapping;
+    }
+
+    /// True if every agent's corridor holds only polygons the navmesh has now.
+    bool CorridorsAreValid(const Crowd& inCrowd) const
+    {
+        bool valid = true;
+        mWorld->Read(
+            [&](const dtNavMesh& inNavMesh)
+            {
+                for (Crowd::AgentID agent : inCrowd.GetAgents())
+                {
+                    const std::vector<uint64_t> corridor = inCrowd.GetCorridor(agent).Value();
+                    for (uint64_t polygon : corridor)
+                        valid = valid && inNavMesh.isValidPolyRef(dtPolyRef(polygon));
+                }
+            });
+        return valid;
+    }
+
+    std::vector<Vec3> mGoals;
+};
+
+// 60 agents cross the ground to their goals: at least 95 % arrive within 30 s, pairs overlap by more than a
+// tenth of a radius in under 1 % of agent-frames, and every agent stands on the navmesh in every frame
+TEST_F(CrowdTest, AgentsReachTheirGoalsApartAndOnTheNavMesh)
+{
+    BuildWalledGround();
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    const std::vector<Crowd::AgentID> agents = AddAgentsWithGoals(*crowd, 60);
+    int overlaps = 0, agentFrames = 0, offNavMesh = 0;
+    for (int frame = 0; frame < 1800; ++frame)
+    {
+        ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
+        overlaps += CountOverlaps(*crowd, agents);
+        agentFrames += int(agents.size());
+        if (frame % 30 == 0)
+            for (Crowd::AgentID agent : agents)
+            {
+                const Vec3 position = crowd->GetPosition(agent).Value();
+                const Result<Vec3> nearest = mWorld->FindNearestPoint(position, {}, Vec3(0.1f, 0.5f, 0.1f));
+                offNavMesh += nearest && (nearest.Value() - position).norm() < 0.05f ? 0 : 1;
+            }
+    }
+    int arrived = 0;
+    for (size_t i = 0; i < agents.size(); ++i)
+    {
+        Vec3 toGoal = crowd->GetPosition(agents[i]).Value() - mGoals[i];
+        toGoal.y() = 0.0f;
+        arrived += toGoal.norm() < 1.5f ? 1 : 0;
+    }
+    EXPECT_GE(arrived, 57) << "of 60";
+    EXPECT_LT(overlaps, agentFrames / 100) << overlaps << " overlapping agent-frames of " << agentFrames;
+    EXPECT_EQ(offNavMesh, 0);
+    EXPECT_GE(crowd->GetStatistics().mPathsApplied, 60u);
+}
+
+/// The crowd above on inThreads job threads (0: none) for 300 frames; every agent's final position.
+std::vector<Vec3> RunCrowd(CrowdTest& ioTest, Crowd& ioCrowd, const std::vector<Crowd::AgentID>& inAgents,
+                           int inThreads)
+{
+    (void)ioTest;
+    std::unique_ptr<jobs::JobSystem> jobSystem;
+    if (inThreads > 0)
+        jobSystem = std::make_unique<jobs::JobSystem>(jobs::JobSystem::Settings{uint32_t(inThreads)});
+    for (int frame = 0; frame < 300; ++frame)
+        EXPECT_TRUE(ioCrowd.Update(1.0f / 60.0f, jobSystem.get()).IsOk());
+    std::vector<Vec3> positions;
+    for (Crowd::AgentID agent : inAgents)
+        positions.push_back(ioCrowd.GetPosition(agent).Value());
+    return positions;
+}
+
+// 300 agents (five ParallelFor chunks) end in the same places, bit for bit, for no job system and 1, 2 and 4
+// threads
+TEST_F(CrowdTest, TheSamePositionsForAnyThreadCount)
+{
+    BuildWalledGround();
+    std::vector<std::vector<Vec3>> results;
+    for (int threads : {0, 1, 2, 4})
+    {
+        std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+        mGoals.clear();
+        const std::vector<Crowd::AgentID> agents = AddAgentsWithGoals(*crowd, 300, 0.0f);
+        results.push_back(RunCrowd(*this, *crowd, agents, threads));
+    }
+    for (size_t run = 1; run < results.size(); ++run)
+        EXPECT_EQ(results[run], results[0]) << "run " << run;
+}
+
+// Tiles rebuilt and removed under 100 walking agents for 1,200 frames: after every Update each corridor holds
+// only polygons that exist; agents on a removed tile wait on it, and walk on once it is built again
+TEST_F(CrowdTest, TilesChangingUnderTheCrowdLeaveNoCorridorThroughAGonePolygon)
+{
+    BuildWalledGround();
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    const std::vector<Crowd::AgentID> agents = AddAgentsWithGoals(*crowd, 100);
+    std::mt19937 random(3);
+    std::uniform_int_distribution<int> tile(-2, 1);
+    for (int frame = 0; frame < 1200; ++frame)
+    {
+        if (frame % 100 == 50)
+        {
+            // A tile removed outright (a tile streamed out)...
+            mWorld->Publish(Changes(NavMeshWorld::Removal(TileCoord{tile(random), tile(random)})));
+        }
+        if (frame % 100 == 0)
+        {
+            // ...and every tile asked for again (the scheduler rebuilds what is missing or dirty)
+            mScheduler->MarkDirty(AABB(Vec3(-25, -1, -25), Vec3(25, 3, 25)));
+        }
+        Frame(); // Physics and the tile scheduler: rebuilt tiles are published here
+        ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
+        ASSERT_TRUE(CorridorsAreValid(*crowd)) << "frame " << frame;
+    }
+    EXPECT_GT(crowd->GetStatistics().mReplans, 0u);
+    EXPECT_GT(crowd->GetStatistics().mOffNavMeshFrames, 0u) << "some agents stood on a removed tile";
+}
+
+TEST_F(CrowdTest, BadInputGetsClearErrors)
+{
+    BuildWalledGround();
+    Crowd::Settings settings;
+    settings.mMaxAgents = 2;
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld, settings).Value();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(crowd->AddAgent(Vec3(500, 0, 500)).GetError().mCode, ErrorCode::InvalidArgument)
+        << "off the navmesh";
+    EXPECT_EQ(crowd->AddAgent(Vec3(nan, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+    AgentParams huge;
+    huge.mRadius = 50.0f;
+    EXPECT_EQ(crowd->AddAgent(Vec3(-20, 0, -20), huge).GetError().mCode, ErrorCode::InvalidArgument);
+    const Crowd::AgentID a = crowd->AddAgent(Vec3(-20, 0, -20)).Value();
+    crowd->AddAgent(Vec3(-18, 0, -20)).Value();
+    EXPECT_EQ(crowd->AddAgent(Vec3(-16, 0, -20)).GetError().mCode, ErrorCode::OutOfCapacity);
+    EXPECT_EQ(crowd->SetTarget(a, Vec3(nan, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(crowd->SetTarget(99, Vec3::Zero()).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_FALSE(crowd->GetPosition(99));
+    EXPECT_EQ(crowd->Update(0.0f).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_TRUE(crowd->RemoveAgent(a).IsOk());
+    EXPECT_FALSE(crowd->RemoveAgent(a).IsOk()) << "removed twice";
+    // A target off the navmesh: the agent's request fails and it says so
+    const Crowd::AgentID b = crowd->AddAgent(Vec3(-20, 0, -20)).Value();
+    ASSERT_TRUE(crowd->SetTarget(b, Vec3(500, 0, 500)).IsOk());
+    for (int frame = 0; frame < 10; ++frame)
+        ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
+    EXPECT_EQ(crowd->GetState(b).Value(), AgentState::NoPath);
+}
+
+} // namespace
+} // namespace cairn::navmesh::test
