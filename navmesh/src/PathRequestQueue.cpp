@@ -160,6 +160,7 @@ void PathRequestQueue::FinishActiveLocked(Result<PathResult>&& inResult)
     const uint64_t wait = mStatistics.mUpdates - mActive->mRequestedAtUpdate;
     mStatistics.mWaitUpdatesSum += wait;
     mStatistics.mWaitUpdatesMax = std::max(mStatistics.mWaitUpdatesMax, wait);
+    ++mStatistics.mWaitHistogram[std::min<uint64_t>(wait, 64)];
     ++(inResult ? mStatistics.mServed : mStatistics.mFailed);
     --mStatistics.mPending;
     mFinished.emplace(mActive->mTicket.mValue, std::move(inResult));

@@ -101,6 +101,10 @@ public:
         uint64_t mOffNavMeshFrames = 0; ///< Agent-frames spent waiting for navmesh under them
         uint64_t mPathsApplied = 0;
         uint64_t mPathsFailed = 0;
+        /// The last Update's time on the calling thread (the path queue's budget, path results and corridor
+        /// checks, the snapshot) and in the steering loop (on the job threads, the caller taking part), ms
+        double mLastSerialMs = 0.0;
+        double mLastMoveMs = 0.0;
     };
     const Statistics& GetStatistics() const { return mStatistics; }
     const PathRequestQueue& GetPathQueue() const { return *mPaths; }
@@ -129,6 +133,7 @@ private:
     std::vector<float> mSnapshotRadii;
     /// The neighbour grid over the snapshot: cell -> first entry in mCellAgents, each cell's agents in order
     std::vector<std::pair<uint64_t, uint32_t>> mCellAgents;
+    float mCellSize = 1.0f; ///< The grid's, this Update
     Statistics mStatistics;
 };
 

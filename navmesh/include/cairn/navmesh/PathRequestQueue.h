@@ -17,6 +17,7 @@
 
 #include "cairn/navmesh/NavMeshWorld.h"
 
+#include <array>
 #include <compare>
 #include <cstdint>
 #include <deque>
@@ -57,6 +58,8 @@ public:
         uint64_t mUpdates = 0;
         uint64_t mWaitUpdatesSum = 0; ///< Over finished requests: Updates from request to result
         uint64_t mWaitUpdatesMax = 0;
+        /// Finished requests by their wait in Updates: [w] for w < 64, [64] for 64 and more (percentiles)
+        std::array<uint64_t, 65> mWaitHistogram{};
         int mPending = 0; ///< Waiting or being searched now
     };
 
