@@ -124,26 +124,31 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
     agent->mParams = inParams;
     if (!agent->mCorridor.init(mSettings.mMaxCorridorPolygons))
         return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not allocate its corridor");
-    bool onNavMesh = false;
+    bool queryReady = false, onNavMesh = false;
     mWorld.Read(
         [&](const dtNavMesh& inNavMesh)
         {
             if (mQueries.empty())
             {
-                mQueries.push_back(dtAllocNavMeshQuery());
-                if (mQueries.back() == nullptr ||
-                    dtStatusFailed(mQueries.back()->init(&inNavMesh, cMaxQueryNodes)))
+                dtNavMeshQuery* query = dtAllocNavMeshQuery();
+                if (query == nullptr || dtStatusFailed(query->init(&inNavMesh, cMaxQueryNodes)))
+                {
+                    dtFreeNavMeshQuery(query);
                     return;
+                }
+                mQueries.push_back(query);
             }
+            queryReady = true;
             dtPolyRef polygon = 0;
             float nearest[3];
             mQueries[0]->findNearestPoly(inPosition.data(), cSnapExtent.data(), mFilter.get(), &polygon,
                                          nearest);
-            if (polygon == 0) return;
-            agent->mCorridor.reset(polygon, nearest);
-            onNavMesh = true;
+            onNavMesh = polygon != 0;
+            agent->mCorridor.reset(polygon, onNavMesh ? nearest : inPosition.data());
         });
-    if (!onNavMesh) return MakeError(ErrorCode::InvalidArgument, "agent: no navmesh under the position");
+    if (!queryReady) return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not make its query");
+    // No navmesh there yet (its tiles not built): it waits in place until there is
+    if (!onNavMesh) agent->mState = AgentState::OffNavMesh;
     // The lowest free id: ids are reused, and the order of updates is the order of ids
     AgentID id = 0;
     while (id < mAgents.size() && mAgents[id] != nullptr)
@@ -169,12 +174,15 @@ Status Crowd::SetTarget(AgentID inAgent, const Vec3& inTarget)
     if (!IsValidWorldPosition(inTarget)) return MakeError(ErrorCode::InvalidArgument, "agent: bad target");
     if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
     agent->mTicket = {};
-    Result<PathTicket> ticket = mPaths->Request(agent->Position(), inTarget);
-    if (!ticket) return ticket.GetError();
-    agent->mTicket = ticket.Value();
     agent->mTarget = inTarget;
     agent->mHasTarget = true;
-    if (agent->mState != AgentState::OffNavMesh) agent->mState = AgentState::WaitingForPath;
+    // An agent with no navmesh under it asks once it has some (UpdatePaths)
+    if (agent->mState == AgentState::OffNavMesh) return Status::Ok();
+    Result<PathTicket> ticket =
+        mPaths->Request(agent->Position(), inTarget, {}, cSnapExtent, agent->mCorridor.getFirstPoly());
+    if (!ticket) return ticket.GetError();
+    agent->mTicket = ticket.Value();
+    agent->mState = AgentState::WaitingForPath;
     return Status::Ok();
 }
 
@@ -185,6 +193,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
     using Clock = std::chrono::steady_clock;
     const Clock::time_point start = Clock::now();
     Clock::time_point moveStart = start;
+    ++mUpdates;
     mPaths->Update(); // Before the navmesh is held below: the queue holds it for its own budget
     mOrder = GetAgents();
     const uint32_t count = uint32_t(mOrder.size());
@@ -254,11 +263,11 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
         dtPathCorridor& corridor = agent.mCorridor;
         if (!navMesh.isValidPolyRef(corridor.getFirstPoly()))
         {
-            // Its tile went away under it: wait in place until navmesh is published there again
+            // Its tile went away under it, or it was added where no tile was built yet: it waits in place
+            // until navmesh is published within the snapping extent
             dtPolyRef polygon = 0;
             float nearest[3];
-            const Vec3 extent(agent.mParams.mRadius, 2.0f, agent.mParams.mRadius);
-            ioQuery.findNearestPoly(corridor.getPos(), extent.data(), mFilter.get(), &polygon, nearest);
+            ioQuery.findNearestPoly(corridor.getPos(), cSnapExtent.data(), mFilter.get(), &polygon, nearest);
             if (polygon == 0)
             {
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
@@ -318,7 +327,8 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
         // time) asks now; a full queue is asked again next Update
         if (agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue == 0)
         {
-            Result<PathTicket> ticket = mPaths->Request(agent.Position(), agent.mTarget);
+            Result<PathTicket> ticket = mPaths->Request(agent.Position(), agent.mTarget, {}, cSnapExtent,
+                                                        agent.mCorridor.getFirstPoly());
             if (ticket) agent.mTicket = ticket.Value();
         }
     }
@@ -340,7 +350,9 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         // The walls near it, again once it has moved a quarter of the range from where they were gathered
         const Vec3 boundaryCentre(agent.mBoundary.getCenter()[0], agent.mBoundary.getCenter()[1],
                                   agent.mBoundary.getCenter()[2]);
-        if (Flat(position - boundaryCentre).norm() > 0.25f * range ||
+        // And every half second (a tile published next to it turns a wall at the tile's edge into a way
+        // through, which the polygons' validity does not tell), spread over the agents by id
+        if (Flat(position - boundaryCentre).norm() > 0.25f * range || (mUpdates + mOrder[i]) % 30 == 0 ||
             !agent.mBoundary.isValid(&ioQuery, mFilter.get()))
             agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
                                    mFilter.get());

@@ -42,7 +42,8 @@ Result<std::unique_ptr<PathRequestQueue>> PathRequestQueue::Create(const NavMesh
 }
 
 Result<PathTicket> PathRequestQueue::Request(const Vec3& inStart, const Vec3& inEnd,
-                                             const PathFilter& inFilter, const Vec3& inSearchExtent)
+                                             const PathFilter& inFilter, const Vec3& inSearchExtent,
+                                             uint64_t inStartPolygon)
 {
     if (!IsValidWorldPosition(inStart) || !IsValidWorldPosition(inEnd))
         return MakeError(ErrorCode::InvalidArgument, "path request: start and end must be finite");
@@ -55,7 +56,8 @@ Result<PathTicket> PathRequestQueue::Request(const Vec3& inStart, const Vec3& in
     if (mStatistics.mPending >= mSettings.mMaxPending)
         return MakeError(ErrorCode::OutOfCapacity, "path request: the queue is full");
     const PathTicket ticket{mNextTicket++};
-    mPending.push_back({ticket, inStart, inEnd, inSearchExtent, inFilter, mStatistics.mUpdates, 0});
+    mPending.push_back(
+        {ticket, inStart, inEnd, inSearchExtent, inFilter, inStartPolygon, mStatistics.mUpdates, 0});
     ++mStatistics.mRequested;
     ++mStatistics.mPending;
     return ticket;
@@ -107,6 +109,13 @@ int PathRequestQueue::Search(const dtNavMesh& inNavMesh)
                                     mStartPoint);
             mQuery->findNearestPoly(request.mEnd.data(), request.mSearchExtent.data(), &filter, &endRef,
                                     mEndPoint);
+            // A start polygon the caller knows, while it exists, over the snapped one
+            const dtNavMesh& navMesh = *mQuery->getAttachedNavMesh();
+            if (request.mStartPolygon != 0 && navMesh.isValidPolyRef(dtPolyRef(request.mStartPolygon)))
+            {
+                startRef = dtPolyRef(request.mStartPolygon);
+                mQuery->closestPointOnPoly(startRef, request.mStart.data(), mStartPoint, nullptr);
+            }
             mStartRef = startRef;
             mEndRef = endRef;
             if (mStartRef == 0 || mEndRef == 0)

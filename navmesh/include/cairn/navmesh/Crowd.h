@@ -75,8 +75,9 @@ public:
     Crowd(const Crowd&) = delete;
     Crowd& operator=(const Crowd&) = delete;
 
-    /// An agent at inPosition, snapped to the navmesh within 2 m across and 4 m up and down. Errors: no
-    /// navmesh there, bad parameters or numbers, the crowd full (OutOfCapacity).
+    /// An agent at inPosition, snapped to the navmesh within 2 m across and 4 m up and down; where there is
+    /// none yet (its tiles not built), it waits there, OffNavMesh, until there is. Errors: bad parameters or
+    /// numbers, the crowd full (OutOfCapacity).
     Result<AgentID> AddAgent(const Vec3& inPosition, const AgentParams& inParams = {});
     Status RemoveAgent(AgentID inAgent);
     /// Asks for a path to inTarget through the crowd's queue; the agent moves once it arrives.
@@ -134,6 +135,7 @@ private:
     /// The neighbour grid over the snapshot: cell -> first entry in mCellAgents, each cell's agents in order
     std::vector<std::pair<uint64_t, uint32_t>> mCellAgents;
     float mCellSize = 1.0f; ///< The grid's, this Update
+    uint64_t mUpdates = 0;  ///< Updates so far (the walls' refresh is spread over them)
     Statistics mStatistics;
 };
 

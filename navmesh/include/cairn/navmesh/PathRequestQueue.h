@@ -75,10 +75,13 @@ public:
     PathRequestQueue& operator=(const PathRequestQueue&) = delete;
 
     /// Queues a path from inStart to inEnd (snapped to the navmesh within inSearchExtent when its search
-    /// starts, as NavMeshWorld::FindPath snaps them). Errors now: bad numbers, a filter or extent FindPath
-    /// refuses, a full queue (OutOfCapacity).
+    /// starts, as NavMeshWorld::FindPath snaps them). inStartPolygon (optional): the Detour polygon the start
+    /// is known to be on (a crowd agent's), used instead of snapping while it exists: on an edge between two
+    /// polygons snapping may choose the other. Errors now: bad numbers, a filter or extent FindPath refuses,
+    /// a full queue (OutOfCapacity).
     Result<PathTicket> Request(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter = {},
-                               const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f));
+                               const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f),
+                               uint64_t inStartPolygon = 0);
     /// Searches for up to the budget, the requests in ticket order; returns how many finished.
     int Update();
     /// A finished request's result, taken out (the ticket is forgotten); nothing while the request waits or
@@ -98,6 +101,7 @@ private:
         Vec3 mEnd;
         Vec3 mSearchExtent;
         PathFilter mFilter;
+        uint64_t mStartPolygon = 0;
         uint64_t mRequestedAtUpdate = 0;
         int mRestarts = 0;
     };
