@@ -1,6 +1,8 @@
 #include "cairn/navmesh/Crowd.h"
 
 #include "DetourPaths.h"
+#include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/body/PublishedPose.h"
 
 #include <DetourCommon.h>
 #include <DetourLocalBoundary.h>
@@ -235,6 +237,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
                                                int32_t(std::floor(mSnapshotPositions[i].z() / cell))),
                                        i});
             }
+            AddPhysicsObstacles(count, inDeltaTime);
             std::sort(mCellAgents.begin(), mCellAgents.end());
             moveStart = Clock::now();
             auto move = [&](uint32_t inBegin, uint32_t inEnd)
@@ -252,6 +255,62 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
     mStatistics.mLastSerialMs = std::chrono::duration<double, std::milli>(moveStart - start).count();
     mStatistics.mLastMoveMs = std::chrono::duration<double, std::milli>(end - moveStart).count();
     return Status::Ok();
+}
+
+void Crowd::SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers)
+{
+    mObstaclePhysics = inPhysics;
+    mObstacleLayers = inLayers;
+    mPreviousObstacles.clear();
+}
+
+void Crowd::AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime)
+{
+    mStatistics.mLastObstacles = 0;
+    if (mObstaclePhysics == nullptr || inNumAgents == 0) return;
+    // The dynamic bodies near the agents, as last published (no lock: the step may be running), as circles
+    // in the ground plane; their velocity from where they were at the last Update
+    AABB around;
+    for (uint32_t i = 0; i < inNumAgents; ++i)
+        around.Encapsulate(AABB(mSnapshotPositions[i], mSnapshotPositions[i]));
+    around =
+        AABB(around.mMin - Vec3(mCellSize, 1.0f, mCellSize), around.mMax + Vec3(mCellSize, 2.5f, mCellSize));
+    QueryFilter filter;
+    filter.mObjectLayers = mObstacleLayers;
+    if (!mObstaclePhysics->GetWorldQuery().CollideAABox(around, mObstacleIDs, filter)) return;
+    std::sort(mObstacleIDs.begin(), mObstacleIDs.end()); // The broad phase's order is not fixed
+    const PoseReader poses(mObstaclePhysics->GetBodyManager());
+    std::vector<std::pair<BodyID, Vec3>> current;
+    for (const BodyID& id : mObstacleIDs)
+    {
+        PublishedPose pose;
+        if (!poses.Read(id, pose) || pose.mMotionType != MotionType::Dynamic || pose.mShape == nullptr)
+            continue;
+        const AABB bounds = pose.mShape->GetWorldBounds(pose.mTransform);
+        const Vec3 centre(0.5f * (bounds.mMin.x() + bounds.mMax.x()), bounds.mMin.y(),
+                          0.5f * (bounds.mMin.z() + bounds.mMax.z()));
+        const float radius =
+            0.5f * std::max(bounds.mMax.x() - bounds.mMin.x(), bounds.mMax.z() - bounds.mMin.z());
+        // A body wider than half a cell is not found from every cell it covers: left to the agents' contacts
+        if (!(radius > 0.0f && radius <= 0.5f * mCellSize)) continue;
+        Vec3 velocity = Vec3::Zero();
+        const auto previous = std::lower_bound(
+            mPreviousObstacles.begin(), mPreviousObstacles.end(), std::pair<BodyID, Vec3>(id, Vec3::Zero()),
+            [](const auto& inA, const auto& inB) { return inA.first < inB.first; });
+        if (previous != mPreviousObstacles.end() && previous->first == id)
+            velocity = Vec3(centre.x() - previous->second.x(), 0.0f, centre.z() - previous->second.z()) /
+                       inDeltaTime;
+        current.push_back({id, centre});
+        const uint32_t index = uint32_t(mSnapshotPositions.size());
+        mSnapshotPositions.push_back(centre);
+        mSnapshotVelocities.push_back(velocity);
+        mSnapshotRadii.push_back(radius);
+        mCellAgents.push_back({CellKey(int32_t(std::floor(centre.x() / mCellSize)),
+                                       int32_t(std::floor(centre.z() / mCellSize))),
+                               index});
+        ++mStatistics.mLastObstacles;
+    }
+    mPreviousObstacles = std::move(current);
 }
 
 void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)

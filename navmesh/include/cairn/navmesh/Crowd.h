@@ -24,6 +24,8 @@
 #include "cairn/jobs/JobInterface.h"
 #include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/PathRequestQueue.h"
+#include "cairn/physics/body/BodyID.h"
+#include "cairn/physics/body/Layers.h"
 
 #include <cstdint>
 #include <memory>
@@ -33,6 +35,11 @@
 class dtNavMeshQuery;
 class dtObstacleAvoidanceQuery;
 class dtQueryFilter;
+
+namespace cairn::physics
+{
+class PhysicsSystem;
+}
 
 namespace cairn::navmesh
 {
@@ -83,6 +90,12 @@ public:
     /// Asks for a path to inTarget through the crowd's queue; the agent moves once it arrives.
     Status SetTarget(AgentID inAgent, const Vec3& inTarget);
 
+    /// Dynamic bodies of inPhysics in inLayers near the agents are avoided like agents that do not give way
+    /// (circles in the ground plane, read from their published poses each Update, no lock; bodies wider than
+    /// half the neighbour grid's cell are left out). Null: none. Between Updates; the world must outlive its
+    /// use.
+    void SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers);
+
     /// One frame of inDeltaTime seconds: the path queue's budget, results and replans, then steering and
     /// moves (on ioJobs' threads when given). Error for a time step out of (0, 1] s.
     Status Update(float inDeltaTime, jobs::JobInterface* ioJobs = nullptr);
@@ -106,6 +119,7 @@ public:
         /// checks, the snapshot) and in the steering loop (on the job threads, the caller taking part), ms
         double mLastSerialMs = 0.0;
         double mLastMoveMs = 0.0;
+        uint32_t mLastObstacles = 0; ///< Physics bodies avoided in the last Update
     };
     const Statistics& GetStatistics() const { return mStatistics; }
     const PathRequestQueue& GetPathQueue() const { return *mPaths; }
@@ -114,6 +128,8 @@ private:
     struct Agent;
     explicit Crowd(const NavMeshWorld& inWorld, const Settings& inSettings);
     Agent* Find(AgentID inAgent) const;
+    /// Appends the physics obstacles near the first inNumAgents snapshot entries to the snapshot and grid.
+    void AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime);
     /// The serial part of an Update (agents in id order): path results, corridor checks, replans.
     void UpdatePaths(dtNavMeshQuery& ioQuery);
     /// Steering and move of agents [inBegin, inEnd) of mOrder, from the snapshot.
@@ -135,7 +151,13 @@ private:
     /// The neighbour grid over the snapshot: cell -> first entry in mCellAgents, each cell's agents in order
     std::vector<std::pair<uint64_t, uint32_t>> mCellAgents;
     float mCellSize = 1.0f; ///< The grid's, this Update
-    uint64_t mUpdates = 0;  ///< Updates so far (the walls' refresh is spread over them)
+    uint64_t mUpdates = 0;
+    const PhysicsSystem* mObstaclePhysics = nullptr;
+    ObjectLayerMask mObstacleLayers = 0;
+    std::vector<BodyID> mObstacleIDs; ///< Scratch
+    std::vector<std::pair<BodyID, Vec3>>
+        mPreviousObstacles; ///< By id: where each was, for its velocity  ///< Updates so far (the walls'
+                            ///< refresh is spread over them)
     Statistics mStatistics;
 };
 
