@@ -130,17 +130,8 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
     mWorld.Read(
         [&](const dtNavMesh& inNavMesh)
         {
-            if (mQueries.empty())
-            {
-                dtNavMeshQuery* query = dtAllocNavMeshQuery();
-                if (query == nullptr || dtStatusFailed(query->init(&inNavMesh, cMaxQueryNodes)))
-                {
-                    dtFreeNavMeshQuery(query);
-                    return;
-                }
-                mQueries.push_back(query);
-            }
-            queryReady = true;
+            queryReady = MakeScratch(inNavMesh, 1);
+            if (!queryReady) return;
             dtPolyRef polygon = 0;
             float nearest[3];
             mQueries[0]->findNearestPoly(inPosition.data(), cSnapExtent.data(), mFilter.get(), &polygon,
@@ -180,8 +171,7 @@ Status Crowd::SetTarget(AgentID inAgent, const Vec3& inTarget)
     agent->mHasTarget = true;
     // An agent with no navmesh under it asks once it has some (UpdatePaths)
     if (agent->mState == AgentState::OffNavMesh) return Status::Ok();
-    Result<PathTicket> ticket =
-        mPaths->Request(agent->Position(), inTarget, {}, cSnapExtent, agent->mCorridor.getFirstPoly());
+    Result<PathTicket> ticket = RequestPath(*agent);
     if (!ticket) return ticket.GetError();
     agent->mTicket = ticket.Value();
     agent->mState = AgentState::WaitingForPath;
@@ -200,20 +190,12 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
     mOrder = GetAgents();
     const uint32_t count = uint32_t(mOrder.size());
     const uint32_t chunks = (count + cAgentsPerChunk - 1) / cAgentsPerChunk;
+    bool scratchReady = false;
     mWorld.Read(
         [&](const dtNavMesh& inNavMesh)
         {
-            while (mQueries.size() < std::max<size_t>(chunks, 1))
-            {
-                dtNavMeshQuery* query = dtAllocNavMeshQuery();
-                if (query == nullptr || dtStatusFailed(query->init(&inNavMesh, cMaxQueryNodes))) return;
-                mQueries.push_back(query);
-            }
-            while (mAvoidance.size() < std::max<size_t>(chunks, 1))
-            {
-                mAvoidance.push_back(std::make_unique<dtObstacleAvoidanceQuery>());
-                if (!mAvoidance.back()->init(cMaxNeighbours, cMaxWallSegments)) return;
-            }
+            scratchReady = MakeScratch(inNavMesh, std::max<uint32_t>(chunks, 1));
+            if (!scratchReady) return;
             UpdatePaths(*mQueries[0]);
             // The snapshot and its neighbour grid
             mSnapshotPositions.resize(count);
@@ -251,6 +233,8 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
                 for (uint32_t begin = 0; begin < count; begin += cAgentsPerChunk)
                     move(begin, std::min(count, begin + cAgentsPerChunk));
         });
+    if (!scratchReady)
+        return MakeError(ErrorCode::OutOfCapacity, "crowd: Detour could not allocate a query for the update");
     const Clock::time_point end = Clock::now();
     mStatistics.mLastSerialMs = std::chrono::duration<double, std::milli>(moveStart - start).count();
     mStatistics.mLastMoveMs = std::chrono::duration<double, std::milli>(end - moveStart).count();
@@ -311,6 +295,35 @@ void Crowd::AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime)
         ++mStatistics.mLastObstacles;
     }
     mPreviousObstacles = std::move(current);
+}
+
+bool Crowd::MakeScratch(const dtNavMesh& inNavMesh, size_t inChunks)
+{
+    // The query keeps a pointer to Detour's navmesh, which lives as long as the world
+    while (mQueries.size() < inChunks)
+    {
+        dtNavMeshQuery* query = dtAllocNavMeshQuery();
+        if (query == nullptr || dtStatusFailed(query->init(&inNavMesh, cMaxQueryNodes)))
+        {
+            dtFreeNavMeshQuery(query);
+            return false;
+        }
+        mQueries.push_back(query);
+    }
+    while (mAvoidance.size() < inChunks)
+    {
+        auto avoidance = std::make_unique<dtObstacleAvoidanceQuery>();
+        if (!avoidance->init(cMaxNeighbours, cMaxWallSegments)) return false;
+        mAvoidance.push_back(std::move(avoidance));
+    }
+    return true;
+}
+
+Result<PathTicket> Crowd::RequestPath(const Agent& inAgent)
+{
+    // From the agent's own polygon: snapping its position may pick the neighbour on a shared edge
+    return mPaths->Request(inAgent.Position(), inAgent.mTarget, {}, cSnapExtent,
+                           inAgent.mCorridor.getFirstPoly());
 }
 
 void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
@@ -386,8 +399,7 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
         // time) asks now; a full queue is asked again next Update
         if (agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue == 0)
         {
-            Result<PathTicket> ticket = mPaths->Request(agent.Position(), agent.mTarget, {}, cSnapExtent,
-                                                        agent.mCorridor.getFirstPoly());
+            Result<PathTicket> ticket = RequestPath(agent);
             if (ticket) agent.mTicket = ticket.Value();
         }
     }

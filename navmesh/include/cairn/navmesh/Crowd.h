@@ -128,6 +128,11 @@ private:
     struct Agent;
     explicit Crowd(const NavMeshWorld& inWorld, const Settings& inSettings);
     Agent* Find(AgentID inAgent) const;
+    /// Makes the per-chunk scratch (a navmesh query and an avoidance query each) for inChunks chunks; false
+    /// when Detour cannot allocate it (nothing half-made is kept).
+    bool MakeScratch(const dtNavMesh& inNavMesh, size_t inChunks);
+    /// Asks the crowd's queue for a path from the agent to its target.
+    Result<PathTicket> RequestPath(const Agent& inAgent);
     /// Appends the physics obstacles near the first inNumAgents snapshot entries to the snapshot and grid.
     void AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime);
     /// The serial part of an Update (agents in id order): path results, corridor checks, replans.
