@@ -35,14 +35,14 @@ void Integration::IntegrateVelocities(const StepContext& inContext, std::span<co
             body.mAngularVelocity = ClampLength(body.mAngularVelocity, body.mMaxAngularVelocity);
             continue;
         }
-        // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new
-        // velocity
-        body.mLinearVelocity +=
-            deltaTime * (body.mGravityFactor * inContext.mSettings.mGravity + body.mInvMass * body.mForce);
         // Kept for the narrow phase: every constraint of the body needs it, and the rotation stays until the
         // solver
-        const Mat3& inverseInertia = mInverseInertia[body.GetActiveIndex()] = body.GetInverseInertiaWorld();
-        body.mAngularVelocity += deltaTime * (inverseInertia * body.mTorque);
+        mInverseInertia[body.GetActiveIndex()] = body.GetInverseInertiaWorld();
+        // Symplectic Euler, velocity half: v(t + dt) = v(t) + dt * a(t); positions follow with the new
+        // velocity. The change is the one the bounces read (ForceVelocityChangeOf): one formula for both
+        const VelocityChange change = ForceVelocityChangeOf(inContext, body);
+        body.mLinearVelocity += change.mLinear;
+        body.mAngularVelocity += change.mAngular;
         body.mLinearVelocity *= std::max(0.0f, 1.0f - body.mLinearDamping * deltaTime);
         body.mAngularVelocity *= std::max(0.0f, 1.0f - body.mAngularDamping * deltaTime);
         body.mLinearVelocity = ClampLength(body.mLinearVelocity, body.mMaxLinearVelocity);
