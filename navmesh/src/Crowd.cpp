@@ -72,6 +72,7 @@ struct Crowd::Agent
     PathTicket mTicket;
     AgentState mState = AgentState::Idle;
     float mStuckSeconds = 0.0f; ///< Moving but hardly: how long, for the way out of a jam
+    bool mReplanned = false;    ///< This Update's corridor check cut its corridor short
 
     Vec3 Position() const
     {
@@ -169,7 +170,7 @@ Status Crowd::SetTarget(AgentID inAgent, const Vec3& inTarget)
     agent->mTicket = {};
     agent->mTarget = inTarget;
     agent->mHasTarget = true;
-    // An agent with no navmesh under it asks once it has some (UpdatePaths)
+    // An agent with no navmesh under it asks once it has some (CheckCorridors)
     if (agent->mState == AgentState::OffNavMesh) return Status::Ok();
     Result<PathTicket> ticket = RequestPath(*agent);
     if (!ticket) return ticket.GetError();
@@ -183,92 +184,146 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
     if (!(inDeltaTime > 0.0f && inDeltaTime <= 1.0f))
         return MakeError(ErrorCode::InvalidArgument, "crowd: the time step must be in (0, 1] s");
     using Clock = std::chrono::steady_clock;
+    double parallelMs = 0.0, searchMs = 0.0;
+    auto since = [](Clock::time_point inStart)
+    { return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count(); };
     const Clock::time_point start = Clock::now();
-    Clock::time_point moveStart = start;
     ++mUpdates;
-    mPaths->Update(); // Before the navmesh is held below: the queue holds it for its own budget
     mOrder = GetAgents();
     const uint32_t count = uint32_t(mOrder.size());
     const uint32_t chunks = (count + cAgentsPerChunk - 1) / cAgentsPerChunk;
+    // Runs inTask beside inLoop(begin, end) over the agents, on the job threads when there are any
+    auto besideLoop = [&](auto& inTask, const auto& inLoop)
+    {
+        const Clock::time_point parallelStart = Clock::now();
+        if (ioJobs != nullptr)
+        {
+            const jobs::TaskHandle task = ioJobs->StartTask("crowd", inTask);
+            if (chunks > 1)
+                ioJobs->ParallelFor(count, cAgentsPerChunk, inLoop);
+            else if (count > 0)
+                inLoop(0, count);
+            (void)ioJobs->TryRunTaskHere(task); // Not started yet: this thread does it
+            ioJobs->FinishTask(task);
+        }
+        else
+        {
+            inTask();
+            for (uint32_t begin = 0; begin < count; begin += cAgentsPerChunk)
+                inLoop(begin, std::min(count, begin + cAgentsPerChunk));
+        }
+        parallelMs += since(parallelStart);
+    };
     bool scratchReady = false;
     mWorld.Read(
         [&](const dtNavMesh& inNavMesh)
         {
             scratchReady = MakeScratch(inNavMesh, std::max<uint32_t>(chunks, 1));
             if (!scratchReady) return;
-            UpdatePaths(*mQueries[0]);
-            // The snapshot and its neighbour grid
-            mSnapshotPositions.resize(count);
-            mSnapshotVelocities.resize(count);
-            mSnapshotRadii.resize(count);
-            mCellAgents.clear();
             // The grid's cell is the largest neighbour range of the agents now: a 3 x 3 block of cells holds
-            // every neighbour in range, and few more
+            // every neighbour in range, and few more. The physics bodies are looked for round the agents
             float largestRadius = 0.0f;
+            AABB around;
             for (AgentID id : mOrder)
-                largestRadius = std::max(largestRadius, mAgents[id]->mParams.mRadius);
-            mCellSize = cNeighbourRangeRadii * std::max(largestRadius, 0.01f);
-            const float cell = mCellSize;
-            for (uint32_t i = 0; i < count; ++i)
             {
-                const Agent& agent = *mAgents[mOrder[i]];
-                mSnapshotPositions[i] = agent.Position();
-                mSnapshotVelocities[i] = agent.mVelocity;
-                mSnapshotRadii[i] = agent.mParams.mRadius;
-                mCellAgents.push_back({CellKey(int32_t(std::floor(mSnapshotPositions[i].x() / cell)),
-                                               int32_t(std::floor(mSnapshotPositions[i].z() / cell))),
-                                       i});
+                largestRadius = std::max(largestRadius, mAgents[id]->mParams.mRadius);
+                const Vec3 position = mAgents[id]->Position();
+                around.Encapsulate(AABB(position, position));
             }
-            AddPhysicsObstacles(count, inDeltaTime);
+            mCellSize = cNeighbourRangeRadii * std::max(largestRadius, 0.01f);
+            around = AABB(around.mMin - Vec3(mCellSize, 1.0f, mCellSize),
+                          around.mMax + Vec3(mCellSize, 2.5f, mCellSize));
+
+            // Each agent's corridor checked against the navmesh (its own agent each), beside the gathering
+            // of the physics bodies to avoid
+            auto gather = [&] { GatherPhysicsObstacles(around, inDeltaTime); };
+            auto check = [&](uint32_t inBegin, uint32_t inEnd)
+            { CheckCorridors(inBegin, inEnd, *mQueries[inBegin / cAgentsPerChunk]); };
+            besideLoop(gather, check);
+            RequestPaths();
+
+            // The snapshot every agent steers from, and its neighbour grid
+            mSnapshotPositions.clear();
+            mSnapshotVelocities.clear();
+            mSnapshotRadii.clear();
+            mCellAgents.clear();
+            for (AgentID id : mOrder)
+            {
+                const Agent& agent = *mAgents[id];
+                AddToSnapshot(agent.Position(), agent.mVelocity, agent.mParams.mRadius);
+            }
+            AddOtherCrowds();
+            mSnapshotNoYield = uint32_t(mSnapshotPositions.size());
+            for (const Obstacle& obstacle : mObstacles)
+                AddToSnapshot(obstacle.mCentre, obstacle.mVelocity, obstacle.mRadius);
+            mStatistics.mLastObstacles = uint32_t(mObstacles.size());
             std::sort(mCellAgents.begin(), mCellAgents.end());
-            moveStart = Clock::now();
+
+            // The path search reads only the navmesh and its queue, the moves only the snapshot and their own
+            // agents: the two run side by side, the search as a task
+            mChunkSampled.assign(std::max<uint32_t>(chunks, 1), 0);
+            auto search = [&]
+            {
+                const Clock::time_point searchStart = Clock::now();
+                mPaths->UpdateWithin(inNavMesh);
+                searchMs = since(searchStart);
+            };
             auto move = [&](uint32_t inBegin, uint32_t inEnd)
             {
                 const uint32_t chunk = inBegin / cAgentsPerChunk;
                 MoveAgents(inBegin, inEnd, inDeltaTime, *mQueries[chunk], *mAvoidance[chunk]);
             };
-            if (ioJobs != nullptr && chunks > 1)
-                ioJobs->ParallelFor(count, cAgentsPerChunk, move);
-            else
-                for (uint32_t begin = 0; begin < count; begin += cAgentsPerChunk)
-                    move(begin, std::min(count, begin + cAgentsPerChunk));
+            besideLoop(search, move);
+            mStatistics.mLastSampled = 0;
+            for (uint32_t sampled : mChunkSampled)
+                mStatistics.mLastSampled += sampled;
+            ApplyPathResults();
         });
     if (!scratchReady)
         return MakeError(ErrorCode::OutOfCapacity, "crowd: Detour could not allocate a query for the update");
-    const Clock::time_point end = Clock::now();
-    mStatistics.mLastSerialMs = std::chrono::duration<double, std::milli>(moveStart - start).count();
-    mStatistics.mLastMoveMs = std::chrono::duration<double, std::milli>(end - moveStart).count();
+    const double totalMs = since(start);
+    mStatistics.mLastSerialMs = totalMs - parallelMs;
+    mStatistics.mLastMoveMs = parallelMs;
+    mStatistics.mLastPathSearchMs = searchMs;
     return Status::Ok();
 }
 
-void Crowd::SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers)
+void Crowd::AddOtherCrowds()
+{
+    for (const Crowd* other : mOtherCrowds)
+    {
+        if (other == nullptr || other == this) continue;
+        for (const std::unique_ptr<Agent>& agent : other->mAgents)
+            if (agent != nullptr && agent->mCorridor.getFirstPoly() != 0)
+                AddToSnapshot(agent->Position(), agent->mVelocity, agent->mParams.mRadius);
+    }
+}
+
+void Crowd::SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers, Obstacles inWhich)
 {
     mObstaclePhysics = inPhysics;
     mObstacleLayers = inLayers;
+    mObstacleKind = inWhich;
     mPreviousObstacles.clear();
 }
 
-void Crowd::AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime)
+void Crowd::GatherPhysicsObstacles(const AABB& inAround, float inDeltaTime)
 {
-    mStatistics.mLastObstacles = 0;
-    if (mObstaclePhysics == nullptr || inNumAgents == 0) return;
+    mObstacles.clear();
+    if (mObstaclePhysics == nullptr) return;
     // The dynamic bodies near the agents, as last published (no lock: the step may be running), as circles
     // in the ground plane; their velocity from where they were at the last Update
-    AABB around;
-    for (uint32_t i = 0; i < inNumAgents; ++i)
-        around.Encapsulate(AABB(mSnapshotPositions[i], mSnapshotPositions[i]));
-    around =
-        AABB(around.mMin - Vec3(mCellSize, 1.0f, mCellSize), around.mMax + Vec3(mCellSize, 2.5f, mCellSize));
     QueryFilter filter;
     filter.mObjectLayers = mObstacleLayers;
-    if (!mObstaclePhysics->GetWorldQuery().CollideAABox(around, mObstacleIDs, filter)) return;
+    if (!mObstaclePhysics->GetWorldQuery().CollideAABox(inAround, mObstacleIDs, filter)) return;
     std::sort(mObstacleIDs.begin(), mObstacleIDs.end()); // The broad phase's order is not fixed
     const PoseReader poses(mObstaclePhysics->GetBodyManager());
     std::vector<std::pair<BodyID, Vec3>> current;
     for (const BodyID& id : mObstacleIDs)
     {
         PublishedPose pose;
-        if (!poses.Read(id, pose) || pose.mMotionType != MotionType::Dynamic || pose.mShape == nullptr)
+        if (!poses.Read(id, pose) || pose.mMotionType != MotionType::Dynamic || pose.mShape == nullptr ||
+            (mObstacleKind == Obstacles::AwakeOnly && !pose.mActive))
             continue;
         const AABB bounds = pose.mShape->GetWorldBounds(pose.mTransform);
         const Vec3 centre(0.5f * (bounds.mMin.x() + bounds.mMax.x()), bounds.mMin.y(),
@@ -285,16 +340,20 @@ void Crowd::AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime)
             velocity = Vec3(centre.x() - previous->second.x(), 0.0f, centre.z() - previous->second.z()) /
                        inDeltaTime;
         current.push_back({id, centre});
-        const uint32_t index = uint32_t(mSnapshotPositions.size());
-        mSnapshotPositions.push_back(centre);
-        mSnapshotVelocities.push_back(velocity);
-        mSnapshotRadii.push_back(radius);
-        mCellAgents.push_back({CellKey(int32_t(std::floor(centre.x() / mCellSize)),
-                                       int32_t(std::floor(centre.z() / mCellSize))),
-                               index});
-        ++mStatistics.mLastObstacles;
+        mObstacles.push_back({centre, velocity, radius});
     }
     mPreviousObstacles = std::move(current);
+}
+
+void Crowd::AddToSnapshot(const Vec3& inPosition, const Vec3& inVelocity, float inRadius)
+{
+    const uint32_t index = uint32_t(mSnapshotPositions.size());
+    mSnapshotPositions.push_back(inPosition);
+    mSnapshotVelocities.push_back(inVelocity);
+    mSnapshotRadii.push_back(inRadius);
+    mCellAgents.push_back({CellKey(int32_t(std::floor(inPosition.x() / mCellSize)),
+                                   int32_t(std::floor(inPosition.z() / mCellSize))),
+                           index});
 }
 
 bool Crowd::MakeScratch(const dtNavMesh& inNavMesh, size_t inChunks)
@@ -326,13 +385,14 @@ Result<PathTicket> Crowd::RequestPath(const Agent& inAgent)
                            inAgent.mCorridor.getFirstPoly());
 }
 
-void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
+void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQuery)
 {
     const dtNavMesh& navMesh = *ioQuery.getAttachedNavMesh();
-    for (AgentID id : mOrder)
+    for (uint32_t i = inBegin; i < inEnd; ++i)
     {
-        Agent& agent = *mAgents[id];
+        Agent& agent = *mAgents[mOrder[i]];
         dtPathCorridor& corridor = agent.mCorridor;
+        agent.mReplanned = false;
         if (!navMesh.isValidPolyRef(corridor.getFirstPoly()))
         {
             // Its tile went away under it, or it was added where no tile was built yet: it waits in place
@@ -345,7 +405,6 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
                 agent.mState = AgentState::OffNavMesh;
                 agent.mVelocity.setZero();
-                ++mStatistics.mOffNavMeshFrames;
                 continue;
             }
             corridor.reset(polygon, nearest);
@@ -354,46 +413,36 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
                 agent.mState = agent.mHasTarget ? AgentState::WaitingForPath : AgentState::Idle;
             }
         }
-        if (agent.mTicket.mValue != 0)
-        {
-            if (std::optional<Result<PathResult>> result = mPaths->TakeResult(agent.mTicket))
-            {
-                agent.mTicket = {};
-                const std::vector<uint64_t>* polygons = *result ? &result->Value().mPolygons : nullptr;
-                // The path starts where the agent was when it asked; it has been standing since, so its
-                // polygon is normally the first. Else the path from its polygon on, if it is in it
-                size_t from = 0;
-                while (polygons != nullptr && from < polygons->size() &&
-                       (*polygons)[from] != corridor.getFirstPoly())
-                    ++from;
-                if (polygons == nullptr || from == polygons->size() || result->Value().mStraightPath.empty())
-                {
-                    ++mStatistics.mPathsFailed;
-                    agent.mState = AgentState::NoPath;
-                }
-                else
-                {
-                    std::vector<dtPolyRef> path(polygons->begin() + long(from), polygons->end());
-                    if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
-                        path.resize(size_t(mSettings.mMaxCorridorPolygons));
-                    corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(),
-                                         int(path.size()));
-                    agent.mState = AgentState::Moving;
-                    ++mStatistics.mPathsApplied;
-                }
-            }
-        }
         if (corridor.getPathCount() > 1 &&
             !corridor.isValid(corridor.getPathCount(), &ioQuery, mFilter.get()))
         {
-            // A polygon of its corridor went away (also one just handed over, searched before a Publish):
-            // it keeps its own polygon and, if it was on its way, asks again from here
-            corridor.reset(corridor.getFirstPoly(), corridor.getPos());
+            // A polygon of its corridor went away (a tile rebuilt or removed): it keeps the part up to there
+            // and walks it meanwhile, and, if it was on its way, asks again from here (DetourCrowd does so)
+            corridor.trimInvalidPath(corridor.getFirstPoly(), corridor.getPos(), &ioQuery, mFilter.get());
             if (agent.mState == AgentState::Moving)
             {
                 agent.mState = AgentState::WaitingForPath;
-                ++mStatistics.mReplans;
+                agent.mReplanned = true;
             }
+        }
+    }
+}
+
+void Crowd::RequestPaths()
+{
+    // In id order, so the queue gets the same requests in the same order for any number of threads
+    for (AgentID id : mOrder)
+    {
+        Agent& agent = *mAgents[id];
+        mStatistics.mReplans += agent.mReplanned ? 1 : 0;
+        if (agent.mState == AgentState::OffNavMesh)
+        {
+            ++mStatistics.mOffNavMeshFrames;
+            // A path asked for before its tile went: it asks again from where it stands once navmesh is
+            // back under it (the result would only fail, and say NoPath instead of OffNavMesh)
+            if (agent.mTicket.mValue != 0) mPaths->Cancel(agent.mTicket);
+            agent.mTicket = {};
+            continue;
         }
         // An agent that needs a path and has no request (a replan, back on navmesh, or a full queue last
         // time) asks now; a full queue is asked again next Update
@@ -402,6 +451,46 @@ void Crowd::UpdatePaths(dtNavMeshQuery& ioQuery)
             Result<PathTicket> ticket = RequestPath(agent);
             if (ticket) agent.mTicket = ticket.Value();
         }
+    }
+}
+
+void Crowd::ApplyPathResults()
+{
+    for (AgentID id : mOrder)
+    {
+        Agent& agent = *mAgents[id];
+        if (agent.mTicket.mValue == 0) continue;
+        std::optional<Result<PathResult>> result = mPaths->TakeResult(agent.mTicket);
+        if (!result) continue;
+        agent.mTicket = {};
+        dtPathCorridor& corridor = agent.mCorridor;
+        if (!*result || result->Value().mStraightPath.empty())
+        {
+            ++mStatistics.mPathsFailed;
+            agent.mState = AgentState::NoPath;
+            continue;
+        }
+        // The path starts where the agent was when it asked; it may have walked on since, along what was
+        // left of its corridor: the path from the polygon it stands in, if the path crosses it
+        const std::vector<uint64_t>& polygons = result->Value().mPolygons;
+        size_t from = 0;
+        while (from < polygons.size() && polygons[from] != corridor.getFirstPoly())
+            ++from;
+        if (from == polygons.size())
+        {
+            // It left the path's polygons meanwhile: it asks again from where it is (searched in the same
+            // navmesh, so this ends once it stands still at the end of what it had)
+            Result<PathTicket> ticket = RequestPath(agent);
+            if (ticket) agent.mTicket = ticket.Value();
+            agent.mState = AgentState::WaitingForPath;
+            continue;
+        }
+        std::vector<dtPolyRef> path(polygons.begin() + long(from), polygons.end());
+        if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
+            path.resize(size_t(mSettings.mMaxCorridorPolygons));
+        corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(), int(path.size()));
+        agent.mState = AgentState::Moving;
+        ++mStatistics.mPathsApplied;
     }
 }
 
@@ -429,7 +518,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                                    mFilter.get());
 
         Vec3 desired = Vec3::Zero();
-        if (agent.mState == AgentState::Moving)
+        // An agent waiting for a new path walks on along what is left of its old corridor
+        const bool waitingOnItsWay =
+            agent.mState == AgentState::WaitingForPath && agent.mCorridor.getPathCount() > 1;
+        if (agent.mState == AgentState::Moving || waitingOnItsWay)
         {
             float corners[3 * 3];
             unsigned char flags[3];
@@ -439,7 +531,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             const Vec3 end(agent.mCorridor.getTarget()[0], agent.mCorridor.getTarget()[1],
                            agent.mCorridor.getTarget()[2]);
             if (numCorners == 0 || Flat(end - position).norm() < radius)
-                agent.mState = AgentState::Arrived;
+            {
+                // The end of a trimmed corridor is not the target: it waits there for its path
+                if (!waitingOnItsWay) agent.mState = AgentState::Arrived;
+            }
             else
             {
                 const Vec3 toCorner = Flat(Vec3(corners[0], corners[1], corners[2]) - position);
@@ -497,8 +592,8 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         // neighbour and no wall within the time horizon
         Vec3 velocity = desired;
         // Sampling costs microseconds an agent: only an agent that would meet a neighbour within the horizon
-        // (both going on as they go) or walks within two radii of a wall samples; the others take their
-        // desired velocity
+        // (both going on as they go) or is heading into a wall samples; the others take their desired
+        // velocity
         bool threatened = false;
         for (int n = 0; n < numNeighbours && !threatened; ++n)
         {
@@ -512,15 +607,22 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             const float reach = radius + mSnapshotRadii[j] + 0.1f * radius;
             threatened = (offset - closing * t).squaredNorm() < reach * reach;
         }
+        // A wall threatens only an agent heading into it: where its desired velocity takes it in half a
+        // second is within half a radius of the wall, in front of it. The corridor keeps every agent on the
+        // navmesh whatever it samples, so walls beside an agent's way (nearly every agent among props) are
+        // left to the move along the surface
+        const Vec3 ahead = position + desired * 0.5f;
         for (int w = 0; w < agent.mBoundary.getSegmentCount() && !threatened; ++w)
         {
             const float* segment = agent.mBoundary.getSegment(w);
+            if (dtTriArea2D(position.data(), segment, segment + 3) < 0.0f) continue; // Behind it
             float along = 0.0f;
             threatened =
-                dtDistancePtSegSqr2D(position.data(), segment, segment + 3, along) < 4.0f * radius * radius;
+                dtDistancePtSegSqr2D(ahead.data(), segment, segment + 3, along) < 0.25f * radius * radius;
         }
         if (threatened)
         {
+            ++mChunkSampled[inBegin / cAgentsPerChunk];
             ioAvoidance.reset();
             for (int n = 0; n < numNeighbours; ++n)
             {
@@ -558,8 +660,9 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                                                                  : Vec3(j < i ? 1.0f : -1.0f, 0.0f, 0.0f);
             const float into = velocity.dot(direction);
             if (into < 0.0f) velocity -= into * direction;
-            // Half the overlap each (the other does the same), within this step
-            velocity += direction * (0.5f * (touching - neighbours[n].first) / inDeltaTime);
+            // Half the overlap each (the other agent does the same), within this step; all of it from a body
+            const float share = j >= mSnapshotNoYield ? 1.0f : 0.5f;
+            velocity += direction * (share * (touching - neighbours[n].first) / inDeltaTime);
         }
         if (velocity.norm() > 2.0f * maxSpeed) velocity *= 2.0f * maxSpeed / velocity.norm();
         const Vec3 wanted = position + velocity * inDeltaTime;

@@ -66,7 +66,13 @@ Result<PathTicket> PathRequestQueue::Request(const Vec3& inStart, const Vec3& in
 int PathRequestQueue::Update()
 {
     int finished = 0;
-    mWorld.Read([&](const dtNavMesh& inNavMesh) { finished = Search(inNavMesh); });
+    mWorld.Read([&](const dtNavMesh& inNavMesh) { finished = UpdateWithin(inNavMesh); });
+    return finished;
+}
+
+int PathRequestQueue::UpdateWithin(const dtNavMesh& inNavMesh)
+{
+    const int finished = Search(inNavMesh);
     const std::lock_guard lock(mMutex);
     ++mStatistics.mUpdates;
     return finished;

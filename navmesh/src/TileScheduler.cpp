@@ -296,7 +296,10 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState,
         mStats.mBuildMs += result->Value().mBuildMs;
         ioChanges.push_back(std::move(result->Value()));
         if (!ioState.mEverPublished)
+        {
             mStats.mFirstPublishFrames.push_back(uint32_t(mFrame - ioState.mNeededSinceFrame));
+            mStats.mFirstPublishTiles.push_back(inTile);
+        }
         ioState.mEverPublished = true;
         ++mStats.mTilesPublished;
     }

@@ -51,6 +51,16 @@ TEST_F(TileSchedulerTest, AnInvokerGetsTheTilesWithinItsRadiusNearestFirstWithin
     EXPECT_TRUE(mWorld->HasTile(TileAt(-2, -2)));
     EXPECT_FALSE(mWorld->HasTile(TileAt(-20, -20))); // Beyond the radius
     EXPECT_EQ(mScheduler->GetStats().mFirstPublishFrames.size(), 4u);
+    // Each latency with its tile, in the order the tiles were first published
+    const std::vector<TileCoord> latencyTiles = mScheduler->GetStats().mFirstPublishTiles;
+    ASSERT_EQ(latencyTiles.size(), 4u);
+    std::vector<TileCoord> sortedLatencyTiles = latencyTiles, sortedPublished = publishOrder;
+    auto byCoordinate = [](const TileCoord& inA, const TileCoord& inB)
+    { return std::pair(inA.mX, inA.mZ) < std::pair(inB.mX, inB.mZ); };
+    std::sort(sortedLatencyTiles.begin(), sortedLatencyTiles.end(), byCoordinate);
+    std::sort(sortedPublished.begin(), sortedPublished.end(), byCoordinate);
+    EXPECT_EQ(sortedLatencyTiles, sortedPublished);
+    EXPECT_EQ(latencyTiles.front(), TileAt(2, 2));
 }
 
 TEST_F(TileSchedulerTest, TilesNoInvokerNeedsAreDroppedAfterTheDelay)

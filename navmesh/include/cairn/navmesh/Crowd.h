@@ -8,17 +8,20 @@
 // own PathRequestQueue, so the frame's path finding stays within its budget whatever the number of agents.
 // Every Update, before anyone moves, each corridor is checked whole against the navmesh as published: an
 // agent whose corridor crosses a polygon that went away (a tile rebuilt, removed or streamed out) keeps the
-// valid part and asks for a new path; an agent whose own polygon went away waits where it is until navmesh
-// is published under it again. So no agent keeps a path through a polygon that no longer exists, and none
-// walks off the navmesh.
+// valid part, walks it and asks for a new path; an agent whose own polygon went away waits where it is until
+// navmesh is published under it again. So no agent keeps a path through a polygon that no longer exists, and
+// none walks off the navmesh.
 //
 // Why not dtCrowd itself: its update is one serial pass over every agent (and its own path queue): it cannot
 // spread over job threads. Here the steering and moving run as a ParallelFor over the agents, each agent
 // reading the others' positions and velocities as they were at the start of the Update (a snapshot) and
-// writing only itself, so the result is the same for any number of threads.
+// writing only itself, so the result is the same for any number of threads. The path queue's budget is
+// searched beside them, as a task: the calling thread only checks corridors, makes the snapshot and hands
+// the paths found to their agents, so its cost is bounded by the agents' count, never by path finding.
 //
-// Threads. Update: one thread at a time, not inside another navmesh call; its loop runs on the job
-// interface's threads while the calling thread holds the navmesh shared (a Publish waits for the Update).
+// Threads. Update: one thread at a time, not inside another navmesh call; its loop and the path search run
+// on the job interface's threads while the calling thread holds the navmesh shared (a Publish waits for the
+// Update).
 // AddAgent, RemoveAgent, SetTarget and the getters: the thread that calls Update, between Updates.
 
 #include "cairn/jobs/JobInterface.h"
@@ -90,14 +93,27 @@ public:
     /// Asks for a path to inTarget through the crowd's queue; the agent moves once it arrives.
     Status SetTarget(AgentID inAgent, const Vec3& inTarget);
 
+    /// Which dynamic bodies the agents avoid as obstacles.
+    enum class Obstacles : uint8_t
+    {
+        AllDynamic, ///< Every dynamic body: for a navmesh that has none of them
+        AwakeOnly,  ///< Moving ones: the tile scheduler's default bakes the sleeping ones into the navmesh
+    };
     /// Dynamic bodies of inPhysics in inLayers near the agents are avoided like agents that do not give way
     /// (circles in the ground plane, read from their published poses each Update, no lock; bodies wider than
     /// half the neighbour grid's cell are left out). Null: none. Between Updates; the world must outlive its
     /// use.
-    void SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers);
+    void SetPhysicsObstacles(const PhysicsSystem* inPhysics, ObjectLayerMask inLayers,
+                             Obstacles inWhich = Obstacles::AllDynamic);
 
-    /// One frame of inDeltaTime seconds: the path queue's budget, results and replans, then steering and
-    /// moves (on ioJobs' threads when given). Error for a time step out of (0, 1] s.
+    /// The agents of inOthers (crowds of other profiles on the same ground) are avoided as agents that give
+    /// way half each, read as they stand when this crowd updates. The crowds must be updated one after
+    /// another on one thread, never at once, and outlive their use here. Between Updates.
+    void SetOtherCrowds(std::vector<const Crowd*> inOthers) { mOtherCrowds = std::move(inOthers); }
+
+    /// One frame of inDeltaTime seconds: corridor checks and replans, then the path queue's budget (a task on
+    /// ioJobs' threads when given) beside the steering and moves (a ParallelFor on them), then the paths
+    /// found are handed to their agents. Error for a time step out of (0, 1] s.
     Status Update(float inDeltaTime, jobs::JobInterface* ioJobs = nullptr);
 
     Result<Vec3> GetPosition(AgentID inAgent) const;
@@ -115,11 +131,17 @@ public:
         uint64_t mOffNavMeshFrames = 0; ///< Agent-frames spent waiting for navmesh under them
         uint64_t mPathsApplied = 0;
         uint64_t mPathsFailed = 0;
-        /// The last Update's time on the calling thread (the path queue's budget, path results and corridor
-        /// checks, the snapshot) and in the steering loop (on the job threads, the caller taking part), ms
+        /// The last Update's time on the calling thread alone (path requests, the snapshot, path results)
+        /// and in its parallel parts (the corridor checks beside the gathering of physics obstacles, then the
+        /// steering loop beside the path queue's budget, on the job threads, the caller taking part), wall
+        /// ms; and the path search's own time, in the second parallel part
         double mLastSerialMs = 0.0;
         double mLastMoveMs = 0.0;
+        double mLastPathSearchMs = 0.0;
         uint32_t mLastObstacles = 0; ///< Physics bodies avoided in the last Update
+        /// Agents that sampled velocities in the last Update (on a collision course or near a wall): the
+        /// steering's cost grows with them
+        uint32_t mLastSampled = 0;
     };
     const Statistics& GetStatistics() const { return mStatistics; }
     const PathRequestQueue& GetPathQueue() const { return *mPaths; }
@@ -133,10 +155,19 @@ private:
     bool MakeScratch(const dtNavMesh& inNavMesh, size_t inChunks);
     /// Asks the crowd's queue for a path from the agent to its target.
     Result<PathTicket> RequestPath(const Agent& inAgent);
-    /// Appends the physics obstacles near the first inNumAgents snapshot entries to the snapshot and grid.
-    void AddPhysicsObstacles(uint32_t inNumAgents, float inDeltaTime);
-    /// The serial part of an Update (agents in id order): path results, corridor checks, replans.
-    void UpdatePaths(dtNavMeshQuery& ioQuery);
+    /// The physics obstacles within inAround into mObstacles (a task beside the corridor checks).
+    void GatherPhysicsObstacles(const AABB& inAround, float inDeltaTime);
+    /// Appends an entry to the snapshot and its grid.
+    void AddToSnapshot(const Vec3& inPosition, const Vec3& inVelocity, float inRadius);
+    /// Before the moves, agents [inBegin, inEnd) of mOrder (a ParallelFor chunk): corridors checked against
+    /// the navmesh, cut short where a polygon went away, agents re-snapped or set waiting.
+    void CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQuery);
+    /// After the checks, agents in id order: the requests for paths, and the checks' statistics.
+    void RequestPaths();
+    /// After the moves and the search, agents in id order: the paths found handed to their agents.
+    void ApplyPathResults();
+    /// Appends the other crowds' agents to the snapshot and grid.
+    void AddOtherCrowds();
     /// Steering and move of agents [inBegin, inEnd) of mOrder, from the snapshot.
     void MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNavMeshQuery& ioQuery,
                     dtObstacleAvoidanceQuery& ioAvoidance);
@@ -148,21 +179,33 @@ private:
     std::vector<dtNavMeshQuery*> mQueries; ///< One per ParallelFor chunk, made as needed (scratch only)
     std::vector<std::unique_ptr<dtObstacleAvoidanceQuery>> mAvoidance; ///< Likewise, for the avoidance
     std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By id; null where removed
-    std::vector<AgentID> mOrder; ///< The agents in id order, for this Update
+    std::vector<AgentID> mOrder;         ///< The agents in id order, for this Update
+    std::vector<uint32_t> mChunkSampled; ///< Per ParallelFor chunk: its agents that sampled (a chunk's own)
     // The snapshot every agent steers from: positions and velocities at the Update's start, by mOrder index
     std::vector<Vec3> mSnapshotPositions;
     std::vector<Vec3> mSnapshotVelocities;
     std::vector<float> mSnapshotRadii;
+    /// Entries from here on (physics bodies) do not give way; those before (this crowd's agents, then the
+    /// other crowds') give way half each
+    uint32_t mSnapshotNoYield = 0;
     /// The neighbour grid over the snapshot: cell -> first entry in mCellAgents, each cell's agents in order
     std::vector<std::pair<uint64_t, uint32_t>> mCellAgents;
     float mCellSize = 1.0f; ///< The grid's, this Update
-    uint64_t mUpdates = 0;
+    uint64_t mUpdates = 0;  ///< Updates so far (the walls' refresh is spread over them)
+    std::vector<const Crowd*> mOtherCrowds;
     const PhysicsSystem* mObstaclePhysics = nullptr;
     ObjectLayerMask mObstacleLayers = 0;
+    Obstacles mObstacleKind = Obstacles::AllDynamic;
     std::vector<BodyID> mObstacleIDs; ///< Scratch
-    std::vector<std::pair<BodyID, Vec3>>
-        mPreviousObstacles; ///< By id: where each was, for its velocity  ///< Updates so far (the walls'
-                            ///< refresh is spread over them)
+    struct Obstacle
+    {
+        Vec3 mCentre;
+        Vec3 mVelocity;
+        float mRadius;
+    };
+    std::vector<Obstacle> mObstacles; ///< This Update's, gathered beside the corridor checks
+    /// By id: where each was, for its velocity
+    std::vector<std::pair<BodyID, Vec3>> mPreviousObstacles;
     Statistics mStatistics;
 };
 

@@ -84,6 +84,10 @@ public:
                                uint64_t inStartPolygon = 0);
     /// Searches for up to the budget, the requests in ticket order; returns how many finished.
     int Update();
+    /// Update for a caller that already reads the queue's world (inside its NavMeshWorld::Read, inNavMesh
+    /// the navmesh it was handed), on any thread while that Read lasts: a crowd searches on a job thread
+    /// beside its steering that way.
+    int UpdateWithin(const dtNavMesh& inNavMesh);
     /// A finished request's result, taken out (the ticket is forgotten); nothing while the request waits or
     /// is searched, nor for a ticket the queue does not know (never given, cancelled, or taken).
     std::optional<Result<PathResult>> TakeResult(PathTicket inTicket);

@@ -59,6 +59,7 @@ public:
         double mBuildMs = 0;    ///< Summed over jobs: Recast and Detour
         /// Frames from a tile being needed to its first publication, one entry per tile
         std::vector<uint32_t> mFirstPublishFrames;
+        std::vector<TileCoord> mFirstPublishTiles; ///< The tile of each entry above
         std::string mLastError;
     };
 
