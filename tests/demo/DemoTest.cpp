@@ -1,6 +1,7 @@
 // The streaming open-world demo, run for 240 frames (4 s) in both broad-phase modes with a fast player
 // (so tiles stream in and out several times): no body lost or duplicated by streaming, every navmesh tile the
-// agents asked for built, no agent path through a wall, nothing reported wrong.
+// agents asked for built, no agent inside a wall or off its navmesh for over a second, no corridor through a
+// polygon that is gone, nothing reported wrong.
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
@@ -54,7 +55,11 @@ void ExpectInvariants(const DemoRunResult& inRun)
 {
     EXPECT_EQ(inRun.mLostOrDuplicatedBodies, 0u) << inRun.mModeName;
     EXPECT_EQ(inRun.mTilesRequestedNeverBuilt, 0u) << inRun.mModeName;
-    EXPECT_EQ(inRun.mPathsThroughWalls, 0u) << inRun.mModeName;
+    const AgentStats& agents = inRun.mAgentStats;
+    EXPECT_EQ(agents.mInsideStatic, 0u) << inRun.mModeName;
+    EXPECT_GT(agents.mInsideStaticChecks, 0u) << inRun.mModeName;
+    EXPECT_EQ(agents.mOffNavMeshOverOneSecond, 0u) << inRun.mModeName;
+    EXPECT_EQ(agents.mCorridorsThroughGone, 0u) << inRun.mModeName;
     for (const std::string& error : inRun.mErrors)
         ADD_FAILURE() << inRun.mModeName << ": " << error;
     // The run did what a demo does: streamed in and out, stepped, queried, built navmesh, walked
@@ -78,12 +83,17 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(inRun.mQueries, 0u);
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
     const std::string paths =
-        inRun.mModeName + ": path queries " + std::to_string(inRun.mPathQueries) + ", reached " +
-        std::to_string(inRun.mPathsFound) + ", partial " + std::to_string(inRun.mPathsPartial) + ", failed " +
-        std::to_string(inRun.mPathsFailed) + ", walked " + std::to_string(inRun.mAgentDistanceMetres) + " m";
-    std::printf("%s\n", paths.c_str()); // The margins of the two checks below, in the log
-    EXPECT_GT(inRun.mPathsFound, 0u) << paths;
-    EXPECT_GT(inRun.mAgentDistanceMetres, 10.0) << paths;
+        inRun.mModeName + ": paths requested " + std::to_string(agents.mPathsRequested) + ", served " +
+        std::to_string(agents.mPathsServed) + ", failed " + std::to_string(agents.mPathsFailed) +
+        ", arrivals " + std::to_string(agents.mArrivals) + ", walked " + std::to_string(agents.mDistance) +
+        " m";
+    std::printf("%s\n", paths.c_str()); // The margins of the checks below, in the log
+    EXPECT_GT(agents.mPathsServed, 0u) << paths;
+    EXPECT_GT(agents.mDistance, 10.0) << paths;
+    EXPECT_EQ(agents.mMainThreadMs.size(), 240u);
+    EXPECT_EQ(agents.mJobThreadsMs.size(), 240u);
+    EXPECT_FALSE(agents.mTrails.empty());
+    EXPECT_FALSE(inRun.mNavMap.empty());
     EXPECT_GT(inRun.mDynamicBodiesPeak, 0u);
 }
 

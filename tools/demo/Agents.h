@@ -1,23 +1,36 @@
 #pragma once
 
-// Agents: the demo's AI. Each agent is a navmesh invoker (the tiles within its radius are built in the
-// background) and walks paths on the navmesh as it appears and changes: it picks a goal on the navmesh (a
-// random point reachable within 15 m, or the navmesh under the player when it falls behind, and while there
-// is none there yet, the navmesh 15 m the player's way), asks the NavMeshWorld for a path, follows the
-// straight path at walking speed, and asks again when it arrives at its goal or every two seconds (half a
-// second after a path that ended short of its goal, a quarter when there was no navmesh to ask yet). The
-// player runs faster than the agents walk: one left 60 m behind catches up (is put back beside the player).
-// Every new path is checked against the physics world: a point of it inside a wall (a static body at chest
-// height) counts as a path through a wall, which must never happen.
+// Agents: the demo's AI, a crowd per agent profile (humans, radius 0.6 m, and one agent in ten large, 1.5 m),
+// each on its own navmesh built from the same physics world. The agents steer with avoidance along path
+// corridors (navmesh::Crowd) and ask for paths through each crowd's budgeted queue. Each has a place by the
+// player (spread over a disc of 10 m^2 an agent) and walks the navmesh: most wander, to a random point
+// reachable within 15 m, a new one on arrival, when no path was found, when stuck and after 15 s; one in
+// twenty is a companion that follows the player once 25 m from its place (to the navmesh under its place,
+// or while there is none there yet, the navmesh 15 m that way; renewed every 2 s). The player runs faster
+// than agents walk: one 50 m from its place is put back near it, on a free spot of navmesh, as an open
+// world's population is moved from behind the player to ahead of it.
 //
-// Threads: the main thread only (path queries may come from any thread; the demo keeps them on one).
+// The frame's navigation work: the goals (random points and nearest points, Detour searches) are picked on
+// the job threads, each agent from its own seed, and set in id order; then each crowd's Update (its path
+// budget and corridor checks on this thread, the steering on the job threads). The same run gives the same
+// agents for any number of threads.
+//
+// The checks of the run (not counted as navigation work): an agent inside a static body (each agent every
+// half second, on the job threads), agents overlapping (every 10th frame), off the navmesh for more than
+// 1 s, a corridor through a polygon that is gone (every second).
+//
+// Threads: the main thread only, between the physics step and the navmesh sync point (the tile schedulers'
+// Update): the crowds read the navmesh and the published poses.
 
+#include "DemoResult.h"
 #include "TileStreamer.h"
+#include "cairn/jobs/JobInterface.h"
+#include "cairn/navmesh/Crowd.h"
 #include "cairn/navmesh/NavMeshWorld.h"
-#include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 
-#include <random>
+#include <array>
+#include <memory>
 #include <vector>
 
 namespace cairn::demo
@@ -48,53 +61,63 @@ Result<Vec3> FollowGoal(const navmesh::NavMeshWorld& inNavMesh, const Vec3& inAg
 class Agents
 {
 public:
-    struct Stats
+    /// An agent profile's navmesh and the agents' radius on it.
+    struct Profile
     {
-        uint64_t mPathQueries = 0;
-        uint64_t mPathsFound = 0;   ///< Reaching the goal
-        uint64_t mPathsPartial = 0; ///< Ending at the reachable point nearest the goal
-        uint64_t mPathsFailed = 0;  ///< No path: mostly no navmesh under the agent or its goal yet
-        double mPathMicros = 0.0;   ///< Summed
-        double mDistance = 0.0;     ///< Metres walked by all agents
-        /// Agents put back beside the player after falling 60 m behind (one that stands where there is no
-        /// navmesh after a failed path is put there too, not counted: it is mostly there already)
-        uint64_t mCatchUps = 0;
-        uint32_t mPathsThroughWalls = 0;
-        std::vector<std::string> mErrors;
+        const navmesh::NavMeshWorld* mNavMesh = nullptr;
+        float mRadius = 0.6f;
     };
+
+    using Stats = AgentStats;
 
     Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, const TileStreamer& inStreamer,
-           navmesh::NavMeshWorld& ioNavMesh, navmesh::TileScheduler& ioScheduler, int inCount,
-           uint64_t inSeed);
+           const Profile& inHuman, const Profile& inLarge, int inCount, uint64_t inSeed);
     ~Agents();
 
-    void Update(float inDeltaTime, const Vec3& inPlayer);
+    /// Where inCount agents keep round the player: their places are within this of the player.
+    static float HomeRadius(int inCount);
+    /// The navmesh the agents need round the player: their places, and as far again as an agent walks from
+    /// its place before it is put back.
+    static float NavMeshRadius(int inCount);
+
+    void Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface& ioJobs);
     const Stats& GetStats() const { return mStats; }
+    /// The crowds' path-queue wait histograms summed, for the percentiles.
+    void FinishStats();
 
 private:
-    struct Agent
-    {
-        Vec3 mPosition;
-        navmesh::TileScheduler::InvokerID mInvoker = 0;
-        std::vector<Vec3> mPath;
-        size_t mNext = 0;              ///< Next corner of mPath
-        float mRepathIn = 0.0f;        ///< Seconds until it asks again
-        bool mPathReachesGoal = false; ///< mPath ends at its goal (arriving asks for a new one at once)
-    };
+    struct Agent;
+    struct Action;
 
-    void Repath(Agent& ioAgent, const Vec3& inPlayer);
-    /// inPoint moved onto the terrain: where an agent put back beside the player stands.
-    Vec3 OnGround(const Vec3& inPoint) const;
-    /// Points of the path inside a static body other than the terrain, sampled every 0.25 m at chest height.
-    bool GoesThroughWall(const std::vector<Vec3>& inPath) const;
+    /// What the agent should do now (a goal, a catch-up), on a job thread: reads the navmesh and the agent.
+    void Decide(uint32_t inIndex, const Vec3& inPlayer, Action& outAction) const;
+    /// Whether an agent at inPosition is inside a static body other than the terrain (a job thread).
+    bool InsideStatic(const Vec3& inPosition) const;
+    /// The static bodies InsideStatic finds at inPosition, for the error message.
+    std::string DescribeStaticAt(const Vec3& inPosition) const;
+    /// Agents overlapping another by more than a tenth of the smaller radius (all crowds).
+    uint64_t CountOverlapping() const;
+    /// Corridors holding a polygon their navmesh no longer has.
+    uint64_t CountCorridorsThroughGone() const;
+    void AddAgent(uint32_t inIndex, const Vec3& inPosition);
+    /// Of a catch-up's spots, the first with no agent within cOccupiedCell (else the first spot).
+    Vec3 FreeSpot(const Action& inAction);
+    static uint64_t OccupiedKey(const Vec3& inPosition);
+    /// Two large agents' radii: a spot this far from every agent is free for any agent
+    static constexpr float cOccupiedCell = 3.0f;
 
     PhysicsSystem& mPhysics;
     const WorldGenerator& mGenerator;
     const TileStreamer& mStreamer;
-    navmesh::NavMeshWorld& mNavMesh;
-    navmesh::TileScheduler& mScheduler;
+    Profile mProfiles[2];
+    std::unique_ptr<navmesh::Crowd> mCrowds[2];
     std::vector<Agent> mAgents;
-    std::mt19937_64 mRandom;
+    std::vector<Action> mActions; ///< Scratch, by agent
+    uint64_t mSeed;
+    uint64_t mFrame = 0;
+    std::vector<std::pair<uint64_t, Vec3>> mOccupied; ///< Agents' positions by cell, for FreeSpot
+    bool mOccupiedValid = false;
+    std::vector<uint32_t> mTrailAgents; ///< Indices of the agents whose trails are kept
     Stats mStats;
 };
 

@@ -3,6 +3,8 @@
 
 #include "demo/DemoReport.h"
 
+#include "demo/NavMapSvg.h"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -28,7 +30,11 @@ namespace fs = std::filesystem;
 constexpr double cQueryTargetRatio = 10.0;
 constexpr double cP99TargetRatio = 2.0; ///< A physics frame's p99 at most this times its average
 constexpr double cSpikeTargetRatio = tools::cSpikeRatio; ///< No physics frame over this times the average
-constexpr double cMainThreadStreamTargetMs = 0.5; ///< Streaming work on the main thread per frame, at most
+constexpr double cMainThreadStreamTargetMs = 0.5;  ///< Streaming work on the main thread per frame, at most
+constexpr double cNavMainThreadTargetMs = 0.5;     ///< Navigation work on the main thread per frame, p99
+constexpr double cNavJobThreadsTargetMs = 2.0;     ///< ... and on the job threads (1,000 agents)
+constexpr double cNavJobThreads10kTargetMs = 12.0; ///< ... (more than 1,000 agents: 10,000's target)
+constexpr double cPathWaitTargetFrames = 10.0;     ///< A path request's wait, p99
 constexpr size_t cMaxHistogramBuckets = 40;
 constexpr int cSummaryTitleWidth = 23; ///< Column of the first metric in the console summary
 
@@ -303,7 +309,8 @@ SampleSummary SummarizeFrames(const std::vector<uint32_t>& inFrames)
 bool InvariantsHold(const DemoRunResult& inRun)
 {
     return inRun.mLostOrDuplicatedBodies == 0 && inRun.mTilesRequestedNeverBuilt == 0 &&
-           inRun.mPathsThroughWalls == 0 && inRun.mErrors.empty();
+           inRun.mAgentStats.mInsideStatic == 0 && inRun.mAgentStats.mOffNavMeshOverOneSecond == 0 &&
+           inRun.mAgentStats.mCorridorsThroughGone == 0 && inRun.mErrors.empty();
 }
 
 std::vector<Section> BuildSummary(const DemoRunResult& inRun)
@@ -319,11 +326,11 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     auto frames = [&](double inValue)
     { return latency.mCount == 0 ? std::string("n/a") : Fixed(inValue, 0); };
 
-    auto ofQueries = [&](uint64_t inCount)
-    {
-        const double percent =
-            inRun.mPathQueries == 0 ? 0.0 : 100.0 * double(inCount) / double(inRun.mPathQueries);
-        return Count(inCount) + Format(" (%.1f%%)", percent);
+    const AgentStats& agents = inRun.mAgentStats;
+    const SampleSummary navMain = Summarize(agents.mMainThreadMs);
+    const SampleSummary navJobs = Summarize(agents.mJobThreadsMs);
+    auto percentOf = [](uint64_t inCount, uint64_t inOf) {
+        return Count(inCount) + Format(" (%.2f%%)", inOf == 0 ? 0.0 : 100.0 * double(inCount) / double(inOf));
     };
 
     std::vector<Section> sections;
@@ -407,20 +414,57 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"latency frames p50", frames(latency.mP50)},
                          {"p99", frames(latency.mP99)},
                          {"max", frames(latency.mMax)}}});
-    sections.push_back({"path queries",
-                        {{"queries", Count(inRun.mPathQueries)},
-                         {"reached goal", ofQueries(inRun.mPathsFound)},
-                         {"partial", ofQueries(inRun.mPathsPartial)},
-                         {"failed (mostly no navmesh yet)", ofQueries(inRun.mPathsFailed)},
-                         {"mean µs", Micros(inRun.mPathQueryMicrosMean)}}});
+    sections.push_back(
+        {"navigation ms/frame",
+         {{"main thread p50", Ms(navMain, navMain.mP50)},
+          {"p99",
+           Ms(navMain, navMain.mP99) +
+               (navMain.mCount == 0 ? std::string() : AtMost(navMain.mP99, cNavMainThreadTargetMs, " ms"))},
+          {"max", Ms(navMain, navMain.mMax)},
+          {"job threads p50", Ms(navJobs, navJobs.mP50)},
+          {"p99", Ms(navJobs, navJobs.mP99) +
+                      (navJobs.mCount == 0
+                           ? std::string()
+                           : AtMost(navJobs.mP99,
+                                    inRun.mAgents > 1000 ? cNavJobThreads10kTargetMs : cNavJobThreadsTargetMs,
+                                    " ms"))},
+          {"max", Ms(navJobs, navJobs.mMax)},
+          {"of which goal picking p99", Ms(Summarize(agents.mGoalPickingMs).mP99)}}});
+    sections.push_back(
+        {"paths",
+         {{"requested", Count(agents.mPathsRequested)},
+          {"served", Count(agents.mPathsServed)},
+          {"failed", Count(agents.mPathsFailed)},
+          {"queue wait frames p99", Count(agents.mPathWaitP99Frames) +
+                                        AtMost(double(agents.mPathWaitP99Frames), cPathWaitTargetFrames, "")},
+          {"max", Count(agents.mPathWaitMaxFrames)},
+          {"replans (tile changes)", Count(agents.mReplans)}}});
     sections.push_back({"agents",
                         {{"agents", Format("%d", inRun.mAgents)},
-                         {"walked m", Fixed(inRun.mAgentDistanceMetres, 1)},
-                         {"caught up with the player", Count(inRun.mAgentCatchUps)}}});
+                         {"goals", Count(agents.mGoalsSet)},
+                         {"arrivals", Count(agents.mArrivals)},
+                         {"goals given up after 15 s", Count(agents.mGoalTimeouts)},
+                         {"stuck 5 s", Count(agents.mStuck)},
+                         {"no goal found", Count(agents.mGoalsNotFound)},
+                         {"walked m", Fixed(agents.mDistance, 0)},
+                         {"put back by the player", Count(agents.mCatchUps)}}});
+    sections.push_back(
+        {"agent checks",
+         {{"overlapping > 10 % of a radius",
+           percentOf(agents.mOverlapping, agents.mOverlapChecks) +
+               (agents.mOverlapChecks == 0
+                    ? std::string()
+                    : AtMost(100.0 * double(agents.mOverlapping) / double(agents.mOverlapChecks), 1.0,
+                             " %"))},
+          {"off navmesh agent-frames", percentOf(agents.mOffNavMeshFrames, agents.mAgentFrames)},
+          {"longest off navmesh frames", Count(agents.mLongestOffNavMeshFrames)}}});
     sections.push_back({"invariants",
                         {{"lost/duplicated bodies", Count(inRun.mLostOrDuplicatedBodies)},
                          {"tiles never built", Count(inRun.mTilesRequestedNeverBuilt)},
-                         {"paths through walls", Count(inRun.mPathsThroughWalls)},
+                         {"agents inside static bodies", Count(agents.mInsideStatic) + " of " +
+                                                             Count(agents.mInsideStaticChecks) + " checks"},
+                         {"off navmesh over 1 s", Count(agents.mOffNavMeshOverOneSecond)},
+                         {"corridors through gone polygons", Count(agents.mCorridorsThroughGone)},
                          {"status", InvariantsHold(inRun) ? "OK" : "FAILED"}}});
     return sections;
 }
@@ -1017,6 +1061,8 @@ std::string ReportMarkdown(const std::vector<DemoRunResult>& inRuns, const std::
             "machine itself is.\n\n";
     text += "## Charts\n\n![Physics ms per frame](frame_times.svg)\n\n";
     text += "![Navmesh tile latency in frames](tile_latency.svg)\n\n";
+    text += "![Navigation ms per frame: main thread and job threads](nav_ms.svg)\n\n";
+    text += "![The final navmesh by tile build latency, and agents' trails](nav_map.svg)\n\n";
     text += "Every frame's figures, with the physics step's phases: [frames.csv](frames.csv).\n";
     return text;
 }
@@ -1120,6 +1166,19 @@ bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& 
             {"report.md", ReportMarkdown(inRuns, inCommandLine)},
             {"frames.csv", FramesCsv(inRuns)},
             {"frame_times.svg", SvgLineChart("Physics ms per frame", "ms", frameSeries)},
+            {"nav_map.svg", inRuns.empty() ? SvgNavMap(DemoRunResult()) : SvgNavMap(inRuns[0])},
+            {"nav_ms.svg",
+             SvgLineChart(
+                 "Navigation ms per frame" +
+                     (inRuns.empty() ? std::string() : " (" + ModeName(inRuns[0], "run 1") + ")"),
+                 "ms",
+                 inRuns.empty()
+                     ? std::vector<std::pair<std::string, std::vector<double>>>()
+                     : std::vector<std::pair<std::string,
+                                             std::vector<double>>>{{"main thread",
+                                                                    inRuns[0].mAgentStats.mMainThreadMs},
+                                                                   {"job threads",
+                                                                    inRuns[0].mAgentStats.mJobThreadsMs}})},
             {"tile_latency.svg",
              SvgHistogram(latencyTitle, "frames",
                           inRuns.empty() ? std::vector<uint32_t>() : inRuns[0].mNavTileLatencyFrames)}};

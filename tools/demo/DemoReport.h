@@ -38,7 +38,7 @@ std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel
 /// (ms), and the game-object jobs' lock waits (µs, all threads).
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns);
 
-/// Writes report.md, frames.csv, frame_times.svg and tile_latency.svg to inFolder (created if missing). With
+/// Writes report.md, frames.csv, frame_times.svg, tile_latency.svg, nav_ms.svg and nav_map.svg to inFolder (created if missing). With
 /// two runs the one whose mode name contains "global" is compared against the other. On failure returns false
 /// with the path and reason in outError, and removes the files it had started; never throws.
 bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& inRuns,

@@ -4,16 +4,55 @@
 // by DemoReport to print the summary and write the Markdown report.
 
 #include "cairn/physics/StepStatistics.h"
+#include "cairn/physics/math/Math.h"
 #include "common/SpikeAttribution.h"
 
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cairn::demo
 {
 using namespace cairn::physics;
+
+/// What the demo's agents did and cost (Agents' figures, for the report).
+struct AgentStats
+{
+    /// Per frame: the navigation work on the main thread (the crowds' path budgets, results and
+    /// corridor checks, goals set, the demo's bookkeeping), ms
+    std::vector<double> mMainThreadMs;
+    /// Per frame: the navigation work spread over the job threads (goal picking and the crowds'
+    /// steering), wall time with the main thread taking part, ms
+    std::vector<double> mJobThreadsMs;
+    std::vector<double> mGoalPickingMs; ///< Per frame: of mJobThreadsMs, the goals' picking
+    uint64_t mGoalsSet = 0;
+    uint64_t mGoalsNotFound = 0; ///< No navmesh point to head for (the navmesh not built there yet)
+    uint64_t mArrivals = 0;
+    uint64_t mGoalTimeouts = 0;   ///< Wander goals not reached in 15 s, given up for another
+    uint64_t mPathsRequested = 0; ///< Through the crowds' queues, replans included
+    uint64_t mPathsServed = 0;    ///< Found (whole or partial)
+    uint64_t mPathsFailed = 0;
+    uint64_t mReplans = 0; ///< Corridors cut by a tile change, asked again
+    uint64_t mPathWaitP99Frames = 0;
+    uint64_t mPathWaitMaxFrames = 0;
+    uint64_t mCatchUps = 0;    ///< Put back by the player after falling 50 m behind
+    uint64_t mStuck = 0;       ///< Moved under 1 m in 5 s while heading for a goal (a new one is picked)
+    double mDistance = 0.0;    ///< Metres walked by all agents
+    uint64_t mAgentFrames = 0; ///< Agents times frames
+    uint64_t mOffNavMeshFrames = 0;
+    uint32_t mLongestOffNavMeshFrames = 0;
+    uint64_t mOffNavMeshOverOneSecond = 0; ///< Spells of more than 60 frames (an invariant: none)
+    uint64_t mOverlapChecks = 0;           ///< Agent-frames checked for overlaps (every 10th frame)
+    uint64_t mOverlapping = 0; ///< Of those, agents overlapping another by more than 10 % of a radius
+    uint64_t mInsideStaticChecks = 0;
+    uint64_t mInsideStatic = 0;             ///< An invariant: none
+    uint64_t mCorridorsThroughGone = 0;     ///< Corridors holding a polygon the navmesh lost: none
+    std::vector<std::vector<Vec3>> mTrails; ///< Of some agents, a point every quarter second
+    std::vector<float> mTrailRadii;
+    std::vector<std::string> mErrors;
+};
 
 /// Summary of a series of samples (milliseconds unless said otherwise).
 struct SampleSummary
@@ -83,18 +122,19 @@ struct DemoRunResult
     /// Navmesh
     uint64_t mNavTilesBuilt = 0;
     std::vector<uint32_t> mNavTileLatencyFrames; ///< Request to publication, per tile
-    uint64_t mPathQueries = 0;
-    uint64_t mPathsFound = 0;   ///< Reaching the goal
-    uint64_t mPathsPartial = 0; ///< Ending short of it
-    uint64_t mPathsFailed = 0;  ///< No path (mostly: no navmesh there yet)
-    double mPathQueryMicrosMean = 0.0;
     int mAgents = 0;
-    double mAgentDistanceMetres = 0.0; ///< Walked by all agents along their paths
-    uint64_t mAgentCatchUps = 0;       ///< Agents put back beside the player after falling too far behind
+    AgentStats mAgentStats;
+    /// The final navmesh of the human profile, for the map: each polygon's outline (x, z) and the build
+    /// latency of its tile in frames (-1: not known, a tile built before the run)
+    struct MapPolygon
+    {
+        std::vector<std::pair<float, float>> mOutline;
+        int mLatencyFrames = -1;
+    };
+    std::vector<MapPolygon> mNavMap;
     /// Invariants (the demo test checks them)
     uint32_t mLostOrDuplicatedBodies = 0;
     uint32_t mTilesRequestedNeverBuilt = 0;
-    uint32_t mPathsThroughWalls = 0;
     std::vector<std::string> mErrors; ///< Anything that went wrong, one line each
     std::string mNavMeshObj;          ///< The navmesh at the end of the run, as Wavefront OBJ text
 };

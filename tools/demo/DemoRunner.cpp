@@ -14,7 +14,10 @@
 #include "common/FrameTimes.h"
 #include "common/ThreadCpuClock.h"
 
+#include <DetourNavMesh.h>
 #include <chrono>
+#include <map>
+#include <optional>
 #include <thread>
 #include <unistd.h>
 
@@ -27,9 +30,99 @@ namespace
 using Clock = std::chrono::steady_clock;
 using tools::MillisecondsSince;
 
+/// The navmesh of each agent profile (human, then large), built from the one physics world by a scheduler
+/// each, on the same background queue; an invoker each at the player keeps the agents' area built.
+struct NavMeshProfiles
+{
+    NavMeshProfiles(PhysicsSystem& ioPhysics, jobs::BackgroundQueue& ioQueue)
+    {
+        navmesh::AgentProfile large;
+        large.mRadius = 1.5f;
+        const navmesh::AgentProfile profiles[2] = {navmesh::AgentProfile(), large};
+        navmesh::TileScheduler::Settings settings;
+        settings.mMaxConcurrentJobs = 2;
+        settings.mDropDelayFrames = 180;
+        for (int p = 0; p < 2; ++p)
+        {
+            const navmesh::TileGrid grid(0.0f, 0.0f, profiles[p].mTileSize, -50.0f, 100.0f);
+            mNavMeshes[p] = std::move(navmesh::NavMeshWorld::Create(grid, profiles[p]).Value());
+            mSchedulers[p] =
+                std::make_unique<navmesh::TileScheduler>(ioPhysics, *mNavMeshes[p], ioQueue, settings);
+        }
+    }
+    ~NavMeshProfiles()
+    {
+        for (auto& scheduler : mSchedulers)
+            scheduler.reset(); // Its jobs read the navmesh
+    }
+    /// The sync point: tiles handed in are published, new jobs started.
+    void Update()
+    {
+        for (auto& scheduler : mSchedulers)
+            scheduler->Update();
+    }
+    bool IsIdle() const { return mSchedulers[0]->IsIdle() && mSchedulers[1]->IsIdle(); }
+    /// The agents' area round inPlayer is kept built (an invoker per profile, added on the first call).
+    Status Focus(const Vec3& inPlayer, float inRadius)
+    {
+        for (int p = 0; p < 2; ++p)
+        {
+            if (!mInvokers[p])
+            {
+                Result<navmesh::TileScheduler::InvokerID> invoker =
+                    mSchedulers[p]->AddInvoker(inPlayer, inRadius);
+                if (!invoker) return invoker.GetError();
+                mInvokers[p] = invoker.Value();
+            }
+            else if (Status moved = mSchedulers[p]->MoveInvoker(*mInvokers[p], inPlayer); !moved)
+                return moved;
+        }
+        return Status::Ok();
+    }
+
+    std::unique_ptr<navmesh::NavMeshWorld> mNavMeshes[2];
+    std::unique_ptr<navmesh::TileScheduler> mSchedulers[2];
+    std::optional<navmesh::TileScheduler::InvokerID> mInvokers[2];
+};
+
+/// The human navmesh's polygons as outlines in the ground plane, each with its tile's build latency.
+std::vector<DemoRunResult::MapPolygon> NavMap(const navmesh::NavMeshWorld& inNavMesh,
+                                              const navmesh::TileScheduler::Stats& inStats)
+{
+    std::map<std::pair<int32_t, int32_t>, int> latency; // The last first-publication of each tile
+    for (size_t i = 0; i < inStats.mFirstPublishTiles.size() && i < inStats.mFirstPublishFrames.size(); ++i)
+        latency[{inStats.mFirstPublishTiles[i].mX, inStats.mFirstPublishTiles[i].mZ}] =
+            int(inStats.mFirstPublishFrames[i]);
+    std::vector<DemoRunResult::MapPolygon> polygons;
+    inNavMesh.Read(
+        [&](const dtNavMesh& inDetour)
+        {
+            for (int t = 0; t < inDetour.getMaxTiles(); ++t)
+            {
+                const dtMeshTile* tile = inDetour.getTile(t);
+                if (tile == nullptr || tile->header == nullptr) continue;
+                const auto found = latency.find({tile->header->x, tile->header->y});
+                for (int p = 0; p < tile->header->polyCount; ++p)
+                {
+                    const dtPoly& poly = tile->polys[p];
+                    if (poly.getType() != DT_POLYTYPE_GROUND) continue;
+                    DemoRunResult::MapPolygon polygon;
+                    polygon.mLatencyFrames = found == latency.end() ? -1 : found->second;
+                    for (int v = 0; v < poly.vertCount; ++v)
+                    {
+                        const float* vertex = &tile->verts[3 * poly.verts[v]];
+                        polygon.mOutline.push_back({vertex[0], vertex[2]});
+                    }
+                    polygons.push_back(std::move(polygon));
+                }
+            }
+        });
+    return polygons;
+}
+
 /// Runs frames of physics and the navmesh sync point (no measuring) until inDone or inMaxSeconds.
 template <class Done>
-bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, navmesh::TileScheduler& ioScheduler,
+bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, NavMeshProfiles& ioNavMeshes,
               const Done& inDone, double inMaxSeconds)
 {
     const Clock::time_point start = Clock::now();
@@ -37,7 +130,7 @@ bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, navmesh::TileSc
     {
         if (MillisecondsSince(start) > inMaxSeconds * 1000.0) return false;
         (void)ioPhysics.Update(1.0f / 60.0f, 1, ioJobs);
-        ioScheduler.Update();
+        ioNavMeshes.Update();
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     return true;
@@ -91,15 +184,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     worldSettings.mPlayerSpeed = inSettings.mPlayerSpeed;
     const WorldGenerator generator(worldSettings);
 
-    const navmesh::AgentProfile profile;
-    const navmesh::TileGrid grid(0.0f, 0.0f, profile.mTileSize, -50.0f, 100.0f);
-    std::unique_ptr<navmesh::NavMeshWorld> navMesh =
-        std::move(navmesh::NavMeshWorld::Create(grid, profile).Value());
-    navmesh::TileScheduler::Settings schedulerSettings;
-    schedulerSettings.mMaxConcurrentJobs = 2;
-    schedulerSettings.mDropDelayFrames = 180;
-    auto scheduler =
-        std::make_unique<navmesh::TileScheduler>(physics, *navMesh, background, schedulerSettings);
+    NavMeshProfiles navMeshes(physics, background);
+    const float navMeshRadius = Agents::NavMeshRadius(inSettings.mAgents);
 
     // Game objects before the streamer: the streamer counts the bodies it finds as not its own
     auto gameObjects =
@@ -111,10 +197,18 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     const float lookAhead = generator.GetSettings().mTileSize / speed; // Seconds to cross one tile
     streamer->SetFocus(generator.GetPlayerPosition(0.0f), generator.GetPlayerPosition(lookAhead));
     if (!RunUntil(
-            physics, frameJobs, *scheduler, [&] { return streamer->IsSettled(); }, 60.0))
+            physics, frameJobs, navMeshes, [&] { return streamer->IsSettled(); }, 60.0))
         result.mErrors.push_back("the start area did not load within 60 s");
-    auto agents = std::make_unique<Agents>(physics, generator, *streamer, *navMesh, *scheduler,
-                                           inSettings.mAgents, inSettings.mSeed + 1);
+    // And the agents' navmesh round the start, of both profiles
+    if (Status focused = navMeshes.Focus(generator.GetPlayerPosition(0.0f), navMeshRadius); !focused)
+        result.mErrors.push_back("navmesh invoker: " + focused.GetError().mMessage);
+    if (!RunUntil(
+            physics, frameJobs, navMeshes, [&] { return navMeshes.IsIdle(); }, 60.0))
+        result.mErrors.push_back("the start area's navmesh was not built within 60 s");
+    const Agents::Profile human{navMeshes.mNavMeshes[0].get(), navMeshes.mNavMeshes[0]->GetProfile().mRadius};
+    const Agents::Profile large{navMeshes.mNavMeshes[1].get(), navMeshes.mNavMeshes[1]->GetProfile().mRadius};
+    auto agents = std::make_unique<Agents>(physics, generator, *streamer, human, large, inSettings.mAgents,
+                                           inSettings.mSeed + 1);
 
     Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
     const float dt = 1.0f / 60.0f;
@@ -163,8 +257,10 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mPhysicsHostTakenMs.push_back(stepping.mTimed.mHostTakenMs);
         result.mSteps.push_back(physics.GetLastStepStatistics());
         gameObjects->ApplyMoves(frameJobs, inSettings.mGameObjectJobs);
-        agents->Update(dt, player);
-        scheduler->Update();
+        if (Status focused = navMeshes.Focus(player, navMeshRadius); !focused && result.mErrors.size() < 20)
+            result.mErrors.push_back("navmesh invoker: " + focused.GetError().mMessage);
+        agents->Update(dt, player, frameJobs);
+        navMeshes.Update();
         result.mFrameMs.push_back(MillisecondsSince(frameStart));
 
         if (IsProgressFrame(inProgress, liveProgress, frame, inSettings.mFrames))
@@ -175,7 +271,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
                          "dynamic  navmesh tiles %3d%s",
                          liveProgress ? "\r" : "", result.mModeName.c_str(), frame + 1, inSettings.mFrames,
                          result.mPhysicsMs.back(), streamer->GetLoadedTiles().size(), streaming.mStaticBodies,
-                         streaming.mDynamicBodies, navMesh->GetNumTiles(), liveProgress ? "   " : "\n");
+                         streaming.mDynamicBodies, navMeshes.mNavMeshes[0]->GetNumTiles(),
+                         liveProgress ? "   " : "\n");
             std::fflush(inProgress);
         }
         if (inSettings.mRealTime)
@@ -188,29 +285,35 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
 
     // Invariants: every tile the agents asked for gets built; no body lost or duplicated by streaming
     if (!RunUntil(
-            physics, frameJobs, *scheduler, [&] { return scheduler->IsIdle() && streamer->IsSettled(); },
-            30.0))
+            physics, frameJobs, navMeshes, [&] { return navMeshes.IsIdle() && streamer->IsSettled(); }, 30.0))
         result.mErrors.push_back("the navmesh or the streaming did not settle within 30 s after the run");
-    result.mTilesRequestedNeverBuilt = scheduler->CountNeededNeverPublished();
+    for (const auto& scheduler : navMeshes.mSchedulers)
+    {
+        result.mTilesRequestedNeverBuilt += scheduler->CountNeededNeverPublished();
+        const navmesh::TileScheduler::Stats navStats = scheduler->GetStats();
+        result.mNavTilesBuilt += navStats.mTilesPublished;
+        result.mNavTileLatencyFrames.insert(result.mNavTileLatencyFrames.end(),
+                                            navStats.mFirstPublishFrames.begin(),
+                                            navStats.mFirstPublishFrames.end());
+        if (navStats.mJobsFailed > 0) result.mErrors.push_back("navmesh: " + navStats.mLastError);
+    }
     result.mLostOrDuplicatedBodies = streamer->CountLostOrDuplicated();
-
-    const navmesh::TileScheduler::Stats navStats = scheduler->GetStats();
-    result.mNavTilesBuilt = navStats.mTilesPublished;
-    navMesh->Read([&](const dtNavMesh& inNavMesh) { result.mNavMeshObj = navmesh::NavMeshToObj(inNavMesh); });
-    result.mNavTileLatencyFrames = navStats.mFirstPublishFrames;
-    if (navStats.mJobsFailed > 0) result.mErrors.push_back("navmesh: " + navStats.mLastError);
-    const Agents::Stats& agentStats = agents->GetStats();
-    result.mPathQueries = agentStats.mPathQueries;
-    result.mPathsFound = agentStats.mPathsFound;
-    result.mPathsPartial = agentStats.mPathsPartial;
-    result.mPathsFailed = agentStats.mPathsFailed;
-    result.mPathQueryMicrosMean =
-        agentStats.mPathQueries == 0 ? 0.0 : agentStats.mPathMicros / double(agentStats.mPathQueries);
-    result.mAgentDistanceMetres = agentStats.mDistance;
-    result.mAgentCatchUps = agentStats.mCatchUps;
-    result.mPathsThroughWalls = agentStats.mPathsThroughWalls;
-    for (const std::string& error : agentStats.mErrors)
+    navMeshes.mNavMeshes[0]->Read([&](const dtNavMesh& inNavMesh)
+                                  { result.mNavMeshObj = navmesh::NavMeshToObj(inNavMesh); });
+    result.mNavMap = NavMap(*navMeshes.mNavMeshes[0], navMeshes.mSchedulers[0]->GetStats());
+    agents->FinishStats();
+    result.mAgentStats = agents->GetStats();
+    for (const std::string& error : result.mAgentStats.mErrors)
         result.mErrors.push_back("agents: " + error);
+    if (result.mAgentStats.mInsideStatic > 0)
+        result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mInsideStatic) +
+                                 " checks found an agent inside a static body");
+    if (result.mAgentStats.mOffNavMeshOverOneSecond > 0)
+        result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mOffNavMeshOverOneSecond) +
+                                 " times an agent was off the navmesh for over 1 s");
+    if (result.mAgentStats.mCorridorsThroughGone > 0)
+        result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mCorridorsThroughGone) +
+                                 " corridors went through a polygon that was gone");
     result.mQueries = gameObjects->GetNumQueries();
     if (const uint64_t queryErrors = gameObjects->GetNumQueryErrors(); queryErrors > 0)
         result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");
@@ -234,7 +337,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     // Tear down in dependency order: agents (invokers), the scheduler (its jobs read the world), then the
     // streamer, whose unload checks every body it made once more
     agents.reset();
-    scheduler.reset();
+    for (auto& scheduler : navMeshes.mSchedulers)
+        scheduler.reset();
     result.mLostOrDuplicatedBodies += streamer->UnloadAllAndCheck();
     streamer.reset();
     gameObjects.reset();

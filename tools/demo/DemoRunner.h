@@ -3,7 +3,8 @@
 // DemoRunner: one run of the streaming open-world demo in one broad-phase mode. The main thread's frame:
 //   streaming focus -> balls thrown by the player -> physics step (job system) -> game-object jobs (queries
 //   and moves on the job threads)
-//   -> AI agents (paths) -> navmesh sync point (TileScheduler::Update) -> wait for the next 1/60 s tick.
+//   -> AI agents (goals and the two crowds: paths on a budget here, steering on the job threads) -> navmesh
+//   sync point (each profile's TileScheduler::Update) -> wait for the next 1/60 s tick.
 // The loading thread streams tiles in and out meanwhile, and background tile jobs build the navmesh.
 // Threads: RunDemo on one thread; it owns everything it makes.
 
@@ -24,7 +25,7 @@ using namespace cairn::physics;
 inline constexpr uint32_t cDemoMaxBodies = 65536;
 inline constexpr uint32_t cDemoSpareBodies = 4096;
 /// The largest values the demo takes, from its flags and its world file alike.
-inline constexpr int cDemoMaxAgents = 1000;
+inline constexpr int cDemoMaxAgents = 10000;
 inline constexpr int cDemoMaxCollisionSteps = 8;
 inline constexpr float cDemoMaxCandidateMargin = 100.0f;
 inline constexpr uint32_t cDemoMaxGameObjects = 20000;
