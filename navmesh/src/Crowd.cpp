@@ -55,11 +55,58 @@ uint64_t CellKey(int32_t inX, int32_t inZ)
     return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ);
 }
 
+/// A cell's bucket before the mask (splitmix64's finalizer: neighbouring cells land far apart).
+uint64_t CellHash(uint64_t inKey)
+{
+    inKey = (inKey ^ (inKey >> 30)) * 0xbf58476d1ce4e5b9ull;
+    inKey = (inKey ^ (inKey >> 27)) * 0x94d049bb133111ebull;
+    return inKey ^ (inKey >> 31);
+}
+
 Vec3 Flat(const Vec3& inV)
 {
     return Vec3(inV.x(), 0.0f, inV.z());
 }
 } // namespace
+
+/// The first three corners of inCorridor's straight path (as dtPathCorridor::findCorners), looked for in its
+/// first cCornerWindow polygons only: Detour's string pulling walks the portals until it has its corners,
+/// which on open ground is the whole corridor, every Update. The window ends on its last polygon's edge, at
+/// the point nearest the corridor's target: a point the agent heads for until the window moves on, not a
+/// corner of the path (no slowing down there).
+constexpr int cCornerWindow = 16;
+int FindCorners(dtPathCorridor& ioCorridor, dtNavMeshQuery& ioQuery, const dtQueryFilter& inFilter,
+                float* outCorners, unsigned char* outFlags, dtPolyRef* outPolygons)
+{
+    constexpr int cMaxCorners = 3;
+    const int count = ioCorridor.getPathCount();
+    const dtPolyRef* path = ioCorridor.getPath();
+    if (count <= cCornerWindow)
+        return ioCorridor.findCorners(outCorners, outFlags, outPolygons, cMaxCorners, &ioQuery, &inFilter);
+    // The window ends on its last polygon's edge, at the point nearest the corridor's target
+    float end[3];
+    if (dtStatusFailed(
+            ioQuery.closestPointOnPolyBoundary(path[cCornerWindow - 1], ioCorridor.getTarget(), end)))
+        return ioCorridor.findCorners(outCorners, outFlags, outPolygons, cMaxCorners, &ioQuery, &inFilter);
+    int numCorners = 0;
+    ioQuery.findStraightPath(ioCorridor.getPos(), end, path, cCornerWindow, outCorners, outFlags, outPolygons,
+                             &numCorners, cMaxCorners);
+    // As Detour's findCorners: corners on the agent are passed already; an off-mesh link ends the list
+    int first = 0;
+    while (first < numCorners && dtVdist2DSqr(&outCorners[3 * first], ioCorridor.getPos()) < 0.01f * 0.01f &&
+           (outFlags[first] & DT_STRAIGHTPATH_OFFMESH_CONNECTION) == 0)
+        ++first;
+    int kept = 0;
+    for (int c = first; c < numCorners; ++c)
+    {
+        dtVcopy(&outCorners[3 * kept], &outCorners[3 * c]);
+        outFlags[kept] = outFlags[c] & ~DT_STRAIGHTPATH_END; // The window's end is not the corridor's
+        outPolygons[kept] = outPolygons[c];
+        ++kept;
+        if ((outFlags[c] & DT_STRAIGHTPATH_OFFMESH_CONNECTION) != 0) break;
+    }
+    return kept;
+}
 
 struct Crowd::Agent
 {
@@ -71,8 +118,9 @@ struct Crowd::Agent
     bool mHasTarget = false;
     PathTicket mTicket;
     AgentState mState = AgentState::Idle;
-    float mStuckSeconds = 0.0f; ///< Moving but hardly: how long, for the way out of a jam
-    bool mReplanned = false;    ///< This Update's corridor check cut its corridor short
+    float mStuckSeconds = 0.0f;     ///< Moving but hardly: how long, for the way out of a jam
+    bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
+    dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
 
     Vec3 Position() const
     {
@@ -220,6 +268,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
         {
             scratchReady = MakeScratch(inNavMesh, std::max<uint32_t>(chunks, 1));
             if (!scratchReady) return;
+            NoteTileChanges(inNavMesh);
             // The grid's cell is the largest neighbour range of the agents now: a 3 x 3 block of cells holds
             // every neighbour in range, and few more. The physics bodies are looked for round the agents
             float largestRadius = 0.0f;
@@ -257,7 +306,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             for (const Obstacle& obstacle : mObstacles)
                 AddToSnapshot(obstacle.mCentre, obstacle.mVelocity, obstacle.mRadius);
             mStatistics.mLastObstacles = uint32_t(mObstacles.size());
-            std::sort(mCellAgents.begin(), mCellAgents.end());
+            BuildBuckets();
 
             // The path search reads only the navmesh and its queue, the moves only the snapshot and their own
             // agents: the two run side by side, the search as a task
@@ -345,6 +394,69 @@ void Crowd::GatherPhysicsObstacles(const AABB& inAround, float inDeltaTime)
     mPreviousObstacles = std::move(current);
 }
 
+void Crowd::NoteTileChanges(const dtNavMesh& inNavMesh)
+{
+    // A tile slot whose salt or presence changed since the last Update was rebuilt, removed or added: the
+    // polygon references into it may be stale, and the walls near it moved
+    const int slots = inNavMesh.getMaxTiles();
+    const bool first = mTileSeen.size() != size_t(slots);
+    mTileSeen.resize(size_t(slots));
+    mTileChanged.assign(size_t(slots), first ? 1 : 0);
+    mChangedAreas.clear();
+    mAnyTileChanged = first;
+    for (int slot = 0; slot < slots; ++slot)
+    {
+        const dtMeshTile* tile = inNavMesh.getTile(slot);
+        TileSeen now;
+        now.mSalt = tile->salt;
+        now.mPresent = tile->header != nullptr;
+        if (now.mPresent)
+        {
+            now.mArea = {tile->header->bmin[0], tile->header->bmin[2], tile->header->bmax[0],
+                         tile->header->bmax[2]};
+        }
+        TileSeen& seen = mTileSeen[size_t(slot)];
+        if (!first && now.mSalt == seen.mSalt && now.mPresent == seen.mPresent) continue;
+        mTileChanged[size_t(slot)] = 1;
+        mAnyTileChanged = true;
+        // The area it covered, and the area it covers now
+        if (seen.mPresent) mChangedAreas.push_back(seen.mArea);
+        if (now.mPresent) mChangedAreas.push_back(now.mArea);
+        if (!now.mPresent) now.mArea = seen.mArea;
+        seen = now;
+    }
+}
+
+bool Crowd::NearChangedTile(const Vec3& inCentre, float inRange) const
+{
+    for (const std::array<float, 4>& area : mChangedAreas)
+    {
+        const float dx = std::max({area[0] - inCentre.x(), 0.0f, inCentre.x() - area[2]});
+        const float dz = std::max({area[1] - inCentre.z(), 0.0f, inCentre.z() - area[3]});
+        if (dx * dx + dz * dz <= inRange * inRange) return true;
+    }
+    return false;
+}
+
+void Crowd::BuildBuckets()
+{
+    // A power of two of at least twice the entries: few cells share a bucket
+    size_t buckets = 64;
+    while (buckets < 2 * mCellAgents.size())
+        buckets *= 2;
+    mBucketMask = buckets - 1;
+    mBucketStart.assign(buckets + 1, 0);
+    for (const auto& [key, index] : mCellAgents)
+        ++mBucketStart[(CellHash(key) & mBucketMask) + 1];
+    for (size_t b = 0; b < buckets; ++b)
+        mBucketStart[b + 1] += mBucketStart[b];
+    mBuckets.resize(mCellAgents.size());
+    std::vector<uint32_t>& next = mBucketFill;
+    next.assign(mBucketStart.begin(), mBucketStart.end() - 1);
+    for (const auto& entry : mCellAgents) // In snapshot order: each bucket keeps it
+        mBuckets[next[CellHash(entry.first) & mBucketMask]++] = entry;
+}
+
 void Crowd::AddToSnapshot(const Vec3& inPosition, const Vec3& inVelocity, float inRadius)
 {
     const uint32_t index = uint32_t(mSnapshotPositions.size());
@@ -413,7 +525,13 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
                 agent.mState = agent.mHasTarget ? AgentState::WaitingForPath : AgentState::Idle;
             }
         }
-        if (corridor.getPathCount() > 1 &&
+        // Only a corridor crossing a tile that changed since the last Update can hold a polygon that is gone:
+        // the others are as valid as they were
+        bool crossesChange = false;
+        if (mAnyTileChanged)
+            for (int p = 0; p < corridor.getPathCount() && !crossesChange; ++p)
+                crossesChange = mTileChanged[navMesh.decodePolyIdTile(corridor.getPath()[p])] != 0;
+        if (crossesChange && corridor.getPathCount() > 1 &&
             !corridor.isValid(corridor.getPathCount(), &ioQuery, mFilter.get()))
         {
             // A polygon of its corridor went away (a tile rebuilt or removed): it keeps the part up to there
@@ -507,15 +625,18 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         const float radius = agent.mParams.mRadius, maxSpeed = agent.mParams.mMaxSpeed;
         const float range = cCollisionRangeRadii * radius;
         const float neighbourRange = cNeighbourRangeRadii * radius;
-        // The walls near it, again once it has moved a quarter of the range from where they were gathered
+        // The walls near it, again once it has moved a quarter of the range from where they were gathered,
+        // or when a tile within the range changed (a tile published next to it turns a wall at the tile's
+        // edge into a way through; a tile rebuilt moves walls and renumbers polygons)
         const Vec3 boundaryCentre(agent.mBoundary.getCenter()[0], agent.mBoundary.getCenter()[1],
                                   agent.mBoundary.getCenter()[2]);
-        // And every half second (a tile published next to it turns a wall at the tile's edge into a way
-        // through, which the polygons' validity does not tell), spread over the agents by id
-        if (Flat(position - boundaryCentre).norm() > 0.25f * range || (mUpdates + mOrder[i]) % 30 == 0 ||
-            !agent.mBoundary.isValid(&ioQuery, mFilter.get()))
+        if (Flat(position - boundaryCentre).norm() > 0.25f * range ||
+            NearChangedTile(boundaryCentre, range) || agent.mBoundaryPolygon == 0)
+        {
             agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
                                    mFilter.get());
+            agent.mBoundaryPolygon = agent.mCorridor.getFirstPoly();
+        }
 
         Vec3 desired = Vec3::Zero();
         // An agent waiting for a new path walks on along what is left of its old corridor
@@ -526,8 +647,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             float corners[3 * 3];
             unsigned char flags[3];
             dtPolyRef polygons[3];
-            const int numCorners =
-                agent.mCorridor.findCorners(corners, flags, polygons, 3, &ioQuery, mFilter.get());
+            const int numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
             const Vec3 end(agent.mCorridor.getTarget()[0], agent.mCorridor.getTarget()[1],
                            agent.mCorridor.getTarget()[2]);
             if (numCorners == 0 || Flat(end - position).norm() < radius)
@@ -566,14 +686,17 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             for (int32_t dz = -1; dz <= 1; ++dz)
             {
                 const uint64_t key = CellKey(cx + dx, cz + dz);
-                auto it = std::lower_bound(mCellAgents.begin(), mCellAgents.end(),
-                                           std::pair<uint64_t, uint32_t>(key, 0));
-                for (; it != mCellAgents.end() && it->first == key; ++it)
+                const uint64_t bucket = CellHash(key) & mBucketMask;
+                for (uint32_t e = mBucketStart[bucket]; e < mBucketStart[bucket + 1]; ++e)
                 {
-                    const uint32_t j = it->second;
+                    if (mBuckets[e].first != key) continue; // Another cell in the same bucket
+                    const uint32_t j = mBuckets[e].second;
                     if (j == i) continue;
-                    const float distance = Flat(position - mSnapshotPositions[j]).norm();
-                    if (distance >= neighbourRange) continue;
+                    const float ox = position.x() - mSnapshotPositions[j].x(),
+                                oz = position.z() - mSnapshotPositions[j].z();
+                    const float distanceSq = ox * ox + oz * oz;
+                    if (distanceSq >= neighbourRange * neighbourRange) continue;
+                    const float distance = std::sqrt(distanceSq);
                     // Kept sorted by insertion: at most cMaxNeighbours, the nearest
                     const std::pair<float, uint32_t> entry(distance, j);
                     if (numNeighbours == cMaxNeighbours && !(entry < neighbours[cMaxNeighbours - 1]))

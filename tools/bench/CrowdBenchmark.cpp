@@ -1,13 +1,18 @@
 // cairn-bench-crowd: a crowd walking on the navmesh of a physics world, for 100, 1,000 and 10,000 agents
 // (issue 32's figures).
-//  crowd_N  a 204.8 m square of ground (16 x 16 tiles of 12.8 m) with 400 crates on it, its navmesh built by
-//           the tile pipeline; N agents (radius 0.6 m) placed at random, each given a random goal on the
-//           navmesh 10-60 m away, and a new one when it arrives. 600 frames of 1/60 s on a job system of
-//           --threads threads (2 by default, 1 also measured with --threads 1,2).
-// Prints per frame (p50, p99, max): the crowd's work on the calling thread (path budget, path results and
-// corridor checks, snapshot) and its steering loop (on the job threads); paths served and failed, the path
-// wait in frames (p99, max), arrivals, replans, and agents stuck (Moving under 0.2 m/s for 5 s or more at the
-// end). The figures are the crowd's own: the physics world does not step (its navmesh is built once).
+//  The world: a 665.6 m square of ground (52 x 52 tiles of 12.8 m) with crates on it (one per 105 m^2), its
+//  navmesh built by the tile pipeline once, before the runs.
+//  crowd_N        N agents (radius 0.6 m) placed at random in a square round the centre sized for 42 m^2 an
+//                 agent (a 204.8 m square for 1,000), so that N grows as an open world's population does:
+//                 with the area. Each is given a random goal on the navmesh 10-60 m away, a new one on
+//                 arrival.
+//  crowd_10000_dense  10,000 agents in the 1,000's square: ten times as dense (4.2 m^2 an agent).
+//  600 frames of 1/60 s on a job system of --threads threads (2 by default, 1 also with --threads 1,2).
+// Prints per frame (p50, p99, max): the crowd's work on the calling thread alone (path requests and results,
+// the snapshot) and in its parallel parts (corridor checks; steering beside the path queue's budget, on the
+// job threads, the caller taking part); paths served and failed, the path wait in frames (p99, max),
+// arrivals, replans, and agents stuck (Moving under 0.2 m/s for 5 s or more at the end). The figures are the
+// crowd's own: the physics world does not step.
 
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/jobs/JobSystem.h"
@@ -20,7 +25,9 @@
 #include "common/MachineInfo.h"
 #include "common/PhysicsSystemOrExit.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <thread>
@@ -32,7 +39,9 @@ using namespace cairn::navmesh;
 
 namespace
 {
-constexpr int cTilesPerSide = 8; // Each side of the origin
+constexpr int cTilesPerSide = 26;        // Each side of the origin
+constexpr float cAreaPerAgent = 41.94f;  ///< m^2: 1,000 agents in a 204.8 m square
+constexpr float cAreaPerCrate = 104.86f; ///< m^2: 400 crates in a 204.8 m square
 constexpr int cFrames = 600;
 
 struct World
@@ -46,7 +55,7 @@ World MakeWorld()
 {
     World world;
     PhysicsSettings settings;
-    settings.mMaxBodies = 4096;
+    settings.mMaxBodies = 8192;
     world.mPhysics = tools::CreatePhysicsSystemOrExit("cairn-bench-crowd", settings);
     BodyInterface& bodies = world.mPhysics->GetBodyInterface();
     const AgentProfile profile;
@@ -59,7 +68,8 @@ World MakeWorld()
     (void)bodies.CreateAndAddBody(ground, Activation::DontActivate);
     std::mt19937 random(17);
     std::uniform_real_distribution<float> coordinate(-half + 3.0f, half - 3.0f), size(0.5f, 2.0f);
-    for (int i = 0; i < 400; ++i)
+    const int crates = int(4.0f * half * half / cAreaPerCrate);
+    for (int i = 0; i < crates; ++i)
     {
         BodyCreationSettings crate = ground;
         crate.mShape = BoxShape::Create(Vec3(size(random), 1.0f, size(random))).Value();
@@ -90,15 +100,16 @@ std::optional<Vec3> GoalNear(const NavMeshWorld& inWorld, const Vec3& inFrom, ui
     return goal.Value();
 }
 
-void Run(const World& inWorld, int inAgents, uint32_t inThreads)
+/// inAgents agents in a square of inSide metres round the centre.
+void Run(const World& inWorld, const char* inName, int inAgents, float inSide, uint32_t inThreads)
 {
     jobs::JobSystem jobSystem(jobs::JobSystem::Settings{inThreads});
     Crowd::Settings settings;
     settings.mMaxAgents = inAgents;
     std::unique_ptr<Crowd> crowd = Crowd::Create(*inWorld.mNavMesh, settings).Value();
-    const float half = float(cTilesPerSide) * AgentProfile().mTileSize;
+    const float half = std::min(0.5f * inSide, float(cTilesPerSide) * AgentProfile().mTileSize - 2.0f);
     std::mt19937 random{uint32_t(inAgents)};
-    std::uniform_real_distribution<float> coordinate(-half + 2.0f, half - 2.0f);
+    std::uniform_real_distribution<float> coordinate(-half, half);
     uint64_t seed = 1;
     while (int(crowd->GetAgents().size()) < inAgents)
     {
@@ -108,7 +119,7 @@ void Run(const World& inWorld, int inAgents, uint32_t inThreads)
                 GoalNear(*inWorld.mNavMesh, crowd->GetPosition(agent.Value()).Value(), seed++))
             (void)crowd->SetTarget(agent.Value(), *goal);
     }
-    std::vector<double> serialMs, moveMs;
+    std::vector<double> serialMs, moveMs, updateMs;
     std::vector<float> slowSeconds(size_t(inAgents), 0.0f);
     uint64_t arrivals = 0;
     for (int frame = 0; frame < cFrames; ++frame)
@@ -116,6 +127,7 @@ void Run(const World& inWorld, int inAgents, uint32_t inThreads)
         (void)crowd->Update(1.0f / 60.0f, &jobSystem);
         serialMs.push_back(crowd->GetStatistics().mLastSerialMs);
         moveMs.push_back(crowd->GetStatistics().mLastMoveMs);
+        updateMs.push_back(crowd->GetStatistics().mLastSerialMs + crowd->GetStatistics().mLastMoveMs);
         for (Crowd::AgentID agent : crowd->GetAgents())
         {
             const AgentState state = crowd->GetState(agent).Value();
@@ -140,16 +152,20 @@ void Run(const World& inWorld, int inAgents, uint32_t inThreads)
     for (; waitP99 < 65 && below + paths.mWaitHistogram[size_t(waitP99)] < (finished * 99 + 99) / 100;
          ++waitP99)
         below += paths.mWaitHistogram[size_t(waitP99)];
-    const tools::TimingSummary serial = tools::Summarize(serialMs), move = tools::Summarize(moveMs);
-    std::printf(
-        "crowd_%d threads=%u: calling thread p50 %.3f p99 %.3f max %.3f ms | steering loop p50 %.3f p99 "
-        "%.3f max %.3f ms | paths served %llu failed %llu, wait p99 %d%s max %llu frames | arrivals %llu, "
-        "replans %llu, stuck %d\n",
-        inAgents, inThreads, serial.mP50, serial.mP99, serial.mMax, move.mP50, move.mP99, move.mMax,
-        static_cast<unsigned long long>(paths.mServed), static_cast<unsigned long long>(paths.mFailed),
-        waitP99, waitP99 == 64 ? "+" : "", static_cast<unsigned long long>(paths.mWaitUpdatesMax),
-        static_cast<unsigned long long>(arrivals),
-        static_cast<unsigned long long>(crowd->GetStatistics().mReplans), stuck);
+    const tools::TimingSummary serial = tools::Summarize(serialMs), move = tools::Summarize(moveMs),
+                               update = tools::Summarize(updateMs);
+    std::printf("%s (%.0f m square, %.1f m^2 an agent) threads=%u: calling thread alone p50 %.3f p99 %.3f "
+                "max %.3f ms | "
+                "parallel parts p50 %.3f p99 %.3f max %.3f ms | whole update p50 %.3f p99 %.3f ms | paths "
+                "served %llu "
+                "failed %llu, wait p99 %d%s max %llu frames | arrivals %llu, replans %llu, stuck %d\n",
+                inName, 2.0 * half, 4.0 * half * half / inAgents, inThreads, serial.mP50, serial.mP99,
+                serial.mMax, move.mP50, move.mP99, move.mMax, update.mP50, update.mP99,
+                static_cast<unsigned long long>(paths.mServed),
+                static_cast<unsigned long long>(paths.mFailed), waitP99, waitP99 == 64 ? "+" : "",
+                static_cast<unsigned long long>(paths.mWaitUpdatesMax),
+                static_cast<unsigned long long>(arrivals),
+                static_cast<unsigned long long>(crowd->GetStatistics().mReplans), stuck);
 }
 } // namespace
 
@@ -158,16 +174,28 @@ int main(int inArgc, char** inArgv)
     tools::BenchOptions options;
     options.mThreads = {2};
     if (auto stop = tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-crowd: a crowd on the navmesh",
-                                             {"crowd_100", "crowd_1000", "crowd_10000"}, options, true))
+                                             {"crowd_100", "crowd_1000", "crowd_10000", "crowd_10000_dense"},
+                                             options, true))
         return *stop;
     std::printf("cairn-bench-crowd: %s\n", tools::DescribeMachine().c_str());
     const World world = MakeWorld();
     std::printf("navmesh: %d tiles\n", world.mNavMesh->GetNumTiles());
-    for (int agents : {100, 1000, 10000})
+    struct Case
     {
-        if (!options.mOnly.empty() && options.mOnly != "crowd_" + std::to_string(agents)) continue;
+        const char* mName;
+        int mAgents;
+        float mSide;
+    };
+    const float side1000 = std::sqrt(1000.0f * cAreaPerAgent);
+    const Case cases[] = {{"crowd_100", 100, std::sqrt(100.0f * cAreaPerAgent)},
+                          {"crowd_1000", 1000, side1000},
+                          {"crowd_10000", 10000, std::sqrt(10000.0f * cAreaPerAgent)},
+                          {"crowd_10000_dense", 10000, side1000}};
+    for (const Case& benchmark : cases)
+    {
+        if (!options.mOnly.empty() && options.mOnly != benchmark.mName) continue;
         for (uint32_t threads : options.mThreads)
-            Run(world, agents, threads);
+            Run(world, benchmark.mName, benchmark.mAgents, benchmark.mSide, threads);
     }
     return 0;
 }

@@ -30,6 +30,7 @@
 #include "cairn/physics/body/BodyID.h"
 #include "cairn/physics/body/Layers.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -188,8 +189,31 @@ private:
     /// Entries from here on (physics bodies) do not give way; those before (this crowd's agents, then the
     /// other crowds') give way half each
     uint32_t mSnapshotNoYield = 0;
-    /// The neighbour grid over the snapshot: cell -> first entry in mCellAgents, each cell's agents in order
+    /// The neighbour grid over the snapshot: each entry's cell, by snapshot index
     std::vector<std::pair<uint64_t, uint32_t>> mCellAgents;
+    /// The same entries by hashed cell (a counting sort, so each bucket keeps snapshot order): bucket b holds
+    /// mBuckets[mBucketStart[b], mBucketStart[b + 1]); a bucket may hold other cells' entries too
+    std::vector<uint32_t> mBucketStart;
+    std::vector<std::pair<uint64_t, uint32_t>> mBuckets;
+    uint64_t mBucketMask = 0;
+    std::vector<uint32_t> mBucketFill; ///< Scratch of BuildBuckets
+    /// Sorts mCellAgents into the buckets.
+    void BuildBuckets();
+    /// Which tile slots changed since the last Update (mTileChanged, mChangedAreas).
+    void NoteTileChanges(const dtNavMesh& inNavMesh);
+    /// Whether a tile that changed since the last Update is within inRange of inCentre (x-z).
+    bool NearChangedTile(const Vec3& inCentre, float inRange) const;
+    /// Each Detour tile slot as the last Update saw it
+    struct TileSeen
+    {
+        unsigned int mSalt = 0;
+        bool mPresent = false;
+        std::array<float, 4> mArea{}; ///< min x, min z, max x, max z (while present, and after)
+    };
+    std::vector<TileSeen> mTileSeen;
+    std::vector<uint8_t> mTileChanged; ///< By slot: changed since the last Update
+    std::vector<std::array<float, 4>> mChangedAreas;
+    bool mAnyTileChanged = true;
     float mCellSize = 1.0f; ///< The grid's, this Update
     uint64_t mUpdates = 0;  ///< Updates so far (the walls' refresh is spread over them)
     std::vector<const Crowd*> mOtherCrowds;
