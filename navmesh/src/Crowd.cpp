@@ -22,7 +22,7 @@ const Vec3 cSnapExtent(2.0f, 4.0f, 2.0f);
 /// Agents in a ParallelFor chunk: steering one costs a few microseconds.
 constexpr uint32_t cAgentsPerChunk = 64;
 /// The neighbours and walls an agent avoids: within this many of its radii (DetourCrowd's choice)
-constexpr float cCollisionRangeRadii = 12.0f;
+constexpr float cCollisionRangeRadii = 8.0f;
 /// The neighbours an agent avoids: within this many of its radii, the nearest cMaxNeighbours (at walking
 /// speed and DetourCrowd's time horizon, those further off are not met before the next few Updates see them
 /// again)
@@ -121,6 +121,8 @@ struct Crowd::Agent
     float mStuckSeconds = 0.0f;     ///< Moving but hardly: how long, for the way out of a jam
     bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
     dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
+    uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
+    Vec3 mSampledVelocity = Vec3::Zero();
 
     Vec3 Position() const
     {
@@ -144,6 +146,9 @@ Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const 
         return MakeError(ErrorCode::InvalidArgument, "crowd: max agents must be in [1, 2^20]");
     if (!(inSettings.mMaxAgentRadius > 0.0f && inSettings.mMaxAgentRadius <= inWorld.GetGrid().GetTileSize()))
         return MakeError(ErrorCode::InvalidArgument, "crowd: the max agent radius must be in (0, a tile]");
+    if (!(inSettings.mAvoidancePeriod >= 1 && inSettings.mAvoidancePeriod <= 60))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "crowd: the avoidance period must be in [1, 60] Updates");
     if (!(inSettings.mMaxCorridorPolygons >= 2 && inSettings.mMaxCorridorPolygons <= cMaxPathPolygons))
         return MakeError(ErrorCode::InvalidArgument, "crowd: corridor polygons must be in [2, 1024]");
     std::unique_ptr<Crowd> crowd(new Crowd(inWorld, inSettings));
@@ -311,6 +316,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             // The path search reads only the navmesh and its queue, the moves only the snapshot and their own
             // agents: the two run side by side, the search as a task
             mChunkSampled.assign(std::max<uint32_t>(chunks, 1), 0);
+            mChunkWalls.assign(std::max<uint32_t>(chunks, 1), 0);
             auto search = [&]
             {
                 const Clock::time_point searchStart = Clock::now();
@@ -326,6 +332,9 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             mStatistics.mLastSampled = 0;
             for (uint32_t sampled : mChunkSampled)
                 mStatistics.mLastSampled += sampled;
+            mStatistics.mLastWallUpdates = 0;
+            for (uint32_t walls : mChunkWalls)
+                mStatistics.mLastWallUpdates += walls;
             ApplyPathResults();
         });
     if (!scratchReady)
@@ -636,6 +645,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
                                    mFilter.get());
             agent.mBoundaryPolygon = agent.mCorridor.getFirstPoly();
+            ++mChunkWalls[inBegin / cAgentsPerChunk];
         }
 
         Vec3 desired = Vec3::Zero();
@@ -677,7 +687,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             }
         }
 
-        // The nearest neighbours in range, as the snapshot has them (ties by order: deterministic)
+        // The nearest neighbours in range, as the snapshot has them, by gap (ties by order: deterministic)
         std::pair<float, uint32_t> neighbours[cMaxNeighbours];
         int numNeighbours = 0;
         const int32_t cx = int32_t(std::floor(position.x() / cell)),
@@ -698,7 +708,9 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                     if (distanceSq >= neighbourRange * neighbourRange) continue;
                     const float distance = std::sqrt(distanceSq);
                     // Kept sorted by insertion: at most cMaxNeighbours, the nearest
-                    const std::pair<float, uint32_t> entry(distance, j);
+                    // Nearest by the gap between them, not their centres: a large agent next to a crowd of
+                    // small ones is among the neighbours it touches
+                    const std::pair<float, uint32_t> entry(distance - radius - mSnapshotRadii[j], j);
                     if (numNeighbours == cMaxNeighbours && !(entry < neighbours[cMaxNeighbours - 1]))
                         continue;
                     int at = numNeighbours < cMaxNeighbours ? numNeighbours++ : cMaxNeighbours - 1;
@@ -743,7 +755,13 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             threatened =
                 dtDistancePtSegSqr2D(ahead.data(), segment, segment + 3, along) < 0.25f * radius * radius;
         }
-        if (threatened)
+        // A threatened agent keeps the velocity it sampled for mAvoidancePeriod Updates from then on: the
+        // acceleration limit and the contacts below still act every Update
+        const bool keepsSample = threatened && agent.mSampledAt != 0 &&
+                                 mUpdates - agent.mSampledAt < uint64_t(mSettings.mAvoidancePeriod);
+        if (keepsSample)
+            velocity = agent.mSampledVelocity;
+        else if (threatened)
         {
             ++mChunkSampled[inBegin / cAgentsPerChunk];
             ioAvoidance.reset();
@@ -765,7 +783,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                                                mSnapshotVelocities[i].data(), desired.data(), chosen.data(),
                                                &params);
             velocity = Flat(chosen);
+            agent.mSampledVelocity = velocity;
+            agent.mSampledAt = mUpdates;
         }
+        if (!threatened) agent.mSampledAt = 0;
         // The acceleration limit
         Vec3 change = velocity - mSnapshotVelocities[i];
         const float maxChange = agent.mParams.mMaxAcceleration * inDeltaTime;
@@ -776,16 +797,17 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         for (int n = 0; n < numNeighbours; ++n)
         {
             const uint32_t j = neighbours[n].second;
-            const float touching = radius + mSnapshotRadii[j];
-            if (neighbours[n].first >= touching) break; // Sorted by distance
+            const float gap = neighbours[n].first;
+            if (gap >= 0.0f) break; // Sorted by gap
+            const float distance = gap + radius + mSnapshotRadii[j];
             const Vec3 away = Flat(position - mSnapshotPositions[j]);
-            const Vec3 direction = neighbours[n].first > 1.0e-4f ? Vec3(away / neighbours[n].first)
-                                                                 : Vec3(j < i ? 1.0f : -1.0f, 0.0f, 0.0f);
+            const Vec3 direction =
+                distance > 1.0e-4f ? Vec3(away / distance) : Vec3(j < i ? 1.0f : -1.0f, 0.0f, 0.0f);
             const float into = velocity.dot(direction);
             if (into < 0.0f) velocity -= into * direction;
             // Half the overlap each (the other agent does the same), within this step; all of it from a body
             const float share = j >= mSnapshotNoYield ? 1.0f : 0.5f;
-            velocity += direction * (share * (touching - neighbours[n].first) / inDeltaTime);
+            velocity += direction * (share * -gap / inDeltaTime);
         }
         if (velocity.norm() > 2.0f * maxSpeed) velocity *= 2.0f * maxSpeed / velocity.norm();
         const Vec3 wanted = position + velocity * inDeltaTime;

@@ -98,6 +98,7 @@ Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, cons
     {
         navmesh::Crowd::Settings settings;
         settings.mMaxAgents = std::max(1, inCount);
+        settings.mAvoidancePeriod = 2; // Avoidance planned at 30 Hz, agents moved at 60
         Result<std::unique_ptr<navmesh::Crowd>> crowd =
             navmesh::Crowd::Create(*mProfiles[profile].mNavMesh, settings);
         if (!crowd)

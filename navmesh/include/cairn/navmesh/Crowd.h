@@ -71,9 +71,15 @@ public:
     struct Settings
     {
         int mMaxAgents = 16384;
-        float mMaxAgentRadius = 2.0f;      ///< m: the neighbour grid's cell is twice this
-        int mMaxCorridorPolygons = 256;    ///< Per agent
-        PathRequestQueue::Settings mPaths; ///< The crowd's own path queue
+        float mMaxAgentRadius = 2.0f;   ///< m: the neighbour grid's cell is twice this
+        int mMaxCorridorPolygons = 256; ///< Per agent
+        /// Updates an agent on a collision course keeps the velocity it sampled (DetourCrowd samples every
+        /// Update: 1). 2 halves the sampling, the crowd's largest cost in a dense crowd: avoidance is planned
+        /// at 30 Hz while agents move and part at 60.
+        int mAvoidancePeriod = 1;
+        /// The crowd's own path queue. Its budget is searched on a job thread beside the steering, not on
+        /// the calling thread: four times the queue's own default, enough for 10,000 agents' requests
+        PathRequestQueue::Settings mPaths{.mIterationsPerUpdate = 8192};
     };
     using AgentID = uint32_t;
 
@@ -143,6 +149,8 @@ public:
         /// Agents that sampled velocities in the last Update (on a collision course or near a wall): the
         /// steering's cost grows with them
         uint32_t mLastSampled = 0;
+        /// Agents that gathered their walls again in the last Update (moved on, or a tile near them changed)
+        uint32_t mLastWallUpdates = 0;
     };
     const Statistics& GetStatistics() const { return mStatistics; }
     const PathRequestQueue& GetPathQueue() const { return *mPaths; }
@@ -182,6 +190,7 @@ private:
     std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By id; null where removed
     std::vector<AgentID> mOrder;         ///< The agents in id order, for this Update
     std::vector<uint32_t> mChunkSampled; ///< Per ParallelFor chunk: its agents that sampled (a chunk's own)
+    std::vector<uint32_t> mChunkWalls;   ///< Per ParallelFor chunk: its agents that gathered walls again
     // The snapshot every agent steers from: positions and velocities at the Update's start, by mOrder index
     std::vector<Vec3> mSnapshotPositions;
     std::vector<Vec3> mSnapshotVelocities;
