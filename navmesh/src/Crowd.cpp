@@ -124,9 +124,21 @@ struct Crowd::Agent
     uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
     Vec3 mSampledVelocity = Vec3::Zero();
 
-    Vec3 Position() const
+    /// Detour's corridor keeps its old height when getPolyHeight fails, which it does on the edges of a
+    /// polygon's detail triangles: an agent stepping onto a crate kept the ground's height, a metre inside
+    /// the crate. The height is taken from the polygon's surface after every move (SetHeightFromSurface).
+    float mHeight = 0.0f;
+
+    Vec3 Position() const { return Vec3(mCorridor.getPos()[0], mHeight, mCorridor.getPos()[2]); }
+    /// mHeight from the surface of the agent's polygon under its position (its corridor's height if none).
+    void SetHeightFromSurface(const dtNavMeshQuery& inQuery)
     {
-        return Vec3(mCorridor.getPos()[0], mCorridor.getPos()[1], mCorridor.getPos()[2]);
+        mHeight = mCorridor.getPos()[1];
+        float closest[3];
+        if (mCorridor.getFirstPoly() != 0 &&
+            dtStatusSucceed(
+                inQuery.closestPointOnPoly(mCorridor.getFirstPoly(), mCorridor.getPos(), closest, nullptr)))
+            mHeight = closest[1];
     }
 };
 
@@ -192,6 +204,7 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
                                          nearest);
             onNavMesh = polygon != 0;
             agent->mCorridor.reset(polygon, onNavMesh ? nearest : inPosition.data());
+            agent->SetHeightFromSurface(*mQueries[0]);
         });
     if (!queryReady) return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not make its query");
     // No navmesh there yet (its tiles not built): it waits in place until there is
@@ -524,11 +537,13 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
             if (polygon == 0)
             {
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
+                agent.mHeight = corridor.getPos()[1];
                 agent.mState = AgentState::OffNavMesh;
                 agent.mVelocity.setZero();
                 continue;
             }
             corridor.reset(polygon, nearest);
+            agent.SetHeightFromSurface(ioQuery);
             if (agent.mState == AgentState::OffNavMesh || agent.mState == AgentState::Moving)
             {
                 agent.mState = agent.mHasTarget ? AgentState::WaitingForPath : AgentState::Idle;
@@ -813,6 +828,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         const Vec3 wanted = position + velocity * inDeltaTime;
         // Along the navmesh surface, inside the corridor: never off it
         agent.mCorridor.movePosition(wanted.data(), &ioQuery, mFilter.get());
+        agent.SetHeightFromSurface(ioQuery);
         agent.mVelocity = Flat(agent.Position() - position) / inDeltaTime;
     }
 }

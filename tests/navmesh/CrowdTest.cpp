@@ -1,6 +1,7 @@
 // A crowd on the navmesh: agents reach their goals keeping apart and on the navmesh; the same positions for
 // any number of job threads; tiles rebuilt and removed under walking agents leave no corridor through a
-// polygon that is gone; physics bodies and the agents of other crowds avoided; clear errors.
+// polygon that is gone; physics bodies and the agents of other crowds avoided; agents on the surface they
+// walk over; clear errors.
 
 #include "cairn/navmesh/Crowd.h"
 
@@ -339,6 +340,57 @@ TEST_F(CrowdTest, CrowdsToldOfEachOtherKeepApart)
     ASSERT_TRUE(RunUntilIdle());
     EXPECT_GT(ClosestGapBetweenCrowds(*mWorld, true), -0.06f);
     EXPECT_LT(ClosestGapBetweenCrowds(*mWorld, false), -1.0f);
+}
+
+// Agents walking over low crates they can step onto stand on them: their height is the surface's wherever
+// they are (Detour's corridor kept the ground's height when its getPolyHeight failed at a triangle's edge,
+// and agents stood inside the crate)
+TEST_F(CrowdTest, AgentsStandOnTheSurfaceTheyWalkOver)
+{
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(25, 0.5f, 25));
+    std::vector<AABB> crates;
+    for (int i = -2; i <= 2; ++i)
+    {
+        const Vec3 centre(float(i) * 4.0f, 0.25f, 0.3f * float(i));
+        const Vec3 half(1.2f, 0.25f, 1.5f + 0.2f * float(i + 2));
+        AddStaticBox(centre, half);
+        crates.push_back(AABB(centre - half, centre + half));
+    }
+    MakeNavMesh(2);
+    ASSERT_TRUE(RunUntilIdle());
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    std::vector<Crowd::AgentID> agents;
+    for (int row = 0; row < 8; ++row)
+    {
+        agents.push_back(crowd->AddAgent(Vec3(-14, 0, -3.5f + float(row))).Value());
+        EXPECT_TRUE(crowd->SetTarget(agents.back(), Vec3(14, 0, 3.5f - float(row))).IsOk());
+    }
+    int onCrates = 0, belowTheirTop = 0;
+    for (int frame = 0; frame < 900; ++frame)
+    {
+        ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
+        for (Crowd::AgentID agent : agents)
+        {
+            const Vec3 position = crowd->GetPosition(agent).Value();
+            for (const AABB& crate : crates)
+            {
+                // Well inside the crate's footprint: on top of it, or inside it
+                if (position.x() < crate.mMin.x() + 0.25f || position.x() > crate.mMax.x() - 0.25f ||
+                    position.z() < crate.mMin.z() + 0.25f || position.z() > crate.mMax.z() - 0.25f)
+                    continue;
+                ++onCrates;
+                if (position.y() < crate.mMax.y() - 0.15f)
+                {
+                    ++belowTheirTop;
+                    ADD_FAILURE() << "frame " << frame << ": agent " << agent << " at "
+                                  << position.transpose() << " below the crate's top " << crate.mMax.y();
+                }
+            }
+        }
+        if (belowTheirTop > 5) break;
+    }
+    EXPECT_GT(onCrates, 100) << "agent-frames on the crates: the scene must make them step up";
+    EXPECT_EQ(belowTheirTop, 0);
 }
 
 TEST_F(CrowdTest, BadInputGetsClearErrors)
