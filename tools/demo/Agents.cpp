@@ -150,10 +150,10 @@ Agents::~Agents() = default;
 
 float Agents::HomeRadius(int inCount)
 {
-    // Their places by the player: spread over a disc of 10 m^2 an agent (a busy street), at most 60 m across
-    // the radius (beyond, more agents walk closer together)
+    // Their places by the player: spread over a disc of 10 m^2 an agent (a busy street), at most 100 m across
+    // the radius (3 m^2 an agent for 10,000), well inside the loaded world
     return std::clamp(std::sqrt(float(std::max(0, inCount)) * 10.0f / std::numbers::pi_v<float>), 8.0f,
-                      60.0f);
+                      100.0f);
 }
 
 float Agents::NavMeshRadius(int inCount)
