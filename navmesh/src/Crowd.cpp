@@ -27,6 +27,8 @@ constexpr float cCollisionRangeRadii = 8.0f;
 /// speed and DetourCrowd's time horizon, those further off are not met before the next few Updates see them
 /// again)
 constexpr float cNeighbourRangeRadii = 6.0f;
+/// How far ahead a corridor is shortened by a straight look (DetourCrowd's pathOptimizationRange)
+constexpr float cPathOptimizationRangeRadii = 30.0f;
 /// At most this many neighbours, the nearest
 constexpr int cMaxNeighbours = 6;
 /// The wall segments a dtLocalBoundary keeps (its MAX_LOCAL_SEGS, private there)
@@ -121,6 +123,7 @@ struct Crowd::Agent
     float mStuckSeconds = 0.0f;     ///< Moving but hardly: how long, for the way out of a jam
     bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
     dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
+    dtPolyRef mLastPolygon = 0;     ///< Its corridor's first polygon at its last move
     uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
     Vec3 mSampledVelocity = Vec3::Zero();
 
@@ -672,7 +675,28 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             float corners[3 * 3];
             unsigned char flags[3];
             dtPolyRef polygons[3];
-            const int numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
+            int numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
+            // Into a new polygon whose corridor turns back through the one it left: an agent walking along a
+            // tile's edge crosses the corner where four tiles meet into a polygon the path does not take,
+            // and its first corner falls behind it (it turned back and forth there). A straight look towards
+            // the next corners and a short local search cut the detour off (DetourCrowd runs them every
+            // Update and every half second; here only on such a turn back)
+            const dtPolyRef first = agent.mCorridor.getFirstPoly();
+            if (first != agent.mLastPolygon && numCorners > 0)
+            {
+                bool turnsBack = false;
+                for (int p = 1; p < std::min(4, agent.mCorridor.getPathCount()) && !turnsBack; ++p)
+                    turnsBack = agent.mCorridor.getPath()[p] == agent.mLastPolygon;
+                if (turnsBack)
+                {
+                    agent.mCorridor.optimizePathVisibility(&corners[3 * std::min(1, numCorners - 1)],
+                                                           cPathOptimizationRangeRadii * radius, &ioQuery,
+                                                           mFilter.get());
+                    agent.mCorridor.optimizePathTopology(&ioQuery, mFilter.get());
+                    numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
+                }
+            }
+            agent.mLastPolygon = first;
             const Vec3 end(agent.mCorridor.getTarget()[0], agent.mCorridor.getTarget()[1],
                            agent.mCorridor.getTarget()[2]);
             if (numCorners == 0 || Flat(end - position).norm() < radius)
