@@ -22,7 +22,8 @@
 // Threads. Update: one thread at a time, not inside another navmesh call; its loop and the path search run
 // on the job interface's threads while the calling thread holds the navmesh shared (a Publish waits for the
 // Update).
-// AddAgent, RemoveAgent, SetTarget and the getters: the thread that calls Update, between Updates.
+// AddAgent, RemoveAgent, SetTarget and the setters: the thread that calls Update, between Updates. The
+// getters: that thread, or several threads at once between Updates (they only read).
 
 #include "cairn/jobs/JobInterface.h"
 #include "cairn/navmesh/NavMeshWorld.h"
