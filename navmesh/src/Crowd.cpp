@@ -27,6 +27,8 @@ constexpr float cCollisionRangeRadii = 8.0f;
 /// speed and DetourCrowd's time horizon, those further off are not met before the next few Updates see them
 /// again)
 constexpr float cNeighbourRangeRadii = 6.0f;
+/// Updates over which agents near a changed tile gather their walls again (by id)
+constexpr uint64_t cWallRefreshSpread = 8;
 /// How far ahead a corridor is shortened by a straight look (DetourCrowd's pathOptimizationRange)
 constexpr float cPathOptimizationRangeRadii = 30.0f;
 /// At most this many neighbours, the nearest
@@ -124,6 +126,7 @@ struct Crowd::Agent
     bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
     dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
     dtPolyRef mLastPolygon = 0;     ///< Its corridor's first polygon at its last move
+    bool mWallsStale = false;       ///< A tile near its walls changed since they were gathered
     uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
     Vec3 mSampledVelocity = Vec3::Zero();
 
@@ -653,16 +656,21 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         const float range = cCollisionRangeRadii * radius;
         const float neighbourRange = cNeighbourRangeRadii * radius;
         // The walls near it, again once it has moved a quarter of the range from where they were gathered,
-        // or when a tile within the range changed (a tile published next to it turns a wall at the tile's
-        // edge into a way through; a tile rebuilt moves walls and renumbers polygons)
+        // and within cWallRefreshSpread Updates of a tile within the range changing (a tile published next
+        // to it turns a wall at the tile's edge into a way through; a tile rebuilt moves walls). Spread by
+        // id: a world tile's crates waking rebuild a dozen tiles at once, and the hundreds of agents near
+        // them gathered walls in the same Update. Walls only steer the sampling: the corridor keeps the
+        // agent on the navmesh as it is now meanwhile
         const Vec3 boundaryCentre(agent.mBoundary.getCenter()[0], agent.mBoundary.getCenter()[1],
                                   agent.mBoundary.getCenter()[2]);
-        if (Flat(position - boundaryCentre).norm() > 0.25f * range ||
-            NearChangedTile(boundaryCentre, range) || agent.mBoundaryPolygon == 0)
+        if (NearChangedTile(boundaryCentre, range)) agent.mWallsStale = true;
+        if (Flat(position - boundaryCentre).norm() > 0.25f * range || agent.mBoundaryPolygon == 0 ||
+            (agent.mWallsStale && (mUpdates + mOrder[i]) % cWallRefreshSpread == 0))
         {
             agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
                                    mFilter.get());
             agent.mBoundaryPolygon = agent.mCorridor.getFirstPoly();
+            agent.mWallsStale = false;
             ++mChunkWalls[inBegin / cAgentsPerChunk];
         }
 

@@ -133,6 +133,8 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mGameObjectLockWaitUs = {0.0, 12.5};
     run.mPhysicsHostTakenMs = {std::nan(""), 0.125}; // Unknown in the first frame
     run.mMainThreadStreamHostTakenMs = {0.0};        // A series one short: its second field is empty
+    run.mAgentStats.mMainThreadMs = {0.125};         // Likewise the navigation's
+    run.mAgentStats.mJobThreadsMs = {1.5};
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
                    uint32_t inActive, uint32_t inPairs, uint32_t inPoints, double inLockWait)
     {
@@ -161,13 +163,13 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     EXPECT_EQ(lines[0],
               "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
               "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-              "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms");
-    EXPECT_EQ(
-        lines[1],
-        "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,0.00,,0.0000");
-    EXPECT_EQ(
-        lines[2],
-        "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,12.50,0.1250,");
+              "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms,nav_main_thread_ms,"
+              "nav_job_threads_ms");
+    EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,"
+                        "0.00,,0.0000,0.1250,"
+                        "1.5000");
+    EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,"
+                        "12.50,0.1250,,,");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 

@@ -1092,6 +1092,13 @@ struct TemporaryFiles
     }
 };
 
+/// A per-frame figure for frames.csv: empty where the series has none for the frame.
+std::string OptionalMsField(const std::vector<double>& inMs, size_t inFrame)
+{
+    if (inFrame >= inMs.size() || !std::isfinite(inMs[inFrame])) return {};
+    return Format("%.4f", inMs[inFrame]);
+}
+
 /// A frame's host share for frames.csv: empty where it can not be told (the thread was switched out).
 std::string HostTakenField(const std::vector<double>& inHostTakenMs, size_t inFrame)
 {
@@ -1106,7 +1113,8 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
     std::string csv =
         "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
         "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
-        "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms\n";
+        "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms,nav_main_thread_ms,"
+        "nav_job_threads_ms\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
@@ -1117,13 +1125,15 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s,%s\n",
+            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s,%s,%s,%s\n",
                           mode.c_str(), i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
                           step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
                           step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
                           step.mLockWaitMs, run.mGameObjectLockWaitUs[i],
                           HostTakenField(run.mPhysicsHostTakenMs, i).c_str(),
-                          HostTakenField(run.mMainThreadStreamHostTakenMs, i).c_str());
+                          HostTakenField(run.mMainThreadStreamHostTakenMs, i).c_str(),
+                          OptionalMsField(run.mAgentStats.mMainThreadMs, i).c_str(),
+                          OptionalMsField(run.mAgentStats.mJobThreadsMs, i).c_str());
         }
     }
     return csv;

@@ -35,12 +35,14 @@ std::string SvgHistogram(const std::string& inTitle, const std::string& inXLabel
 
 /// Per-frame figures of every run, one row per frame: mode, frame, the main thread's frame, its physics step
 /// and streaming work (ms), the step's phases (ms), its active bodies, pairs, contact points and lock waits
-/// (ms), and the game-object jobs' lock waits (µs, all threads).
+/// (ms), the game-object jobs' lock waits (µs, all threads), the host's share of the step and of the
+/// streaming call, and the navigation's work on the main thread and on the job threads (ms).
 std::string FramesCsv(const std::vector<DemoRunResult>& inRuns);
 
-/// Writes report.md, frames.csv, frame_times.svg, tile_latency.svg, nav_ms.svg and nav_map.svg to inFolder (created if missing). With
-/// two runs the one whose mode name contains "global" is compared against the other. On failure returns false
-/// with the path and reason in outError, and removes the files it had started; never throws.
+/// Writes report.md, frames.csv, frame_times.svg, tile_latency.svg, nav_ms.svg and nav_map.svg to inFolder
+/// (created if missing). With two runs the one whose mode name contains "global" is compared against the
+/// other. On failure returns false with the path and reason in outError, and removes the files it had
+/// started; never throws.
 bool WriteReport(const std::string& inFolder, const std::vector<DemoRunResult>& inRuns,
                  const std::string& inCommandLine, std::string& outError);
 
