@@ -5,6 +5,7 @@
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
+#include "NavMapSvg.h"
 #include "common/TempFiles.h"
 
 #include <algorithm>
@@ -240,6 +241,35 @@ TEST(DemoResultTest, MaxLessHostLeavesOutTheHostsKnownShareOfEachFrame)
     EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.5, 1.0, 0.75}, {1.5, std::nan(""), 3.0}), 1.5);
     EXPECT_DOUBLE_EQ(tools::MaxLessHost({2.0, 1.25}, {1.5, 0.0}), 1.25);
     EXPECT_TRUE(std::isnan(tools::MaxLessHost({}, {})));
+}
+
+// The map: a polygon per navmesh polygon, coloured by its tile's latency (grey when not known), and a line
+// per stretch of a trail: a put-back agent's trail breaks instead of drawing a line across the map
+TEST(DemoReportTest, NavMapDrawsPolygonsByLatencyAndBreaksTrailsWhereAgentsWerePutBack)
+{
+    DemoRunResult run;
+    run.mNavMap.push_back({{{0.0f, 0.0f}, {10.0f, 0.0f}, {10.0f, 10.0f}}, 0});
+    run.mNavMap.push_back({{{10.0f, 0.0f}, {20.0f, 0.0f}, {20.0f, 10.0f}}, 100});
+    run.mNavMap.push_back({{{0.0f, 10.0f}, {10.0f, 10.0f}, {0.0f, 20.0f}}, -1});
+    const float nan = std::nanf("");
+    run.mAgentStats.mTrails = {
+        {Vec3(1, 0, 1), Vec3(2, 0, 2), Vec3(nan, nan, nan), Vec3(15, 0, 5), Vec3(16, 0, 6)}};
+    run.mAgentStats.mTrailRadii = {0.6f};
+    const std::string svg = SvgNavMap(run);
+    auto count = [&](const std::string& inText)
+    {
+        size_t n = 0;
+        for (size_t at = svg.find(inText); at != std::string::npos; at = svg.find(inText, at + 1))
+            ++n;
+        return n;
+    };
+    EXPECT_EQ(count("<polygon "), 3u) << svg;
+    EXPECT_EQ(count("<polyline "), 2u) << svg;
+    EXPECT_EQ(count("fill=\"#00c840\" stroke=\"#ffffff\""), 1u) << "built at once: green";
+    EXPECT_EQ(count("fill=\"#ff0040\" stroke=\"#ffffff\""), 1u) << "the slowest (the p99): red";
+    EXPECT_EQ(count("fill=\"#c8c8c8\" stroke=\"#ffffff\""), 1u) << "not known: grey";
+    EXPECT_EQ(svg.find("nan"), std::string::npos);
+    EXPECT_NE(SvgNavMap(DemoRunResult()).find("no data"), std::string::npos);
 }
 
 TEST(DemoReportTest, SummaryJudgesTheFrameTargets)

@@ -304,6 +304,9 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
             (void)crowd.RemoveAgent(agent.mID); // Its own, known to the crowd
             AddAgent(i, FreeSpot(action));
             ++mStats.mCatchUps;
+            // Its trail breaks here: it was put back, it did not walk
+            for (size_t t = 0; t < mTrailAgents.size(); ++t)
+                if (mTrailAgents[t] == i) mStats.mTrails[t].push_back(Vec3::Constant(std::nanf("")));
             break;
         case Action::Kind::Goal:
             if (Status set = crowd.SetTarget(agent.mID, action.mPoint); !set)

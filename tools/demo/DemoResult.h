@@ -47,9 +47,10 @@ struct AgentStats
     uint64_t mOverlapChecks = 0;           ///< Agent-frames checked for overlaps (every 10th frame)
     uint64_t mOverlapping = 0; ///< Of those, agents overlapping another by more than 10 % of a radius
     uint64_t mInsideStaticChecks = 0;
-    uint64_t mInsideStatic = 0;             ///< An invariant: none
-    uint64_t mCorridorsThroughGone = 0;     ///< Corridors holding a polygon the navmesh lost: none
-    std::vector<std::vector<Vec3>> mTrails; ///< Of some agents, a point every quarter second
+    uint64_t mInsideStatic = 0;         ///< An invariant: none
+    uint64_t mCorridorsThroughGone = 0; ///< Corridors holding a polygon the navmesh lost: none
+    /// Of some agents, a point every quarter second; a NaN point where the agent was put back (no walk)
+    std::vector<std::vector<Vec3>> mTrails;
     std::vector<float> mTrailRadii;
     std::vector<std::string> mErrors;
 };

@@ -92,17 +92,28 @@ std::string SvgNavMap(const DemoRunResult& inRun)
     const std::vector<std::vector<Vec3>>& trails = inRun.mAgentStats.mTrails;
     for (size_t t = 0; t < trails.size(); ++t)
     {
-        std::string points;
-        for (const Vec3& point : trails[t])
-            if (std::isfinite(point.x()) && std::isfinite(point.z()))
-                points += Number(px(point.x())) + "," + Number(py(point.z())) + " ";
-        if (points.empty()) continue;
-        // A large agent's trail is drawn wider
+        // A large agent's trail is drawn wider; a non-finite point (the agent put back) breaks the line
         const float radius =
             t < inRun.mAgentStats.mTrailRadii.size() ? inRun.mAgentStats.mTrailRadii[t] : 0.6f;
-        svg += "<polyline points=\"" + points + "\" fill=\"none\" stroke=\"" +
-               cTrailColours[t % std::size(cTrailColours)] + "\" stroke-width=\"" +
-               Number(std::max(1.0, 1.5 * radius)) + "\" stroke-opacity=\"0.8\"/>\n";
+        auto draw = [&](const std::string& inPoints)
+        {
+            if (inPoints.empty()) return;
+            svg += "<polyline points=\"" + inPoints + "\" fill=\"none\" stroke=\"" +
+                   cTrailColours[t % std::size(cTrailColours)] + "\" stroke-width=\"" +
+                   Number(std::max(1.0, 1.5 * radius)) + "\" stroke-opacity=\"0.8\"/>\n";
+        };
+        std::string points;
+        for (const Vec3& point : trails[t])
+        {
+            if (std::isfinite(point.x()) && std::isfinite(point.z()))
+                points += Number(px(point.x())) + "," + Number(py(point.z())) + " ";
+            else
+            {
+                draw(points);
+                points.clear();
+            }
+        }
+        draw(points);
     }
 
     // Legend: the colour scale, the map's scale
