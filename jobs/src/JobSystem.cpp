@@ -6,6 +6,8 @@
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+#include <pthread.h>
+#include <sched.h>
 #endif
 
 namespace cairn::jobs
@@ -94,6 +96,25 @@ JobSystem::JobSystem(const Settings& inSettings)
     mWorkers.reserve(numThreads - 1);
     for (uint32_t i = 1; i < numThreads; ++i)
         mWorkers.emplace_back([this] { WorkerMain(); });
+    if (inSettings.mPinWorkers) PinWorkers();
+}
+
+void JobSystem::PinWorkers()
+{
+    cpu_set_t allowed;
+    CPU_ZERO(&allowed);
+    if (sched_getaffinity(0, sizeof(allowed), &allowed) != 0) return; // Left to the OS: a hint only
+    std::vector<int> cores;
+    for (int core = 0; core < CPU_SETSIZE; ++core)
+        if (CPU_ISSET(core, &allowed)) cores.push_back(core);
+    if (cores.size() < 2) return;
+    for (size_t i = 0; i < mWorkers.size(); ++i)
+    {
+        cpu_set_t one;
+        CPU_ZERO(&one);
+        CPU_SET(cores[(i + 1) % cores.size()], &one);
+        (void)pthread_setaffinity_np(mWorkers[i].native_handle(), sizeof(one), &one); // A hint as well
+    }
 }
 
 JobSystem::~JobSystem()

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <gtest/gtest.h>
 #include <random>
+#include <sched.h>
 #include <thread>
 #include <vector>
 
@@ -500,6 +501,55 @@ TEST(JobSystemTest, SchedulingAndRunningAllocateNothing)
     }
     EXPECT_EQ(scope.GetCount(), 0u);
     EXPECT_EQ(sum.load(), 20 * 1002);
+}
+
+} // namespace
+} // namespace cairn::jobs
+
+namespace cairn::jobs
+{
+namespace
+{
+
+/// The cores the calling thread may run on.
+int AllowedCores()
+{
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof(set), &set) != 0) return 0;
+    return CPU_COUNT(&set);
+}
+
+// With mPinWorkers each worker runs on one core (not the first the process may use, left to the caller), the
+// caller keeps its cores, and without it the workers keep every core
+TEST(JobSystemPinningTest, PinnedWorkersRunOnOneCoreEachAndTheCallerKeepsItsCores)
+{
+    const int cores = AllowedCores();
+    if (cores < 2) GTEST_SKIP() << "one core: nothing to pin";
+    for (bool pin : {true, false})
+    {
+        JobSystem::Settings settings;
+        settings.mNumThreads = 2;
+        settings.mPinWorkers = pin;
+        JobSystem jobs(settings);
+        std::atomic<int> workerCores{-1};
+        const std::thread::id caller = std::this_thread::get_id();
+        // Jobs until one runs on the worker (the caller may take some itself)
+        for (int attempt = 0; attempt < 1000 && workerCores.load() < 0; ++attempt)
+        {
+            const JobHandle job = jobs.Schedule("where",
+                                                [&]
+                                                {
+                                                    if (std::this_thread::get_id() != caller)
+                                                        workerCores.store(AllowedCores());
+                                                });
+            std::this_thread::sleep_for(std::chrono::microseconds(200)); // Leave it to the worker
+            jobs.Wait(job);
+        }
+        ASSERT_GE(workerCores.load(), 1) << "no job ran on the worker";
+        EXPECT_EQ(workerCores.load(), pin ? 1 : cores) << (pin ? "pinned" : "not pinned");
+        EXPECT_EQ(AllowedCores(), cores) << "the caller's cores";
+    }
 }
 
 } // namespace

@@ -12,6 +12,7 @@
 #include "cairn/navmesh/TileScheduler.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "common/FrameTimes.h"
+#include "common/PinnedThread.h"
 #include "common/ThreadCpuClock.h"
 
 #include <DetourNavMesh.h>
@@ -169,6 +170,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     PhysicsSystem& physics = *physicsWorld.Value();
     jobs::JobSystem::Settings jobSettings;
     jobSettings.mNumThreads = inSettings.mThreads;
+    jobSettings.mPinWorkers = inSettings.mPinThreads;
     jobs::JobSystem frameJobs(jobSettings);
     result.mThreads = frameJobs.GetNumThreads();
     jobs::BackgroundQueue::Settings queueSettings;
@@ -191,6 +193,10 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     auto gameObjects =
         std::make_unique<GameObjects>(physics, generator, inSettings.mGameObjects, inSettings.mSeed);
     auto streamer = std::make_unique<TileStreamer>(physics, generator, inSettings.mCollisionRadius);
+
+    // The main thread on the first core, the job workers on the others (see PinnedThread); pinned after the
+    // loading and background threads are made, which would otherwise inherit its one core
+    const tools::PinnedThread pinnedMain(inSettings.mPinThreads);
 
     // The loading screen: the tiles around the start, before the clock runs
     const float speed = worldSettings.mPlayerSpeed;

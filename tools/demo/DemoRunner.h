@@ -35,7 +35,11 @@ struct DemoSettings
     uint64_t mSeed = 1;
     int mFrames = 1200; ///< Per mode
     int mAgents = 8;
-    uint32_t mThreads = 0;   ///< Job system threads (0: all cores)
+    uint32_t mThreads = 0; ///< Job system threads (0: all cores)
+    /// The main thread pinned to the first core and the job workers to the others (tools::PinnedThread,
+    /// JobSystem::Settings::mPinWorkers): with idle time between paced frames, the OS woke the main thread on
+    /// the worker's core, and a loop of a millisecond or two ran on one core
+    bool mPinThreads = true;
     int mCollisionSteps = 1; ///< Per 1/60 s frame
     /// PhysicsSettings::mBroadPhaseCandidateMargin (m; 0: the pair search walks the static tree every step)
     float mCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;

@@ -68,6 +68,10 @@ public:
     {
         uint32_t mNumThreads = 0; ///< Threads that run frame jobs, the waiting caller included; 0: all cores
         uint32_t mMaxJobs = 4096; ///< Jobs that may exist at once
+        /// Worker i runs on the process's i-th allowed core only (wrapping round), leaving the first to the
+        /// caller. On a machine with idle time between frames the OS put a waking worker on the caller's
+        /// core and took milliseconds to spread them again, so a short loop got no second core
+        bool mPinWorkers = false;
     };
 
     struct Stats
@@ -225,6 +229,8 @@ public:
     Stats GetStats() const;
 
 private:
+    /// Settings::mPinWorkers: each worker to one allowed core, from the second on.
+    void PinWorkers();
     static TaskHandle ToTask(const JobHandle& inJob)
     {
         return {uint64_t(inJob.mIndex) << 32 | inJob.mGeneration};
