@@ -190,14 +190,23 @@ std::string CheckTileData(std::span<const unsigned char> inData)
     return "";
 }
 
+namespace
+{
+/// The smallest tile side a navmesh may have, m (a tile of 16 cells of 2 cm)
+constexpr float cMinTileSize = 0.25f;
+} // namespace
+
 std::string CheckNavMeshParams(const dtNavMeshParams& inParams)
 {
     if (!IsSaneCoordinate(inParams.orig[0]) || !IsSaneCoordinate(inParams.orig[1]) ||
         !IsSaneCoordinate(inParams.orig[2]))
         return "the origin is not finite or beyond " + std::to_string(int(cMaxWorldCoordinate)) + " m";
-    if (!(inParams.tileWidth > 0.0f && inParams.tileWidth <= cMaxWorldCoordinate &&
-          inParams.tileHeight > 0.0f && inParams.tileHeight <= cMaxWorldCoordinate))
-        return "the tile size is not a positive finite length";
+    // At least cMinTileSize: Detour's polygon queries visit every tile slot their box covers, and a fuzzed
+    // file with tiles a hair wide made one search box of a few metres cover billions (a query ran for
+    // seconds)
+    if (!(inParams.tileWidth >= cMinTileSize && inParams.tileWidth <= cMaxWorldCoordinate &&
+          inParams.tileHeight >= cMinTileSize && inParams.tileHeight <= cMaxWorldCoordinate))
+        return "the tile size is not a finite length from " + std::to_string(cMinTileSize) + " m";
     if (inParams.maxTiles < 1 || inParams.maxTiles > cMaxNavMeshTiles)
         return "max tiles " + std::to_string(inParams.maxTiles) + " is not 1 to " +
                std::to_string(cMaxNavMeshTiles);

@@ -97,6 +97,9 @@ TEST_F(NavMeshFileHostileTest, ParametersDetourWouldLetThroughAreRefused)
     ExpectRefused(withParams([](dtNavMeshParams& p) { p.orig[0] = std::numeric_limits<float>::quiet_NaN(); }),
                   "origin");
     ExpectRefused(withParams([](dtNavMeshParams& p) { p.tileWidth = 0.0f; }), "tile size");
+    // Tiles a hair wide: a search box of a few metres covered billions of tile slots (the fuzzer's timeout)
+    ExpectRefused(withParams([](dtNavMeshParams& p) { p.tileWidth = 1.0e-6f; }), "tile size");
+    ExpectRefused(withParams([](dtNavMeshParams& p) { p.tileHeight = 0.2f; }), "tile size");
     ExpectRefused(
         withParams([](dtNavMeshParams& p) { p.tileHeight = std::numeric_limits<float>::infinity(); }),
         "tile size");
