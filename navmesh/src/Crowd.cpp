@@ -71,7 +71,6 @@ Vec3 Flat(const Vec3& inV)
 {
     return Vec3(inV.x(), 0.0f, inV.z());
 }
-} // namespace
 
 /// The first three corners of inCorridor's straight path (as dtPathCorridor::findCorners), looked for in its
 /// first cCornerWindow polygons only: Detour's string pulling walks the portals until it has its corners,
@@ -111,6 +110,8 @@ int FindCorners(dtPathCorridor& ioCorridor, dtNavMeshQuery& ioQuery, const dtQue
     }
     return kept;
 }
+
+} // namespace
 
 struct Crowd::Agent
 {
@@ -192,7 +193,7 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
         return MakeError(
             ErrorCode::InvalidArgument,
             "agent: radius in (0, the crowd's max], speed in (0, 100], acceleration in (0, 1000]");
-    if (GetAgents().size() >= size_t(mSettings.mMaxAgents))
+    if (mAgents.size() - mFreeIDs.size() >= size_t(mSettings.mMaxAgents))
         return MakeError(ErrorCode::OutOfCapacity, "agent: the crowd is full");
     auto agent = std::make_unique<Agent>();
     agent->mParams = inParams;
@@ -216,10 +217,14 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
     // No navmesh there yet (its tiles not built): it waits in place until there is
     if (!onNavMesh) agent->mState = AgentState::OffNavMesh;
     // The lowest free id: ids are reused, and the order of updates is the order of ids
-    AgentID id = 0;
-    while (id < mAgents.size() && mAgents[id] != nullptr)
-        ++id;
-    if (id == mAgents.size()) mAgents.emplace_back();
+    AgentID id = AgentID(mAgents.size());
+    if (!mFreeIDs.empty())
+    {
+        id = *mFreeIDs.begin();
+        mFreeIDs.erase(mFreeIDs.begin());
+    }
+    else
+        mAgents.emplace_back();
     mAgents[id] = std::move(agent);
     return id;
 }
@@ -230,6 +235,7 @@ Status Crowd::RemoveAgent(AgentID inAgent)
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
     if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
     mAgents[inAgent].reset();
+    mFreeIDs.insert(inAgent);
     return Status::Ok();
 }
 

@@ -34,6 +34,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <set>
 #include <span>
 #include <vector>
 
@@ -189,7 +190,8 @@ private:
     std::vector<dtNavMeshQuery*> mQueries; ///< One per ParallelFor chunk, made as needed (scratch only)
     std::vector<std::unique_ptr<dtObstacleAvoidanceQuery>> mAvoidance; ///< Likewise, for the avoidance
     std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By id; null where removed
-    std::vector<AgentID> mOrder;         ///< The agents in id order, for this Update
+    std::set<AgentID> mFreeIDs;  ///< The ids below mAgents.size() whose slot is null, for the lowest free id
+    std::vector<AgentID> mOrder; ///< The agents in id order, for this Update
     std::vector<uint32_t> mChunkSampled; ///< Per ParallelFor chunk: its agents that sampled (a chunk's own)
     std::vector<uint32_t> mChunkWalls;   ///< Per ParallelFor chunk: its agents that gathered walls again
     // The snapshot every agent steers from: positions and velocities at the Update's start, by mOrder index
