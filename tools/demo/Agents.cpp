@@ -47,6 +47,19 @@ float FlatDistance(const Vec3& inA, const Vec3& inB)
 {
     return std::hypot(inA.x() - inB.x(), inA.z() - inB.z());
 }
+
+/// A cell of a grid in the ground plane, as one key.
+uint64_t CellKey(int32_t inX, int32_t inZ)
+{
+    return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ);
+}
+
+/// The cell of inCellSize metres that holds inPosition.
+uint64_t CellKeyAt(const Vec3& inPosition, float inCellSize)
+{
+    return CellKey(int32_t(std::floor(inPosition.x() / inCellSize)),
+                   int32_t(std::floor(inPosition.z() / inCellSize)));
+}
 } // namespace
 
 struct Agents::Agent
@@ -55,7 +68,6 @@ struct Agents::Agent
     bool mCompanion = false; ///< Follows the player (else it wanders where it is)
     navmesh::Crowd::AgentID mID = 0;
     Vec3 mHome = Vec3::Zero(); ///< Its place relative to the player (x, z)
-    Vec3 mGoal = Vec3::Zero();
     bool mHasGoal = false;
     bool mFollowing = false;
     float mGoalSeconds = 0.0f;  ///< Since its goal was set
@@ -180,40 +192,39 @@ void Agents::AddAgent(uint32_t inIndex, const Vec3& inPosition)
     agent.mProgressSeconds = 0.0f;
 }
 
-bool Agents::InsideStatic(const Vec3& inPosition) const
+bool Agents::StaticBodiesAt(const Vec3& inPosition, std::vector<BodyID>& outBodies) const
 {
     QueryFilter filter;
     filter.mObjectLayers = ObjectLayerMask(1) << Layers::cStatic;
-    std::vector<BodyID> hits;
     // The agent's centre line at chest height. Not its whole radius: Recast's contours cut round the corners
     // of obstacles by up to half a metre (cells and simplification), so agents brush corners, as in
     // DetourCrowd
-    if (!mPhysics.GetWorldQuery().CollideSphere(inPosition + Vec3(0.0f, 1.0f, 0.0f), 0.05f, hits, filter))
-        return true; // Not known to be clear: counts against the invariant
-    for (const BodyID& hit : hits)
-        if (!mStreamer.IsTerrain(hit)) return true;
-    return false;
+    if (!mPhysics.GetWorldQuery().CollideSphere(inPosition + Vec3(0.0f, 1.0f, 0.0f), 0.05f, outBodies,
+                                                filter))
+        return false;
+    std::erase_if(outBodies, [&](const BodyID& inBody) { return mStreamer.IsTerrain(inBody); });
+    return true;
+}
+
+bool Agents::InsideStatic(const Vec3& inPosition) const
+{
+    std::vector<BodyID> bodies;
+    // A spot that cannot be checked is not known to be clear: it counts against the invariant
+    return !StaticBodiesAt(inPosition, bodies) || !bodies.empty();
 }
 
 std::string Agents::DescribeStaticAt(const Vec3& inPosition) const
 {
-    QueryFilter filter;
-    filter.mObjectLayers = ObjectLayerMask(1) << Layers::cStatic;
-    std::vector<BodyID> hits;
+    std::vector<BodyID> bodies;
+    if (!StaticBodiesAt(inPosition, bodies)) return " (the query failed)";
     std::string text;
-    if (!mPhysics.GetWorldQuery().CollideSphere(inPosition + Vec3(0.0f, 1.0f, 0.0f), 0.05f, hits, filter))
-        return " (the query failed)";
-    for (const BodyID& hit : hits)
-    {
-        if (mStreamer.IsTerrain(hit)) continue;
-        const Result<AABB> bounds = mPhysics.GetBodyInterface().GetWorldBounds(hit);
-        if (bounds)
+    for (const BodyID& body : bodies)
+        if (const Result<AABB> bounds = mPhysics.GetBodyInterface().GetWorldBounds(body))
             text += " (a body from " + std::to_string(bounds.Value().mMin.x()) + ", " +
                     std::to_string(bounds.Value().mMin.y()) + ", " + std::to_string(bounds.Value().mMin.z()) +
                     " to " + std::to_string(bounds.Value().mMax.x()) + ", " +
                     std::to_string(bounds.Value().mMax.y()) + ", " + std::to_string(bounds.Value().mMax.z()) +
                     ")";
-    }
     return text;
 }
 
@@ -315,7 +326,6 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
                 break;
             }
             ++mStats.mGoalsSet;
-            agent.mGoal = action.mPoint;
             agent.mHasGoal = true;
             agent.mFollowing = action.mFollowing;
             agent.mGoalSeconds = 0.0f;
@@ -413,7 +423,7 @@ Vec3 Agents::FreeSpot(const Action& inAction)
         mOccupied.clear();
         for (const Agent& agent : mAgents)
             if (const Result<Vec3> position = mCrowds[agent.mProfile]->GetPosition(agent.mID))
-                mOccupied.push_back({OccupiedKey(position.Value()), position.Value()});
+                mOccupied.push_back({CellKeyAt(position.Value(), cOccupiedCell), position.Value()});
         std::sort(mOccupied.begin(), mOccupied.end(),
                   [](const auto& inA, const auto& inB) { return inA.first < inB.first; });
         mOccupiedValid = true;
@@ -427,7 +437,7 @@ Vec3 Agents::FreeSpot(const Action& inAction)
         for (int32_t dx = -1; dx <= 1 && free; ++dx)
             for (int32_t dz = -1; dz <= 1 && free; ++dz)
             {
-                const uint64_t key = uint64_t(uint32_t(cx + dx)) << 32 | uint32_t(cz + dz);
+                const uint64_t key = CellKey(cx + dx, cz + dz);
                 auto it = std::lower_bound(mOccupied.begin(), mOccupied.end(), key,
                                            [](const auto& inEntry, uint64_t inKey)
                                            { return inEntry.first < inKey; });
@@ -437,7 +447,7 @@ Vec3 Agents::FreeSpot(const Action& inAction)
         if (free)
         {
             // Taken now: the next agent put back this frame does not land on it
-            const uint64_t key = OccupiedKey(spot);
+            const uint64_t key = CellKeyAt(spot, cOccupiedCell);
             mOccupied.insert(std::upper_bound(mOccupied.begin(), mOccupied.end(), key,
                                               [](uint64_t inKey, const auto& inEntry)
                                               { return inKey < inEntry.first; }),
@@ -446,12 +456,6 @@ Vec3 Agents::FreeSpot(const Action& inAction)
         }
     }
     return inAction.mNumSpots > 0 ? inAction.mSpots[0] : inAction.mPoint;
-}
-
-uint64_t Agents::OccupiedKey(const Vec3& inPosition)
-{
-    return uint64_t(uint32_t(int32_t(std::floor(inPosition.x() / cOccupiedCell)))) << 32 |
-           uint32_t(int32_t(std::floor(inPosition.z() / cOccupiedCell)));
 }
 
 uint64_t Agents::CountOverlapping() const
@@ -466,12 +470,10 @@ uint64_t Agents::CountOverlapping() const
     entries.reserve(mAgents.size());
     std::unordered_map<uint64_t, std::vector<uint32_t>> cells;
     constexpr float cell = 4.0f;
-    auto key = [](int32_t inX, int32_t inZ) { return uint64_t(uint32_t(inX)) << 32 | uint32_t(inZ); };
     for (const Agent& agent : mAgents)
     {
         const Vec3 position = mCrowds[agent.mProfile]->GetPosition(agent.mID).Value();
-        cells[key(int32_t(std::floor(position.x() / cell)), int32_t(std::floor(position.z() / cell)))]
-            .push_back(uint32_t(entries.size()));
+        cells[CellKeyAt(position, cell)].push_back(uint32_t(entries.size()));
         entries.push_back({position, mProfiles[agent.mProfile].mRadius});
     }
     uint64_t overlapping = 0;
@@ -484,7 +486,7 @@ uint64_t Agents::CountOverlapping() const
         for (int32_t dx = -1; dx <= 1 && !found; ++dx)
             for (int32_t dz = -1; dz <= 1 && !found; ++dz)
             {
-                const auto it = cells.find(key(cx + dx, cz + dz));
+                const auto it = cells.find(CellKey(cx + dx, cz + dz));
                 if (it == cells.end()) continue;
                 for (uint32_t j : it->second)
                 {

@@ -91,6 +91,9 @@ private:
 
     /// What the agent should do now (a goal, a catch-up), on a job thread: reads the navmesh and the agent.
     void Decide(uint32_t inIndex, const Vec3& inPlayer, Action& outAction) const;
+    /// The static bodies other than the terrain at an agent's centre line at inPosition; false when the query
+    /// failed. Any thread.
+    bool StaticBodiesAt(const Vec3& inPosition, std::vector<BodyID>& outBodies) const;
     /// Whether an agent at inPosition is inside a static body other than the terrain (a job thread).
     bool InsideStatic(const Vec3& inPosition) const;
     /// The static bodies InsideStatic finds at inPosition, for the error message.
@@ -102,7 +105,6 @@ private:
     void AddAgent(uint32_t inIndex, const Vec3& inPosition);
     /// Of a catch-up's spots, the first with no agent within cOccupiedCell (else the first spot).
     Vec3 FreeSpot(const Action& inAction);
-    static uint64_t OccupiedKey(const Vec3& inPosition);
     /// Two large agents' radii: a spot this far from every agent is free for any agent
     static constexpr float cOccupiedCell = 3.0f;
 
