@@ -395,10 +395,12 @@ void Crowd::GatherPhysicsObstacles(const AABB& inAround, float inDeltaTime)
     mObstacles.clear();
     if (mObstaclePhysics == nullptr) return;
     // The dynamic bodies near the agents, as last published (no lock: the step may be running), as circles
-    // in the ground plane; their velocity from where they were at the last Update
-    QueryFilter filter;
-    filter.mObjectLayers = mObstacleLayers;
-    if (!mObstaclePhysics->GetWorldQuery().CollideAABox(inAround, mObstacleIDs, filter)) return;
+    // in the ground plane; their velocity from where they were at the last Update. The broad phase's bounds
+    // are enough: each body's circle comes from its own bounds below, and an exact test of the agents' box
+    // against hundreds of shapes (most of them asleep) cost as much as the corridor checks it runs beside
+    mObstacleIDs.clear();
+    mObstaclePhysics->GetBroadPhase().CollideAABox(inAround, {mObstacleLayers},
+                                                   [this](BodyID inBody) { mObstacleIDs.push_back(inBody); });
     std::sort(mObstacleIDs.begin(), mObstacleIDs.end()); // The broad phase's order is not fixed
     const PoseReader poses(mObstaclePhysics->GetBodyManager());
     std::vector<std::pair<BodyID, Vec3>> current;
