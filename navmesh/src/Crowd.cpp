@@ -35,6 +35,10 @@ constexpr float cPathOptimizationRangeRadii = 30.0f;
 constexpr int cMaxNeighbours = 6;
 /// The wall segments a dtLocalBoundary keeps (its MAX_LOCAL_SEGS, private there)
 constexpr int cMaxWallSegments = 8;
+/// An agent's corners are found again after this many Updates at the most, and once it is this many radii
+/// off the straight line from where they were found to the first (see Crowd::Agent::Corners)
+constexpr uint64_t cCornerReuseUpdates = 8;
+constexpr float cCornerLineToleranceRadii = 0.1f;
 
 /// DetourCrowd's "medium" quality: adaptive sampling, 5 divisions, 2 rings, depth 2 (22 samples a threatened
 /// agent, against 75 for its "good": the sampling was half of a 10,000-agent crowd's time at "good").
@@ -130,6 +134,50 @@ struct Crowd::Agent
     bool mWallsStale = false;       ///< A tile near its walls changed since they were gathered
     uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
     Vec3 mSampledVelocity = Vec3::Zero();
+
+    /// The first corners of its corridor's straight path, as FindCorners found them at mFrom. From any point
+    /// on the straight line from mFrom to the first corner, the path through the same polygons has the same
+    /// corners (a part of a shortest path is the shortest path between its ends), so they are kept while the
+    /// agent walks that line with the corridor unchanged: string pulling was a third of the steering's cost.
+    /// Found again when the corridor changes (mValid false, another first polygon or length), the agent is
+    /// off the line (avoiding others, sliding along a wall) or near the first corner, and every
+    /// cCornerReuseUpdates Updates.
+    struct Corners
+    {
+        float mPoints[3 * 3];
+        unsigned char mFlags[3];
+        dtPolyRef mPolygons[3];
+        int mCount = 0;
+        Vec3 mFrom = Vec3::Zero();
+        dtPolyRef mFirstPolygon = 0;
+        int mPathCount = 0;
+        uint64_t mFoundAt = 0;
+        bool mValid = false;
+    } mCorners;
+
+    /// mCorners, found again unless they still hold for the agent at inPosition (at the Update inUpdate).
+    void UpdateCorners(const Vec3& inPosition, uint64_t inUpdate, dtNavMeshQuery& ioQuery,
+                       const dtQueryFilter& inFilter)
+    {
+        Corners& c = mCorners;
+        if (c.mValid && c.mCount > 0 && c.mFirstPolygon == mCorridor.getFirstPoly() &&
+            c.mPathCount == mCorridor.getPathCount() && inUpdate - c.mFoundAt < cCornerReuseUpdates)
+        {
+            const float tolerance = cCornerLineToleranceRadii * mParams.mRadius;
+            float along = 0.0f;
+            const Vec3 first(c.mPoints[0], c.mPoints[1], c.mPoints[2]);
+            if (dtDistancePtSegSqr2D(inPosition.data(), c.mFrom.data(), first.data(), along) <
+                    tolerance * tolerance &&
+                Flat(first - inPosition).squaredNorm() > mParams.mRadius * mParams.mRadius)
+                return;
+        }
+        c.mCount = FindCorners(mCorridor, ioQuery, inFilter, c.mPoints, c.mFlags, c.mPolygons);
+        c.mFrom = inPosition;
+        c.mFirstPolygon = mCorridor.getFirstPoly();
+        c.mPathCount = mCorridor.getPathCount();
+        c.mFoundAt = inUpdate;
+        c.mValid = true;
+    }
 
     /// Detour's corridor keeps its old height when getPolyHeight fails, which it does on the edges of a
     /// polygon's detail triangles: an agent stepping onto a crate kept the ground's height, a metre inside
@@ -551,12 +599,14 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
             if (polygon == 0)
             {
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
+                agent.mCorners.mValid = false;
                 agent.mHeight = corridor.getPos()[1];
                 agent.mState = AgentState::OffNavMesh;
                 agent.mVelocity.setZero();
                 continue;
             }
             corridor.reset(polygon, nearest);
+            agent.mCorners.mValid = false;
             agent.SetHeightFromSurface(ioQuery);
             if (agent.mState == AgentState::OffNavMesh || agent.mState == AgentState::Moving)
             {
@@ -569,6 +619,7 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
         if (mAnyTileChanged)
             for (int p = 0; p < corridor.getPathCount() && !crossesChange; ++p)
                 crossesChange = mTileChanged[navMesh.decodePolyIdTile(corridor.getPath()[p])] != 0;
+        if (crossesChange) agent.mCorners.mValid = false; // Its polygons may have moved
         if (crossesChange && corridor.getPathCount() > 1 &&
             !corridor.isValid(corridor.getPathCount(), &ioQuery, mFilter.get()))
         {
@@ -645,6 +696,7 @@ void Crowd::ApplyPathResults()
         if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
             path.resize(size_t(mSettings.mMaxCorridorPolygons));
         corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(), int(path.size()));
+        agent.mCorners.mValid = false;
         agent.mState = AgentState::Moving;
         ++mStatistics.mPathsApplied;
     }
@@ -688,10 +740,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             agent.mState == AgentState::WaitingForPath && agent.mCorridor.getPathCount() > 1;
         if (agent.mState == AgentState::Moving || waitingOnItsWay)
         {
-            float corners[3 * 3];
-            unsigned char flags[3];
-            dtPolyRef polygons[3];
-            int numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
+            agent.UpdateCorners(position, mUpdates, ioQuery, *mFilter);
+            const float* corners = agent.mCorners.mPoints;
+            const unsigned char* flags = agent.mCorners.mFlags;
+            int numCorners = agent.mCorners.mCount;
             // Into a new polygon whose corridor turns back through the one it left: an agent walking along a
             // tile's edge crosses the corner where four tiles meet into a polygon the path does not take,
             // and its first corner falls behind it (it turned back and forth there). A straight look towards
@@ -709,7 +761,9 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                                                            cPathOptimizationRangeRadii * radius, &ioQuery,
                                                            mFilter.get());
                     agent.mCorridor.optimizePathTopology(&ioQuery, mFilter.get());
-                    numCorners = FindCorners(agent.mCorridor, ioQuery, *mFilter, corners, flags, polygons);
+                    agent.mCorners.mValid = false;
+                    agent.UpdateCorners(position, mUpdates, ioQuery, *mFilter);
+                    numCorners = agent.mCorners.mCount;
                 }
             }
             agent.mLastPolygon = first;
