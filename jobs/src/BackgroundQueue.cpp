@@ -1,5 +1,6 @@
 #include "cairn/jobs/BackgroundQueue.h"
 
+#include "ThreadName.h"
 #include "cairn/jobs/JobSystem.h"
 
 #include <algorithm>
@@ -147,7 +148,10 @@ BackgroundQueue::BackgroundQueue(const Settings& inSettings) : mSettings(inSetti
     try
     {
         for (uint32_t i = 0; i < numThreads; ++i)
+        {
             mThreads.emplace_back([this] { ThreadMain(); });
+            NameThread(mThreads.back(), "cairn-bg", i);
+        }
     }
     catch (...)
     {

@@ -1,5 +1,7 @@
 #include "cairn/jobs/JobSystem.h"
 
+#include "ThreadName.h"
+
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -95,7 +97,10 @@ JobSystem::JobSystem(const Settings& inSettings)
     mMoreThreadsThanCores = numThreads > std::max(1u, std::thread::hardware_concurrency());
     mWorkers.reserve(numThreads - 1);
     for (uint32_t i = 1; i < numThreads; ++i)
+    {
         mWorkers.emplace_back([this] { WorkerMain(); });
+        NameThread(mWorkers.back(), cWorkerThreadNamePrefix, i);
+    }
     if (inSettings.mPinWorkers) PinWorkers();
 }
 

@@ -60,6 +60,9 @@ public:
     static constexpr size_t cFunctionCapacity = 64; ///< Bytes of captures a job may carry
     static constexpr uint32_t cMaxDependents = 16;  ///< Jobs that can wait on one job through the queue
     static constexpr uint32_t cMaxThreads = 64;
+    /// The workers' thread names begin so (cairn-job-1, cairn-job-2, ...; Linux), for profilers and for tools
+    /// that watch the frame's threads
+    static constexpr const char* cWorkerThreadNamePrefix = "cairn-job";
     /// A thread that runs out of work spins this long before it sleeps: the frame's parallel phases follow
     /// each other within microseconds, and waking a sleeping thread costs tens of them
     static constexpr uint32_t cSpinMicroseconds = 50;
