@@ -136,6 +136,7 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
     run.mMainThreadStreamHostTakenMs = {0.0};        // A series one short: its second field is empty
     run.mAgentStats.mMainThreadMs = {0.125};         // Likewise the navigation's
     run.mAgentStats.mJobThreadsMs = {1.5};
+    run.mAgentStats.mOtherTaskSwitches = {2, -1}; // Unreadable in the second frame: an empty field
     auto step = [](double inBroadPhase, double inNarrow, double inIslands, double inSolve, double inFinish,
                    uint32_t inActive, uint32_t inPairs, uint32_t inPoints, double inLockWait)
     {
@@ -165,12 +166,12 @@ TEST(DemoReportTest, FramesCsvHasARowPerFrameOfEveryRun)
               "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
               "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
               "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms,nav_main_thread_ms,"
-              "nav_job_threads_ms");
+              "nav_job_threads_ms,nav_other_task_switches");
     EXPECT_EQ(lines[1], "lock-free,0,2.5000,0.2500,0.0100,0.0300,0.1000,0.0020,0.0500,0.0040,26,40,66,0.0000,"
                         "0.00,,0.0000,0.1250,"
-                        "1.5000");
+                        "1.5000,2");
     EXPECT_EQ(lines[2], "lock-free,1,3.0000,0.5000,0.0200,0.3000,0.1200,0.0030,0.0600,0.0050,27,41,70,0.2500,"
-                        "12.50,0.1250,,,");
+                        "12.50,0.1250,,,,");
     EXPECT_EQ(lines[3].rfind("\"a, \"\"b\"\"\",0,", 0), 0u) << lines[3];
 }
 
@@ -309,6 +310,32 @@ TEST(DemoReportTest, SummaryJudgesTheFrameTargets)
     EXPECT_NE(text.find("(target <= 0.5 ms: NOT met)"), std::string::npos) << text;
     // p99 is at most 2.0 ms on an average of 1.055 ms, whichever sample the percentile picks
     EXPECT_NE(text.find("(target <= 2x: met)"), std::string::npos) << text;
+}
+
+TEST(DemoReportTest, SummaryCountsTheFramesAnotherTaskInterruptedAndTheRestsTail)
+{
+    DemoRunResult run;
+    run.mModeName = "lock-free";
+    run.mAgents = 1000;
+    run.mAgentStats.mMainThreadMs.assign(100, 0.1);
+    run.mAgentStats.mJobThreadsMs.assign(100, 1.0);
+    run.mAgentStats.mOtherTaskSwitches.assign(100, 0);
+    for (size_t i = 0; i < 4; ++i)
+    {
+        run.mAgentStats.mJobThreadsMs[i] = 3.0; // Each of these interrupted by another task...
+        run.mAgentStats.mOtherTaskSwitches[i] = 1;
+    }
+    run.mAgentStats.mOtherTaskSwitches[4] = -1; // ... this one not known: counted in neither
+    std::string text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("p99 3.000 (target <= 2 ms: NOT met)"), std::string::npos) << text;
+    EXPECT_NE(text.find("frames another task took a navigation thread's core 4 (4.04%)"), std::string::npos)
+        << text;
+    EXPECT_NE(text.find("job threads p99 in the other frames 1.000"), std::string::npos) << text;
+
+    run.mAgentStats.mOtherTaskSwitches.clear(); // Not watched
+    text = Printed([&](std::FILE* inFile) { PrintSummary(inFile, run); });
+    EXPECT_NE(text.find("frames another task took a navigation thread's core n/a"), std::string::npos)
+        << text;
 }
 
 TEST(DemoReportTest, ComparisonShowsTheLockWaitsOfBothModes)

@@ -1,6 +1,7 @@
 #include "Agents.h"
 
 #include "common/Mix64.h"
+#include "common/ThreadSwitches.h"
 
 #include <DetourNavMesh.h>
 #include <algorithm>
@@ -275,6 +276,8 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
     if (mCrowds[0] == nullptr || mCrowds[1] == nullptr) return;
     const uint32_t count = uint32_t(mAgents.size());
     double mainMs = 0.0, jobMs = 0.0;
+    // Read before the first clock read and after the last, so the reads stay out of the timed work
+    const int64_t switchesBefore = mWatchedThreads.empty() ? -1 : tools::InvoluntarySwitches(mWatchedThreads);
 
     // What each agent does, on the job threads
     Clock::time_point start = Clock::now();
@@ -349,8 +352,11 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
         jobMs += crowd->GetStatistics().mLastMoveMs;
         mStats.mReplans += crowd->GetStatistics().mReplans - before.mReplans;
     }
+    const int64_t switchesAfter = mWatchedThreads.empty() ? -1 : tools::InvoluntarySwitches(mWatchedThreads);
     mStats.mMainThreadMs.push_back(mainMs);
     mStats.mJobThreadsMs.push_back(jobMs);
+    mStats.mOtherTaskSwitches.push_back(
+        switchesBefore < 0 || switchesAfter < 0 ? -1 : switchesAfter - switchesBefore);
 
     // The checks of the run, not navigation work: each agent's own, on the job threads
     ioJobs.ParallelFor(count, cAgentsPerChunk,

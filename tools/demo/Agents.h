@@ -81,6 +81,9 @@ public:
     static float NavMeshRadius(int inCount);
 
     void Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface& ioJobs);
+    /// The threads that do the navigation work (the caller of Update and the job workers, ThreadSwitches.h's
+    /// ids): each frame counts the times another task took one of their cores during it. Between Updates.
+    void WatchThreads(std::vector<int> inThreadIds) { mWatchedThreads = std::move(inThreadIds); }
     const Stats& GetStats() const { return mStats; }
     /// The crowds' path-queue wait histograms summed, for the percentiles.
     void FinishStats();
@@ -120,6 +123,7 @@ private:
     std::vector<std::pair<uint64_t, Vec3>> mOccupied; ///< Agents' positions by cell, for FreeSpot
     bool mOccupiedValid = false;
     std::vector<uint32_t> mTrailAgents; ///< Indices of the agents whose trails are kept
+    std::vector<int> mWatchedThreads;
     Stats mStats;
 };
 

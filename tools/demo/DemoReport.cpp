@@ -329,6 +329,19 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     const AgentStats& agents = inRun.mAgentStats;
     const SampleSummary navMain = Summarize(agents.mMainThreadMs);
     const SampleSummary navJobs = Summarize(agents.mJobThreadsMs);
+    // The frames in which no other task took a navigation thread's core, apart: what the rest's tail holds
+    std::vector<double> navJobsAlone;
+    uint64_t navInterrupted = 0, navWatched = 0;
+    for (size_t i = 0; i < agents.mJobThreadsMs.size() && i < agents.mOtherTaskSwitches.size(); ++i)
+    {
+        if (agents.mOtherTaskSwitches[i] < 0) continue;
+        ++navWatched;
+        if (agents.mOtherTaskSwitches[i] > 0)
+            ++navInterrupted;
+        else
+            navJobsAlone.push_back(agents.mJobThreadsMs[i]);
+    }
+    const SampleSummary navJobsUninterrupted = Summarize(navJobsAlone);
     auto percentOf = [](uint64_t inCount, uint64_t inOf) {
         return Count(inCount) + Format(" (%.2f%%)", inOf == 0 ? 0.0 : 100.0 * double(inCount) / double(inOf));
     };
@@ -429,7 +442,10 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                                     inRun.mAgents > 1000 ? cNavJobThreads10kTargetMs : cNavJobThreadsTargetMs,
                                     " ms"))},
           {"max", Ms(navJobs, navJobs.mMax)},
-          {"of which goal picking p99", Ms(Summarize(agents.mGoalPickingMs).mP99)}}});
+          {"of which goal picking p99", Ms(Summarize(agents.mGoalPickingMs).mP99)},
+          {"frames another task took a navigation thread's core",
+           navWatched == 0 ? std::string("n/a") : percentOf(navInterrupted, navWatched)},
+          {"job threads p99 in the other frames", Ms(navJobsUninterrupted, navJobsUninterrupted.mP99)}}});
     sections.push_back(
         {"paths",
          {{"requested", Count(agents.mPathsRequested)},
@@ -1114,7 +1130,7 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         "mode,frame,frame_ms,physics_ms,streaming_ms,broadphase_update_ms,narrow_phase_ms,"
         "islands_ms,solve_ms,finish_ms,active_bodies,body_pairs,contact_points,step_lock_wait_ms,"
         "game_object_lock_wait_us,physics_host_taken_ms,streaming_host_taken_ms,nav_main_thread_ms,"
-        "nav_job_threads_ms\n";
+        "nav_job_threads_ms,nav_other_task_switches\n";
     for (const DemoRunResult& run : inRuns)
     {
         const std::string mode = CsvField(run.mModeName);
@@ -1125,15 +1141,19 @@ std::string FramesCsv(const std::vector<DemoRunResult>& inRuns)
         for (size_t i = 0; i < frames; ++i)
         {
             const StepStatistics& step = run.mSteps[i];
-            csv += Format("%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s,%s,%s,%s\n",
-                          mode.c_str(), i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
-                          step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs,
-                          step.mFinishMs, step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints,
-                          step.mLockWaitMs, run.mGameObjectLockWaitUs[i],
-                          HostTakenField(run.mPhysicsHostTakenMs, i).c_str(),
-                          HostTakenField(run.mMainThreadStreamHostTakenMs, i).c_str(),
-                          OptionalMsField(run.mAgentStats.mMainThreadMs, i).c_str(),
-                          OptionalMsField(run.mAgentStats.mJobThreadsMs, i).c_str());
+            const std::vector<int64_t>& switches = run.mAgentStats.mOtherTaskSwitches;
+            const std::string switchesField = i < switches.size() && switches[i] >= 0
+                                                  ? Format("%lld", (long long)switches[i])
+                                                  : std::string();
+            csv += Format(
+                "%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%u,%u,%u,%.4f,%.2f,%s,%s,%s,%s,%s\n",
+                mode.c_str(), i, run.mFrameMs[i], run.mPhysicsMs[i], run.mMainThreadStreamMs[i],
+                step.mBroadPhaseUpdateMs, step.mNarrowPhaseMs, step.mIslandsMs, step.mSolveMs, step.mFinishMs,
+                step.mNumActiveBodies, step.mNumBodyPairs, step.mNumContactPoints, step.mLockWaitMs,
+                run.mGameObjectLockWaitUs[i], HostTakenField(run.mPhysicsHostTakenMs, i).c_str(),
+                HostTakenField(run.mMainThreadStreamHostTakenMs, i).c_str(),
+                OptionalMsField(run.mAgentStats.mMainThreadMs, i).c_str(),
+                OptionalMsField(run.mAgentStats.mJobThreadsMs, i).c_str(), switchesField.c_str());
         }
     }
     return csv;

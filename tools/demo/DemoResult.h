@@ -27,6 +27,9 @@ struct AgentStats
     /// steering), wall time with the main thread taking part, ms
     std::vector<double> mJobThreadsMs;
     std::vector<double> mGoalPickingMs; ///< Per frame: of mJobThreadsMs, the goals' picking
+    /// Per frame: the times another task (a kernel thread, another process) took the core of a thread doing
+    /// the navigation work while it could still run; -1 where that could not be read
+    std::vector<int64_t> mOtherTaskSwitches;
     uint64_t mGoalsSet = 0;
     uint64_t mGoalsNotFound = 0; ///< No navmesh point to head for (the navmesh not built there yet)
     uint64_t mArrivals = 0;

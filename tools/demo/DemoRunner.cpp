@@ -14,6 +14,7 @@
 #include "common/FrameTimes.h"
 #include "common/PinnedThread.h"
 #include "common/ThreadCpuClock.h"
+#include "common/ThreadSwitches.h"
 
 #include <DetourNavMesh.h>
 #include <chrono>
@@ -215,6 +216,9 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     const Agents::Profile large{navMeshes.mNavMeshes[1].get(), navMeshes.mNavMeshes[1]->GetProfile().mRadius};
     auto agents = std::make_unique<Agents>(physics, generator, *streamer, human, large, inSettings.mAgents,
                                            inSettings.mSeed + 1);
+    std::vector<int> navigationThreads = tools::FindThreadsNamed(jobs::JobSystem::cWorkerThreadNamePrefix);
+    navigationThreads.push_back(tools::CurrentThreadId());
+    agents->WatchThreads(std::move(navigationThreads));
 
     Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
     const float dt = 1.0f / 60.0f;
