@@ -1,0 +1,68 @@
+#include "solver/PointJointPart.h"
+
+#include <cmath>
+
+namespace cairn::physics
+{
+
+void PointJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                             const JointBodyMass& inB)
+{
+    mArmA = inArmA;
+    mArmB = inArmB;
+    mA = inA;
+    mB = inB;
+    // K = (1/mA + 1/mB) I - [rA] IA^-1 [rA] - [rB] IB^-1 [rB]: the point's velocity change per unit impulse
+    const Mat3 skewA = Skew(inArmA), skewB = Skew(inArmB);
+    const Mat3 k = (inA.mInverseMass + inB.mInverseMass) * Mat3::Identity() -
+                   skewA * inA.mInverseInertia * skewA - skewB * inB.mInverseInertia * skewB;
+    bool invertible = false;
+    float determinant = 0.0f;
+    k.computeInverseAndDetWithCheck(mEffectiveMass, determinant, invertible);
+    // Relative to K's scale: a matrix of heavy bodies is small, not singular
+    const float scale = k.cwiseAbs().maxCoeff();
+    mActive = invertible && scale > 0.0f && std::isfinite(determinant) &&
+              std::abs(determinant) > 1.0e-12f * scale * scale * scale && mEffectiveMass.allFinite();
+    if (!mActive) mEffectiveMass.setZero();
+}
+
+void PointJointPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inImpulse) const
+{
+    ioA.mLinearVelocity -= mA.mInverseMass * inImpulse;
+    ioA.mAngularVelocity -= mA.mInverseInertia * mArmA.cross(inImpulse);
+    ioB.mLinearVelocity += mB.mInverseMass * inImpulse;
+    ioB.mAngularVelocity += mB.mInverseInertia * mArmB.cross(inImpulse);
+}
+
+void PointJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
+{
+    mTotalImpulse *= inRatio;
+    if (mActive) Apply(ioA, ioB, mTotalImpulse);
+}
+
+void PointJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const Vec3 relative = ioB.mLinearVelocity + ioB.mAngularVelocity.cross(mArmB) - ioA.mLinearVelocity -
+                          ioA.mAngularVelocity.cross(mArmA);
+    const Vec3 impulse = -(mEffectiveMass * relative);
+    mTotalImpulse += impulse;
+    Apply(ioA, ioB, impulse);
+}
+
+PointJointPart::PoseCorrection PointJointPart::CorrectPositions(const Vec3& inAnchorA, const Vec3& inAnchorB,
+                                                                float inFraction) const
+{
+    PoseCorrection correction;
+    if (!mActive) return correction;
+    // The same rows on positions: the "impulse" whose velocity change, applied for one unit of time, closes
+    // inFraction of the gap
+    const Vec3 impulse = -(mEffectiveMass * (inFraction * (inAnchorB - inAnchorA)));
+    correction.mTranslationA = -mA.mInverseMass * impulse;
+    correction.mRotationA = -(mA.mInverseInertia * mArmA.cross(impulse));
+    correction.mTranslationB = mB.mInverseMass * impulse;
+    correction.mRotationB = mB.mInverseInertia * mArmB.cross(impulse);
+    return correction;
+}
+
+} // namespace cairn::physics

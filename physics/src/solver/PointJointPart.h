@@ -1,0 +1,69 @@
+#pragma once
+
+// The three linear rows that hold a point of body A on a point of body B: the ball-and-socket joint, and the
+// translation half of the fixed, hinge and swing-twist joints (issue 33). Sequential impulses as the contacts
+// (SequentialImpulseSolver.h): the velocity rows take the relative velocity of the two points to zero with
+// one 3x3 effective mass (Catto, GDC 2009; Jolt and Box2D block-solve the point the same way), an impulse
+// accumulated over the step and kept for the next one's warm start; the drift the velocity rows leave is
+// taken out on the poses after integration (non-linear Gauss-Seidel, as the contacts' position iterations),
+// never by a Baumgarte velocity that would add energy.
+//
+// Works on SolverBody blocks and world-space arms; a static or kinematic side has a zero inverse mass and
+// inertia, so impulses leave it as it is. Threads: the one solving the island the joint is in; no locks.
+
+#include "cairn/physics/math/Math.h"
+#include "solver/SolverBody.h"
+
+namespace cairn::physics
+{
+
+/// A body as a joint's rows see it: its inverse mass and world inverse inertia (both zero when it is not
+/// dynamic).
+struct JointBodyMass
+{
+    float mInverseMass = 0.0f;
+    Mat3 mInverseInertia = Mat3::Zero();
+};
+
+class PointJointPart
+{
+public:
+    /// Sets the rows for the arms inArmA and inArmB (world space, from each centre of mass to its anchor).
+    /// The effective mass is zero, and the part inactive, when neither side can move (both static, or
+    /// kinematic) or the 3x3 mass matrix cannot be inverted; the accumulated impulse is kept (warm start).
+    void Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB, const JointBodyMass& inB);
+    bool IsActive() const { return mActive; }
+
+    /// Applies the accumulated impulse, scaled by inRatio (1: the last step's as it was; 0: none).
+    void WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio = 1.0f);
+    /// One velocity iteration: the impulse that makes the two points move together, accumulated.
+    void SolveVelocity(SolverBody& ioA, SolverBody& ioB);
+    /// The impulse accumulated over this step's iterations (on B; A takes its opposite), N s.
+    const Vec3& GetTotalImpulse() const { return mTotalImpulse; }
+    void ResetImpulse() { mTotalImpulse.setZero(); }
+
+    /// A position iteration's correction for the anchors at inAnchorA and inAnchorB (world space, after
+    /// integration, with the arms Prepare was given): the translations and rotation vectors that move the
+    /// two bodies so that inFraction of the gap closes (to first order in the rotation). Zero when inactive.
+    struct PoseCorrection
+    {
+        Vec3 mTranslationA = Vec3::Zero();
+        Vec3 mRotationA = Vec3::Zero();
+        Vec3 mTranslationB = Vec3::Zero();
+        Vec3 mRotationB = Vec3::Zero();
+    };
+    PoseCorrection CorrectPositions(const Vec3& inAnchorA, const Vec3& inAnchorB, float inFraction) const;
+
+private:
+    void Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inImpulse) const;
+
+    Vec3 mArmA = Vec3::Zero();
+    Vec3 mArmB = Vec3::Zero();
+    JointBodyMass mA;
+    JointBodyMass mB;
+    Mat3 mEffectiveMass = Mat3::Zero(); ///< The inverse of the 3x3 mass matrix K
+    Vec3 mTotalImpulse = Vec3::Zero();
+    bool mActive = false;
+};
+
+} // namespace cairn::physics
