@@ -26,9 +26,9 @@ double MillisecondsSince(Clock::time_point& ioStart)
 } // namespace
 
 PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& inLayers, BodyManager& ioBodies,
-                         BroadPhase& ioBroadPhase)
+                         BroadPhase& ioBroadPhase, ConstraintManager& ioConstraints)
     : mSettings(inSettings), mLayers(inLayers), mBodies(ioBodies), mBroadPhase(ioBroadPhase),
-      mContacts(inSettings.mPairCacheMaxDeltaAngle)
+      mConstraints(ioConstraints), mContacts(inSettings.mPairCacheMaxDeltaAngle)
 {
 }
 
@@ -51,6 +51,7 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     mContinuous.BeginStep();
     mContacts.BeginStep();
     IslandSleep::WakeIslandsOfWokenBodies(context);
+    mJoints.BeginStep(context, mConstraints); // May wake bodies: before the islands are sized
     mIslands.Reset(uint32_t(active.size()));
     update.RunHereUnlessStarted(); // After a few microseconds of other work: see there
 
@@ -84,12 +85,14 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
 
     // 6. Islands: serial, the solve's loops follow
     mScheduler.KeepWorkersSpinningFor(mContacts.GetConstraints().size() * StepCosts::cIslandsNanoseconds);
+    mJoints.LinkIslands(context);
     mIslandStage.Build(context, mContacts.GetConstraintInfo());
+    mJoints.GroupByIsland(context);
     ioStatistics.mIslandsMs += MillisecondsSince(phase);
 
     // 7. Solve (the constraints' ordering counted as solver time), positions integrated
-    mIslandStage.Order(context, mContacts.GetConstraints(), mContacts.GetConstraintInfo());
-    mSolver.Solve(context, mIslandStage.GetPlan(), uint32_t(mContacts.GetConstraints().size()));
+    mIslandStage.Order(context, mContacts.GetConstraints(), mContacts.GetConstraintInfo(), mJoints);
+    mSolver.Solve(context, mIslandStage.GetPlan(), uint32_t(mContacts.GetConstraints().size()), mJoints);
     mContactCache.EndStep(mContacts.IsCacheInOrder());
     ioStatistics.mSolveMs += MillisecondsSince(phase);
 

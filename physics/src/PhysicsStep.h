@@ -9,7 +9,8 @@
 //  2. velocities: forces, gravity, damping (body/Integration, its velocity half);
 //  3. pairs, 4. narrow phase, 5. merge (narrowphase/ContactsStage); bodies the merge wakes go round 2-5
 //     again, so a sleeping pile wakes whole within one step;
-//  6. islands: finalized, constraints ordered, large islands colored (islands/IslandStage);
+//  6. islands: joints link theirs (constraints/JointStage), finalized, constraints ordered, large islands
+//     colored (islands/IslandStage);
 //  7. solve, with the position half of integration (solver/IslandSolver);
 //  8. finish: bounds, broad-phase moves, published poses (step/FinishStage), then sleep
 //  (islands/IslandSleep).
@@ -25,6 +26,7 @@
 #include "cairn/physics/StepStatistics.h"
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
+#include "constraints/JointStage.h"
 #include "islands/AtomicUnionFind.h"
 #include "islands/IslandSleep.h"
 #include "islands/IslandStage.h"
@@ -56,7 +58,7 @@ class PhysicsStep
 {
 public:
     PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& inLayers, BodyManager& ioBodies,
-                BroadPhase& ioBroadPhase);
+                BroadPhase& ioBroadPhase, ConstraintManager& ioConstraints);
 
     /// One collision step of inDeltaTime seconds; adds its figures to ioStatistics. ioJobs (may be null: all
     /// on this thread) runs the parallel parts.
@@ -70,6 +72,7 @@ private:
     const LayerSetup& mLayers;
     BodyManager& mBodies;
     BroadPhase& mBroadPhase;
+    ConstraintManager& mConstraints; ///< Its mutex held by the Update that runs this step
 
     // What several stages share (StepContext)
     ContactCache mContactCache;
@@ -81,6 +84,7 @@ private:
     // The stages, in step order
     Integration mIntegration;
     ContactsStage mContacts;
+    JointStage mJoints;
     IslandStage mIslandStage;
     IslandSolver mSolver;
     ContinuousCollision mContinuous;

@@ -66,8 +66,10 @@ PhysicsSystem::PhysicsSystem(const PhysicsSettings& inSettings, const LayerSetup
       mBodies(std::make_unique<BodyManager>(mSettings.mMaxBodies, mSettings.mNumBodyMutexes)),
       mBroadPhase(CreateBroadPhase(mSettings, mLayers)),
       mBodyInterface(std::make_unique<BodyInterface>(*mBodies, *mBroadPhase, mLayers)),
+      mConstraints(std::make_unique<ConstraintManager>()),
+      mConstraintInterface(std::make_unique<ConstraintInterface>(*mConstraints, *mBodies)),
       mWorldQuery(std::make_unique<WorldQuery>(*mBodies, *mBroadPhase, mSettings.mQueryReads)),
-      mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase))
+      mStep(std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase, *mConstraints))
 {
 }
 
@@ -121,13 +123,15 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
     {
         // The step's state between steps is caches only (bodies, their poses and the broad phase live
         // elsewhere), so a fresh one is a world's first step again, with nothing to warm-start from
-        mStep = std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase);
+        mStep = std::make_unique<PhysicsStep>(mSettings, mLayers, *mBodies, *mBroadPhase, *mConstraints);
         mStepInterrupted = false;
     }
 
     const uint64_t waitedBefore = GetThisThreadLockWaitNanoseconds();
     mBodies->LockAllBodies();
     locked = true;
+    // The joints' mutex after the body mutexes (ConstraintManager.h): released before them, at scope exit
+    const std::lock_guard jointsLock(mConstraints->GetMutex());
     mLastStatistics = {};
     mLastStatistics.mLockWaitMs = double(GetThisThreadLockWaitNanoseconds() - waitedBefore) / 1.0e6;
     const float stepTime = inDeltaTime / float(inCollisionSteps);

@@ -1,6 +1,7 @@
 // IslandStage::Order: each island's constraints in solve order, the islands by size, and how each island is
 // solved (colored by every thread, colored or whole by one thread, or in a group of small ones).
 
+#include "constraints/JointStage.h"
 #include "islands/IslandStage.h"
 #include "math/RadixSort.h"
 #include "narrowphase/ContactsStage.h"
@@ -13,7 +14,7 @@ namespace cairn::physics
 {
 
 void IslandStage::Order(const StepContext& inContext, std::span<ContactConstraint* const> inConstraints,
-                        std::span<const ConstraintInfo> inInfo)
+                        std::span<const ConstraintInfo> inInfo, const JointStage& inJoints)
 {
     const AtomicUnionFind& islands = inContext.mIslands;
     const uint32_t numIslands = islands.GetNumIslands();
@@ -96,7 +97,9 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
     for (uint32_t island : mIslandOrder)
     {
         const uint32_t numConstraints = constraintStart[island + 1] - constraintStart[island];
-        if (numConstraints >= coloredMin)
+        if (inJoints.HasJoints(island))
+            mPlan.mSolvedIslands.push_back(island); // Whole, by one thread: see Order's declaration
+        else if (numConstraints >= coloredMin)
             mPlan.mColoredIslands.push_back(island);
         else if (wide && numConstraints >= cColoredIslandMinConstraints)
         {

@@ -19,6 +19,7 @@ namespace cairn::physics
 
 struct StepContext;
 struct ConstraintInfo;
+class JointStage;
 
 class IslandStage
 {
@@ -26,8 +27,9 @@ public:
     /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
     void Build(const StepContext& inContext, std::span<const ConstraintInfo> inInfo);
     /// The solver's order: hashed within each island; large islands colored.
+    /// An island with joints (inJoints) is solved whole by one thread (SolveIsland), whatever its size.
     void Order(const StepContext& inContext, std::span<ContactConstraint* const> inConstraints,
-               std::span<const ConstraintInfo> inInfo);
+               std::span<const ConstraintInfo> inInfo, const JointStage& inJoints);
 
     SolvePlan& GetPlan() { return mPlan; }
     /// Bodies in the largest island (0 without islands). After Order.

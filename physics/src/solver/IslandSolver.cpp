@@ -1,6 +1,7 @@
 #include "solver/IslandSolver.h"
 
 #include "body/Integration.h"
+#include "constraints/JointStage.h"
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
 
@@ -10,9 +11,11 @@
 namespace cairn::physics
 {
 
-void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints)
+void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints,
+                         JointStage& ioJoints)
 {
     mContext = &inContext;
+    mJoints = &ioJoints;
     mPlan = &ioPlan;
     const StepScheduler& scheduler = inContext.mScheduler;
     // The velocity solver works on packed copies of the velocities (SolverBody): one block per active body,
@@ -170,9 +173,15 @@ void IslandSolver::SolveIsland(uint32_t inIsland)
     const std::span<ContactConstraint* const> constraints = mPlan->ConstraintsOf(inIsland);
     const SolverSettings& solver = mContext->mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
+    // Joints before contacts in each pass (as Jolt and Box2D): the contacts, solved last, keep bodies apart
+    const bool joints = mJoints->HasJoints(inIsland);
+    if (joints) mJoints->WarmStart(inIsland, solverBodies);
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
+    {
+        if (joints) mJoints->SolveVelocities(inIsland, solverBodies);
         SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, i);
+    }
     FinishIsland(inIsland);
 }
 
@@ -222,8 +231,12 @@ void IslandSolver::FinishIsland(uint32_t inIsland)
     for (uint32_t activeIndex : mContext->mIslands.GetBodies(inIsland))
         StoreVelocitiesAndIntegrate(mContext->BodyAt(active[activeIndex]));
 
+    const bool joints = mJoints->HasJoints(inIsland);
     for (int i = 0; i < solver.mPositionIterations; ++i)
+    {
+        if (joints) mJoints->SolvePositions(inIsland, solver);
         SequentialImpulseSolver::SolvePositions(PositionConstraintsOf(inIsland), solver);
+    }
 
     StoreImpulses(constraints);
 }

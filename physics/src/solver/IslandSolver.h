@@ -25,6 +25,8 @@
 namespace cairn::physics
 {
 
+class JointStage;
+
 struct StepContext;
 class Body;
 
@@ -33,7 +35,9 @@ class IslandSolver
 public:
     /// Solves every island of ioPlan, integrates kinematic bodies and the bodies alone in their islands.
     /// inNumConstraints: the step's.
-    void Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints);
+    /// ioJoints: the step's joints, solved in their islands' passes (islands with joints are solved whole).
+    void Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints,
+               JointStage& ioJoints);
 
 private:
     void SolveIsland(uint32_t inIsland);
@@ -79,6 +83,7 @@ private:
 
     const StepContext* mContext = nullptr; ///< During Solve only
     SolvePlan* mPlan = nullptr;            ///< During Solve only
+    JointStage* mJoints = nullptr;         ///< During Solve only
 
     std::vector<ContactConstraint> mSolveOrder; ///< The other islands' constraints copied in solve order
     /// Ranges of the plan's island constraints copied into mSolveOrder, each one task of the copy

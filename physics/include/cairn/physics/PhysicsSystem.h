@@ -17,6 +17,7 @@
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/StepStatistics.h"
 #include "cairn/physics/body/BodyInterface.h"
+#include "cairn/physics/constraints/ConstraintInterface.h"
 #include "cairn/physics/narrowphase/ContactListener.h"
 #include "cairn/physics/queries/WorldQuery.h"
 
@@ -54,6 +55,8 @@ public:
     Status Update(float inDeltaTime, int inCollisionSteps, jobs::JobInterface& ioJobs);
 
     BodyInterface& GetBodyInterface() { return *mBodyInterface; }
+    /// Joints (ConstraintInterface.h): from any thread, outside step callbacks.
+    ConstraintInterface& GetConstraintInterface() { return *mConstraintInterface; }
     const WorldQuery& GetWorldQuery() const { return *mWorldQuery; }
     const BroadPhase& GetBroadPhase() const { return *mBroadPhase; }
     const BodyManager& GetBodyManager() const { return *mBodies; }
@@ -94,6 +97,8 @@ private:
     std::unique_ptr<BodyManager> mBodies;
     std::unique_ptr<BroadPhase> mBroadPhase;
     std::unique_ptr<BodyInterface> mBodyInterface;
+    std::unique_ptr<ConstraintManager> mConstraints;
+    std::unique_ptr<ConstraintInterface> mConstraintInterface;
     std::unique_ptr<WorldQuery> mWorldQuery;
     std::unique_ptr<PhysicsStep> mStep;
 

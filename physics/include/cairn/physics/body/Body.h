@@ -75,6 +75,7 @@ private:
     friend class IslandSolver;
     friend class FinishStage;
     friend class IslandSleep;
+    friend class JointStage;
 
     /// Sets mass properties and everything else from the settings (validated by the caller).
     void Init(const BodyID& inID, const BodyCreationSettings& inSettings);

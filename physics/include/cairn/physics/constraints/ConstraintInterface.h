@@ -1,0 +1,83 @@
+#pragma once
+
+// ConstraintInterface: joints between two bodies, or a body and the world (issue 33). A joint links its
+// bodies into one simulation island, as a contact does: they are solved together, sleep together and wake
+// together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
+// last step's impulse, drift taken out on the poses after integration).
+//
+// Joints so far: the point (ball and socket). An island with a joint is solved by one thread, whole (not
+// colored, not grouped): the same result for any thread count.
+//
+// Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
+// (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
+// joints' mutex, as it holds every body mutex). A joint whose body is gone or not in the world does nothing
+// until it is (a stale body id never reaches another body: ids carry their sequence).
+
+#include "cairn/physics/body/BodyID.h"
+#include "cairn/physics/math/Math.h"
+#include "cairn/physics/math/Result.h"
+
+#include <cstdint>
+
+namespace cairn::physics
+{
+
+class BodyManager;
+class ConstraintManager;
+
+/// A joint, as Add returns it: its slot and that slot's generation (a removed joint's id goes stale).
+class ConstraintID
+{
+public:
+    static constexpr uint32_t cInvalidIndex = 0xffffffffu;
+    constexpr ConstraintID() = default;
+    constexpr ConstraintID(uint32_t inIndex, uint32_t inSequence) : mIndex(inIndex), mSequence(inSequence) {}
+    constexpr uint32_t GetIndex() const { return mIndex; }
+    constexpr uint32_t GetSequence() const { return mSequence; }
+    constexpr bool IsInvalid() const { return mIndex == cInvalidIndex; }
+    constexpr auto operator<=>(const ConstraintID&) const = default;
+
+private:
+    uint32_t mIndex = cInvalidIndex;
+    uint32_t mSequence = 0;
+};
+
+/// A ball and socket: a point of A stays on a point of B, any rotation free.
+struct PointConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB; ///< Likewise; at most one side is the world, and the two are different bodies
+    /// The joint's point in world space, at creation: each body keeps the point where it is on it now
+    Vec3 mPoint = Vec3::Zero();
+};
+
+class ConstraintInterface
+{
+public:
+    /// At most this many joints at once: a bad count gets OutOfCapacity, not memory to match.
+    static constexpr uint32_t cMaxConstraints = 1u << 20;
+
+    ConstraintInterface(ConstraintManager& ioManager, BodyManager& ioBodies);
+
+    /// A point joint, enabled. The dynamic bodies it joins are woken. Errors: a point that is NaN or beyond
+    /// the world, both sides the world or the same body (InvalidArgument), a stale or unknown body id
+    /// (InvalidBodyID), cMaxConstraints reached (OutOfCapacity), the wrong thread (WrongThread).
+    Result<ConstraintID> AddPoint(const PointConstraintSettings& inSettings);
+    /// Removes a joint; its id goes stale. Its bodies are woken (a body hanging from it falls).
+    Status Remove(ConstraintID inID);
+    /// A disabled joint does nothing and links no island; enabling starts it from no impulse. Its bodies are
+    /// woken either way.
+    Status SetEnabled(ConstraintID inID, bool inEnabled);
+    Result<bool> IsEnabled(ConstraintID inID) const;
+    /// Joints that exist (enabled or not).
+    Result<uint32_t> GetNumConstraints() const;
+
+private:
+    /// Wakes the body inID if it is dynamic and in the world (a stale id or the world: nothing).
+    void WakeBody(const BodyID& inID);
+
+    ConstraintManager& mManager;
+    BodyManager& mBodies;
+};
+
+} // namespace cairn::physics

@@ -1,0 +1,82 @@
+#pragma once
+
+// ConstraintManager: the joints, in slots that ids name (ConstraintID: slot and generation).
+// Threads: ConstraintInterface's calls, from any thread, under mMutex. The physics step, on the updating
+// thread and its jobs, while PhysicsSystem::Update holds mMutex for the whole Update (taken after the body
+// mutexes; the interface never holds a body lock and this mutex at once): it reads the slots, and writes a
+// joint's part (its impulse, kept for the next step's warm start) only from the thread that solves the
+// joint's island.
+
+#include "cairn/physics/constraints/ConstraintInterface.h"
+#include "solver/PointJointPart.h"
+
+#include <mutex>
+#include <vector>
+
+namespace cairn::physics
+{
+
+struct Joint
+{
+    uint32_t mSequence = 0;
+    bool mInUse = false;
+    bool mEnabled = false;
+    BodyID mBodyA; ///< Invalid: the world
+    BodyID mBodyB;
+    /// The anchor in each body's centre-of-mass frame (in world space for the world's side)
+    Vec3 mLocalA = Vec3::Zero();
+    Vec3 mLocalB = Vec3::Zero();
+    PointJointPart mPart;
+};
+
+class ConstraintManager
+{
+public:
+    std::mutex& GetMutex() const { return mMutex; }
+
+    // Under the mutex:
+    /// The joint inID names, or null for a stale or unknown id.
+    Joint* Find(ConstraintID inID)
+    {
+        if (inID.GetIndex() >= mJoints.size()) return nullptr;
+        Joint& joint = mJoints[inID.GetIndex()];
+        return joint.mInUse && joint.mSequence == inID.GetSequence() ? &joint : nullptr;
+    }
+    /// Stores inJoint in a free slot (the lowest freed first, else a new one); false when full.
+    bool Add(Joint inJoint, uint32_t inMaxJoints, ConstraintID& outID)
+    {
+        if (mNumInUse >= inMaxJoints) return false;
+        uint32_t index = uint32_t(mJoints.size());
+        if (!mFree.empty())
+        {
+            index = mFree.back();
+            mFree.pop_back();
+        }
+        else
+            mJoints.emplace_back();
+        inJoint.mSequence = mJoints[index].mSequence + 1; // A new generation: the slot's old ids go stale
+        inJoint.mInUse = true;
+        mJoints[index] = inJoint;
+        ++mNumInUse;
+        outID = ConstraintID(index, inJoint.mSequence);
+        return true;
+    }
+    void Remove(ConstraintID inID)
+    {
+        Joint& joint = mJoints[inID.GetIndex()];
+        joint.mInUse = false;
+        mFree.push_back(inID.GetIndex());
+        --mNumInUse;
+    }
+    uint32_t GetNumInUse() const { return mNumInUse; }
+    /// Every slot, in use or not (the step walks them in slot order: the same order on every run).
+    std::vector<Joint>& GetJoints() { return mJoints; }
+
+private:
+    mutable std::mutex mMutex;
+    std::vector<Joint> mJoints;
+    std::vector<uint32_t> mFree;
+    uint32_t mNumInUse = 0;
+};
+
+} // namespace cairn::physics

@@ -1,0 +1,72 @@
+#pragma once
+
+// JointStage: the step's part of the joints (ConstraintManager). At the step's start it takes the enabled
+// joints whose bodies are in the world and wakes a sleeping dynamic body jointed to an active one (through
+// chains of joints, in slot order); after the narrow phase it links the islands of the joints' two active
+// dynamic bodies; after the islands are numbered it groups the joints by island (slot order within one). The
+// solver then runs each island's joints in the island's passes: warm start and velocity rows before the
+// contacts', and position rows before the contacts' after integration.
+//
+// Threads: BeginStep, LinkIslands and GroupByIsland on the updating thread, while Update holds the joints'
+// mutex; the solve calls from the thread that solves the island, which writes only that island's joints and
+// its bodies.
+
+#include "constraints/ConstraintManager.h"
+#include "solver/SolverBody.h"
+
+#include <span>
+#include <vector>
+
+namespace cairn::physics
+{
+
+struct SolverSettings;
+struct StepContext;
+class Body;
+
+class JointStage
+{
+public:
+    /// Before the islands are reset for this step (active bodies may be added).
+    void BeginStep(const StepContext& inContext, ConstraintManager& ioManager);
+    /// After the narrow phase's last merge, before the islands are finalized.
+    void LinkIslands(const StepContext& inContext);
+    /// After the islands are finalized.
+    void GroupByIsland(const StepContext& inContext);
+
+    bool HasJoints(uint32_t inIsland) const
+    {
+        return !mStepJoints.empty() && mJointStart[inIsland + 1] > mJointStart[inIsland];
+    }
+    uint32_t GetNumStepJoints() const { return uint32_t(mStepJoints.size()); }
+
+    // The solve of island inIsland, by the thread that solves it; ioBodies: the solver's velocity blocks by
+    // active index
+    /// Sets the rows from the poses at the step's start and applies the last step's impulses.
+    void WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies);
+    void SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodies);
+    /// One position iteration, on the integrated poses.
+    void SolvePositions(uint32_t inIsland, const SolverSettings& inSettings);
+
+private:
+    struct StepJoint
+    {
+        Joint* mJoint;
+        Body* mA; ///< Null: the world
+        Body* mB;
+        SolverBody mBlockA; ///< The velocity block of a side that is not dynamic (static, kinematic, world)
+        SolverBody mBlockB;
+    };
+    /// The arms (world space) and the masses of a joint's sides at their current poses.
+    void Prepare(StepJoint& ioJoint);
+    SolverBody& BlockA(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
+    SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
+
+    const StepContext* mContext = nullptr;
+    std::vector<StepJoint> mStepJoints;  ///< This step's joints, in slot order
+    std::vector<uint32_t> mJointStart;   ///< Per island, offsets into mIslandJoints
+    std::vector<uint32_t> mIslandJoints; ///< Indices into mStepJoints, by island
+    std::vector<uint32_t> mJointIsland;  ///< Scratch: per step joint
+};
+
+} // namespace cairn::physics
