@@ -37,46 +37,77 @@ void ConstraintInterface::WakeBody(const BodyID& inID)
     if (body != nullptr && body->IsInWorld() && body->IsDynamic()) mBodies.ActivateBody(*body);
 }
 
-Result<ConstraintID> ConstraintInterface::AddPoint(const PointConstraintSettings& inSettings)
+Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPointA, const Vec3& inPointB)
 {
     if (IsWrongThread()) return WrongThread();
-    if (!IsValidWorldPosition(inSettings.mPoint))
+    if (!IsValidWorldPosition(inPointA) || !IsValidWorldPosition(inPointB))
         return MakeError(ErrorCode::InvalidArgument, "joint point is NaN, infinite or beyond the world");
-    if (inSettings.mBodyA.IsInvalid() && inSettings.mBodyB.IsInvalid())
+    if (ioJoint.mBodyA.IsInvalid() && ioJoint.mBodyB.IsInvalid())
         return MakeError(ErrorCode::InvalidArgument, "a joint needs a body on at least one side");
-    if (inSettings.mBodyA == inSettings.mBodyB)
+    if (ioJoint.mBodyA == ioJoint.mBodyB)
         return MakeError(ErrorCode::InvalidArgument, "a joint joins two different bodies");
-    Joint joint;
-    joint.mEnabled = true;
-    joint.mBodyA = inSettings.mBodyA;
-    joint.mBodyB = inSettings.mBodyB;
+    ioJoint.mEnabled = true;
     // Each side's anchor in its centre-of-mass frame, from the body's pose now (one body lock at a time,
     // released before the joints' mutex: the step takes the body mutexes first)
-    auto anchor = [&](const BodyID& inID, Vec3& outLocal) -> Status
+    auto anchor = [&](const BodyID& inID, const Vec3& inPoint, Vec3& outLocal) -> Status
     {
         if (inID.IsInvalid())
         {
-            outLocal = inSettings.mPoint;
+            outLocal = inPoint;
             return Status::Ok();
         }
         BodyLockRead lock(mBodies, inID);
         if (lock.WasWrongThread()) return WrongThread();
         const Body* body = lock.GetBody();
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
-        outLocal = body->GetRotation().conjugate() * (inSettings.mPoint - body->GetCenterOfMassPosition());
+        outLocal = body->GetRotation().conjugate() * (inPoint - body->GetCenterOfMassPosition());
         return Status::Ok();
     };
-    if (Status a = anchor(joint.mBodyA, joint.mLocalA); !a) return a.GetError();
-    if (Status b = anchor(joint.mBodyB, joint.mLocalB); !b) return b.GetError();
+    if (Status a = anchor(ioJoint.mBodyA, inPointA, ioJoint.mLocalA); !a) return a.GetError();
+    if (Status b = anchor(ioJoint.mBodyB, inPointB, ioJoint.mLocalB); !b) return b.GetError();
     ConstraintID id;
     {
         std::lock_guard lock(mManager.GetMutex());
-        if (!mManager.Add(joint, cMaxConstraints, id))
+        if (!mManager.Add(ioJoint, cMaxConstraints, id))
             return MakeError(ErrorCode::OutOfCapacity, "too many constraints");
     }
-    WakeBody(joint.mBodyA);
-    WakeBody(joint.mBodyB);
+    WakeBody(ioJoint.mBodyA);
+    WakeBody(ioJoint.mBodyB);
     return id;
+}
+
+Result<ConstraintID> ConstraintInterface::AddPoint(const PointConstraintSettings& inSettings)
+{
+    Joint joint;
+    joint.mType = JointType::Point;
+    joint.mBodyA = inSettings.mBodyA;
+    joint.mBodyB = inSettings.mBodyB;
+    return Add(joint, inSettings.mPoint, inSettings.mPoint);
+}
+
+Result<ConstraintID> ConstraintInterface::AddDistance(const DistanceConstraintSettings& inSettings)
+{
+    // A distance or limit beyond this is not a joint but bad input (the world is smaller)
+    constexpr float cMaxDistance = 1.0e6f;
+    const float now = (inSettings.mPointB - inSettings.mPointA).norm();
+    const float minDistance = inSettings.mMinDistance < 0.0f ? now : inSettings.mMinDistance;
+    const float maxDistance = inSettings.mMaxDistance < 0.0f ? now : inSettings.mMaxDistance;
+    if (!(minDistance >= 0.0f && minDistance <= maxDistance && maxDistance <= cMaxDistance))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "distance limits must be finite, at least 0, at most 1e6 m and min <= max");
+    const SpringSettings& spring = inSettings.mLimitsSpring;
+    if (!(spring.mFrequency >= 0.0f && spring.mFrequency <= 1.0e4f && spring.mDamping >= 0.0f &&
+          spring.mDamping <= 1.0e4f))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "a spring's frequency and damping must be finite and at least 0 (at most 1e4)");
+    Joint joint;
+    joint.mType = JointType::Distance;
+    joint.mBodyA = inSettings.mBodyA;
+    joint.mBodyB = inSettings.mBodyB;
+    joint.mMinDistance = minDistance;
+    joint.mMaxDistance = maxDistance;
+    joint.mSpring = spring;
+    return Add(joint, inSettings.mPointA, inSettings.mPointB);
 }
 
 Status ConstraintInterface::Remove(ConstraintID inID)
@@ -104,7 +135,11 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
         std::lock_guard lock(mManager.GetMutex());
         Joint* joint = mManager.Find(inID);
         if (joint == nullptr) return StaleID();
-        if (inEnabled && !joint->mEnabled) joint->mPart.ResetImpulse(); // No warm start from before
+        if (inEnabled && !joint->mEnabled) // No warm start from before
+        {
+            joint->mPart.ResetImpulse();
+            joint->mAxisPart.ResetImpulse();
+        }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;
         b = joint->mBodyB;

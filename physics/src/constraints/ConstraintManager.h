@@ -8,6 +8,7 @@
 // joint's island.
 
 #include "cairn/physics/constraints/ConstraintInterface.h"
+#include "solver/AxisJointPart.h"
 #include "solver/PointJointPart.h"
 
 #include <mutex>
@@ -16,8 +17,15 @@
 namespace cairn::physics
 {
 
+enum class JointType : uint8_t
+{
+    Point,
+    Distance,
+};
+
 struct Joint
 {
+    JointType mType = JointType::Point;
     uint32_t mSequence = 0;
     bool mInUse = false;
     bool mEnabled = false;
@@ -26,7 +34,12 @@ struct Joint
     /// The anchor in each body's centre-of-mass frame (in world space for the world's side)
     Vec3 mLocalA = Vec3::Zero();
     Vec3 mLocalB = Vec3::Zero();
-    PointJointPart mPart;
+    PointJointPart mPart; ///< Point
+    // Distance
+    float mMinDistance = 0.0f;
+    float mMaxDistance = 0.0f;
+    SpringSettings mSpring;
+    AxisJointPart mAxisPart;
 };
 
 class ConstraintManager

@@ -72,7 +72,8 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
         if ((a != nullptr && a->IsDynamic() && !a->IsActive()) ||
             (b != nullptr && b->IsDynamic() && !b->IsActive()))
             continue; // Could not wake (defensive: ActivateBody refused)
-        mStepJoints.push_back({&joint, a, b, BlockOf(a), BlockOf(b)});
+        mStepJoints.push_back(
+            {&joint, a, b, BlockOf(a), BlockOf(b), Vec3::Zero(), Vec3::Zero(), false, 0.0f});
     }
 }
 
@@ -108,18 +109,62 @@ void JointStage::GroupByIsland(const StepContext& inContext)
 void JointStage::Prepare(StepJoint& ioJoint)
 {
     Joint& joint = *ioJoint.mJoint;
-    auto side = [](const Body* inBody, const Vec3& inLocal, Vec3& outArm, JointBodyMass& outMass)
+    // Each side's arm (centre of mass to anchor, world space), anchor and masses at its pose now; the world's
+    // side: its point, no arm, nothing that moves
+    auto side =
+        [](const Body* inBody, const Vec3& inLocal, Vec3& outArm, Vec3& outAnchor, JointBodyMass& outMass)
     {
         outArm = inBody != nullptr ? Vec3(inBody->GetRotation() * inLocal) : Vec3::Zero();
+        outAnchor = inBody != nullptr ? Vec3(inBody->GetCenterOfMassPosition() + outArm) : inLocal;
         outMass = {};
         if (inBody != nullptr && inBody->IsDynamic())
             outMass = {inBody->GetInverseMass(), inBody->GetInverseInertiaWorld()};
     };
-    Vec3 armA, armB;
+    Vec3 armA, armB, anchorA, anchorB;
     JointBodyMass massA, massB;
-    side(ioJoint.mA, joint.mLocalA, armA, massA);
-    side(ioJoint.mB, joint.mLocalB, armB, massB);
-    joint.mPart.Prepare(armA, massA, armB, massB);
+    side(ioJoint.mA, joint.mLocalA, armA, anchorA, massA);
+    side(ioJoint.mB, joint.mLocalB, armB, anchorB, massB);
+    ioJoint.mAnchorA = anchorA;
+    ioJoint.mAnchorB = anchorB;
+    switch (joint.mType)
+    {
+    case JointType::Point:
+        joint.mPart.Prepare(armA, massA, armB, massB);
+        break;
+    case JointType::Distance:
+    {
+        const Vec3 between = anchorB - anchorA;
+        const float length = between.norm();
+        // Points on each other: any direction will do to push them apart (a rod of length 0 holds them)
+        const Vec3 axis = length > 1.0e-6f ? Vec3(between / length) : Vec3::UnitX();
+        AxisJointPart::Side rowSide = AxisJointPart::Side::Both;
+        float error = 0.0f;
+        if (joint.mMinDistance == joint.mMaxDistance)
+            error = length - joint.mMinDistance;
+        else if (length < joint.mMinDistance)
+        {
+            error = length - joint.mMinDistance;
+            rowSide = AxisJointPart::Side::Positive;
+        }
+        else if (length > joint.mMaxDistance)
+        {
+            error = length - joint.mMaxDistance;
+            rowSide = AxisJointPart::Side::Negative;
+        }
+        else
+        {
+            // Within its limits: no row this step (and no impulse to warm-start the next one from)
+            ioJoint.mRowActive = false;
+            joint.mAxisPart.ResetImpulse();
+            break;
+        }
+        ioJoint.mRowActive = true;
+        ioJoint.mError = error;
+        joint.mAxisPart.Prepare(armA, massA, armB, massB, axis, error, rowSide, joint.mSpring.mFrequency,
+                                joint.mSpring.mDamping, mContext->mDeltaTime);
+        break;
+    }
+    }
 }
 
 SolverBody& JointStage::BlockA(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const
@@ -138,7 +183,10 @@ void JointStage::WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
         Prepare(joint);
-        joint.mJoint->mPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        if (joint.mJoint->mType == JointType::Point)
+            joint.mJoint->mPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        else if (joint.mRowActive)
+            joint.mJoint->mAxisPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
     }
 }
 
@@ -147,7 +195,10 @@ void JointStage::SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodi
     for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
-        joint.mJoint->mPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        if (joint.mJoint->mType == JointType::Point)
+            joint.mJoint->mPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        else if (joint.mRowActive)
+            joint.mJoint->mAxisPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
     }
 }
 
@@ -157,17 +208,14 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
         // The rows again at the integrated poses (the arms turned with their bodies), then the part of the
-        // gap the position iterations take out
+        // error the position iterations take out
         Prepare(joint);
         const Joint& data = *joint.mJoint;
-        auto anchor = [](const Body* inBody, const Vec3& inLocal)
-        {
-            return inBody != nullptr
-                       ? Vec3(inBody->GetCenterOfMassPosition() + inBody->GetRotation() * inLocal)
-                       : inLocal;
-        };
-        const PointJointPart::PoseCorrection correction = data.mPart.CorrectPositions(
-            anchor(joint.mA, data.mLocalA), anchor(joint.mB, data.mLocalB), inSettings.mBaumgarte);
+        PointJointPart::PoseCorrection correction;
+        if (data.mType == JointType::Point)
+            correction = data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte);
+        else if (joint.mRowActive)
+            correction = data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte);
         if (joint.mA != nullptr && joint.mA->IsDynamic())
             Integration::CorrectPose(*joint.mA, correction.mTranslationA, correction.mRotationA);
         if (joint.mB != nullptr && joint.mB->IsDynamic())

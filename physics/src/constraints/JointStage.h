@@ -56,8 +56,14 @@ private:
         Body* mB;
         SolverBody mBlockA; ///< The velocity block of a side that is not dynamic (static, kinematic, world)
         SolverBody mBlockB;
+        // As the last Prepare found them
+        Vec3 mAnchorA = Vec3::Zero(); ///< World space
+        Vec3 mAnchorB = Vec3::Zero();
+        bool mRowActive = false; ///< A distance joint out of its limits (or a rod)
+        float mError = 0.0f;     ///< A distance joint's length less the limit it is at
     };
-    /// The arms (world space) and the masses of a joint's sides at their current poses.
+    /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
+    /// and limit).
     void Prepare(StepJoint& ioJoint);
     SolverBody& BlockA(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
     SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;

@@ -1,10 +1,12 @@
-// Joints (issue 33), the point joint so far: a pendulum against its analytic period, a joint that joins two
-// islands into one that sleeps and wakes whole, the same bodies for any thread count, and bad input.
+// Joints (issue 33), the point and distance joints so far: a pendulum against its analytic period, a spring
+// against the implicit spring step, a rope and a rod, a joint that joins two islands into one that sleeps and
+// wakes whole, the same bodies for any thread count, and bad input.
 
 #include "SimulationFixture.h"
 #include "cairn/physics/body/BodyLock.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace cairn::test
@@ -192,6 +194,85 @@ TEST_F(JointTest, AChainOfJointedBodiesIsTheSameForAnyThreadCount)
     EXPECT_LT(alone.front().y(), 3.0f); // It swung down
 }
 
+TEST_F(JointTest, ADistanceSpringFollowsTheImplicitSpringStep)
+{
+    // A sphere on a spring of rest length 1 m to a point of the world, pulled 0.2 m along it and let go, no
+    // gravity, no damping of its own. The soft row is the implicit Euler step of the spring and damper on the
+    // row's effective mass (here the body's mass: the anchor is its centre): for the stretch e and its rate
+    // v,
+    //   v' = (v - h w^2 e) / (1 + 2 z h w + h^2 w^2),  e' = e + h v'
+    // whatever the mass, and the position iterations leave a soft row alone
+    const float frequency = 1.0f, damping = 0.1f, rest = 1.0f;
+    const Vec3 pivot(0.0f, 5.0f, 0.0f);
+    BodyCreationSettings settings = DynamicSettings(Sphere(0.1f), pivot + Vec3(rest + 0.2f, 0.0f, 0.0f));
+    settings.mGravityFactor = 0.0f;
+    settings.mLinearDamping = 0.0f;
+    settings.mAngularDamping = 0.0f;
+    settings.mAllowSleeping = false;
+    settings.mDensity = 7800.0f; // Heavy: the frequency does not depend on the mass
+    const BodyID bob = AddDynamic(settings);
+    DistanceConstraintSettings spring;
+    spring.mBodyB = bob;
+    spring.mPointA = pivot;
+    spring.mPointB = Position(bob);
+    spring.mMinDistance = spring.mMaxDistance = rest;
+    spring.mLimitsSpring = {frequency, damping};
+    ASSERT_TRUE(Joints().AddDistance(spring).IsOk());
+
+    const double h = cDeltaTime, omega = 2.0 * std::numbers::pi * frequency;
+    double e = 0.2, v = 0.0, largestDifference = 0.0;
+    for (int step = 0; step < 180; ++step)
+    {
+        ASSERT_TRUE(UpdateWorld(cDeltaTime).IsOk());
+        v = (v - h * omega * omega * e) / (1.0 + 2.0 * damping * h * omega + h * h * omega * omega);
+        e += h * v;
+        largestDifference =
+            std::max(largestDifference, std::abs(double((Position(bob) - pivot).norm()) - rest - e));
+    }
+    // Float rounding over 180 steps of a 0.2 m swing
+    EXPECT_LT(largestDifference, 2.0e-4);
+    // And it did swing: three periods later the stretch is what the formula says, not 0.2 m or 0
+    EXPECT_GT(std::abs(e), 0.01);
+}
+
+TEST_F(JointTest, ARopeIsSlackWithinItsLengthAndHoldsAtIt)
+{
+    const Vec3 pivot(0.0f, 5.0f, 0.0f);
+    BodyCreationSettings settings = DynamicSettings(Sphere(0.1f), pivot - Vec3(0.0f, 0.5f, 0.0f));
+    settings.mLinearDamping = 0.0f;
+    const BodyID bob = AddDynamic(settings);
+    DistanceConstraintSettings rope;
+    rope.mBodyB = bob;
+    rope.mPointA = pivot;
+    rope.mPointB = Position(bob);
+    rope.mMinDistance = 0.0f;
+    rope.mMaxDistance = 1.5f;
+    ASSERT_TRUE(Joints().AddDistance(rope).IsOk());
+    Step(6); // 0.1 s of free fall: slack, the rope does nothing
+    EXPECT_NEAR(Position(bob).y(), 4.5f - 0.5f * 9.81f * 0.1f * 0.1f, 0.01f);
+    float longest = 0.0f;
+    for (int step = 0; step < 120; ++step)
+    {
+        Step(1);
+        longest = std::max(longest, (Position(bob) - pivot).norm());
+    }
+    EXPECT_NEAR((Position(bob) - pivot).norm(), 1.5f, 0.015f); // Taut, hanging
+    EXPECT_LT(longest, 1.5f * 1.02f); // The jerk when it went taut stretched it 2 % at most
+    // A rod (equal limits) pushes too: a body on a 1 m rod above its pivot stays 1 m up while it topples
+    ResetWorld(PhysicsSettings{});
+    const BodyID top = AddDynamic(DynamicSettings(Sphere(0.1f), pivot + Vec3(0.01f, 1.0f, 0.0f)));
+    DistanceConstraintSettings rod;
+    rod.mBodyB = top;
+    rod.mPointA = pivot;
+    rod.mPointB = Position(top);
+    ASSERT_TRUE(Joints().AddDistance(rod).IsOk()); // Limits: the distance now
+    for (int step = 0; step < 120; ++step)
+    {
+        Step(1);
+        ASSERT_NEAR((Position(top) - pivot).norm(), (rod.mPointB - pivot).norm(), 0.01f) << "step " << step;
+    }
+}
+
 TEST_F(JointTest, BadInputGetsClearErrors)
 {
     const BodyID bob = AddDynamic(DynamicSettings(Sphere(0.1f), Vec3(0.0f, 1.0f, 0.0f)));
@@ -213,6 +294,21 @@ TEST_F(JointTest, BadInputGetsClearErrors)
     EXPECT_EQ(Joints().AddPoint(settings).GetError().mCode, ErrorCode::InvalidBodyID);
     EXPECT_EQ(Joints().Remove(ConstraintID()).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(Joints().SetEnabled(ConstraintID(7, 1), true).GetError().mCode, ErrorCode::InvalidArgument);
+    DistanceConstraintSettings distance;
+    distance.mBodyB = bob;
+    distance.mMinDistance = 2.0f;
+    distance.mMaxDistance = 1.0f; // min > max
+    EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
+    distance.mMaxDistance = std::nanf("");
+    EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
+    distance.mMaxDistance = 3.0f;
+    distance.mLimitsSpring.mFrequency = -1.0f;
+    EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
+    distance.mLimitsSpring = {1.0f, std::numeric_limits<float>::infinity()};
+    EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
+    distance.mLimitsSpring = {};
+    distance.mPointA = Vec3(std::nanf(""), 0.0f, 0.0f);
+    EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(Joints().GetNumConstraints().Value(), 0u);
     {
         // Holding a body lock: a joint call could wait for a step that waits for this lock

@@ -5,8 +5,8 @@
 // together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
 // last step's impulse, drift taken out on the poses after integration).
 //
-// Joints so far: the point (ball and socket). An island with a joint is solved by one thread, whole (not
-// colored, not grouped): the same result for any thread count.
+// Joints so far: the point (ball and socket) and the distance (rod, rope, spring). An island with a joint is
+// solved by one thread, whole (not colored, not grouped): the same result for any thread count.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
 // (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
@@ -24,6 +24,7 @@ namespace cairn::physics
 
 class BodyManager;
 class ConstraintManager;
+struct Joint;
 
 /// A joint, as Add returns it: its slot and that slot's generation (a removed joint's id goes stale).
 class ConstraintID
@@ -51,6 +52,27 @@ struct PointConstraintSettings
     Vec3 mPoint = Vec3::Zero();
 };
 
+/// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
+/// mass, so its frequency does not depend on the bodies' masses.
+struct SpringSettings
+{
+    float mFrequency = 0.0f; ///< Hz; 0: rigid
+    float mDamping = 0.0f;   ///< Ratio to critical damping (1: critical)
+};
+
+/// Keeps the distance between a point of A and a point of B within [min, max]: equal, a rod; min 0, a rope;
+/// with a spring, the limits give like a spring (equal limits: a spring of that rest length).
+struct DistanceConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB;
+    Vec3 mPointA = Vec3::Zero(); ///< World space, at creation (each body keeps its point where it is on it)
+    Vec3 mPointB = Vec3::Zero();
+    float mMinDistance = -1.0f; ///< m; negative: the distance between the points now
+    float mMaxDistance = -1.0f; ///< m; negative: the distance between the points now
+    SpringSettings mLimitsSpring;
+};
+
 class ConstraintInterface
 {
 public:
@@ -63,6 +85,10 @@ public:
     /// the world, both sides the world or the same body (InvalidArgument), a stale or unknown body id
     /// (InvalidBodyID), cMaxConstraints reached (OutOfCapacity), the wrong thread (WrongThread).
     Result<ConstraintID> AddPoint(const PointConstraintSettings& inSettings);
+    /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
+    /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
+    /// (InvalidArgument).
+    Result<ConstraintID> AddDistance(const DistanceConstraintSettings& inSettings);
     /// Removes a joint; its id goes stale. Its bodies are woken (a body hanging from it falls).
     Status Remove(ConstraintID inID);
     /// A disabled joint does nothing and links no island; enabling starts it from no impulse. Its bodies are
@@ -75,6 +101,9 @@ public:
 private:
     /// Wakes the body inID if it is dynamic and in the world (a stale id or the world: nothing).
     void WakeBody(const BodyID& inID);
+    /// The checks every joint needs, its anchors from the world points, then the joint stored and its bodies
+    /// woken.
+    Result<ConstraintID> Add(Joint& ioJoint, const Vec3& inPointA, const Vec3& inPointB);
 
     ConstraintManager& mManager;
     BodyManager& mBodies;

@@ -1,0 +1,91 @@
+#include "solver/AxisJointPart.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace cairn::physics
+{
+
+void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                            const JointBodyMass& inB, const Vec3& inAxis, float inError, Side inSide,
+                            float inFrequency, float inDamping, float inDeltaTime)
+{
+    mAxis = inAxis;
+    mArmCrossA = inArmA.cross(inAxis);
+    mArmCrossB = inArmB.cross(inAxis);
+    mAngularA = inA.mInverseInertia * mArmCrossA;
+    mAngularB = inB.mInverseInertia * mArmCrossB;
+    mInverseMassA = inA.mInverseMass;
+    mInverseMassB = inB.mInverseMass;
+    const float k =
+        inA.mInverseMass + inB.mInverseMass + mArmCrossA.dot(mAngularA) + mArmCrossB.dot(mAngularB);
+    mActive = k > 0.0f && std::isfinite(k);
+    mEffectiveMass = mActive ? 1.0f / k : 0.0f;
+    if (mSide != inSide) mTotalImpulse = 0.0f; // Another limit than last step's: nothing to warm-start
+    mSide = inSide;
+    mSoft = inFrequency > 0.0f;
+    mBias = 0.0f;
+    mMassScale = 1.0f;
+    mImpulseScale = 0.0f;
+    if (mSoft && mActive)
+    {
+        // Box2D v3's b2MakeSoft, Catto's soft step: the implicit Euler step of a spring of angular frequency
+        // w and damping ratio z on the effective mass
+        const float omega = 2.0f * std::numbers::pi_v<float> * inFrequency;
+        const float a1 = 2.0f * inDamping + inDeltaTime * omega;
+        const float a2 = inDeltaTime * omega * a1;
+        const float a3 = 1.0f / (1.0f + a2);
+        mBias = omega / a1 * inError;
+        mMassScale = a2 * a3;
+        mImpulseScale = a3;
+    }
+    if (!mActive) mTotalImpulse = 0.0f;
+}
+
+void AxisJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
+{
+    ioA.mLinearVelocity -= (mInverseMassA * inImpulse) * mAxis;
+    ioA.mAngularVelocity -= inImpulse * mAngularA;
+    ioB.mLinearVelocity += (mInverseMassB * inImpulse) * mAxis;
+    ioB.mAngularVelocity += inImpulse * mAngularB;
+}
+
+void AxisJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
+{
+    mTotalImpulse *= inRatio;
+    if (mActive) Apply(ioA, ioB, mTotalImpulse);
+}
+
+void AxisJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const float speed = mAxis.dot(ioB.mLinearVelocity - ioA.mLinearVelocity) +
+                        mArmCrossB.dot(ioB.mAngularVelocity) - mArmCrossA.dot(ioA.mAngularVelocity);
+    float impulse = -mMassScale * mEffectiveMass * (speed + mBias) - mImpulseScale * mTotalImpulse;
+    // A limit's accumulated impulse stays on its side (it may take back what earlier iterations gave)
+    const float total = mTotalImpulse + impulse;
+    const float clamped = mSide == Side::Positive   ? std::max(total, 0.0f)
+                          : mSide == Side::Negative ? std::min(total, 0.0f)
+                                                    : total;
+    impulse = clamped - mTotalImpulse;
+    mTotalImpulse = clamped;
+    Apply(ioA, ioB, impulse);
+}
+
+PointJointPart::PoseCorrection AxisJointPart::CorrectPositions(float inError, float inFraction) const
+{
+    PointJointPart::PoseCorrection correction;
+    if (!mActive || mSoft) return correction;
+    // Only an error the row pushes against: too short for a lower limit, too long for an upper one
+    if ((mSide == Side::Positive && inError >= 0.0f) || (mSide == Side::Negative && inError <= 0.0f))
+        return correction;
+    const float impulse = -mEffectiveMass * inFraction * inError;
+    correction.mTranslationA = -(mInverseMassA * impulse) * mAxis;
+    correction.mRotationA = -impulse * mAngularA;
+    correction.mTranslationB = (mInverseMassB * impulse) * mAxis;
+    correction.mRotationB = impulse * mAngularB;
+    return correction;
+}
+
+} // namespace cairn::physics

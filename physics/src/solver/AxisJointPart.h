@@ -1,0 +1,66 @@
+#pragma once
+
+// One linear row along an axis between a point of A and a point of B: the distance joint's length, its limits
+// and its spring (issue 33), later the slider's limits. Hard, the row is a sequential impulse with the drift
+// taken out on the poses (as PointJointPart); soft (a spring of a frequency and damping ratio), it is the
+// soft step of Catto (GDC 2011) and Box2D v3: the impulse that an implicit Euler step of the spring and
+// damper gives, v' = (v - h w^2 C) / (1 + 2 z h w + h^2 w^2) along the axis for the row's effective mass,
+// with no position pass. A limit pushes one way only: the accumulated impulse is clamped to its side.
+//
+// Threads: the one solving the island the joint is in; no locks.
+
+#include "solver/PointJointPart.h"
+
+namespace cairn::physics
+{
+
+class AxisJointPart
+{
+public:
+    /// Which impulses the row may apply along the axis (on B; A takes the opposite).
+    enum class Side : uint8_t
+    {
+        Both,     ///< An equality: the length itself
+        Positive, ///< A lower limit: B pushed away from A only
+        Negative, ///< An upper limit: B pulled towards A only
+    };
+    /// Sets the row along inAxis (unit, world space) for the arms and masses given, with the position error
+    /// inError (the length now less the length wanted, m). inFrequency > 0 (Hz) makes it a spring with the
+    /// damping ratio inDamping; 0 a hard row. Inactive (and its impulse dropped) when neither side can move.
+    void Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB, const JointBodyMass& inB,
+                 const Vec3& inAxis, float inError, Side inSide, float inFrequency, float inDamping,
+                 float inDeltaTime);
+    bool IsActive() const { return mActive; }
+    bool IsSoft() const { return mSoft; }
+
+    void WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio = 1.0f);
+    void SolveVelocity(SolverBody& ioA, SolverBody& ioB);
+    /// N s, along the axis, on B
+    float GetTotalImpulse() const { return mTotalImpulse; }
+    void ResetImpulse() { mTotalImpulse = 0.0f; }
+
+    /// A hard row's position iteration for the error inError now (the same sign rules): the moves that take
+    /// inFraction of it out. Zero for a soft or inactive row, or an error on the side the row allows.
+    PointJointPart::PoseCorrection CorrectPositions(float inError, float inFraction) const;
+
+private:
+    void Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const;
+
+    Vec3 mAxis = Vec3::UnitX();
+    Vec3 mAngularA = Vec3::Zero(); ///< inv inertia A (rA x n)
+    Vec3 mAngularB = Vec3::Zero(); ///< inv inertia B (rB x n)
+    Vec3 mArmCrossA = Vec3::Zero();
+    Vec3 mArmCrossB = Vec3::Zero();
+    float mInverseMassA = 0.0f;
+    float mInverseMassB = 0.0f;
+    float mEffectiveMass = 0.0f;
+    float mBias = 0.0f;         ///< Soft: the spring's velocity bias
+    float mMassScale = 1.0f;    ///< Soft: of the effective mass
+    float mImpulseScale = 0.0f; ///< Soft: of the accumulated impulse
+    float mTotalImpulse = 0.0f;
+    Side mSide = Side::Both;
+    bool mSoft = false;
+    bool mActive = false;
+};
+
+} // namespace cairn::physics
