@@ -49,7 +49,8 @@ Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPoin
     ioJoint.mEnabled = true;
     // Each side's anchor in its centre-of-mass frame, from the body's pose now (one body lock at a time,
     // released before the joints' mutex: the step takes the body mutexes first)
-    auto anchor = [&](const BodyID& inID, const Vec3& inPoint, Vec3& outLocal) -> Status
+    Quat rotationA = Quat::Identity(), rotationB = Quat::Identity();
+    auto anchor = [&](const BodyID& inID, const Vec3& inPoint, Vec3& outLocal, Quat& outRotation) -> Status
     {
         if (inID.IsInvalid())
         {
@@ -61,10 +62,12 @@ Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPoin
         const Body* body = lock.GetBody();
         if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "stale or unknown body id");
         outLocal = body->GetRotation().conjugate() * (inPoint - body->GetCenterOfMassPosition());
+        outRotation = body->GetRotation();
         return Status::Ok();
     };
-    if (Status a = anchor(ioJoint.mBodyA, inPointA, ioJoint.mLocalA); !a) return a.GetError();
-    if (Status b = anchor(ioJoint.mBodyB, inPointB, ioJoint.mLocalB); !b) return b.GetError();
+    if (Status a = anchor(ioJoint.mBodyA, inPointA, ioJoint.mLocalA, rotationA); !a) return a.GetError();
+    if (Status b = anchor(ioJoint.mBodyB, inPointB, ioJoint.mLocalB, rotationB); !b) return b.GetError();
+    ioJoint.mRelativeRotation = (rotationA.conjugate() * rotationB).normalized();
     ConstraintID id;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -80,6 +83,15 @@ Result<ConstraintID> ConstraintInterface::AddPoint(const PointConstraintSettings
 {
     Joint joint;
     joint.mType = JointType::Point;
+    joint.mBodyA = inSettings.mBodyA;
+    joint.mBodyB = inSettings.mBodyB;
+    return Add(joint, inSettings.mPoint, inSettings.mPoint);
+}
+
+Result<ConstraintID> ConstraintInterface::AddFixed(const FixedConstraintSettings& inSettings)
+{
+    Joint joint;
+    joint.mType = JointType::Fixed;
     joint.mBodyA = inSettings.mBodyA;
     joint.mBodyB = inSettings.mBodyB;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
@@ -139,6 +151,7 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
         {
             joint->mPart.ResetImpulse();
             joint->mAxisPart.ResetImpulse();
+            joint->mRotationPart.ResetImpulse();
         }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;

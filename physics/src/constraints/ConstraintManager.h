@@ -10,6 +10,7 @@
 #include "cairn/physics/constraints/ConstraintInterface.h"
 #include "solver/AxisJointPart.h"
 #include "solver/PointJointPart.h"
+#include "solver/RotationJointPart.h"
 
 #include <mutex>
 #include <vector>
@@ -21,6 +22,7 @@ enum class JointType : uint8_t
 {
     Point,
     Distance,
+    Fixed,
 };
 
 struct Joint
@@ -34,7 +36,10 @@ struct Joint
     /// The anchor in each body's centre-of-mass frame (in world space for the world's side)
     Vec3 mLocalA = Vec3::Zero();
     Vec3 mLocalB = Vec3::Zero();
-    PointJointPart mPart; ///< Point
+    PointJointPart mPart; ///< Point, fixed
+    /// B's rotation in A's frame at creation (A's: the world's for the world's side)
+    Quat mRelativeRotation = Quat::Identity();
+    RotationJointPart mRotationPart; ///< Fixed
     // Distance
     float mMinDistance = 0.0f;
     float mMaxDistance = 0.0f;

@@ -131,6 +131,10 @@ void JointStage::Prepare(StepJoint& ioJoint)
     case JointType::Point:
         joint.mPart.Prepare(armA, massA, armB, massB);
         break;
+    case JointType::Fixed:
+        joint.mPart.Prepare(armA, massA, armB, massB);
+        joint.mRotationPart.Prepare(massA, massB);
+        break;
     case JointType::Distance:
     {
         const Vec3 between = anchorB - anchorA;
@@ -183,7 +187,9 @@ void JointStage::WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
         Prepare(joint);
-        if (joint.mJoint->mType == JointType::Point)
+        if (joint.mJoint->mType == JointType::Fixed)
+            joint.mJoint->mRotationPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        if (joint.mJoint->mType != JointType::Distance)
             joint.mJoint->mPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
         else if (joint.mRowActive)
             joint.mJoint->mAxisPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
@@ -195,7 +201,10 @@ void JointStage::SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodi
     for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
-        if (joint.mJoint->mType == JointType::Point)
+        // A fixed joint's rotation first: the point's rows then see the bodies turning together
+        if (joint.mJoint->mType == JointType::Fixed)
+            joint.mJoint->mRotationPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        if (joint.mJoint->mType != JointType::Distance)
             joint.mJoint->mPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
         else if (joint.mRowActive)
             joint.mJoint->mAxisPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
@@ -211,8 +220,21 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
         // error the position iterations take out
         Prepare(joint);
         const Joint& data = *joint.mJoint;
+        if (data.mType == JointType::Fixed)
+        {
+            const Quat rotationA = joint.mA != nullptr ? joint.mA->GetRotation() : Quat::Identity();
+            const Quat rotationB = joint.mB != nullptr ? joint.mB->GetRotation() : Quat::Identity();
+            const PointJointPart::PoseCorrection turn = data.mRotationPart.CorrectPositions(
+                RotationJointPart::RotationError(rotationA, rotationB, data.mRelativeRotation),
+                inSettings.mBaumgarte);
+            if (joint.mA != nullptr && joint.mA->IsDynamic())
+                Integration::CorrectPose(*joint.mA, Vec3::Zero(), turn.mRotationA);
+            if (joint.mB != nullptr && joint.mB->IsDynamic())
+                Integration::CorrectPose(*joint.mB, Vec3::Zero(), turn.mRotationB);
+            Prepare(joint); // The anchors where the turn put them
+        }
         PointJointPart::PoseCorrection correction;
-        if (data.mType == JointType::Point)
+        if (data.mType != JointType::Distance)
             correction = data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte);
         else if (joint.mRowActive)
             correction = data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte);

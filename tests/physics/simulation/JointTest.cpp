@@ -1,6 +1,7 @@
-// Joints (issue 33), the point and distance joints so far: a pendulum against its analytic period, a spring
-// against the implicit spring step, a rope and a rod, a joint that joins two islands into one that sleeps and
-// wakes whole, the same bodies for any thread count, and bad input.
+// Joints (issue 33), the fixed, point and distance joints so far: a welded cantilever and a welded pair, a
+// pendulum against its analytic period, a spring against the implicit spring step, a rope and a rod, a joint
+// that joins two islands into one that sleeps and wakes whole, the same bodies for any thread count, and bad
+// input.
 
 #include "SimulationFixture.h"
 #include "cairn/physics/body/BodyLock.h"
@@ -271,6 +272,54 @@ TEST_F(JointTest, ARopeIsSlackWithinItsLengthAndHoldsAtIt)
         Step(1);
         ASSERT_NEAR((Position(top) - pivot).norm(), (rod.mPointB - pivot).norm(), 0.01f) << "step " << step;
     }
+}
+
+TEST_F(JointTest, AFixedJointHoldsACantileverAndTwoBodiesTumblingAsOne)
+{
+    // A box welded to the world at a point half a metre beside its centre: gravity's torque turns it about
+    // that point unless the rotation rows hold it (a point joint alone lets it swing down)
+    const BodyID beam = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.1f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f)));
+    FixedConstraintSettings weld;
+    weld.mBodyB = beam;
+    weld.mPoint = Vec3(-0.5f, 3.0f, 0.0f);
+    ASSERT_TRUE(Joints().AddFixed(weld).IsOk());
+    Step(120);
+    EXPECT_LT((Position(beam) - Vec3(0.0f, 3.0f, 0.0f)).norm(), 0.01f);
+    EXPECT_LT(Bodies().GetRotation(beam).Value().angularDistance(Quat::Identity()),
+              1.0f * std::numbers::pi_v<float> / 180.0f);
+
+    // Two bodies welded at a point between them, thrown spinning with no gravity: they keep their pose
+    // relative to each other while the pair tumbles (each started with its own spin: the joint makes it one)
+    ResetWorld(PhysicsSettings{});
+    BodyCreationSettings boxSettings = DynamicSettings(Box(Vec3(0.4f, 0.2f, 0.3f)), Vec3(0.0f, 5.0f, 0.0f));
+    boxSettings.mGravityFactor = 0.0f;
+    boxSettings.mAngularVelocity = Vec3(0.0f, 2.0f, 1.0f);
+    boxSettings.mAllowSleeping = false;
+    BodyCreationSettings ballSettings = DynamicSettings(Sphere(0.3f), Vec3(0.8f, 5.0f, 0.0f));
+    ballSettings.mGravityFactor = 0.0f;
+    ballSettings.mAngularVelocity = Vec3(3.0f, 0.0f, 0.0f);
+    ballSettings.mAllowSleeping = false;
+    const BodyID box = AddDynamic(boxSettings), ball = AddDynamic(ballSettings);
+    FixedConstraintSettings pair;
+    pair.mBodyA = box;
+    pair.mBodyB = ball;
+    pair.mPoint = Vec3(0.4f, 5.0f, 0.0f);
+    ASSERT_TRUE(Joints().AddFixed(pair).IsOk());
+    const Quat relative0 = Bodies().GetRotation(box).Value().conjugate() * Bodies().GetRotation(ball).Value();
+    const Vec3 offset0 = Vec3(0.8f, 0.0f, 0.0f); // The ball's centre in the box's frame
+    float worstAngle = 0.0f, worstOffset = 0.0f;
+    for (int step = 0; step < 120; ++step)
+    {
+        Step(1);
+        const Quat boxRotation = Bodies().GetRotation(box).Value();
+        const Quat relative = boxRotation.conjugate() * Bodies().GetRotation(ball).Value();
+        worstAngle = std::max(worstAngle, relative.angularDistance(relative0));
+        const Vec3 offset = boxRotation.conjugate() * (Position(ball) - Position(box));
+        worstOffset = std::max(worstOffset, (offset - offset0).norm());
+    }
+    EXPECT_LT(worstAngle, 0.5f * std::numbers::pi_v<float> / 180.0f);
+    EXPECT_LT(worstOffset, 0.005f);
+    EXPECT_GT(Bodies().GetAngularVelocity(box).Value().norm(), 0.5f); // Tumbling, not stopped
 }
 
 TEST_F(JointTest, BadInputGetsClearErrors)

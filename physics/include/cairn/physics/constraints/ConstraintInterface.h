@@ -5,8 +5,8 @@
 // together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
 // last step's impulse, drift taken out on the poses after integration).
 //
-// Joints so far: the point (ball and socket) and the distance (rod, rope, spring). An island with a joint is
-// solved by one thread, whole (not colored, not grouped): the same result for any thread count.
+// Joints so far: fixed (welded), point (ball and socket) and distance (rod, rope, spring). An island with a
+// joint is solved by one thread, whole (not colored, not grouped): the same result for any thread count.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
 // (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
@@ -52,6 +52,14 @@ struct PointConstraintSettings
     Vec3 mPoint = Vec3::Zero();
 };
 
+/// Welds B to A: a point of each stays together and B keeps its rotation relative to A's as at creation.
+struct FixedConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB;
+    Vec3 mPoint = Vec3::Zero(); ///< World space, at creation: where the two are held together
+};
+
 /// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
 /// mass, so its frequency does not depend on the bodies' masses.
 struct SpringSettings
@@ -85,6 +93,8 @@ public:
     /// the world, both sides the world or the same body (InvalidArgument), a stale or unknown body id
     /// (InvalidBodyID), cMaxConstraints reached (OutOfCapacity), the wrong thread (WrongThread).
     Result<ConstraintID> AddPoint(const PointConstraintSettings& inSettings);
+    /// A fixed joint, enabled, its bodies woken. Errors as AddPoint's.
+    Result<ConstraintID> AddFixed(const FixedConstraintSettings& inSettings);
     /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
     /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
     /// (InvalidArgument).
