@@ -3,6 +3,9 @@
 #include "cairn/physics/body/BodyLock.h"
 #include "constraints/ConstraintManager.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace cairn::physics
 {
 
@@ -68,6 +71,11 @@ Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPoin
     if (Status a = anchor(ioJoint.mBodyA, inPointA, ioJoint.mLocalA, rotationA); !a) return a.GetError();
     if (Status b = anchor(ioJoint.mBodyB, inPointB, ioJoint.mLocalB, rotationB); !b) return b.GetError();
     ioJoint.mRelativeRotation = (rotationA.conjugate() * rotationB).normalized();
+    // Directions given in world space into each body's frame (the world's side keeps them)
+    ioJoint.mLocalAxisA = rotationA.conjugate() * ioJoint.mLocalAxisA;
+    ioJoint.mLocalNormalA = rotationA.conjugate() * ioJoint.mLocalNormalA;
+    ioJoint.mLocalAxisB = rotationB.conjugate() * ioJoint.mLocalAxisB;
+    ioJoint.mLocalNormalB = rotationB.conjugate() * ioJoint.mLocalNormalB;
     ConstraintID id;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -94,6 +102,39 @@ Result<ConstraintID> ConstraintInterface::AddFixed(const FixedConstraintSettings
     joint.mType = JointType::Fixed;
     joint.mBodyA = inSettings.mBodyA;
     joint.mBodyB = inSettings.mBodyB;
+    return Add(joint, inSettings.mPoint, inSettings.mPoint);
+}
+
+Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings& inSettings)
+{
+    constexpr float cPi = 3.14159265358979f, cMaxTorque = 1.0e12f, cMaxSpeed = 1.0e4f;
+    const float axisLength = inSettings.mHingeAxis.norm();
+    if (!(axisLength > 1.0e-6f && axisLength < 1.0e12f))
+        return MakeError(ErrorCode::InvalidArgument, "a hinge axis must be finite and not zero");
+    if (!(inSettings.mLimitsMin >= -cPi - 1.0e-5f && inSettings.mLimitsMin <= inSettings.mLimitsMax &&
+          inSettings.mLimitsMax <= cPi + 1.0e-5f))
+        return MakeError(ErrorCode::InvalidArgument, "hinge limits must be within [-pi, pi] with min <= max");
+    if (!(inSettings.mMaxFrictionTorque >= 0.0f && inSettings.mMaxFrictionTorque <= cMaxTorque &&
+          inSettings.mMaxMotorTorque >= 0.0f && inSettings.mMaxMotorTorque <= cMaxTorque &&
+          std::abs(inSettings.mTargetAngularVelocity) <= cMaxSpeed))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "hinge torques must be finite and at least 0, a motor's speed finite");
+    if (inSettings.mMotorMode != MotorMode::Off && inSettings.mMotorMode != MotorMode::Velocity)
+        return MakeError(ErrorCode::InvalidArgument, "unknown motor mode");
+    Joint joint;
+    joint.mType = JointType::Hinge;
+    joint.mBodyA = inSettings.mBodyA;
+    joint.mBodyB = inSettings.mBodyB;
+    const Vec3 axis = inSettings.mHingeAxis / axisLength;
+    const Vec3 normal = AnyPerpendicular(axis);
+    joint.mLocalAxisA = joint.mLocalAxisB = axis; // World space here: Add turns them into the bodies' frames
+    joint.mLocalNormalA = joint.mLocalNormalB = normal;
+    joint.mLimitsMin = std::max(inSettings.mLimitsMin, -cPi);
+    joint.mLimitsMax = std::min(inSettings.mLimitsMax, cPi);
+    joint.mMaxFrictionTorque = inSettings.mMaxFrictionTorque;
+    joint.mMotorMode = inSettings.mMotorMode;
+    joint.mTargetAngularVelocity = inSettings.mTargetAngularVelocity;
+    joint.mMaxMotorTorque = inSettings.mMaxMotorTorque;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
@@ -152,6 +193,9 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
             joint->mPart.ResetImpulse();
             joint->mAxisPart.ResetImpulse();
             joint->mRotationPart.ResetImpulse();
+            joint->mHingePart.ResetImpulse();
+            joint->mLimitPart.ResetImpulse();
+            joint->mMotorPart.ResetImpulse();
         }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;

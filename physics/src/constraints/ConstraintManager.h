@@ -8,7 +8,9 @@
 // joint's island.
 
 #include "cairn/physics/constraints/ConstraintInterface.h"
+#include "solver/AngleJointPart.h"
 #include "solver/AxisJointPart.h"
+#include "solver/HingeRotationJointPart.h"
 #include "solver/PointJointPart.h"
 #include "solver/RotationJointPart.h"
 
@@ -23,6 +25,7 @@ enum class JointType : uint8_t
     Point,
     Distance,
     Fixed,
+    Hinge,
 };
 
 struct Joint
@@ -45,6 +48,21 @@ struct Joint
     float mMaxDistance = 0.0f;
     SpringSettings mSpring;
     AxisJointPart mAxisPart;
+    // Hinge: its axis and a direction across it in each body's frame (given in world space until the joint is
+    // stored), the limits, friction and motor
+    Vec3 mLocalAxisA = Vec3::Zero();
+    Vec3 mLocalAxisB = Vec3::Zero();
+    Vec3 mLocalNormalA = Vec3::Zero();
+    Vec3 mLocalNormalB = Vec3::Zero();
+    float mLimitsMin = 0.0f;
+    float mLimitsMax = 0.0f;
+    float mMaxFrictionTorque = 0.0f;
+    MotorMode mMotorMode = MotorMode::Off;
+    float mTargetAngularVelocity = 0.0f;
+    float mMaxMotorTorque = 0.0f;
+    HingeRotationJointPart mHingePart;
+    AngleJointPart mLimitPart;
+    AngleJointPart mMotorPart; ///< The motor, or the friction while it is off
 };
 
 class ConstraintManager

@@ -135,6 +135,42 @@ void JointStage::Prepare(StepJoint& ioJoint)
         joint.mPart.Prepare(armA, massA, armB, massB);
         joint.mRotationPart.Prepare(massA, massB);
         break;
+    case JointType::Hinge:
+    {
+        joint.mPart.Prepare(armA, massA, armB, massB);
+        const Quat rotationA = ioJoint.mA != nullptr ? ioJoint.mA->GetRotation() : Quat::Identity();
+        const Quat rotationB = ioJoint.mB != nullptr ? ioJoint.mB->GetRotation() : Quat::Identity();
+        const Vec3 axisA = rotationA * joint.mLocalAxisA, axisB = rotationB * joint.mLocalAxisB;
+        joint.mHingePart.Prepare(massA, massB, axisA, axisB);
+        // B's angle about A's axis from where it was at creation: the turn from A's normal to B's
+        const Vec3 normalA = rotationA * joint.mLocalNormalA, normalB = rotationB * joint.mLocalNormalB;
+        const float angle = std::atan2(normalA.cross(normalB).dot(axisA), normalA.dot(normalB));
+        constexpr float cPi = 3.14159265358979f;
+        const bool limited = joint.mLimitsMin > -cPi || joint.mLimitsMax < cPi;
+        if (limited && joint.mLimitsMin == joint.mLimitsMax)
+            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
+                                     AxisJointPart::Side::Both, angle - joint.mLimitsMin);
+        else if (limited && angle < joint.mLimitsMin)
+            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
+                                     AxisJointPart::Side::Positive, angle - joint.mLimitsMin);
+        else if (limited && angle > joint.mLimitsMax)
+            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
+                                     AxisJointPart::Side::Negative, angle - joint.mLimitsMax);
+        else
+            joint.mLimitPart.Deactivate();
+        // The motor, or the friction while it is off: a spin towards the target, within its torque this step
+        const float dt = mContext->mDeltaTime;
+        if (joint.mMotorMode == MotorMode::Velocity && joint.mMaxMotorTorque > 0.0f)
+            joint.mMotorPart.Prepare(massA, massB, axisA, joint.mTargetAngularVelocity,
+                                     -joint.mMaxMotorTorque * dt, joint.mMaxMotorTorque * dt,
+                                     AxisJointPart::Side::Both, 0.0f);
+        else if (joint.mMotorMode == MotorMode::Off && joint.mMaxFrictionTorque > 0.0f)
+            joint.mMotorPart.Prepare(massA, massB, axisA, 0.0f, -joint.mMaxFrictionTorque * dt,
+                                     joint.mMaxFrictionTorque * dt, AxisJointPart::Side::Both, 0.0f);
+        else
+            joint.mMotorPart.Deactivate();
+        break;
+    }
     case JointType::Distance:
     {
         const Vec3 between = anchorB - anchorA;
@@ -189,6 +225,12 @@ void JointStage::WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies)
         Prepare(joint);
         if (joint.mJoint->mType == JointType::Fixed)
             joint.mJoint->mRotationPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        if (joint.mJoint->mType == JointType::Hinge)
+        {
+            joint.mJoint->mMotorPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+            joint.mJoint->mLimitPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+            joint.mJoint->mHingePart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        }
         if (joint.mJoint->mType != JointType::Distance)
             joint.mJoint->mPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
         else if (joint.mRowActive)
@@ -204,6 +246,14 @@ void JointStage::SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodi
         // A fixed joint's rotation first: the point's rows then see the bodies turning together
         if (joint.mJoint->mType == JointType::Fixed)
             joint.mJoint->mRotationPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        // A hinge's motor (or friction) first, then its limit, which has the last word on the spin about the
+        // axis, then the axis and the point
+        if (joint.mJoint->mType == JointType::Hinge)
+        {
+            joint.mJoint->mMotorPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+            joint.mJoint->mLimitPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+            joint.mJoint->mHingePart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        }
         if (joint.mJoint->mType != JointType::Distance)
             joint.mJoint->mPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
         else if (joint.mRowActive)
@@ -232,6 +282,19 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
             if (joint.mB != nullptr && joint.mB->IsDynamic())
                 Integration::CorrectPose(*joint.mB, Vec3::Zero(), turn.mRotationB);
             Prepare(joint); // The anchors where the turn put them
+        }
+        if (data.mType == JointType::Hinge)
+        {
+            for (const PointJointPart::PoseCorrection& turn :
+                 {data.mHingePart.CorrectPositions(inSettings.mBaumgarte),
+                  data.mLimitPart.CorrectPositions(inSettings.mBaumgarte)})
+            {
+                if (joint.mA != nullptr && joint.mA->IsDynamic())
+                    Integration::CorrectPose(*joint.mA, Vec3::Zero(), turn.mRotationA);
+                if (joint.mB != nullptr && joint.mB->IsDynamic())
+                    Integration::CorrectPose(*joint.mB, Vec3::Zero(), turn.mRotationB);
+            }
+            Prepare(joint); // The anchors where the turns put them
         }
         PointJointPart::PoseCorrection correction;
         if (data.mType != JointType::Distance)

@@ -18,7 +18,8 @@ void PointJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const
                    skewA * inA.mInverseInertia * skewA - skewB * inB.mInverseInertia * skewB;
     bool invertible = false;
     float determinant = 0.0f;
-    k.computeInverseAndDetWithCheck(mEffectiveMass, determinant, invertible);
+    // No absolute threshold (Eigen's default, 1e-5, refused a 200 kg body's matrix): the relative test below
+    k.computeInverseAndDetWithCheck(mEffectiveMass, determinant, invertible, 0.0f);
     // Relative to K's scale: a matrix of heavy bodies is small, not singular
     const float scale = k.cwiseAbs().maxCoeff();
     mActive = invertible && scale > 0.0f && std::isfinite(determinant) &&

@@ -6,6 +6,7 @@
 #include "SimulationFixture.h"
 #include "cairn/physics/body/BodyLock.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -322,6 +323,80 @@ TEST_F(JointTest, AFixedJointHoldsACantileverAndTwoBodiesTumblingAsOne)
     EXPECT_GT(Bodies().GetAngularVelocity(box).Value().norm(), 0.5f); // Tumbling, not stopped
 }
 
+TEST_F(JointTest, AHingeMotorReachesItsSpeedAndALimitStopsTheDoor)
+{
+    // A wheel (a box turning about its own centre, so gravity gives no torque) on a hinge to the world with
+    // a velocity motor: it spins up to the target within the motor's torque
+    const float target = 2.0f;
+    BodyCreationSettings wheelSettings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f));
+    wheelSettings.mAngularDamping = 0.0f;
+    wheelSettings.mAllowSleeping = false;
+    const BodyID wheel = AddDynamic(wheelSettings);
+    HingeConstraintSettings motor;
+    motor.mBodyB = wheel;
+    motor.mPoint = Vec3(0.0f, 3.0f, 0.0f);
+    motor.mHingeAxis = Vec3(0.0f, 0.0f, 1.0f);
+    motor.mMotorMode = MotorMode::Velocity;
+    motor.mTargetAngularVelocity = target;
+    motor.mMaxMotorTorque = 500.0f;
+    ASSERT_TRUE(Joints().AddHinge(motor).IsOk());
+    Step(60);
+    const Vec3 spin = Bodies().GetAngularVelocity(wheel).Value();
+    EXPECT_NEAR(spin.z(), target, 0.05f * target);    // The 5 %
+    EXPECT_LT(std::hypot(spin.x(), spin.y()), 0.01f); // About its axis only
+    EXPECT_LT((Position(wheel) - Vec3(0.0f, 3.0f, 0.0f)).norm(), 0.005f);
+
+    // A door hinged at its edge on a vertical axis, pushed open fast: the limit at 0.5 rad stops it there,
+    // and the door keeps to its axis under gravity
+    ResetWorld(PhysicsSettings{});
+    BodyCreationSettings doorSettings = DynamicSettings(Box(Vec3(0.5f, 1.0f, 0.05f)), Vec3(0.5f, 1.2f, 0.0f));
+    doorSettings.mAngularVelocity = Vec3(0.0f, 3.0f, 0.0f);
+    doorSettings.mLinearVelocity = Vec3(0.0f, 0.0f, -1.5f); // The hinge edge at rest
+    doorSettings.mAllowSleeping = false;
+    const BodyID door = AddDynamic(doorSettings);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = door;
+    hinge.mPoint = Vec3(0.0f, 1.2f, 0.0f);
+    hinge.mHingeAxis = Vec3(0.0f, 1.0f, 0.0f);
+    hinge.mLimitsMin = -0.5f;
+    hinge.mLimitsMax = 0.5f;
+    ASSERT_TRUE(Joints().AddHinge(hinge).IsOk());
+    float widest = 0.0f, tilt = 0.0f;
+    for (int step = 0; step < 90; ++step)
+    {
+        Step(1);
+        const Quat rotation = Bodies().GetRotation(door).Value();
+        const Vec3 across = rotation * Vec3::UnitX();
+        widest = std::max(widest, std::abs(std::atan2(-across.z(), across.x())));
+        tilt = std::max(tilt, std::acos(std::clamp((rotation * Vec3::UnitY()).y(), -1.0f, 1.0f)));
+    }
+    // The limit's row starts once the angle is past it: one step's travel at 3 rad/s (0.05 rad) at most, and
+    // 3 s of 3 rad/s would be far past it
+    EXPECT_LT(widest, 0.5f + 3.0f / 60.0f);
+    EXPECT_GT(widest, 0.45f); // It did swing to the limit
+    EXPECT_LT(tilt, 1.0f * std::numbers::pi_v<float> / 180.0f);
+}
+
+TEST_F(JointTest, HingeFrictionSlowsASpinAsItsTorqueSays)
+{
+    // A spinning wheel on a hinge with friction torque T and no motor: its spin drops by T t / I
+    BodyCreationSettings settings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f));
+    settings.mAngularDamping = 0.0f;
+    settings.mAngularVelocity = Vec3(0.0f, 0.0f, 5.0f);
+    settings.mAllowSleeping = false;
+    const BodyID wheel = AddDynamic(settings);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = wheel;
+    hinge.mPoint = Vec3(0.0f, 3.0f, 0.0f);
+    hinge.mHingeAxis = Vec3(0.0f, 0.0f, 1.0f);
+    hinge.mMaxFrictionTorque = 20.0f;
+    ASSERT_TRUE(Joints().AddHinge(hinge).IsOk());
+    Step(30);
+    // A box of 1 x 1 x 0.2 m at 1000 kg/m^3: 200 kg, I about z = m (1 + 1) / 12
+    const float inertia = 200.0f * 2.0f / 12.0f;
+    EXPECT_NEAR(Bodies().GetAngularVelocity(wheel).Value().z(), 5.0f - 20.0f * 0.5f / inertia, 0.02f);
+}
+
 TEST_F(JointTest, BadInputGetsClearErrors)
 {
     const BodyID bob = AddDynamic(DynamicSettings(Sphere(0.1f), Vec3(0.0f, 1.0f, 0.0f)));
@@ -358,6 +433,22 @@ TEST_F(JointTest, BadInputGetsClearErrors)
     distance.mLimitsSpring = {};
     distance.mPointA = Vec3(std::nanf(""), 0.0f, 0.0f);
     EXPECT_EQ(Joints().AddDistance(distance).GetError().mCode, ErrorCode::InvalidArgument);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = bob;
+    hinge.mHingeAxis = Vec3::Zero();
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mHingeAxis = Vec3(0.0f, 1.0f, 0.0f);
+    hinge.mLimitsMin = 0.5f;
+    hinge.mLimitsMax = 0.2f;
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mLimitsMin = -4.0f; // Past -pi
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mLimitsMin = -0.5f;
+    hinge.mMaxMotorTorque = -1.0f;
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mMaxMotorTorque = 1.0f;
+    hinge.mTargetAngularVelocity = std::nanf("");
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(Joints().GetNumConstraints().Value(), 0u);
     {
         // Holding a body lock: a joint call could wait for a step that waits for this lock

@@ -97,6 +97,24 @@ TEST(PointJointPartTest, OneIterationMakesTheAnchorsMoveTogetherAndKeepsMomentum
     }
 }
 
+TEST(PointJointPartTest, HeavyAndLightBodiesAlikeAreHeld)
+{
+    // The mass matrix of a heavy body is small, not singular: a tonne and a gram both get active rows
+    for (float mass : {1.0e-3f, 1.0f, 200.0f, 1.0e4f})
+    {
+        JointedBody body;
+        body.mMass = mass;
+        body.mInertia = (mass * 0.1f) * Mat3::Identity();
+        body.mVelocity.mLinearVelocity = Vec3(0.0f, -3.0f, 0.0f);
+        SolverBody world = AtRest();
+        PointJointPart part;
+        part.Prepare(Vec3::Zero(), JointBodyMass{}, Vec3(0.2f, 0.0f, 0.0f), body.Mass());
+        ASSERT_TRUE(part.IsActive()) << mass << " kg";
+        part.SolveVelocity(world, body.mVelocity);
+        EXPECT_LT(AnchorVelocity(body.mVelocity, Vec3(0.2f, 0.0f, 0.0f)).norm(), 1.0e-4f) << mass << " kg";
+    }
+}
+
 TEST(PointJointPartTest, ASideThatCannotMoveIsLeftAsItIs)
 {
     std::mt19937 random(7);

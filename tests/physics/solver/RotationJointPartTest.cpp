@@ -45,6 +45,10 @@ TEST(RotationJointPartTest, OneIterationStopsTheRelativeSpinAndKeepsAngularMomen
     toWorld.SolveVelocity(world, b);
     EXPECT_LT(b.mAngularVelocity.norm(), 1.0e-5f);
     EXPECT_EQ(world.mAngularVelocity, Vec3::Zero());
+    // A heavy body's small inverse inertia is not a singular matrix
+    RotationJointPart heavy;
+    heavy.Prepare({}, {1.0e-4f, (1.0e-4f * Vec3(1.0f, 2.0f, 3.0f)).asDiagonal()});
+    EXPECT_TRUE(heavy.IsActive());
     RotationJointPart none;
     none.Prepare({}, {});
     EXPECT_FALSE(none.IsActive());

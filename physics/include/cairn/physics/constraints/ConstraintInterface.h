@@ -5,7 +5,8 @@
 // together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
 // last step's impulse, drift taken out on the poses after integration).
 //
-// Joints so far: fixed (welded), point (ball and socket) and distance (rod, rope, spring). An island with a
+// Joints so far: fixed (welded), point (ball and socket), distance (rod, rope, spring) and hinge (limits, a
+// velocity motor, friction). An island with a
 // joint is solved by one thread, whole (not colored, not grouped): the same result for any thread count.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
@@ -60,6 +61,31 @@ struct FixedConstraintSettings
     Vec3 mPoint = Vec3::Zero(); ///< World space, at creation: where the two are held together
 };
 
+/// What a joint's motor does.
+enum class MotorMode : uint8_t
+{
+    Off,      ///< Nothing (the joint's friction acts instead)
+    Velocity, ///< Drives the relative spin (or speed) to a target, within its largest torque (or force)
+};
+
+/// A door, a wheel: B turns about an axis through a point of A, within limits, driven by a motor or held by
+/// friction.
+struct HingeConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB;
+    Vec3 mPoint = Vec3::Zero();               ///< World space, at creation: a point of the axis
+    Vec3 mHingeAxis = Vec3(0.0f, 1.0f, 0.0f); ///< World space, at creation (normalised)
+    /// B's angle about the axis from where it is at creation (rad, right-handed, within [-pi, pi]); the
+    /// whole range: no limit
+    float mLimitsMin = -3.14159265358979f;
+    float mLimitsMax = 3.14159265358979f;
+    float mMaxFrictionTorque = 0.0f; ///< N m, while the motor is off
+    MotorMode mMotorMode = MotorMode::Off;
+    float mTargetAngularVelocity = 0.0f; ///< rad/s, B's spin about the axis relative to A's
+    float mMaxMotorTorque = 0.0f;        ///< N m
+};
+
 /// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
 /// mass, so its frequency does not depend on the bodies' masses.
 struct SpringSettings
@@ -95,6 +121,9 @@ public:
     Result<ConstraintID> AddPoint(const PointConstraintSettings& inSettings);
     /// A fixed joint, enabled, its bodies woken. Errors as AddPoint's.
     Result<ConstraintID> AddFixed(const FixedConstraintSettings& inSettings);
+    /// A hinge joint, enabled, its bodies woken. Errors as AddPoint's, and for an axis that is zero or not
+    /// finite, limits outside [-pi, pi] or with min > max, a torque below 0 or not finite (InvalidArgument).
+    Result<ConstraintID> AddHinge(const HingeConstraintSettings& inSettings);
     /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
     /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
     /// (InvalidArgument).

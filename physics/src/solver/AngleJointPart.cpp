@@ -1,0 +1,67 @@
+#include "solver/AngleJointPart.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn::physics
+{
+
+void AngleJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
+                             float inTargetSpeed, float inMinImpulse, float inMaxImpulse,
+                             AxisJointPart::Side inSide, float inError)
+{
+    mAxis = inAxis;
+    mAngularA = inA.mInverseInertia * inAxis;
+    mAngularB = inB.mInverseInertia * inAxis;
+    const float k = inAxis.dot(mAngularA) + inAxis.dot(mAngularB);
+    mActive = k > 0.0f && std::isfinite(k);
+    mEffectiveMass = mActive ? 1.0f / k : 0.0f;
+    if (mSide != inSide) mTotalImpulse = 0.0f; // Another limit than last step's: nothing to warm-start
+    mSide = inSide;
+    mTargetSpeed = inTargetSpeed;
+    mMinImpulse = inMinImpulse;
+    mMaxImpulse = inMaxImpulse;
+    mError = inError;
+    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse);
+    if (!mActive) mTotalImpulse = 0.0f;
+}
+
+void AngleJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
+{
+    ioA.mAngularVelocity -= inImpulse * mAngularA;
+    ioB.mAngularVelocity += inImpulse * mAngularB;
+}
+
+void AngleJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
+{
+    mTotalImpulse *= inRatio;
+    if (mActive) Apply(ioA, ioB, mTotalImpulse);
+}
+
+void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const float spin = mAxis.dot(ioB.mAngularVelocity - ioA.mAngularVelocity);
+    float total =
+        std::clamp(mTotalImpulse - mEffectiveMass * (spin - mTargetSpeed), mMinImpulse, mMaxImpulse);
+    if (mSide == AxisJointPart::Side::Positive) total = std::max(total, 0.0f);
+    if (mSide == AxisJointPart::Side::Negative) total = std::min(total, 0.0f);
+    const float impulse = total - mTotalImpulse;
+    mTotalImpulse = total;
+    Apply(ioA, ioB, impulse);
+}
+
+PointJointPart::PoseCorrection AngleJointPart::CorrectPositions(float inFraction) const
+{
+    PointJointPart::PoseCorrection correction;
+    if (!mActive || mSide == AxisJointPart::Side::Both) return correction; // Only a limit has a position
+    if ((mSide == AxisJointPart::Side::Positive && mError >= 0.0f) ||
+        (mSide == AxisJointPart::Side::Negative && mError <= 0.0f))
+        return correction;
+    const float impulse = -mEffectiveMass * inFraction * mError;
+    correction.mRotationA = -impulse * mAngularA;
+    correction.mRotationB = impulse * mAngularB;
+    return correction;
+}
+
+} // namespace cairn::physics

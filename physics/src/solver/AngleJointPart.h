@@ -1,0 +1,53 @@
+#pragma once
+
+// One angular row about an axis between bodies A and B: a hinge's limit (one-sided), its motor (a target
+// relative spin, the impulse within what its torque gives in a step) or its friction (a motor towards no spin
+// with the friction torque's bound). Sequential impulses; a limit's error is taken out on the poses after
+// integration, as the other joints' rows.
+//
+// Threads: the one solving the island the joint is in; no locks.
+
+#include "solver/AxisJointPart.h"
+
+namespace cairn::physics
+{
+
+class AngleJointPart
+{
+public:
+    /// A row about inAxis (unit, world space): the relative spin (B's less A's) along it is taken towards
+    /// inTargetSpeed (rad/s), the accumulated impulse kept within [inMinImpulse, inMaxImpulse] (N m s) and,
+    /// for a limit, to its side. inError: a limit's angle past it (rad), for the position rows.
+    void Prepare(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed,
+                 float inMinImpulse, float inMaxImpulse, AxisJointPart::Side inSide, float inError);
+    /// No row this step (a limit not reached, no motor, no friction): its impulse dropped.
+    void Deactivate()
+    {
+        mActive = false;
+        mTotalImpulse = 0.0f;
+    }
+    bool IsActive() const { return mActive; }
+    void WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio = 1.0f);
+    void SolveVelocity(SolverBody& ioA, SolverBody& ioB);
+    float GetTotalImpulse() const { return mTotalImpulse; }
+    void ResetImpulse() { mTotalImpulse = 0.0f; }
+    /// A limit's position iteration: the turns that take inFraction of its error out. Zero otherwise.
+    PointJointPart::PoseCorrection CorrectPositions(float inFraction) const;
+
+private:
+    void Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const;
+
+    Vec3 mAxis = Vec3::UnitX();
+    Vec3 mAngularA = Vec3::Zero(); ///< IA^-1 axis
+    Vec3 mAngularB = Vec3::Zero();
+    float mEffectiveMass = 0.0f;
+    float mTargetSpeed = 0.0f;
+    float mMinImpulse = 0.0f;
+    float mMaxImpulse = 0.0f;
+    float mError = 0.0f;
+    float mTotalImpulse = 0.0f;
+    AxisJointPart::Side mSide = AxisJointPart::Side::Both;
+    bool mActive = false;
+};
+
+} // namespace cairn::physics
