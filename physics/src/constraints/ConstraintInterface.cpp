@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace cairn::physics
 {
@@ -20,6 +21,15 @@ Error WrongThread()
 bool IsWrongThread()
 {
     return BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0;
+}
+/// A joint of inType between the settings' two bodies, the rest of it as Joint starts it.
+template <class Settings> Joint JointOf(JointType inType, const Settings& inSettings)
+{
+    Joint joint;
+    joint.mType = inType;
+    joint.mBodyA = inSettings.mBodyA;
+    joint.mBodyB = inSettings.mBodyB;
+    return joint;
 }
 Error StaleID()
 {
@@ -89,25 +99,19 @@ Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPoin
 
 Result<ConstraintID> ConstraintInterface::AddPoint(const PointConstraintSettings& inSettings)
 {
-    Joint joint;
-    joint.mType = JointType::Point;
-    joint.mBodyA = inSettings.mBodyA;
-    joint.mBodyB = inSettings.mBodyB;
+    Joint joint = JointOf(JointType::Point, inSettings);
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
 Result<ConstraintID> ConstraintInterface::AddFixed(const FixedConstraintSettings& inSettings)
 {
-    Joint joint;
-    joint.mType = JointType::Fixed;
-    joint.mBodyA = inSettings.mBodyA;
-    joint.mBodyB = inSettings.mBodyB;
+    Joint joint = JointOf(JointType::Fixed, inSettings);
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
 Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings& inSettings)
 {
-    constexpr float cPi = 3.14159265358979f, cMaxTorque = 1.0e12f, cMaxSpeed = 1.0e4f;
+    constexpr float cPi = std::numbers::pi_v<float>, cMaxTorque = 1.0e12f, cMaxSpeed = 1.0e4f;
     const float axisLength = inSettings.mHingeAxis.norm();
     if (!(axisLength > 1.0e-6f && axisLength < 1.0e12f))
         return MakeError(ErrorCode::InvalidArgument, "a hinge axis must be finite and not zero");
@@ -121,10 +125,7 @@ Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings
                          "hinge torques must be finite and at least 0, a motor's speed finite");
     if (inSettings.mMotorMode != MotorMode::Off && inSettings.mMotorMode != MotorMode::Velocity)
         return MakeError(ErrorCode::InvalidArgument, "unknown motor mode");
-    Joint joint;
-    joint.mType = JointType::Hinge;
-    joint.mBodyA = inSettings.mBodyA;
-    joint.mBodyB = inSettings.mBodyB;
+    Joint joint = JointOf(JointType::Hinge, inSettings);
     const Vec3 axis = inSettings.mHingeAxis / axisLength;
     const Vec3 normal = AnyPerpendicular(axis);
     joint.mLocalAxisA = joint.mLocalAxisB = axis; // World space here: Add turns them into the bodies' frames
@@ -153,10 +154,7 @@ Result<ConstraintID> ConstraintInterface::AddDistance(const DistanceConstraintSe
           spring.mDamping <= 1.0e4f))
         return MakeError(ErrorCode::InvalidArgument,
                          "a spring's frequency and damping must be finite and at least 0 (at most 1e4)");
-    Joint joint;
-    joint.mType = JointType::Distance;
-    joint.mBodyA = inSettings.mBodyA;
-    joint.mBodyB = inSettings.mBodyB;
+    Joint joint = JointOf(JointType::Distance, inSettings);
     joint.mMinDistance = minDistance;
     joint.mMaxDistance = maxDistance;
     joint.mSpring = spring;

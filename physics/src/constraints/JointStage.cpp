@@ -4,6 +4,8 @@
 #include "cairn/physics/solver/SolverSettings.h"
 #include "step/StepContext.h"
 
+#include <numbers>
+
 namespace cairn::physics
 {
 
@@ -24,6 +26,11 @@ bool IsActiveDynamic(const Body* inBody)
 {
     return inBody != nullptr && inBody->IsDynamic() && inBody->IsActive();
 }
+
+Quat RotationOf(const Body* inBody)
+{
+    return inBody != nullptr ? inBody->GetRotation() : Quat::Identity(); // The world does not turn
+}
 } // namespace
 
 void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioManager)
@@ -32,11 +39,19 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
     mStepJoints.clear();
     std::vector<Joint>& joints = ioManager.GetJoints();
     if (ioManager.GetNumInUse() == 0) return;
-    auto bodyOf = [&](const BodyID& inID) -> Body*
+    // A joint's bodies (null: the world); false while a side is gone or out of the world (the joint waits)
+    auto sides = [&](const Joint& inJoint, Body*& outA, Body*& outB)
     {
-        if (inID.IsInvalid()) return nullptr;
-        Body* body = inContext.mBodies.TryGetBody(inID);
-        return body != nullptr && body->IsInWorld() ? body : nullptr;
+        auto bodyOf = [&](const BodyID& inID) -> Body*
+        {
+            if (inID.IsInvalid()) return nullptr;
+            Body* body = inContext.mBodies.TryGetBody(inID);
+            return body != nullptr && body->IsInWorld() ? body : nullptr;
+        };
+        outA = bodyOf(inJoint.mBodyA);
+        outB = bodyOf(inJoint.mBodyB);
+        return (inJoint.mBodyA.IsInvalid() || outA != nullptr) &&
+               (inJoint.mBodyB.IsInvalid() || outB != nullptr);
     };
     // A sleeping dynamic body jointed to an active one wakes (and then its own jointed sleepers): in slot
     // order, again until nothing wakes, so the same bodies wake on every run
@@ -45,11 +60,8 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
         woke = false;
         for (Joint& joint : joints)
         {
-            if (!joint.mInUse || !joint.mEnabled) continue;
-            Body* a = bodyOf(joint.mBodyA);
-            Body* b = bodyOf(joint.mBodyB);
-            if ((!joint.mBodyA.IsInvalid() && a == nullptr) || (!joint.mBodyB.IsInvalid() && b == nullptr))
-                continue; // A side gone or out of the world: the joint waits
+            Body *a, *b;
+            if (!joint.mInUse || !joint.mEnabled || !sides(joint, a, b)) continue;
             for (auto [sleeper, other] : {std::pair(a, b), std::pair(b, a)})
                 if (sleeper != nullptr && sleeper->IsDynamic() && !sleeper->IsActive() && other != nullptr &&
                     other->IsActive())
@@ -61,11 +73,8 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
     }
     for (Joint& joint : joints)
     {
-        if (!joint.mInUse || !joint.mEnabled) continue;
-        Body* a = bodyOf(joint.mBodyA);
-        Body* b = bodyOf(joint.mBodyB);
-        if ((!joint.mBodyA.IsInvalid() && a == nullptr) || (!joint.mBodyB.IsInvalid() && b == nullptr))
-            continue;
+        Body *a, *b;
+        if (!joint.mInUse || !joint.mEnabled || !sides(joint, a, b)) continue;
         // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot be
         // (it woke above), so both dynamic sides are awake here
         if (!IsActiveDynamic(a) && !IsActiveDynamic(b)) continue;
@@ -101,9 +110,9 @@ void JointStage::GroupByIsland(const StepContext& inContext)
     for (uint32_t island = 0; island < numIslands; ++island)
         mJointStart[island + 1] += mJointStart[island];
     mIslandJoints.resize(mStepJoints.size());
-    std::vector<uint32_t> cursor(mJointStart.begin(), mJointStart.end() - 1);
+    mCursor.assign(mJointStart.begin(), mJointStart.end() - 1);
     for (uint32_t i = 0; i < uint32_t(mStepJoints.size()); ++i) // Slot order within each island
-        mIslandJoints[cursor[mJointIsland[i]]++] = i;
+        mIslandJoints[mCursor[mJointIsland[i]]++] = i;
 }
 
 void JointStage::Prepare(StepJoint& ioJoint)
@@ -138,35 +147,31 @@ void JointStage::Prepare(StepJoint& ioJoint)
     case JointType::Hinge:
     {
         joint.mPart.Prepare(armA, massA, armB, massB);
-        const Quat rotationA = ioJoint.mA != nullptr ? ioJoint.mA->GetRotation() : Quat::Identity();
-        const Quat rotationB = ioJoint.mB != nullptr ? ioJoint.mB->GetRotation() : Quat::Identity();
+        const Quat rotationA = RotationOf(ioJoint.mA), rotationB = RotationOf(ioJoint.mB);
         const Vec3 axisA = rotationA * joint.mLocalAxisA, axisB = rotationB * joint.mLocalAxisB;
         joint.mHingePart.Prepare(massA, massB, axisA, axisB);
         // B's angle about A's axis from where it was at creation: the turn from A's normal to B's
         const Vec3 normalA = rotationA * joint.mLocalNormalA, normalB = rotationB * joint.mLocalNormalB;
         const float angle = std::atan2(normalA.cross(normalB).dot(axisA), normalA.dot(normalB));
-        constexpr float cPi = 3.14159265358979f;
-        const bool limited = joint.mLimitsMin > -cPi || joint.mLimitsMax < cPi;
-        if (limited && joint.mLimitsMin == joint.mLimitsMax)
-            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
-                                     AxisJointPart::Side::Both, angle - joint.mLimitsMin);
-        else if (limited && angle < joint.mLimitsMin)
-            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
-                                     AxisJointPart::Side::Positive, angle - joint.mLimitsMin);
-        else if (limited && angle > joint.mLimitsMax)
-            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat,
-                                     AxisJointPart::Side::Negative, angle - joint.mLimitsMax);
+        constexpr float cPi = std::numbers::pi_v<float>;
+        AxisJointPart::Side limitSide;
+        float limitError = 0.0f;
+        if ((joint.mLimitsMin > -cPi || joint.mLimitsMax < cPi) &&
+            AxisJointPart::LimitRow(angle, joint.mLimitsMin, joint.mLimitsMax, limitSide, limitError))
+            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat, limitSide,
+                                     limitError);
         else
             joint.mLimitPart.Deactivate();
-        // The motor, or the friction while it is off: a spin towards the target, within its torque this step
-        const float dt = mContext->mDeltaTime;
-        if (joint.mMotorMode == MotorMode::Velocity && joint.mMaxMotorTorque > 0.0f)
-            joint.mMotorPart.Prepare(massA, massB, axisA, joint.mTargetAngularVelocity,
-                                     -joint.mMaxMotorTorque * dt, joint.mMaxMotorTorque * dt,
-                                     AxisJointPart::Side::Both, 0.0f);
-        else if (joint.mMotorMode == MotorMode::Off && joint.mMaxFrictionTorque > 0.0f)
-            joint.mMotorPart.Prepare(massA, massB, axisA, 0.0f, -joint.mMaxFrictionTorque * dt,
-                                     joint.mMaxFrictionTorque * dt, AxisJointPart::Side::Both, 0.0f);
+        // The motor, or the friction while it is off: a spin towards the target (none for friction), within
+        // its torque this step
+        const bool motor = joint.mMotorMode == MotorMode::Velocity;
+        const float torque = motor ? joint.mMaxMotorTorque : joint.mMaxFrictionTorque;
+        if (torque > 0.0f)
+        {
+            const float bound = torque * mContext->mDeltaTime;
+            joint.mMotorPart.Prepare(massA, massB, axisA, motor ? joint.mTargetAngularVelocity : 0.0f, -bound,
+                                     bound, AxisJointPart::Side::Both, 0.0f);
+        }
         else
             joint.mMotorPart.Deactivate();
         break;
@@ -177,21 +182,9 @@ void JointStage::Prepare(StepJoint& ioJoint)
         const float length = between.norm();
         // Points on each other: any direction will do to push them apart (a rod of length 0 holds them)
         const Vec3 axis = length > 1.0e-6f ? Vec3(between / length) : Vec3::UnitX();
-        AxisJointPart::Side rowSide = AxisJointPart::Side::Both;
+        AxisJointPart::Side rowSide;
         float error = 0.0f;
-        if (joint.mMinDistance == joint.mMaxDistance)
-            error = length - joint.mMinDistance;
-        else if (length < joint.mMinDistance)
-        {
-            error = length - joint.mMinDistance;
-            rowSide = AxisJointPart::Side::Positive;
-        }
-        else if (length > joint.mMaxDistance)
-        {
-            error = length - joint.mMaxDistance;
-            rowSide = AxisJointPart::Side::Negative;
-        }
-        else
+        if (!AxisJointPart::LimitRow(length, joint.mMinDistance, joint.mMaxDistance, rowSide, error))
         {
             // Within its limits: no row this step (and no impulse to warm-start the next one from)
             ioJoint.mRowActive = false;
@@ -217,24 +210,41 @@ SolverBody& JointStage::BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodie
     return IsActiveDynamic(ioJoint.mB) ? ioBodies[ioJoint.mB->GetActiveIndex()] : ioJoint.mBlockB;
 }
 
+template <class Visit> void JointStage::VisitVelocityRows(StepJoint& ioJoint, const Visit& inVisit)
+{
+    Joint& joint = *ioJoint.mJoint;
+    switch (joint.mType)
+    {
+    case JointType::Fixed:
+        // The rotation first: the point's rows then see the bodies turning together
+        inVisit(joint.mRotationPart);
+        inVisit(joint.mPart);
+        break;
+    case JointType::Hinge:
+        // The motor (or friction), then the limit, which has the last word on the spin about the axis, then
+        // the axis and the point
+        inVisit(joint.mMotorPart);
+        inVisit(joint.mLimitPart);
+        inVisit(joint.mHingePart);
+        inVisit(joint.mPart);
+        break;
+    case JointType::Point:
+        inVisit(joint.mPart);
+        break;
+    case JointType::Distance:
+        if (ioJoint.mRowActive) inVisit(joint.mAxisPart);
+        break;
+    }
+}
+
 void JointStage::WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies)
 {
     for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
         Prepare(joint);
-        if (joint.mJoint->mType == JointType::Fixed)
-            joint.mJoint->mRotationPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        if (joint.mJoint->mType == JointType::Hinge)
-        {
-            joint.mJoint->mMotorPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-            joint.mJoint->mLimitPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-            joint.mJoint->mHingePart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        }
-        if (joint.mJoint->mType != JointType::Distance)
-            joint.mJoint->mPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        else if (joint.mRowActive)
-            joint.mJoint->mAxisPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        VisitVelocityRows(joint, [&](auto& ioPart)
+                          { ioPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
     }
 }
 
@@ -243,22 +253,17 @@ void JointStage::SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodi
     for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
     {
         StepJoint& joint = mStepJoints[mIslandJoints[j]];
-        // A fixed joint's rotation first: the point's rows then see the bodies turning together
-        if (joint.mJoint->mType == JointType::Fixed)
-            joint.mJoint->mRotationPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        // A hinge's motor (or friction) first, then its limit, which has the last word on the spin about the
-        // axis, then the axis and the point
-        if (joint.mJoint->mType == JointType::Hinge)
-        {
-            joint.mJoint->mMotorPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-            joint.mJoint->mLimitPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-            joint.mJoint->mHingePart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        }
-        if (joint.mJoint->mType != JointType::Distance)
-            joint.mJoint->mPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
-        else if (joint.mRowActive)
-            joint.mJoint->mAxisPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies));
+        VisitVelocityRows(joint, [&](auto& ioPart)
+                          { ioPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
     }
+}
+
+void JointStage::ApplyCorrection(StepJoint& ioJoint, const PointJointPart::PoseCorrection& inCorrection)
+{
+    if (ioJoint.mA != nullptr && ioJoint.mA->IsDynamic())
+        Integration::CorrectPose(*ioJoint.mA, inCorrection.mTranslationA, inCorrection.mRotationA);
+    if (ioJoint.mB != nullptr && ioJoint.mB->IsDynamic())
+        Integration::CorrectPose(*ioJoint.mB, inCorrection.mTranslationB, inCorrection.mRotationB);
 }
 
 void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSettings)
@@ -270,41 +275,28 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
         // error the position iterations take out
         Prepare(joint);
         const Joint& data = *joint.mJoint;
+        // The turns first (a rotation part's correction moves no centre), then the point or the length at the
+        // anchors where they put them
         if (data.mType == JointType::Fixed)
         {
-            const Quat rotationA = joint.mA != nullptr ? joint.mA->GetRotation() : Quat::Identity();
-            const Quat rotationB = joint.mB != nullptr ? joint.mB->GetRotation() : Quat::Identity();
-            const PointJointPart::PoseCorrection turn = data.mRotationPart.CorrectPositions(
-                RotationJointPart::RotationError(rotationA, rotationB, data.mRelativeRotation),
-                inSettings.mBaumgarte);
-            if (joint.mA != nullptr && joint.mA->IsDynamic())
-                Integration::CorrectPose(*joint.mA, Vec3::Zero(), turn.mRotationA);
-            if (joint.mB != nullptr && joint.mB->IsDynamic())
-                Integration::CorrectPose(*joint.mB, Vec3::Zero(), turn.mRotationB);
-            Prepare(joint); // The anchors where the turn put them
+            ApplyCorrection(joint,
+                            data.mRotationPart.CorrectPositions(
+                                RotationJointPart::RotationError(RotationOf(joint.mA), RotationOf(joint.mB),
+                                                                 data.mRelativeRotation),
+                                inSettings.mBaumgarte));
+            Prepare(joint);
         }
         if (data.mType == JointType::Hinge)
         {
-            for (const PointJointPart::PoseCorrection& turn :
-                 {data.mHingePart.CorrectPositions(inSettings.mBaumgarte),
-                  data.mLimitPart.CorrectPositions(inSettings.mBaumgarte)})
-            {
-                if (joint.mA != nullptr && joint.mA->IsDynamic())
-                    Integration::CorrectPose(*joint.mA, Vec3::Zero(), turn.mRotationA);
-                if (joint.mB != nullptr && joint.mB->IsDynamic())
-                    Integration::CorrectPose(*joint.mB, Vec3::Zero(), turn.mRotationB);
-            }
-            Prepare(joint); // The anchors where the turns put them
+            ApplyCorrection(joint, data.mHingePart.CorrectPositions(inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mBaumgarte));
+            Prepare(joint);
         }
-        PointJointPart::PoseCorrection correction;
         if (data.mType != JointType::Distance)
-            correction = data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte);
+            ApplyCorrection(
+                joint, data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte));
         else if (joint.mRowActive)
-            correction = data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte);
-        if (joint.mA != nullptr && joint.mA->IsDynamic())
-            Integration::CorrectPose(*joint.mA, correction.mTranslationA, correction.mRotationA);
-        if (joint.mB != nullptr && joint.mB->IsDynamic())
-            Integration::CorrectPose(*joint.mB, correction.mTranslationB, correction.mRotationB);
+            ApplyCorrection(joint, data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte));
     }
 }
 

@@ -65,6 +65,10 @@ private:
     /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
     /// and limit).
     void Prepare(StepJoint& ioJoint);
+    /// inVisit(part) for each of the joint's velocity rows now in play, in solve order.
+    template <class Visit> static void VisitVelocityRows(StepJoint& ioJoint, const Visit& inVisit);
+    /// Moves the joint's dynamic bodies by a position iteration's correction.
+    static void ApplyCorrection(StepJoint& ioJoint, const PointJointPart::PoseCorrection& inCorrection);
     SolverBody& BlockA(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
     SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
 
@@ -73,6 +77,7 @@ private:
     std::vector<uint32_t> mJointStart;   ///< Per island, offsets into mIslandJoints
     std::vector<uint32_t> mIslandJoints; ///< Indices into mStepJoints, by island
     std::vector<uint32_t> mJointIsland;  ///< Scratch: per step joint
+    std::vector<uint32_t> mCursor;       ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
 };
 
 } // namespace cairn::physics

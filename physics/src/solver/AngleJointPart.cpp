@@ -42,10 +42,8 @@ void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
 {
     if (!mActive) return;
     const float spin = mAxis.dot(ioB.mAngularVelocity - ioA.mAngularVelocity);
-    float total =
-        std::clamp(mTotalImpulse - mEffectiveMass * (spin - mTargetSpeed), mMinImpulse, mMaxImpulse);
-    if (mSide == AxisJointPart::Side::Positive) total = std::max(total, 0.0f);
-    if (mSide == AxisJointPart::Side::Negative) total = std::min(total, 0.0f);
+    const float total = AxisJointPart::ClampToSide(
+        std::clamp(mTotalImpulse - mEffectiveMass * (spin - mTargetSpeed), mMinImpulse, mMaxImpulse), mSide);
     const float impulse = total - mTotalImpulse;
     mTotalImpulse = total;
     Apply(ioA, ioB, impulse);
@@ -55,9 +53,7 @@ PointJointPart::PoseCorrection AngleJointPart::CorrectPositions(float inFraction
 {
     PointJointPart::PoseCorrection correction;
     if (!mActive || mSide == AxisJointPart::Side::Both) return correction; // Only a limit has a position
-    if ((mSide == AxisJointPart::Side::Positive && mError >= 0.0f) ||
-        (mSide == AxisJointPart::Side::Negative && mError <= 0.0f))
-        return correction;
+    if (!AxisJointPart::PushesAgainst(mSide, mError)) return correction;
     const float impulse = -mEffectiveMass * inFraction * mError;
     correction.mRotationA = -impulse * mAngularA;
     correction.mRotationB = impulse * mAngularB;

@@ -65,9 +65,7 @@ void AxisJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
     float impulse = -mMassScale * mEffectiveMass * (speed + mBias) - mImpulseScale * mTotalImpulse;
     // A limit's accumulated impulse stays on its side (it may take back what earlier iterations gave)
     const float total = mTotalImpulse + impulse;
-    const float clamped = mSide == Side::Positive   ? std::max(total, 0.0f)
-                          : mSide == Side::Negative ? std::min(total, 0.0f)
-                                                    : total;
+    const float clamped = ClampToSide(total, mSide);
     impulse = clamped - mTotalImpulse;
     mTotalImpulse = clamped;
     Apply(ioA, ioB, impulse);
@@ -78,8 +76,7 @@ PointJointPart::PoseCorrection AxisJointPart::CorrectPositions(float inError, fl
     PointJointPart::PoseCorrection correction;
     if (!mActive || mSoft) return correction;
     // Only an error the row pushes against: too short for a lower limit, too long for an upper one
-    if ((mSide == Side::Positive && inError >= 0.0f) || (mSide == Side::Negative && inError <= 0.0f))
-        return correction;
+    if (!PushesAgainst(mSide, inError)) return correction;
     const float impulse = -mEffectiveMass * inFraction * inError;
     correction.mTranslationA = -(mInverseMassA * impulse) * mAxis;
     correction.mRotationA = -impulse * mAngularA;

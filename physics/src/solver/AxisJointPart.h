@@ -11,6 +11,8 @@
 
 #include "solver/PointJointPart.h"
 
+#include <algorithm>
+
 namespace cairn::physics
 {
 
@@ -24,6 +26,36 @@ public:
         Positive, ///< A lower limit: B pushed away from A only
         Negative, ///< An upper limit: B pulled towards A only
     };
+    /// inTotal kept on the side a row of inSide may push (unchanged for Both).
+    static float ClampToSide(float inTotal, Side inSide)
+    {
+        return inSide == Side::Positive   ? std::max(inTotal, 0.0f)
+               : inSide == Side::Negative ? std::min(inTotal, 0.0f)
+                                          : inTotal;
+    }
+    /// Whether a row of inSide pushes against the error inError: too short (or too little turned) for a
+    /// lower limit, too long for an upper one, either way for an equality.
+    static bool PushesAgainst(Side inSide, float inError)
+    {
+        return !((inSide == Side::Positive && inError >= 0.0f) ||
+                 (inSide == Side::Negative && inError <= 0.0f));
+    }
+    /// The side and error of a row that keeps inValue within [inMin, inMax]: an equality when they are equal,
+    /// else the limit it is past; false (no row) while it is within them.
+    static bool LimitRow(float inValue, float inMin, float inMax, Side& outSide, float& outError)
+    {
+        if (inMin == inMax)
+            outSide = Side::Both;
+        else if (inValue < inMin)
+            outSide = Side::Positive;
+        else if (inValue > inMax)
+            outSide = Side::Negative;
+        else
+            return false;
+        outError = inValue - (outSide == Side::Negative ? inMax : inMin);
+        return true;
+    }
+
     /// Sets the row along inAxis (unit, world space) for the arms and masses given, with the position error
     /// inError (the length now less the length wanted, m). inFrequency > 0 (Hz) makes it a spring with the
     /// damping ratio inDamping; 0 a hard row. Inactive (and its impulse dropped) when neither side can move.

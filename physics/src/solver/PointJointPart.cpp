@@ -5,6 +5,19 @@
 namespace cairn::physics
 {
 
+bool InvertJointMassMatrix(const Mat3& inK, Mat3& outInverse)
+{
+    bool invertible = false;
+    float determinant = 0.0f;
+    // No absolute threshold (Eigen's default, 1e-5, refused a 200 kg body's matrix): the relative test below
+    inK.computeInverseAndDetWithCheck(outInverse, determinant, invertible, 0.0f);
+    const float scale = inK.cwiseAbs().maxCoeff();
+    const bool ok = invertible && scale > 0.0f && std::isfinite(determinant) &&
+                    std::abs(determinant) > 1.0e-12f * scale * scale * scale && outInverse.allFinite();
+    if (!ok) outInverse.setZero();
+    return ok;
+}
+
 void PointJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
                              const JointBodyMass& inB)
 {
@@ -16,15 +29,7 @@ void PointJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const
     const Mat3 skewA = Skew(inArmA), skewB = Skew(inArmB);
     const Mat3 k = (inA.mInverseMass + inB.mInverseMass) * Mat3::Identity() -
                    skewA * inA.mInverseInertia * skewA - skewB * inB.mInverseInertia * skewB;
-    bool invertible = false;
-    float determinant = 0.0f;
-    // No absolute threshold (Eigen's default, 1e-5, refused a 200 kg body's matrix): the relative test below
-    k.computeInverseAndDetWithCheck(mEffectiveMass, determinant, invertible, 0.0f);
-    // Relative to K's scale: a matrix of heavy bodies is small, not singular
-    const float scale = k.cwiseAbs().maxCoeff();
-    mActive = invertible && scale > 0.0f && std::isfinite(determinant) &&
-              std::abs(determinant) > 1.0e-12f * scale * scale * scale && mEffectiveMass.allFinite();
-    if (!mActive) mEffectiveMass.setZero();
+    mActive = InvertJointMassMatrix(k, mEffectiveMass);
 }
 
 void PointJointPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inImpulse) const

@@ -25,6 +25,10 @@ struct JointBodyMass
     Mat3 mInverseInertia = Mat3::Zero();
 };
 
+/// The inverse of a joint's 3x3 mass matrix inK into outInverse; false (and zero) when it has none. Singular
+/// relative to K's own scale, not by an absolute threshold: a heavy body's matrix is small, not singular.
+bool InvertJointMassMatrix(const Mat3& inK, Mat3& outInverse);
+
 class PointJointPart
 {
 public:

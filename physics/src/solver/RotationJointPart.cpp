@@ -9,15 +9,7 @@ void RotationJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& i
 {
     mA = inA;
     mB = inB;
-    const Mat3 k = inA.mInverseInertia + inB.mInverseInertia;
-    bool invertible = false;
-    float determinant = 0.0f;
-    // No absolute threshold (Eigen's default, 1e-5, refused a 200 kg body's matrix): the relative test below
-    k.computeInverseAndDetWithCheck(mEffectiveMass, determinant, invertible, 0.0f);
-    const float scale = k.cwiseAbs().maxCoeff();
-    mActive = invertible && scale > 0.0f && std::isfinite(determinant) &&
-              std::abs(determinant) > 1.0e-12f * scale * scale * scale && mEffectiveMass.allFinite();
-    if (!mActive) mEffectiveMass.setZero();
+    mActive = InvertJointMassMatrix(inA.mInverseInertia + inB.mInverseInertia, mEffectiveMass);
 }
 
 void RotationJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)

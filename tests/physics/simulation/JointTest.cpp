@@ -5,6 +5,7 @@
 
 #include "SimulationFixture.h"
 #include "cairn/physics/body/BodyLock.h"
+#include "common/StaticFloor.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,6 +21,16 @@ class JointTest : public SimulationFixture
 {
 protected:
     ConstraintInterface& Joints() { return System().GetConstraintInterface(); }
+    /// A 200 kg box wheel (1 x 1 x 0.2 m) at (0, 3, 0) spinning about z at inSpin, kept awake, its spin
+    /// undamped
+    BodyID AddWheel(float inSpin)
+    {
+        BodyCreationSettings settings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f));
+        settings.mAngularDamping = 0.0f;
+        settings.mAngularVelocity = Vec3(0.0f, 0.0f, inSpin);
+        settings.mAllowSleeping = false;
+        return AddDynamic(settings);
+    }
 };
 
 TEST_F(JointTest, APendulumSwingsWithThePeriodOfItsLengthAndKeepsIt)
@@ -143,12 +154,7 @@ TEST_F(JointTest, AChainOfJointedBodiesIsTheSameForAnyThreadCount)
     {
         std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem();
         BodyInterface& bodies = system->GetBodyInterface();
-        BodyCreationSettings floor;
-        floor.mShape = BoxShape::Create(Vec3(20, 1, 20)).Value();
-        floor.mPosition = Vec3(0, -1, 0);
-        floor.mMotionType = MotionType::Static;
-        floor.mObjectLayer = Layers::cStatic;
-        (void)bodies.CreateAndAddBody(floor, Activation::DontActivate);
+        (void)bodies.CreateAndAddBody(StaticFloorSettings(20.0f), Activation::DontActivate);
         BodyCreationSettings box;
         box.mShape = BoxShape::Create(Vec3(0.3f, 0.3f, 0.3f)).Value();
         box.mPosition = Vec3(-1.0f, 0.3f, 0.0f);
@@ -328,10 +334,7 @@ TEST_F(JointTest, AHingeMotorReachesItsSpeedAndALimitStopsTheDoor)
     // A wheel (a box turning about its own centre, so gravity gives no torque) on a hinge to the world with
     // a velocity motor: it spins up to the target within the motor's torque
     const float target = 2.0f;
-    BodyCreationSettings wheelSettings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f));
-    wheelSettings.mAngularDamping = 0.0f;
-    wheelSettings.mAllowSleeping = false;
-    const BodyID wheel = AddDynamic(wheelSettings);
+    const BodyID wheel = AddWheel(0.0f);
     HingeConstraintSettings motor;
     motor.mBodyB = wheel;
     motor.mPoint = Vec3(0.0f, 3.0f, 0.0f);
@@ -380,11 +383,7 @@ TEST_F(JointTest, AHingeMotorReachesItsSpeedAndALimitStopsTheDoor)
 TEST_F(JointTest, HingeFrictionSlowsASpinAsItsTorqueSays)
 {
     // A spinning wheel on a hinge with friction torque T and no motor: its spin drops by T t / I
-    BodyCreationSettings settings = DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.1f)), Vec3(0.0f, 3.0f, 0.0f));
-    settings.mAngularDamping = 0.0f;
-    settings.mAngularVelocity = Vec3(0.0f, 0.0f, 5.0f);
-    settings.mAllowSleeping = false;
-    const BodyID wheel = AddDynamic(settings);
+    const BodyID wheel = AddWheel(5.0f);
     HingeConstraintSettings hinge;
     hinge.mBodyB = wheel;
     hinge.mPoint = Vec3(0.0f, 3.0f, 0.0f);

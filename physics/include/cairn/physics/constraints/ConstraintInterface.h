@@ -19,6 +19,7 @@
 #include "cairn/physics/math/Result.h"
 
 #include <cstdint>
+#include <numbers>
 
 namespace cairn::physics
 {
@@ -78,8 +79,8 @@ struct HingeConstraintSettings
     Vec3 mHingeAxis = Vec3(0.0f, 1.0f, 0.0f); ///< World space, at creation (normalised)
     /// B's angle about the axis from where it is at creation (rad, right-handed, within [-pi, pi]); the
     /// whole range: no limit
-    float mLimitsMin = -3.14159265358979f;
-    float mLimitsMax = 3.14159265358979f;
+    float mLimitsMin = -std::numbers::pi_v<float>;
+    float mLimitsMax = std::numbers::pi_v<float>;
     float mMaxFrictionTorque = 0.0f; ///< N m, while the motor is off
     MotorMode mMotorMode = MotorMode::Off;
     float mTargetAngularVelocity = 0.0f; ///< rad/s, B's spin about the axis relative to A's
