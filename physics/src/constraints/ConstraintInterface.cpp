@@ -132,10 +132,38 @@ Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings
     joint.mLocalNormalA = joint.mLocalNormalB = normal;
     joint.mLimitsMin = std::max(inSettings.mLimitsMin, -cPi);
     joint.mLimitsMax = std::min(inSettings.mLimitsMax, cPi);
-    joint.mMaxFrictionTorque = inSettings.mMaxFrictionTorque;
+    joint.mMaxFriction = inSettings.mMaxFrictionTorque;
     joint.mMotorMode = inSettings.mMotorMode;
-    joint.mTargetAngularVelocity = inSettings.mTargetAngularVelocity;
-    joint.mMaxMotorTorque = inSettings.mMaxMotorTorque;
+    joint.mTargetVelocity = inSettings.mTargetAngularVelocity;
+    joint.mMaxMotor = inSettings.mMaxMotorTorque;
+    return Add(joint, inSettings.mPoint, inSettings.mPoint);
+}
+
+Result<ConstraintID> ConstraintInterface::AddSlider(const SliderConstraintSettings& inSettings)
+{
+    constexpr float cMaxForce = 1.0e12f, cMaxSpeed = 1.0e4f;
+    const float axisLength = inSettings.mSliderAxis.norm();
+    if (!(axisLength > 1.0e-6f && axisLength < 1.0e12f))
+        return MakeError(ErrorCode::InvalidArgument, "a slider axis must be finite and not zero");
+    if (!(inSettings.mLimitsMin <= inSettings.mLimitsMax))
+        return MakeError(ErrorCode::InvalidArgument, "slider limits must not be NaN, and min <= max");
+    if (!(inSettings.mMaxFrictionForce >= 0.0f && inSettings.mMaxFrictionForce <= cMaxForce &&
+          inSettings.mMaxMotorForce >= 0.0f && inSettings.mMaxMotorForce <= cMaxForce &&
+          std::abs(inSettings.mTargetVelocity) <= cMaxSpeed))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "slider forces must be finite and at least 0, a motor's speed finite");
+    if (inSettings.mMotorMode != MotorMode::Off && inSettings.mMotorMode != MotorMode::Velocity)
+        return MakeError(ErrorCode::InvalidArgument, "unknown motor mode");
+    Joint joint = JointOf(JointType::Slider, inSettings);
+    joint.mLocalAxisA = joint.mLocalAxisB =
+        inSettings.mSliderAxis / axisLength; // Add: into the bodies' frames
+    // A limit beyond the world is none (and keeps the rows' errors finite)
+    joint.mLimitsMin = std::max(inSettings.mLimitsMin, -cLargeFloat);
+    joint.mLimitsMax = std::min(inSettings.mLimitsMax, cLargeFloat);
+    joint.mMaxFriction = inSettings.mMaxFrictionForce;
+    joint.mMotorMode = inSettings.mMotorMode;
+    joint.mTargetVelocity = inSettings.mTargetVelocity;
+    joint.mMaxMotor = inSettings.mMaxMotorForce;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
@@ -194,6 +222,8 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
             joint->mHingePart.ResetImpulse();
             joint->mLimitPart.ResetImpulse();
             joint->mMotorPart.ResetImpulse();
+            joint->mLinePart.ResetImpulse();
+            joint->mAxisMotorPart.ResetImpulse();
         }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;

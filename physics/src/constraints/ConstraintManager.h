@@ -11,6 +11,7 @@
 #include "solver/AngleJointPart.h"
 #include "solver/AxisJointPart.h"
 #include "solver/HingeRotationJointPart.h"
+#include "solver/LineJointPart.h"
 #include "solver/PointJointPart.h"
 #include "solver/RotationJointPart.h"
 
@@ -26,6 +27,7 @@ enum class JointType : uint8_t
     Distance,
     Fixed,
     Hinge,
+    Slider,
 };
 
 struct Joint
@@ -39,30 +41,33 @@ struct Joint
     /// The anchor in each body's centre-of-mass frame (in world space for the world's side)
     Vec3 mLocalA = Vec3::Zero();
     Vec3 mLocalB = Vec3::Zero();
-    PointJointPart mPart; ///< Point, fixed
+    PointJointPart mPart; ///< Point, fixed, hinge
     /// B's rotation in A's frame at creation (A's: the world's for the world's side)
     Quat mRelativeRotation = Quat::Identity();
-    RotationJointPart mRotationPart; ///< Fixed
+    RotationJointPart mRotationPart; ///< Fixed, slider
     // Distance
     float mMinDistance = 0.0f;
     float mMaxDistance = 0.0f;
     SpringSettings mSpring;
-    AxisJointPart mAxisPart;
-    // Hinge: its axis and a direction across it in each body's frame (given in world space until the joint is
-    // stored), the limits, friction and motor
+    AxisJointPart mAxisPart; ///< Distance; the slider's limit
+    // Hinge and slider: the axis and a direction across it in each body's frame (given in world space until
+    // the joint is stored), the limits (rad for a hinge, m for a slider), friction and motor (torques and
+    // rad/s for a hinge, forces and m/s for a slider)
     Vec3 mLocalAxisA = Vec3::Zero();
     Vec3 mLocalAxisB = Vec3::Zero();
     Vec3 mLocalNormalA = Vec3::Zero();
     Vec3 mLocalNormalB = Vec3::Zero();
     float mLimitsMin = 0.0f;
     float mLimitsMax = 0.0f;
-    float mMaxFrictionTorque = 0.0f;
+    float mMaxFriction = 0.0f;
     MotorMode mMotorMode = MotorMode::Off;
-    float mTargetAngularVelocity = 0.0f;
-    float mMaxMotorTorque = 0.0f;
+    float mTargetVelocity = 0.0f;
+    float mMaxMotor = 0.0f;
     HingeRotationJointPart mHingePart;
     AngleJointPart mLimitPart;
-    AngleJointPart mMotorPart; ///< The motor, or the friction while it is off
+    AngleJointPart mMotorPart;    ///< The hinge's motor, or its friction while the motor is off
+    LineJointPart mLinePart;      ///< Slider
+    AxisJointPart mAxisMotorPart; ///< The slider's motor, or its friction while the motor is off
 };
 
 class ConstraintManager

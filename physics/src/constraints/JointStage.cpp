@@ -165,15 +165,49 @@ void JointStage::Prepare(StepJoint& ioJoint)
         // The motor, or the friction while it is off: a spin towards the target (none for friction), within
         // its torque this step
         const bool motor = joint.mMotorMode == MotorMode::Velocity;
-        const float torque = motor ? joint.mMaxMotorTorque : joint.mMaxFrictionTorque;
+        const float torque = motor ? joint.mMaxMotor : joint.mMaxFriction;
         if (torque > 0.0f)
         {
             const float bound = torque * mContext->mDeltaTime;
-            joint.mMotorPart.Prepare(massA, massB, axisA, motor ? joint.mTargetAngularVelocity : 0.0f, -bound,
-                                     bound, AxisJointPart::Side::Both, 0.0f);
+            joint.mMotorPart.Prepare(massA, massB, axisA, motor ? joint.mTargetVelocity : 0.0f, -bound, bound,
+                                     AxisJointPart::Side::Both, 0.0f);
         }
         else
             joint.mMotorPart.Deactivate();
+        break;
+    }
+    case JointType::Slider:
+    {
+        joint.mRotationPart.Prepare(massA, massB);
+        // The rows act at B's point: A's arm reaches it through the offset u (A turning swings its line and
+        // its axis under B's point)
+        const Vec3 axis = RotationOf(ioJoint.mA) * joint.mLocalAxisA;
+        const Vec3 offset = anchorB - anchorA;
+        const Vec3 armAtB = armA + offset;
+        joint.mLinePart.Prepare(armAtB, massA, armB, massB, axis, offset);
+        // B's place along the axis from where it was at creation, against the limits
+        AxisJointPart::Side limitSide;
+        float limitError = 0.0f;
+        ioJoint.mRowActive = AxisJointPart::LimitRow(offset.dot(axis), joint.mLimitsMin, joint.mLimitsMax,
+                                                     limitSide, limitError);
+        if (ioJoint.mRowActive)
+        {
+            ioJoint.mError = limitError;
+            joint.mAxisPart.Prepare(armAtB, massA, armB, massB, axis, limitError, limitSide, 0.0f, 0.0f,
+                                    mContext->mDeltaTime);
+        }
+        else
+            joint.mAxisPart.Deactivate();
+        const bool motor = joint.mMotorMode == MotorMode::Velocity;
+        const float force = motor ? joint.mMaxMotor : joint.mMaxFriction;
+        if (force > 0.0f)
+        {
+            const float bound = force * mContext->mDeltaTime;
+            joint.mAxisMotorPart.PrepareMotor(armAtB, massA, armB, massB, axis,
+                                              motor ? joint.mTargetVelocity : 0.0f, -bound, bound);
+        }
+        else
+            joint.mAxisMotorPart.Deactivate();
         break;
     }
     case JointType::Distance:
@@ -228,6 +262,13 @@ template <class Visit> void JointStage::VisitVelocityRows(StepJoint& ioJoint, co
         inVisit(joint.mHingePart);
         inVisit(joint.mPart);
         break;
+    case JointType::Slider:
+        // As the hinge: the motor (or friction), the limit, then the rows that hold the rest
+        inVisit(joint.mAxisMotorPart);
+        if (ioJoint.mRowActive) inVisit(joint.mAxisPart);
+        inVisit(joint.mRotationPart);
+        inVisit(joint.mLinePart);
+        break;
     case JointType::Point:
         inVisit(joint.mPart);
         break;
@@ -277,7 +318,7 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
         const Joint& data = *joint.mJoint;
         // The turns first (a rotation part's correction moves no centre), then the point or the length at the
         // anchors where they put them
-        if (data.mType == JointType::Fixed)
+        if (data.mType == JointType::Fixed || data.mType == JointType::Slider)
         {
             ApplyCorrection(joint,
                             data.mRotationPart.CorrectPositions(
@@ -292,7 +333,15 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
             ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mBaumgarte));
             Prepare(joint);
         }
-        if (data.mType != JointType::Distance)
+        if (data.mType == JointType::Slider)
+        {
+            // Back onto the line, then within the limits at the place that puts it
+            ApplyCorrection(joint, data.mLinePart.CorrectPositions(inSettings.mBaumgarte));
+            Prepare(joint);
+            if (joint.mRowActive)
+                ApplyCorrection(joint, data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte));
+        }
+        else if (data.mType != JointType::Distance)
             ApplyCorrection(
                 joint, data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte));
         else if (joint.mRowActive)

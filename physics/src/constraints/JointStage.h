@@ -59,8 +59,8 @@ private:
         // As the last Prepare found them
         Vec3 mAnchorA = Vec3::Zero(); ///< World space
         Vec3 mAnchorB = Vec3::Zero();
-        bool mRowActive = false; ///< A distance joint out of its limits (or a rod)
-        float mError = 0.0f;     ///< A distance joint's length less the limit it is at
+        bool mRowActive = false; ///< A distance joint out of its limits (or a rod), a slider past a limit
+        float mError = 0.0f;     ///< Its length (a slider's place) less the limit it is at
     };
     /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
     /// and limit).

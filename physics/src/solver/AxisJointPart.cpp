@@ -11,6 +11,9 @@ void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
                             const JointBodyMass& inB, const Vec3& inAxis, float inError, Side inSide,
                             float inFrequency, float inDamping, float inDeltaTime)
 {
+    mMotor = false;
+    mMinImpulse = -cLargeFloat;
+    mMaxImpulse = cLargeFloat;
     mAxis = inAxis;
     mArmCrossA = inArmA.cross(inAxis);
     mArmCrossB = inArmB.cross(inAxis);
@@ -43,6 +46,19 @@ void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
     if (!mActive) mTotalImpulse = 0.0f;
 }
 
+void AxisJointPart::PrepareMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                                 const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed,
+                                 float inMinImpulse, float inMaxImpulse)
+{
+    Prepare(inArmA, inA, inArmB, inB, inAxis, 0.0f, Side::Both, 0.0f, 0.0f, 0.0f);
+    // The rate the row drives to zero is the speed less the target
+    mBias = -inTargetSpeed;
+    mMinImpulse = inMinImpulse;
+    mMaxImpulse = inMaxImpulse;
+    mMotor = true;
+    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse); // The bound may have shrunk
+}
+
 void AxisJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
 {
     ioA.mLinearVelocity -= (mInverseMassA * inImpulse) * mAxis;
@@ -65,7 +81,7 @@ void AxisJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
     float impulse = -mMassScale * mEffectiveMass * (speed + mBias) - mImpulseScale * mTotalImpulse;
     // A limit's accumulated impulse stays on its side (it may take back what earlier iterations gave)
     const float total = mTotalImpulse + impulse;
-    const float clamped = ClampToSide(total, mSide);
+    const float clamped = std::clamp(ClampToSide(total, mSide), mMinImpulse, mMaxImpulse);
     impulse = clamped - mTotalImpulse;
     mTotalImpulse = clamped;
     Apply(ioA, ioB, impulse);
@@ -74,7 +90,7 @@ void AxisJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
 PointJointPart::PoseCorrection AxisJointPart::CorrectPositions(float inError, float inFraction) const
 {
     PointJointPart::PoseCorrection correction;
-    if (!mActive || mSoft) return correction;
+    if (!mActive || mSoft || mMotor) return correction;
     // Only an error the row pushes against: too short for a lower limit, too long for an upper one
     if (!PushesAgainst(mSide, inError)) return correction;
     const float impulse = -mEffectiveMass * inFraction * inError;

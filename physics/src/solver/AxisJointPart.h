@@ -1,11 +1,12 @@
 #pragma once
 
 // One linear row along an axis between a point of A and a point of B: the distance joint's length, its limits
-// and its spring (issue 33), later the slider's limits. Hard, the row is a sequential impulse with the drift
-// taken out on the poses (as PointJointPart); soft (a spring of a frequency and damping ratio), it is the
-// soft step of Catto (GDC 2011) and Box2D v3: the impulse that an implicit Euler step of the spring and
-// damper gives, v' = (v - h w^2 C) / (1 + 2 z h w + h^2 w^2) along the axis for the row's effective mass,
-// with no position pass. A limit pushes one way only: the accumulated impulse is clamped to its side.
+// and its spring (issue 33), the slider's limit, and (PrepareMotor) the slider's motor or friction. Hard, the
+// row is a sequential impulse with the drift taken out on the poses (as PointJointPart); soft (a spring of a
+// frequency and damping ratio), it is the soft step of Catto (GDC 2011) and Box2D v3: the impulse that an
+// implicit Euler step of the spring and damper gives, v' = (v - h w^2 C) / (1 + 2 z h w + h^2 w^2) along the
+// axis for the row's effective mass, with no position pass. A limit pushes one way only: the accumulated
+// impulse is clamped to its side.
 //
 // Threads: the one solving the island the joint is in; no locks.
 
@@ -62,6 +63,18 @@ public:
     void Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB, const JointBodyMass& inB,
                  const Vec3& inAxis, float inError, Side inSide, float inFrequency, float inDamping,
                  float inDeltaTime);
+    /// A motor or friction row instead (the slider's): the relative speed along inAxis (unit) taken towards
+    /// inTargetSpeed (m/s), the accumulated impulse kept within [inMinImpulse, inMaxImpulse] (N s: a force's
+    /// bound times the step). No position pass.
+    void PrepareMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                      const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed, float inMinImpulse,
+                      float inMaxImpulse);
+    /// No row this step (a limit not reached, no motor, no friction): its impulse dropped.
+    void Deactivate()
+    {
+        mActive = false;
+        mTotalImpulse = 0.0f;
+    }
     bool IsActive() const { return mActive; }
     bool IsSoft() const { return mSoft; }
 
@@ -90,8 +103,11 @@ private:
     float mMassScale = 1.0f;    ///< Soft: of the effective mass
     float mImpulseScale = 0.0f; ///< Soft: of the accumulated impulse
     float mTotalImpulse = 0.0f;
+    float mMinImpulse = -cLargeFloat; ///< A motor's bounds on the accumulated impulse (a limit's: none)
+    float mMaxImpulse = cLargeFloat;
     Side mSide = Side::Both;
     bool mSoft = false;
+    bool mMotor = false;
     bool mActive = false;
 };
 

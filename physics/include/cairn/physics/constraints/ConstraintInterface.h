@@ -5,9 +5,9 @@
 // together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
 // last step's impulse, drift taken out on the poses after integration).
 //
-// Joints so far: fixed (welded), point (ball and socket), distance (rod, rope, spring) and hinge (limits, a
-// velocity motor, friction). An island with a
-// joint is solved by one thread, whole (not colored, not grouped): the same result for any thread count.
+// Joints so far: fixed (welded), point (ball and socket), distance (rod, rope, spring), hinge and slider
+// (each with limits, a velocity motor and friction). An island with a joint is solved by one thread, whole
+// (not colored, not grouped): the same result for any thread count.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
 // (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
@@ -87,6 +87,23 @@ struct HingeConstraintSettings
     float mMaxMotorTorque = 0.0f;        ///< N m
 };
 
+/// A drawer, a piston, a sliding gate: B moves along an axis fixed in A, within limits, driven by a motor or
+/// held by friction; its rotation relative to A's is kept as at creation.
+struct SliderConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB;
+    Vec3 mPoint = Vec3::Zero();                ///< World space, at creation: a point of the axis
+    Vec3 mSliderAxis = Vec3(1.0f, 0.0f, 0.0f); ///< World space, at creation (normalised)
+    /// B's place along the axis from where it is at creation (m); the defaults: no limit
+    float mLimitsMin = -cLargeFloat;
+    float mLimitsMax = cLargeFloat;
+    float mMaxFrictionForce = 0.0f; ///< N, while the motor is off
+    MotorMode mMotorMode = MotorMode::Off;
+    float mTargetVelocity = 0.0f; ///< m/s, B's speed along the axis relative to A's
+    float mMaxMotorForce = 0.0f;  ///< N
+};
+
 /// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
 /// mass, so its frequency does not depend on the bodies' masses.
 struct SpringSettings
@@ -125,6 +142,9 @@ public:
     /// A hinge joint, enabled, its bodies woken. Errors as AddPoint's, and for an axis that is zero or not
     /// finite, limits outside [-pi, pi] or with min > max, a torque below 0 or not finite (InvalidArgument).
     Result<ConstraintID> AddHinge(const HingeConstraintSettings& inSettings);
+    /// A slider joint, enabled, its bodies woken. Errors as AddPoint's, and for an axis that is zero or not
+    /// finite, limits that are NaN or with min > max, a force below 0 or not finite (InvalidArgument).
+    Result<ConstraintID> AddSlider(const SliderConstraintSettings& inSettings);
     /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
     /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
     /// (InvalidArgument).
