@@ -158,8 +158,7 @@ void JointStage::Prepare(StepJoint& ioJoint)
         float limitError = 0.0f;
         if ((joint.mLimitsMin > -cPi || joint.mLimitsMax < cPi) &&
             AxisJointPart::LimitRow(angle, joint.mLimitsMin, joint.mLimitsMax, limitSide, limitError))
-            joint.mLimitPart.Prepare(massA, massB, axisA, 0.0f, -cLargeFloat, cLargeFloat, limitSide,
-                                     limitError);
+            joint.mLimitPart.PrepareLimit(massA, massB, axisA, limitSide, limitError);
         else
             joint.mLimitPart.Deactivate();
         // The motor, or the friction while it is off: a spin towards the target (none for friction), within

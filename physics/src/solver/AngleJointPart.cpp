@@ -10,6 +10,7 @@ void AngleJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB,
                              float inTargetSpeed, float inMinImpulse, float inMaxImpulse,
                              AxisJointPart::Side inSide, float inError)
 {
+    mLimit = false;
     mAxis = inAxis;
     mAngularA = inA.mInverseInertia * inAxis;
     mAngularB = inB.mInverseInertia * inAxis;
@@ -24,6 +25,13 @@ void AngleJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB,
     mError = inError;
     mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse);
     if (!mActive) mTotalImpulse = 0.0f;
+}
+
+void AngleJointPart::PrepareLimit(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
+                                  AxisJointPart::Side inSide, float inError)
+{
+    Prepare(inA, inB, inAxis, 0.0f, -cLargeFloat, cLargeFloat, inSide, inError);
+    mLimit = true;
 }
 
 void AngleJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
@@ -52,8 +60,8 @@ void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
 PointJointPart::PoseCorrection AngleJointPart::CorrectPositions(float inFraction) const
 {
     PointJointPart::PoseCorrection correction;
-    if (!mActive || mSide == AxisJointPart::Side::Both) return correction; // Only a limit has a position
-    if (!AxisJointPart::PushesAgainst(mSide, mError)) return correction;
+    // Only a limit has a position; an equality (equal limits) pushes against its error either way
+    if (!mActive || !mLimit || !AxisJointPart::PushesAgainst(mSide, mError)) return correction;
     const float impulse = -mEffectiveMass * inFraction * mError;
     correction.mRotationA = -impulse * mAngularA;
     correction.mRotationB = impulse * mAngularB;

@@ -20,6 +20,10 @@ public:
     /// for a limit, to its side. inError: a limit's angle past it (rad), for the position rows.
     void Prepare(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed,
                  float inMinImpulse, float inMaxImpulse, AxisJointPart::Side inSide, float inError);
+    /// A limit's row (or, inSide Both, an equality: the angle held): no speed target, no bound but its side;
+    /// the position pass takes out inError.
+    void PrepareLimit(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
+                      AxisJointPart::Side inSide, float inError);
     /// No row this step (a limit not reached, no motor, no friction): its impulse dropped.
     void Deactivate()
     {
@@ -31,7 +35,8 @@ public:
     void SolveVelocity(SolverBody& ioA, SolverBody& ioB);
     float GetTotalImpulse() const { return mTotalImpulse; }
     void ResetImpulse() { mTotalImpulse = 0.0f; }
-    /// A limit's position iteration: the turns that take inFraction of its error out. Zero otherwise.
+    /// A limit's position iteration (PrepareLimit's): the turns that take inFraction of its error out. Zero
+    /// for a motor or friction row.
     PointJointPart::PoseCorrection CorrectPositions(float inFraction) const;
 
 private:
@@ -47,6 +52,7 @@ private:
     float mError = 0.0f;
     float mTotalImpulse = 0.0f;
     AxisJointPart::Side mSide = AxisJointPart::Side::Both;
+    bool mLimit = false; ///< Prepared by PrepareLimit: it has a position error to take out
     bool mActive = false;
 };
 

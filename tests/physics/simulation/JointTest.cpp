@@ -380,6 +380,26 @@ TEST_F(JointTest, AHingeMotorReachesItsSpeedAndALimitStopsTheDoor)
     EXPECT_LT(tilt, 1.0f * std::numbers::pi_v<float> / 180.0f);
 }
 
+TEST_F(JointTest, AHingeWithEqualLimitsTurnsToThatAngleAndHoldsItUnderLoad)
+{
+    // A beam hinged at its end on a horizontal axis, its limits both 0.3 rad from where it is made: the
+    // position pass turns it there and the row holds it against gravity's torque, as a fixed joint would
+    BodyCreationSettings beamSettings =
+        DynamicSettings(Box(Vec3(0.5f, 0.05f, 0.05f)), Vec3(0.5f, 3.0f, 0.0f));
+    beamSettings.mAllowSleeping = false; // The position pass turns it with no speed: it would look at rest
+    const BodyID beam = AddDynamic(beamSettings);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = beam;
+    hinge.mPoint = Vec3(0.0f, 3.0f, 0.0f);
+    hinge.mHingeAxis = Vec3(0.0f, 0.0f, 1.0f);
+    hinge.mLimitsMin = hinge.mLimitsMax = 0.3f;
+    ASSERT_TRUE(Joints().AddHinge(hinge).IsOk());
+    Step(120);
+    const Vec3 along = Bodies().GetRotation(beam).Value() * Vec3::UnitX();
+    EXPECT_NEAR(std::atan2(along.y(), along.x()), 0.3f, 0.01f); // Raised 0.3 rad, not sagging
+    EXPECT_LT(Bodies().GetAngularVelocity(beam).Value().norm(), 0.01f);
+}
+
 TEST_F(JointTest, HingeFrictionSlowsASpinAsItsTorqueSays)
 {
     // A spinning wheel on a hinge with friction torque T and no motor: its spin drops by T t / I
