@@ -2,10 +2,12 @@
 
 #include "cairn/physics/body/BodyLock.h"
 #include "constraints/ConstraintManager.h"
+#include "constraints/JointGeometry.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 namespace cairn::physics
 {
@@ -34,6 +36,33 @@ template <class Settings> Joint JointOf(JointType inType, const Settings& inSett
 Error StaleID()
 {
     return {ErrorCode::InvalidArgument, "stale or unknown constraint id"};
+}
+/// The checks a hinge's (inAngles) or a slider's motor needs; a message names the joint.
+Status CheckMotor(const MotorSettings& inMotor, bool inAngles)
+{
+    constexpr float cMaxForce = 1.0e12f, cMaxSpeed = 1.0e4f, cMaxPlace = 1.0e6f;
+    const char* joint = inAngles ? "hinge" : "slider";
+    if (inMotor.mMode != MotorMode::Off && inMotor.mMode != MotorMode::Velocity &&
+        inMotor.mMode != MotorMode::Position)
+        return MakeError(ErrorCode::InvalidArgument, std::string(joint) + ": unknown motor mode");
+    if (!(inMotor.mMaxForce >= 0.0f && inMotor.mMaxForce <= cMaxForce &&
+          std::abs(inMotor.mTargetVelocity) <= cMaxSpeed))
+        return MakeError(ErrorCode::InvalidArgument,
+                         std::string(joint) +
+                             ": a motor's force must be finite and at least 0, its speed finite");
+    const float maxPlace = inAngles ? std::numbers::pi_v<float> + 1.0e-5f : cMaxPlace;
+    if (!(std::abs(inMotor.mTargetPosition) <= maxPlace))
+        return MakeError(ErrorCode::InvalidArgument,
+                         std::string(joint) + (inAngles ? ": a motor's target angle must be within [-pi, pi]"
+                                                        : ": a motor's target place must be finite"));
+    if (inMotor.mMode == MotorMode::Position &&
+        !(inMotor.mSpring.mFrequency > 0.0f && inMotor.mSpring.mFrequency <= 1.0e4f &&
+          inMotor.mSpring.mDamping >= 0.0f && inMotor.mSpring.mDamping <= 1.0e4f))
+        return MakeError(ErrorCode::InvalidArgument,
+                         std::string(joint) +
+                             ": a position motor's spring needs a frequency above 0 and a damping at least 0 "
+                             "(both finite, at most 1e4)");
+    return Status::Ok();
 }
 } // namespace
 
@@ -111,20 +140,17 @@ Result<ConstraintID> ConstraintInterface::AddFixed(const FixedConstraintSettings
 
 Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings& inSettings)
 {
-    constexpr float cPi = std::numbers::pi_v<float>, cMaxTorque = 1.0e12f, cMaxSpeed = 1.0e4f;
+    constexpr float cPi = std::numbers::pi_v<float>, cMaxTorque = 1.0e12f;
     const float axisLength = inSettings.mHingeAxis.norm();
     if (!(axisLength > 1.0e-6f && axisLength < 1.0e12f))
         return MakeError(ErrorCode::InvalidArgument, "a hinge axis must be finite and not zero");
     if (!(inSettings.mLimitsMin >= -cPi - 1.0e-5f && inSettings.mLimitsMin <= inSettings.mLimitsMax &&
           inSettings.mLimitsMax <= cPi + 1.0e-5f))
         return MakeError(ErrorCode::InvalidArgument, "hinge limits must be within [-pi, pi] with min <= max");
-    if (!(inSettings.mMaxFrictionTorque >= 0.0f && inSettings.mMaxFrictionTorque <= cMaxTorque &&
-          inSettings.mMaxMotorTorque >= 0.0f && inSettings.mMaxMotorTorque <= cMaxTorque &&
-          std::abs(inSettings.mTargetAngularVelocity) <= cMaxSpeed))
+    if (!(inSettings.mMaxFrictionTorque >= 0.0f && inSettings.mMaxFrictionTorque <= cMaxTorque))
         return MakeError(ErrorCode::InvalidArgument,
-                         "hinge torques must be finite and at least 0, a motor's speed finite");
-    if (inSettings.mMotorMode != MotorMode::Off && inSettings.mMotorMode != MotorMode::Velocity)
-        return MakeError(ErrorCode::InvalidArgument, "unknown motor mode");
+                         "a hinge's friction torque must be finite and at least 0");
+    if (Status motor = CheckMotor(inSettings.mMotor, true); !motor) return motor.GetError();
     Joint joint = JointOf(JointType::Hinge, inSettings);
     const Vec3 axis = inSettings.mHingeAxis / axisLength;
     const Vec3 normal = AnyPerpendicular(axis);
@@ -133,27 +159,22 @@ Result<ConstraintID> ConstraintInterface::AddHinge(const HingeConstraintSettings
     joint.mLimitsMin = std::max(inSettings.mLimitsMin, -cPi);
     joint.mLimitsMax = std::min(inSettings.mLimitsMax, cPi);
     joint.mMaxFriction = inSettings.mMaxFrictionTorque;
-    joint.mMotorMode = inSettings.mMotorMode;
-    joint.mTargetVelocity = inSettings.mTargetAngularVelocity;
-    joint.mMaxMotor = inSettings.mMaxMotorTorque;
+    joint.mMotor = inSettings.mMotor;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
 Result<ConstraintID> ConstraintInterface::AddSlider(const SliderConstraintSettings& inSettings)
 {
-    constexpr float cMaxForce = 1.0e12f, cMaxSpeed = 1.0e4f;
+    constexpr float cMaxForce = 1.0e12f;
     const float axisLength = inSettings.mSliderAxis.norm();
     if (!(axisLength > 1.0e-6f && axisLength < 1.0e12f))
         return MakeError(ErrorCode::InvalidArgument, "a slider axis must be finite and not zero");
     if (!(inSettings.mLimitsMin <= inSettings.mLimitsMax))
         return MakeError(ErrorCode::InvalidArgument, "slider limits must not be NaN, and min <= max");
-    if (!(inSettings.mMaxFrictionForce >= 0.0f && inSettings.mMaxFrictionForce <= cMaxForce &&
-          inSettings.mMaxMotorForce >= 0.0f && inSettings.mMaxMotorForce <= cMaxForce &&
-          std::abs(inSettings.mTargetVelocity) <= cMaxSpeed))
+    if (!(inSettings.mMaxFrictionForce >= 0.0f && inSettings.mMaxFrictionForce <= cMaxForce))
         return MakeError(ErrorCode::InvalidArgument,
-                         "slider forces must be finite and at least 0, a motor's speed finite");
-    if (inSettings.mMotorMode != MotorMode::Off && inSettings.mMotorMode != MotorMode::Velocity)
-        return MakeError(ErrorCode::InvalidArgument, "unknown motor mode");
+                         "a slider's friction force must be finite and at least 0");
+    if (Status motor = CheckMotor(inSettings.mMotor, false); !motor) return motor.GetError();
     Joint joint = JointOf(JointType::Slider, inSettings);
     joint.mLocalAxisA = joint.mLocalAxisB =
         inSettings.mSliderAxis / axisLength; // Add: into the bodies' frames
@@ -161,9 +182,7 @@ Result<ConstraintID> ConstraintInterface::AddSlider(const SliderConstraintSettin
     joint.mLimitsMin = std::max(inSettings.mLimitsMin, -cLargeFloat);
     joint.mLimitsMax = std::min(inSettings.mLimitsMax, cLargeFloat);
     joint.mMaxFriction = inSettings.mMaxFrictionForce;
-    joint.mMotorMode = inSettings.mMotorMode;
-    joint.mTargetVelocity = inSettings.mTargetVelocity;
-    joint.mMaxMotor = inSettings.mMaxMotorForce;
+    joint.mMotor = inSettings.mMotor;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
@@ -187,6 +206,61 @@ Result<ConstraintID> ConstraintInterface::AddDistance(const DistanceConstraintSe
     joint.mMaxDistance = maxDistance;
     joint.mSpring = spring;
     return Add(joint, inSettings.mPointA, inSettings.mPointB);
+}
+
+Status ConstraintInterface::SetMotor(ConstraintID inID, const MotorSettings& inMotor)
+{
+    if (IsWrongThread()) return WrongThread();
+    BodyID a, b;
+    {
+        std::lock_guard lock(mManager.GetMutex());
+        Joint* joint = mManager.Find(inID);
+        if (joint == nullptr) return StaleID();
+        if (joint->mType != JointType::Hinge && joint->mType != JointType::Slider)
+            return MakeError(ErrorCode::InvalidArgument, "only a hinge or a slider has a motor");
+        if (Status motor = CheckMotor(inMotor, joint->mType == JointType::Hinge); !motor) return motor;
+        joint->mMotor = inMotor;
+        a = joint->mBodyA;
+        b = joint->mBodyB;
+    }
+    // A door at rest asleep: it must wake to move
+    WakeBody(a);
+    WakeBody(b);
+    return Status::Ok();
+}
+
+Result<float> ConstraintInterface::GetPosition(ConstraintID inID) const
+{
+    if (IsWrongThread()) return WrongThread();
+    Joint joint;
+    {
+        std::lock_guard lock(mManager.GetMutex());
+        const Joint* found = mManager.Find(inID);
+        if (found == nullptr) return StaleID();
+        if (found->mType != JointType::Hinge && found->mType != JointType::Slider)
+            return MakeError(ErrorCode::InvalidArgument, "only a hinge or a slider has a position");
+        joint = *found;
+    }
+    // Each side's rotation and anchor now (one body lock at a time, none with the joints' mutex)
+    auto pose = [&](const BodyID& inID, const Vec3& inLocal, Quat& outRotation, Vec3& outAnchor) -> Status
+    {
+        outRotation = Quat::Identity();
+        outAnchor = inLocal; // The world's side: its point
+        if (inID.IsInvalid()) return Status::Ok();
+        BodyLockRead lock(mBodies, inID);
+        if (lock.WasWrongThread()) return WrongThread();
+        const Body* body = lock.GetBody();
+        if (body == nullptr) return MakeError(ErrorCode::InvalidBodyID, "a body of the joint is gone");
+        outRotation = body->GetRotation();
+        outAnchor = body->GetCenterOfMassPosition() + body->GetRotation() * inLocal;
+        return Status::Ok();
+    };
+    Quat rotationA, rotationB;
+    Vec3 anchorA, anchorB;
+    if (Status a = pose(joint.mBodyA, joint.mLocalA, rotationA, anchorA); !a) return a.GetError();
+    if (Status b = pose(joint.mBodyB, joint.mLocalB, rotationB, anchorB); !b) return b.GetError();
+    return joint.mType == JointType::Hinge ? HingeAngle(joint, rotationA, rotationB)
+                                           : SliderPlace(joint, anchorA, anchorB, rotationA);
 }
 
 Status ConstraintInterface::Remove(ConstraintID inID)

@@ -60,9 +60,7 @@ struct Joint
     float mLimitsMin = 0.0f;
     float mLimitsMax = 0.0f;
     float mMaxFriction = 0.0f;
-    MotorMode mMotorMode = MotorMode::Off;
-    float mTargetVelocity = 0.0f;
-    float mMaxMotor = 0.0f;
+    MotorSettings mMotor;
     HingeRotationJointPart mHingePart;
     AngleJointPart mLimitPart;
     AngleJointPart mMotorPart;    ///< The hinge's motor, or its friction while the motor is off

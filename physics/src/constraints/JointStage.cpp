@@ -2,6 +2,7 @@
 
 #include "body/Integration.h"
 #include "cairn/physics/solver/SolverSettings.h"
+#include "constraints/JointGeometry.h"
 #include "step/StepContext.h"
 
 #include <numbers>
@@ -150,9 +151,7 @@ void JointStage::Prepare(StepJoint& ioJoint)
         const Quat rotationA = RotationOf(ioJoint.mA), rotationB = RotationOf(ioJoint.mB);
         const Vec3 axisA = rotationA * joint.mLocalAxisA, axisB = rotationB * joint.mLocalAxisB;
         joint.mHingePart.Prepare(massA, massB, axisA, axisB);
-        // B's angle about A's axis from where it was at creation: the turn from A's normal to B's
-        const Vec3 normalA = rotationA * joint.mLocalNormalA, normalB = rotationB * joint.mLocalNormalB;
-        const float angle = std::atan2(normalA.cross(normalB).dot(axisA), normalA.dot(normalB));
+        const float angle = HingeAngle(joint, rotationA, rotationB);
         constexpr float cPi = std::numbers::pi_v<float>;
         AxisJointPart::Side limitSide;
         float limitError = 0.0f;
@@ -161,18 +160,20 @@ void JointStage::Prepare(StepJoint& ioJoint)
             joint.mLimitPart.PrepareLimit(massA, massB, axisA, limitSide, limitError);
         else
             joint.mLimitPart.Deactivate();
-        // The motor, or the friction while it is off: a spin towards the target (none for friction), within
-        // its torque this step
-        const bool motor = joint.mMotorMode == MotorMode::Velocity;
-        const float torque = motor ? joint.mMaxMotor : joint.mMaxFriction;
-        if (torque > 0.0f)
-        {
-            const float bound = torque * mContext->mDeltaTime;
-            joint.mMotorPart.Prepare(massA, massB, axisA, motor ? joint.mTargetVelocity : 0.0f, -bound, bound,
-                                     AxisJointPart::Side::Both, 0.0f);
-        }
-        else
+        // The motor, or the friction while it is off (a spin towards none), within its torque this step
+        const MotorSettings& motor = joint.mMotor;
+        const float torque = motor.mMode != MotorMode::Off ? motor.mMaxForce : joint.mMaxFriction;
+        const float bound = torque * mContext->mDeltaTime;
+        if (!(torque > 0.0f))
             joint.mMotorPart.Deactivate();
+        else if (motor.mMode == MotorMode::Position)
+            joint.mMotorPart.PrepareSpring(massA, massB, axisA, AngleBetween(angle, motor.mTargetPosition),
+                                           motor.mSpring.mFrequency, motor.mSpring.mDamping,
+                                           mContext->mDeltaTime, -bound, bound);
+        else
+            joint.mMotorPart.Prepare(massA, massB, axisA,
+                                     motor.mMode == MotorMode::Velocity ? motor.mTargetVelocity : 0.0f,
+                                     -bound, bound, AxisJointPart::Side::Both, 0.0f);
         break;
     }
     case JointType::Slider:
@@ -187,8 +188,9 @@ void JointStage::Prepare(StepJoint& ioJoint)
         // B's place along the axis from where it was at creation, against the limits
         AxisJointPart::Side limitSide;
         float limitError = 0.0f;
-        ioJoint.mRowActive = AxisJointPart::LimitRow(offset.dot(axis), joint.mLimitsMin, joint.mLimitsMax,
-                                                     limitSide, limitError);
+        const float place = SliderPlace(joint, anchorA, anchorB, RotationOf(ioJoint.mA));
+        ioJoint.mRowActive =
+            AxisJointPart::LimitRow(place, joint.mLimitsMin, joint.mLimitsMax, limitSide, limitError);
         if (ioJoint.mRowActive)
         {
             ioJoint.mError = limitError;
@@ -197,16 +199,19 @@ void JointStage::Prepare(StepJoint& ioJoint)
         }
         else
             joint.mAxisPart.Deactivate();
-        const bool motor = joint.mMotorMode == MotorMode::Velocity;
-        const float force = motor ? joint.mMaxMotor : joint.mMaxFriction;
-        if (force > 0.0f)
-        {
-            const float bound = force * mContext->mDeltaTime;
-            joint.mAxisMotorPart.PrepareMotor(armAtB, massA, armB, massB, axis,
-                                              motor ? joint.mTargetVelocity : 0.0f, -bound, bound);
-        }
-        else
+        const MotorSettings& motor = joint.mMotor;
+        const float force = motor.mMode != MotorMode::Off ? motor.mMaxForce : joint.mMaxFriction;
+        const float bound = force * mContext->mDeltaTime;
+        if (!(force > 0.0f))
             joint.mAxisMotorPart.Deactivate();
+        else if (motor.mMode == MotorMode::Position)
+            joint.mAxisMotorPart.PrepareSpringMotor(
+                armAtB, massA, armB, massB, axis, place - motor.mTargetPosition, motor.mSpring.mFrequency,
+                motor.mSpring.mDamping, mContext->mDeltaTime, -bound, bound);
+        else
+            joint.mAxisMotorPart.PrepareMotor(
+                armAtB, massA, armB, massB, axis,
+                motor.mMode == MotorMode::Velocity ? motor.mTargetVelocity : 0.0f, -bound, bound);
         break;
     }
     case JointType::Distance:

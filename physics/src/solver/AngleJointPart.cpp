@@ -11,6 +11,9 @@ void AngleJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB,
                              AxisJointPart::Side inSide, float inError)
 {
     mLimit = false;
+    mBias = 0.0f;
+    mMassScale = 1.0f;
+    mImpulseScale = 0.0f;
     mAxis = inAxis;
     mAngularA = inA.mInverseInertia * inAxis;
     mAngularB = inB.mInverseInertia * inAxis;
@@ -34,6 +37,17 @@ void AngleJointPart::PrepareLimit(const JointBodyMass& inA, const JointBodyMass&
     mLimit = true;
 }
 
+void AngleJointPart::PrepareSpring(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
+                                   float inError, float inFrequency, float inDamping, float inDeltaTime,
+                                   float inMinImpulse, float inMaxImpulse)
+{
+    Prepare(inA, inB, inAxis, 0.0f, inMinImpulse, inMaxImpulse, AxisJointPart::Side::Both, 0.0f);
+    const SoftStep soft = SoftStep::Of(inFrequency, inDamping, inDeltaTime);
+    mBias = soft.mBiasPerError * inError;
+    mMassScale = soft.mMassScale;
+    mImpulseScale = soft.mImpulseScale;
+}
+
 void AngleJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
 {
     ioA.mAngularVelocity -= inImpulse * mAngularA;
@@ -50,8 +64,10 @@ void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
 {
     if (!mActive) return;
     const float spin = mAxis.dot(ioB.mAngularVelocity - ioA.mAngularVelocity);
-    const float total = AxisJointPart::ClampToSide(
-        std::clamp(mTotalImpulse - mEffectiveMass * (spin - mTargetSpeed), mMinImpulse, mMaxImpulse), mSide);
+    const float impulse0 =
+        -mMassScale * mEffectiveMass * (spin - mTargetSpeed + mBias) - mImpulseScale * mTotalImpulse;
+    const float total =
+        AxisJointPart::ClampToSide(std::clamp(mTotalImpulse + impulse0, mMinImpulse, mMaxImpulse), mSide);
     const float impulse = total - mTotalImpulse;
     mTotalImpulse = total;
     Apply(ioA, ioB, impulse);

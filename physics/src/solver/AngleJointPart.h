@@ -1,9 +1,10 @@
 #pragma once
 
 // One angular row about an axis between bodies A and B: a hinge's limit (one-sided), its motor (a target
-// relative spin, the impulse within what its torque gives in a step) or its friction (a motor towards no spin
-// with the friction torque's bound). Sequential impulses; a limit's error is taken out on the poses after
-// integration, as the other joints' rows.
+// relative spin, or a spring towards a target angle: the soft step of AxisJointPart; either within what its
+// torque gives in a step) or its friction (a motor towards no spin with the friction torque's bound).
+// Sequential impulses; a limit's error is taken out on the poses after integration, as the other joints'
+// rows.
 //
 // Threads: the one solving the island the joint is in; no locks.
 
@@ -24,6 +25,11 @@ public:
     /// the position pass takes out inError.
     void PrepareLimit(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
                       AxisJointPart::Side inSide, float inError);
+    /// A position motor's row: a spring of inFrequency (Hz, above 0) and damping ratio inDamping pulling the
+    /// angle error inError (rad: the angle less the target) to zero, within [inMinImpulse, inMaxImpulse].
+    void PrepareSpring(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis, float inError,
+                       float inFrequency, float inDamping, float inDeltaTime, float inMinImpulse,
+                       float inMaxImpulse);
     /// No row this step (a limit not reached, no motor, no friction): its impulse dropped.
     void Deactivate()
     {
@@ -47,6 +53,9 @@ private:
     Vec3 mAngularB = Vec3::Zero();
     float mEffectiveMass = 0.0f;
     float mTargetSpeed = 0.0f;
+    float mBias = 0.0f;         ///< A spring's velocity bias
+    float mMassScale = 1.0f;    ///< A spring's, of the effective mass
+    float mImpulseScale = 0.0f; ///< A spring's, of the accumulated impulse
     float mMinImpulse = 0.0f;
     float mMaxImpulse = 0.0f;
     float mError = 0.0f;

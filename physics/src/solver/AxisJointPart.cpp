@@ -7,6 +7,15 @@
 namespace cairn::physics
 {
 
+SoftStep SoftStep::Of(float inFrequency, float inDamping, float inDeltaTime)
+{
+    const float omega = 2.0f * std::numbers::pi_v<float> * inFrequency; // Angular frequency
+    const float a1 = 2.0f * inDamping + inDeltaTime * omega;
+    const float a2 = inDeltaTime * omega * a1;
+    const float a3 = 1.0f / (1.0f + a2);
+    return {omega / a1, a2 * a3, a3};
+}
+
 void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
                             const JointBodyMass& inB, const Vec3& inAxis, float inError, Side inSide,
                             float inFrequency, float inDamping, float inDeltaTime)
@@ -33,15 +42,10 @@ void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
     mImpulseScale = 0.0f;
     if (mSoft && mActive)
     {
-        // Box2D v3's b2MakeSoft, Catto's soft step: the implicit Euler step of a spring of angular frequency
-        // w and damping ratio z on the effective mass
-        const float omega = 2.0f * std::numbers::pi_v<float> * inFrequency;
-        const float a1 = 2.0f * inDamping + inDeltaTime * omega;
-        const float a2 = inDeltaTime * omega * a1;
-        const float a3 = 1.0f / (1.0f + a2);
-        mBias = omega / a1 * inError;
-        mMassScale = a2 * a3;
-        mImpulseScale = a3;
+        const SoftStep soft = SoftStep::Of(inFrequency, inDamping, inDeltaTime);
+        mBias = soft.mBiasPerError * inError;
+        mMassScale = soft.mMassScale;
+        mImpulseScale = soft.mImpulseScale;
     }
     if (!mActive) mTotalImpulse = 0.0f;
 }
@@ -57,6 +61,18 @@ void AxisJointPart::PrepareMotor(const Vec3& inArmA, const JointBodyMass& inA, c
     mMaxImpulse = inMaxImpulse;
     mMotor = true;
     mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse); // The bound may have shrunk
+}
+
+void AxisJointPart::PrepareSpringMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                                       const JointBodyMass& inB, const Vec3& inAxis, float inError,
+                                       float inFrequency, float inDamping, float inDeltaTime,
+                                       float inMinImpulse, float inMaxImpulse)
+{
+    Prepare(inArmA, inA, inArmB, inB, inAxis, inError, Side::Both, inFrequency, inDamping, inDeltaTime);
+    mMinImpulse = inMinImpulse;
+    mMaxImpulse = inMaxImpulse;
+    mMotor = true;
+    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse);
 }
 
 void AxisJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const

@@ -17,6 +17,17 @@
 namespace cairn::physics
 {
 
+/// Box2D v3's b2MakeSoft, Catto's soft step (GDC 2011): the implicit Euler step of a spring of frequency f
+/// and damping ratio z on a row's effective mass m gives the impulse -mMassScale m (v + mBiasPerError C) -
+/// mImpulseScale (the impulse accumulated so far) for the speed v and error C.
+struct SoftStep
+{
+    float mBiasPerError = 0.0f;
+    float mMassScale = 1.0f;
+    float mImpulseScale = 0.0f;
+    static SoftStep Of(float inFrequency, float inDamping, float inDeltaTime);
+};
+
 class AxisJointPart
 {
 public:
@@ -69,6 +80,11 @@ public:
     void PrepareMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
                       const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed, float inMinImpulse,
                       float inMaxImpulse);
+    /// A position motor's row: a spring of inFrequency (Hz, above 0) and damping ratio inDamping pulling the
+    /// error inError (m: the place less the target) to zero, within [inMinImpulse, inMaxImpulse].
+    void PrepareSpringMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
+                            const JointBodyMass& inB, const Vec3& inAxis, float inError, float inFrequency,
+                            float inDamping, float inDeltaTime, float inMinImpulse, float inMaxImpulse);
     /// No row this step (a limit not reached, no motor, no friction): its impulse dropped.
     void Deactivate()
     {

@@ -339,9 +339,9 @@ TEST_F(JointTest, AHingeMotorReachesItsSpeedAndALimitStopsTheDoor)
     motor.mBodyB = wheel;
     motor.mPoint = Vec3(0.0f, 3.0f, 0.0f);
     motor.mHingeAxis = Vec3(0.0f, 0.0f, 1.0f);
-    motor.mMotorMode = MotorMode::Velocity;
-    motor.mTargetAngularVelocity = target;
-    motor.mMaxMotorTorque = 500.0f;
+    motor.mMotor.mMode = MotorMode::Velocity;
+    motor.mMotor.mTargetVelocity = target;
+    motor.mMotor.mMaxForce = 500.0f;
     ASSERT_TRUE(Joints().AddHinge(motor).IsOk());
     Step(60);
     const Vec3 spin = Bodies().GetAngularVelocity(wheel).Value();
@@ -398,6 +398,71 @@ TEST_F(JointTest, AHingeWithEqualLimitsTurnsToThatAngleAndHoldsItUnderLoad)
     const Vec3 along = Bodies().GetRotation(beam).Value() * Vec3::UnitX();
     EXPECT_NEAR(std::atan2(along.y(), along.x()), 0.3f, 0.01f); // Raised 0.3 rad, not sagging
     EXPECT_LT(Bodies().GetAngularVelocity(beam).Value().norm(), 0.01f);
+}
+
+TEST_F(JointTest, AHingePositionMotorFollowsTheImplicitSpringStep)
+{
+    // A wheel turning about its own centre (no other row pulls on its spin) driven to 1 rad by a position
+    // motor: each step its spin is the implicit Euler step of the spring, v' = (v - h w^2 C) / (1 + 2 z h w +
+    // h^2 w^2), and its angle C' = C + h v' (relative to the target), whatever its inertia
+    const BodyID wheel = AddWheel(0.0f);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = wheel;
+    hinge.mPoint = Vec3(0.0f, 3.0f, 0.0f);
+    hinge.mHingeAxis = Vec3(0.0f, 0.0f, 1.0f);
+    hinge.mMotor.mMode = MotorMode::Position;
+    hinge.mMotor.mTargetPosition = 1.0f;
+    hinge.mMotor.mMaxForce = 1.0e6f; // Never reached: the spring alone
+    hinge.mMotor.mSpring = {2.0f, 0.7f};
+    const Result<ConstraintID> id = Joints().AddHinge(hinge);
+    ASSERT_TRUE(id.IsOk());
+    const float h = 1.0f / 60.0f, omega = 2.0f * std::numbers::pi_v<float> * 2.0f, zeta = 0.7f;
+    float error = -1.0f, spin = 0.0f, worst = 0.0f;
+    for (int step = 0; step < 120; ++step)
+    {
+        Step(1);
+        spin = (spin - h * omega * omega * error) / (1.0f + 2.0f * zeta * h * omega + h * h * omega * omega);
+        error += h * spin;
+        worst = std::max(worst, std::abs(Joints().GetPosition(id.Value()).Value() - (1.0f + error)));
+    }
+    EXPECT_LT(worst, 0.002f);
+    EXPECT_NEAR(Joints().GetPosition(id.Value()).Value(), 1.0f, 0.01f); // There after 2 s
+}
+
+TEST_F(JointTest, ADoorOpensAndClosesAsItsMotorIsToldWhileTheWorldRuns)
+{
+    // A door hinged at its edge on a vertical axis, limits 0 to 1.6 rad: a velocity motor opens it, then
+    // (from outside the step) a position motor closes it; asleep once shut, a new motor wakes it
+    BodyCreationSettings doorSettings = DynamicSettings(Box(Vec3(0.5f, 1.0f, 0.05f)), Vec3(0.5f, 1.2f, 0.0f));
+    doorSettings.mAngularDamping = 0.0f;
+    const BodyID door = AddDynamic(doorSettings);
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = door;
+    hinge.mPoint = Vec3(0.0f, 1.2f, 0.0f);
+    hinge.mHingeAxis = Vec3(0.0f, 1.0f, 0.0f);
+    hinge.mLimitsMin = 0.0f;
+    hinge.mLimitsMax = 1.6f;
+    hinge.mMotor = {MotorMode::Velocity, 1.0f, 0.0f, 2000.0f, {}};
+    const Result<ConstraintID> id = Joints().AddHinge(hinge);
+    ASSERT_TRUE(id.IsOk());
+    Step(60);
+    EXPECT_NEAR(Joints().GetPosition(id.Value()).Value(), 1.0f, 0.05f); // A second at 1 rad/s
+    ASSERT_TRUE(
+        Joints().SetMotor(id.Value(), {MotorMode::Position, 0.0f, 0.0f, 2000.0f, {1.5f, 1.0f}}).IsOk());
+    Step(180);
+    EXPECT_LT(std::abs(Joints().GetPosition(id.Value()).Value()), 0.02f);
+    // The position rows read the same angle as the door's own rotation: its face turned about y
+    const Vec3 across = Bodies().GetRotation(door).Value() * Vec3::UnitX();
+    EXPECT_NEAR(Joints().GetPosition(id.Value()).Value(), std::atan2(-across.z(), across.x()), 1.0e-4f);
+
+    // Motor off: it falls asleep shut; told to open, it wakes and opens
+    ASSERT_TRUE(Joints().SetMotor(id.Value(), {}).IsOk());
+    for (int step = 0; step < 600 && Bodies().IsActive(door).Value(); ++step)
+        Step(1);
+    ASSERT_FALSE(Bodies().IsActive(door).Value());
+    ASSERT_TRUE(Joints().SetMotor(id.Value(), {MotorMode::Velocity, 1.0f, 0.0f, 2000.0f, {}}).IsOk());
+    Step(30);
+    EXPECT_GT(Joints().GetPosition(id.Value()).Value(), 0.4f);
 }
 
 TEST_F(JointTest, HingeFrictionSlowsASpinAsItsTorqueSays)
@@ -486,9 +551,9 @@ TEST_F(SliderTest, AMotorDrivesWithinItsForceAndFrictionBrakesAsItsForceSays)
     slider.mBodyB = box;
     slider.mPoint = Vec3(0.0f, 3.0f, 0.0f);
     slider.mSliderAxis = Vec3(1.0f, 0.0f, 0.0f);
-    slider.mMotorMode = MotorMode::Velocity;
-    slider.mTargetVelocity = 1.5f;
-    slider.mMaxMotorForce = 2000.0f;
+    slider.mMotor.mMode = MotorMode::Velocity;
+    slider.mMotor.mTargetVelocity = 1.5f;
+    slider.mMotor.mMaxForce = 2000.0f;
     ASSERT_TRUE(Joints().AddSlider(slider).IsOk());
     Step(30);
     EXPECT_NEAR(Bodies().GetLinearVelocity(box).Value().x(), 1.5f, 0.05f * 1.5f); // The 5 %
@@ -499,8 +564,8 @@ TEST_F(SliderTest, AMotorDrivesWithinItsForceAndFrictionBrakesAsItsForceSays)
     const BodyID lift = AddSliding();
     slider.mBodyB = lift;
     slider.mSliderAxis = Vec3(0.0f, 1.0f, 0.0f);
-    slider.mTargetVelocity = 2.0f;
-    slider.mMaxMotorForce = 1000.0f;
+    slider.mMotor.mTargetVelocity = 2.0f;
+    slider.mMotor.mMaxForce = 1000.0f;
     ASSERT_TRUE(Joints().AddSlider(slider).IsOk());
     Step(12);
     const float lifting = (1000.0f - cMass * cGravity) / cMass;
@@ -521,6 +586,24 @@ TEST_F(SliderTest, AMotorDrivesWithinItsForceAndFrictionBrakesAsItsForceSays)
     EXPECT_NEAR(Bodies().GetLinearVelocity(falling).Value().y(), -falls * 0.5f, 0.02f * falls * 0.5f);
 }
 
+TEST_F(SliderTest, APositionMotorLiftsToItsTargetLessTheSagOfItsSpringUnderTheLoad)
+{
+    // A vertical slider's position motor is a spring of frequency f: holding a weight, it rests g / w^2
+    // below its target (w = 2 pi f), whatever the mass
+    const BodyID lift = AddSliding();
+    SliderConstraintSettings slider;
+    slider.mBodyB = lift;
+    slider.mPoint = Vec3(0.0f, 3.0f, 0.0f);
+    slider.mSliderAxis = Vec3(0.0f, 1.0f, 0.0f);
+    slider.mMotor = {MotorMode::Position, 0.0f, 0.5f, 1.0e5f, {2.0f, 1.0f}};
+    const Result<ConstraintID> id = Joints().AddSlider(slider);
+    ASSERT_TRUE(id.IsOk());
+    Step(240);
+    const float omega = 2.0f * std::numbers::pi_v<float> * 2.0f;
+    EXPECT_NEAR(Joints().GetPosition(id.Value()).Value(), 0.5f - cGravity / (omega * omega), 0.002f);
+    EXPECT_NEAR(Position(lift).y(), 3.0f + Joints().GetPosition(id.Value()).Value(), 1.0e-4f);
+}
+
 TEST_F(SliderTest, TwoBodiesPushedApartAlongTheSliderKeepTheirMomentumAndTheLine)
 {
     // No gravity: a piston between a heavy box and a light ball drives them apart at 1 m/s; what one gains
@@ -539,9 +622,9 @@ TEST_F(SliderTest, TwoBodiesPushedApartAlongTheSliderKeepTheirMomentumAndTheLine
     piston.mBodyB = ball;
     piston.mPoint = Vec3(0.5f, 3.0f, 0.0f);
     piston.mSliderAxis = Vec3(1.0f, 0.0f, 0.0f);
-    piston.mMotorMode = MotorMode::Velocity;
-    piston.mTargetVelocity = 1.0f;
-    piston.mMaxMotorForce = 500.0f;
+    piston.mMotor.mMode = MotorMode::Velocity;
+    piston.mMotor.mTargetVelocity = 1.0f;
+    piston.mMotor.mMaxForce = 500.0f;
     ASSERT_TRUE(Joints().AddSlider(piston).IsOk());
     const float ballMass = 1000.0f * 4.0f / 3.0f * std::numbers::pi_v<float> * 0.001f;
     float worstAcross = 0.0f;
@@ -661,10 +744,10 @@ TEST_F(JointTest, BadInputGetsClearErrors)
     hinge.mLimitsMin = -4.0f; // Past -pi
     EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
     hinge.mLimitsMin = -0.5f;
-    hinge.mMaxMotorTorque = -1.0f;
+    hinge.mMotor.mMaxForce = -1.0f;
     EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
-    hinge.mMaxMotorTorque = 1.0f;
-    hinge.mTargetAngularVelocity = std::nanf("");
+    hinge.mMotor.mMaxForce = 1.0f;
+    hinge.mMotor.mTargetVelocity = std::nanf("");
     EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
     SliderConstraintSettings slider;
     slider.mBodyB = bob;
@@ -682,9 +765,35 @@ TEST_F(JointTest, BadInputGetsClearErrors)
     slider.mMaxFrictionForce = -1.0f;
     EXPECT_EQ(Joints().AddSlider(slider).GetError().mCode, ErrorCode::InvalidArgument);
     slider.mMaxFrictionForce = 0.0f;
-    slider.mTargetVelocity = std::numeric_limits<float>::infinity();
+    slider.mMotor.mTargetVelocity = std::numeric_limits<float>::infinity();
     EXPECT_EQ(Joints().AddSlider(slider).GetError().mCode, ErrorCode::InvalidArgument);
+    slider.mMotor.mTargetVelocity = 0.0f;
+    slider.mMotor.mMode = MotorMode::Position;
+    slider.mMotor.mSpring.mFrequency = 0.0f; // A position motor needs a spring
+    EXPECT_EQ(Joints().AddSlider(slider).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mMotor = {MotorMode::Position, 0.0f, 4.0f, 1.0f, {}}; // A target angle past pi
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mMotor = {static_cast<MotorMode>(7), 0.0f, 0.0f, 1.0f, {}};
+    EXPECT_EQ(Joints().AddHinge(hinge).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(Joints().GetNumConstraints().Value(), 0u);
+    settings.mBodyA = BodyID();
+    settings.mBodyB = bob;
+    const Result<ConstraintID> point = Joints().AddPoint(settings);
+    ASSERT_TRUE(point.IsOk());
+    EXPECT_EQ(Joints().SetMotor(point.Value(), {}).GetError().mCode, ErrorCode::InvalidArgument); // No motor
+    EXPECT_EQ(Joints().GetPosition(point.Value()).GetError().mCode, ErrorCode::InvalidArgument);
+    hinge.mMotor = {};
+    const Result<ConstraintID> door = Joints().AddHinge(hinge);
+    ASSERT_TRUE(door.IsOk());
+    EXPECT_EQ(Joints()
+                  .SetMotor(door.Value(), {MotorMode::Velocity, std::nanf(""), 0.0f, 1.0f, {}})
+                  .GetError()
+                  .mCode,
+              ErrorCode::InvalidArgument);
+    ASSERT_TRUE(Joints().Remove(door.Value()).IsOk());
+    EXPECT_EQ(Joints().SetMotor(door.Value(), {}).GetError().mCode, ErrorCode::InvalidArgument); // Stale
+    EXPECT_EQ(Joints().GetPosition(door.Value()).GetError().mCode, ErrorCode::InvalidArgument);
+    ASSERT_TRUE(Joints().Remove(point.Value()).IsOk());
     {
         // Holding a body lock: a joint call could wait for a step that waits for this lock
         const BodyLockRead lock(System().GetBodyManager(), bob);

@@ -67,6 +67,27 @@ enum class MotorMode : uint8_t
 {
     Off,      ///< Nothing (the joint's friction acts instead)
     Velocity, ///< Drives the relative spin (or speed) to a target, within its largest torque (or force)
+    Position, ///< Pulls the angle (or place) to a target as a spring would, within its largest torque (force)
+};
+
+/// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
+/// mass, so its frequency does not depend on the bodies' masses.
+struct SpringSettings
+{
+    float mFrequency = 0.0f; ///< Hz; 0: rigid
+    float mDamping = 0.0f;   ///< Ratio to critical damping (1: critical)
+};
+
+/// A hinge's or a slider's motor: rad, rad/s and N m for a hinge; m, m/s and N for a slider. B's motion
+/// relative to A's, measured as the joint's limits are.
+struct MotorSettings
+{
+    MotorMode mMode = MotorMode::Off;
+    float mTargetVelocity = 0.0f; ///< Velocity mode
+    float mTargetPosition = 0.0f; ///< Position mode: an angle within [-pi, pi] for a hinge
+    float mMaxForce = 0.0f;       ///< The most it drives with, torque or force (0: it does nothing)
+    /// Position mode: how it pulls; a frequency above 0 (a door: 1-4 Hz), damping 1 stops without overshoot
+    SpringSettings mSpring{2.0f, 1.0f};
 };
 
 /// A door, a wheel: B turns about an axis through a point of A, within limits, driven by a motor or held by
@@ -82,9 +103,7 @@ struct HingeConstraintSettings
     float mLimitsMin = -std::numbers::pi_v<float>;
     float mLimitsMax = std::numbers::pi_v<float>;
     float mMaxFrictionTorque = 0.0f; ///< N m, while the motor is off
-    MotorMode mMotorMode = MotorMode::Off;
-    float mTargetAngularVelocity = 0.0f; ///< rad/s, B's spin about the axis relative to A's
-    float mMaxMotorTorque = 0.0f;        ///< N m
+    MotorSettings mMotor;            ///< rad, rad/s, N m
 };
 
 /// A drawer, a piston, a sliding gate: B moves along an axis fixed in A, within limits, driven by a motor or
@@ -99,17 +118,7 @@ struct SliderConstraintSettings
     float mLimitsMin = -cLargeFloat;
     float mLimitsMax = cLargeFloat;
     float mMaxFrictionForce = 0.0f; ///< N, while the motor is off
-    MotorMode mMotorMode = MotorMode::Off;
-    float mTargetVelocity = 0.0f; ///< m/s, B's speed along the axis relative to A's
-    float mMaxMotorForce = 0.0f;  ///< N
-};
-
-/// A spring that softens a joint's row: the implicit Euler step of a spring and damper on the row's effective
-/// mass, so its frequency does not depend on the bodies' masses.
-struct SpringSettings
-{
-    float mFrequency = 0.0f; ///< Hz; 0: rigid
-    float mDamping = 0.0f;   ///< Ratio to critical damping (1: critical)
+    MotorSettings mMotor;           ///< m, m/s, N
 };
 
 /// Keeps the distance between a point of A and a point of B within [min, max]: equal, a rod; min 0, a rope;
@@ -140,15 +149,24 @@ public:
     /// A fixed joint, enabled, its bodies woken. Errors as AddPoint's.
     Result<ConstraintID> AddFixed(const FixedConstraintSettings& inSettings);
     /// A hinge joint, enabled, its bodies woken. Errors as AddPoint's, and for an axis that is zero or not
-    /// finite, limits outside [-pi, pi] or with min > max, a torque below 0 or not finite (InvalidArgument).
+    /// finite, limits or a motor's target angle outside [-pi, pi] or with min > max, a torque below 0 or not
+    /// finite, a motor's speed not finite, a position motor's spring frequency not above 0 (InvalidArgument).
     Result<ConstraintID> AddHinge(const HingeConstraintSettings& inSettings);
     /// A slider joint, enabled, its bodies woken. Errors as AddPoint's, and for an axis that is zero or not
-    /// finite, limits that are NaN or with min > max, a force below 0 or not finite (InvalidArgument).
+    /// finite, limits that are NaN or with min > max, a force below 0 or not finite, a motor's target not
+    /// finite, a position motor's spring frequency not above 0 (InvalidArgument).
     Result<ConstraintID> AddSlider(const SliderConstraintSettings& inSettings);
     /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
     /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
     /// (InvalidArgument).
     Result<ConstraintID> AddDistance(const DistanceConstraintSettings& inSettings);
+    /// A hinge's or slider's motor, from the next step (a door closing on a timer: Position mode, the closed
+    /// angle). Its bodies are woken. Errors: a stale id, a joint of another type, or settings AddHinge or
+    /// AddSlider would refuse (InvalidArgument); the wrong thread (WrongThread).
+    Status SetMotor(ConstraintID inID, const MotorSettings& inMotor);
+    /// A hinge's angle (rad, within [-pi, pi]) or a slider's place (m) now, as its limits measure them.
+    /// Errors: a stale id or another type (InvalidArgument), a body of it gone (InvalidBodyID), WrongThread.
+    Result<float> GetPosition(ConstraintID inID) const;
     /// Removes a joint; its id goes stale. Its bodies are woken (a body hanging from it falls).
     Status Remove(ConstraintID inID);
     /// A disabled joint does nothing and links no island; enabling starts it from no impulse. Its bodies are
