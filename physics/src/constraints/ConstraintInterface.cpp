@@ -115,6 +115,8 @@ Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPoin
     ioJoint.mLocalNormalA = rotationA.conjugate() * ioJoint.mLocalNormalA;
     ioJoint.mLocalAxisB = rotationB.conjugate() * ioJoint.mLocalAxisB;
     ioJoint.mLocalNormalB = rotationB.conjugate() * ioJoint.mLocalNormalB;
+    ioJoint.mLocalFrameA = (rotationA.conjugate() * ioJoint.mLocalFrameA).normalized();
+    ioJoint.mLocalFrameB = (rotationB.conjugate() * ioJoint.mLocalFrameB).normalized();
     ConstraintID id;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -183,6 +185,43 @@ Result<ConstraintID> ConstraintInterface::AddSlider(const SliderConstraintSettin
     joint.mLimitsMax = std::min(inSettings.mLimitsMax, cLargeFloat);
     joint.mMaxFriction = inSettings.mMaxFrictionForce;
     joint.mMotor = inSettings.mMotor;
+    return Add(joint, inSettings.mPoint, inSettings.mPoint);
+}
+
+Result<ConstraintID> ConstraintInterface::AddSwingTwist(const SwingTwistConstraintSettings& inSettings)
+{
+    constexpr float cPi = std::numbers::pi_v<float>, cMaxTorque = 1.0e12f, cSlack = 1.0e-5f;
+    const float twistLength = inSettings.mTwistAxis.norm(), planeLength = inSettings.mPlaneAxis.norm();
+    if (!(twistLength > 1.0e-6f && twistLength < 1.0e12f && planeLength > 1.0e-6f && planeLength < 1.0e12f))
+        return MakeError(ErrorCode::InvalidArgument, "swing-twist axes must be finite and not zero");
+    const Vec3 twist = inSettings.mTwistAxis / twistLength;
+    Vec3 plane = inSettings.mPlaneAxis / planeLength;
+    if (!(std::abs(twist.dot(plane)) <= 1.0e-3f))
+        return MakeError(ErrorCode::InvalidArgument, "swing-twist axes must be perpendicular");
+    plane = (plane - twist.dot(plane) * twist).normalized(); // Exactly, for the frame
+    if (!(inSettings.mNormalHalfConeAngle >= 0.0f && inSettings.mNormalHalfConeAngle <= cPi + cSlack &&
+          inSettings.mPlaneHalfConeAngle >= 0.0f && inSettings.mPlaneHalfConeAngle <= cPi + cSlack))
+        return MakeError(ErrorCode::InvalidArgument, "swing-twist half cone angles must be within [0, pi]");
+    if (!(inSettings.mTwistMinAngle >= -cPi - cSlack &&
+          inSettings.mTwistMinAngle <= inSettings.mTwistMaxAngle &&
+          inSettings.mTwistMaxAngle <= cPi + cSlack))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "swing-twist twist limits must be within [-pi, pi] with min <= max");
+    if (!(inSettings.mMaxFrictionTorque >= 0.0f && inSettings.mMaxFrictionTorque <= cMaxTorque))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "a swing-twist's friction torque must be finite and at least 0");
+    Joint joint = JointOf(JointType::SwingTwist, inSettings);
+    Mat3 frame;
+    frame.col(0) = twist;
+    frame.col(1) = plane;
+    frame.col(2) = twist.cross(plane);
+    joint.mLocalFrameA = joint.mLocalFrameB =
+        Quat(frame); // World space here: Add turns them into the bodies'
+    joint.mNormalHalfCone = std::min(inSettings.mNormalHalfConeAngle, cPi);
+    joint.mPlaneHalfCone = std::min(inSettings.mPlaneHalfConeAngle, cPi);
+    joint.mLimitsMin = std::max(inSettings.mTwistMinAngle, -cPi);
+    joint.mLimitsMax = std::min(inSettings.mTwistMaxAngle, cPi);
+    joint.mMaxFriction = inSettings.mMaxFrictionTorque;
     return Add(joint, inSettings.mPoint, inSettings.mPoint);
 }
 
@@ -298,6 +337,9 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
             joint->mMotorPart.ResetImpulse();
             joint->mLinePart.ResetImpulse();
             joint->mAxisMotorPart.ResetImpulse();
+            joint->mSwingPart.ResetImpulse();
+            for (AngleJointPart& friction : joint->mFrictionParts)
+                friction.ResetImpulse();
         }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;

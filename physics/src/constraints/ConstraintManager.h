@@ -15,6 +15,7 @@
 #include "solver/PointJointPart.h"
 #include "solver/RotationJointPart.h"
 
+#include <array>
 #include <mutex>
 #include <vector>
 
@@ -28,6 +29,7 @@ enum class JointType : uint8_t
     Fixed,
     Hinge,
     Slider,
+    SwingTwist,
 };
 
 struct Joint
@@ -63,8 +65,17 @@ struct Joint
     MotorSettings mMotor;
     HingeRotationJointPart mHingePart;
     AngleJointPart mLimitPart;
-    AngleJointPart mMotorPart;    ///< The hinge's motor, or its friction while the motor is off
-    LineJointPart mLinePart;      ///< Slider
+    AngleJointPart mMotorPart; ///< The hinge's motor, or its friction while the motor is off
+    LineJointPart mLinePart;   ///< Slider
+    // Swing-twist: the joint's frame (x twist, y plane, z normal) in each body's frame (given in world space
+    // until the joint is stored; the world's side keeps it), the cone's half angles (the twist's range is in
+    // mLimitsMin and mLimitsMax, its friction in mMaxFriction)
+    Quat mLocalFrameA = Quat::Identity();
+    Quat mLocalFrameB = Quat::Identity();
+    float mNormalHalfCone = 0.0f;
+    float mPlaneHalfCone = 0.0f;
+    AngleJointPart mSwingPart;                    ///< The cone, while the swing is past it
+    std::array<AngleJointPart, 3> mFrictionParts; ///< About the frame's axes
     AxisJointPart mAxisMotorPart; ///< The slider's motor, or its friction while the motor is off
 };
 

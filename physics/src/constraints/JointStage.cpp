@@ -3,6 +3,7 @@
 #include "body/Integration.h"
 #include "cairn/physics/solver/SolverSettings.h"
 #include "constraints/JointGeometry.h"
+#include "constraints/SwingTwist.h"
 #include "step/StepContext.h"
 
 #include <numbers>
@@ -214,6 +215,39 @@ void JointStage::Prepare(StepJoint& ioJoint)
                 motor.mMode == MotorMode::Velocity ? motor.mTargetVelocity : 0.0f, -bound, bound);
         break;
     }
+    case JointType::SwingTwist:
+    {
+        joint.mPart.Prepare(armA, massA, armB, massB);
+        const Quat frameA = RotationOf(ioJoint.mA) * joint.mLocalFrameA;
+        const Quat frameB = RotationOf(ioJoint.mB) * joint.mLocalFrameB;
+        Quat swing, twist;
+        SplitSwingTwist(frameA.conjugate() * frameB, swing, twist);
+        // The cone: a row along the direction (in A's frame) that takes the swing further out
+        Vec3 outwards;
+        float swingError = 0.0f;
+        if (SwingPastCone(RotationVector(swing), joint.mNormalHalfCone, joint.mPlaneHalfCone, outwards,
+                          swingError))
+            joint.mSwingPart.PrepareLimit(massA, massB, frameA * outwards, AxisJointPart::Side::Negative,
+                                          swingError);
+        else
+            joint.mSwingPart.Deactivate();
+        // The twist about B's limb axis, within its range
+        AxisJointPart::Side twistSide;
+        float twistError = 0.0f;
+        if (AxisJointPart::LimitRow(TwistAngle(twist), joint.mLimitsMin, joint.mLimitsMax, twistSide,
+                                    twistError))
+            joint.mLimitPart.PrepareLimit(massA, massB, frameB * Vec3::UnitX(), twistSide, twistError);
+        else
+            joint.mLimitPart.Deactivate();
+        const float bound = joint.mMaxFriction * mContext->mDeltaTime;
+        for (int axis = 0; axis < 3; ++axis)
+            if (bound > 0.0f)
+                joint.mFrictionParts[axis].Prepare(massA, massB, frameA * Vec3::Unit(axis), 0.0f, -bound,
+                                                   bound, AxisJointPart::Side::Both, 0.0f);
+            else
+                joint.mFrictionParts[axis].Deactivate();
+        break;
+    }
     case JointType::Distance:
     {
         const Vec3 between = anchorB - anchorA;
@@ -273,6 +307,15 @@ template <class Visit> void JointStage::VisitVelocityRows(StepJoint& ioJoint, co
         inVisit(joint.mRotationPart);
         inVisit(joint.mLinePart);
         break;
+    case JointType::SwingTwist:
+        // The friction, then the cone and the twist's range, which have the last word on the turn, then the
+        // point
+        for (AngleJointPart& friction : joint.mFrictionParts)
+            inVisit(friction);
+        inVisit(joint.mSwingPart);
+        inVisit(joint.mLimitPart);
+        inVisit(joint.mPart);
+        break;
     case JointType::Point:
         inVisit(joint.mPart);
         break;
@@ -329,6 +372,12 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
                                 RotationJointPart::RotationError(RotationOf(joint.mA), RotationOf(joint.mB),
                                                                  data.mRelativeRotation),
                                 inSettings.mBaumgarte));
+            Prepare(joint);
+        }
+        if (data.mType == JointType::SwingTwist)
+        {
+            ApplyCorrection(joint, data.mSwingPart.CorrectPositions(inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mBaumgarte));
             Prepare(joint);
         }
         if (data.mType == JointType::Hinge)

@@ -121,6 +121,26 @@ struct SliderConstraintSettings
     MotorSettings mMotor;           ///< m, m/s, N
 };
 
+/// A shoulder, a hip, a neck: a ball and socket whose swing is limited to an elliptic cone round the twist
+/// axis and whose twist about that axis is limited to a range (a ragdoll's joints; Jolt's SwingTwist, PhysX's
+/// D6 with swing and twist limits). The angles are B's frame relative to A's from where they are at creation:
+/// the twist axis, the plane axis across it and the normal axis (twist x plane) make the frame.
+struct SwingTwistConstraintSettings
+{
+    BodyID mBodyA; ///< An invalid id: the world
+    BodyID mBodyB;
+    Vec3 mPoint = Vec3::Zero();               ///< World space, at creation: the socket
+    Vec3 mTwistAxis = Vec3(1.0f, 0.0f, 0.0f); ///< World space, at creation: along the limb, A to B
+    Vec3 mPlaneAxis = Vec3(0.0f, 1.0f, 0.0f); ///< World space, at creation, perpendicular to the twist axis
+    /// How far the twist axis may tilt towards the normal axis (a turn about the plane axis), and within the
+    /// twist and plane axes' plane (a turn about the normal axis), rad in [0, pi]
+    float mNormalHalfConeAngle = 0.0f;
+    float mPlaneHalfConeAngle = 0.0f;
+    float mTwistMinAngle = 0.0f; ///< rad, within [-pi, pi], min <= max
+    float mTwistMaxAngle = 0.0f;
+    float mMaxFrictionTorque = 0.0f; ///< N m about each of the frame's axes: a limb that settles, not jitters
+};
+
 /// Keeps the distance between a point of A and a point of B within [min, max]: equal, a rod; min 0, a rope;
 /// with a spring, the limits give like a spring (equal limits: a spring of that rest length).
 struct DistanceConstraintSettings
@@ -156,6 +176,10 @@ public:
     /// finite, limits that are NaN or with min > max, a force below 0 or not finite, a motor's target not
     /// finite, a position motor's spring frequency not above 0 (InvalidArgument).
     Result<ConstraintID> AddSlider(const SliderConstraintSettings& inSettings);
+    /// A swing-twist joint, enabled, its bodies woken. Errors as AddPoint's, and for axes that are zero, not
+    /// finite or not perpendicular, half angles outside [0, pi], twist limits outside [-pi, pi] or with min >
+    /// max, a torque below 0 or not finite (InvalidArgument).
+    Result<ConstraintID> AddSwingTwist(const SwingTwistConstraintSettings& inSettings);
     /// A distance joint, enabled, its bodies woken. Errors as AddPoint's, and for limits that are not finite,
     /// below 0 or with min > max, or a spring's frequency or damping negative or not finite
     /// (InvalidArgument).
