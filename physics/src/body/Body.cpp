@@ -13,6 +13,8 @@ void Body::Init(const BodyID& inID, const BodyCreationSettings& inSettings)
     mShape = inSettings.mShape;
     mMotionType = inSettings.mMotionType;
     mObjectLayer = inSettings.mObjectLayer;
+    mCollisionGroupID = inSettings.mCollisionGroup.mGroupID;
+    mCollisionSubGroupID = uint16_t(inSettings.mCollisionGroup.mSubGroupID); // Checked below the table's size
     mRotation = inSettings.mRotation.normalized();
     mFriction = inSettings.mFriction;
     mRestitution = inSettings.mRestitution;

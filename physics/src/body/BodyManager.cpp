@@ -45,6 +45,10 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
     if (inSettings.mMotionQuality != MotionQuality::Discrete &&
         inSettings.mMotionQuality != MotionQuality::LinearCast)
         return invalid("motion quality is not a MotionQuality");
+    const CollisionGroup& group = inSettings.mCollisionGroup;
+    if (group.mSubGroupID >=
+        (group.mFilter != nullptr ? group.mFilter->GetNumSubGroups() : GroupFilterTable::cMaxSubGroups))
+        return invalid("collision sub-group is beyond its group's filter table (or 4096 without one)");
     const AABB bounds = inSettings.mShape->GetWorldBounds({inSettings.mPosition, inSettings.mRotation});
     if (!bounds.IsFinite()) return invalid("body bounds are not finite");
     // An empty or inverted box (a shape built around its checked Create) would be dropped by the broad phase
@@ -55,9 +59,20 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
 }
 } // namespace
 
+bool BodyManager::BodiesCollide(const Body& inA, const Body& inB) const
+{
+    const uint32_t group = inA.GetCollisionGroupID();
+    if (group == CollisionGroup::cNoGroup || group != inB.GetCollisionGroupID()) return true;
+    const GroupFilterTable* table = mGroupFilters[inA.GetID().GetIndex()] != nullptr
+                                        ? mGroupFilters[inA.GetID().GetIndex()].get()
+                                        : mGroupFilters[inB.GetID().GetIndex()].get();
+    return table != nullptr && table->CanCollide(inA.GetCollisionSubGroupID(), inB.GetCollisionSubGroupID());
+}
+
 BodyManager::BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes)
     : mMaxBodies(inMaxBodies), mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
       mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]()),
+      mGroupFilters(new std::shared_ptr<const GroupFilterTable>[inMaxBodies]),
       mPoses(std::make_unique<PublishedPoseStore>(inMaxBodies))
 {
     // Hand out low indices first: they pack the hot part of the array
@@ -100,6 +115,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
     Body& body = mBodies[index];
     const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
+    mGroupFilters[index] = inSettings.mCollisionGroup.mFilter;
     mSlotInUse[index] = true;
     mPoses->Publish(body);
     return id;
@@ -125,6 +141,7 @@ Status BodyManager::DestroyBody(const BodyID& inID)
         // A new sequence makes every copy of the old id stale
         body->mID = BodyID(inID.GetIndex(), inID.GetSequence() + 1);
         mSlotInUse[inID.GetIndex()] = false;
+        mGroupFilters[inID.GetIndex()].reset();
         mPoses->Publish(*body); // Names the shape no more, so it can be retired
     }
     mPoses->Retire(std::move(shape));

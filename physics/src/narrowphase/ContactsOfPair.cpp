@@ -31,6 +31,8 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
                                 Body& ioB, NarrowPhaseChunk& ioOut) const
 {
     if (!ioA.IsDynamic() && !ioB.IsDynamic()) return;
+    // Two parts of one object that its group keeps apart (a ragdoll's jointed limbs): no contact, no record
+    if (!inContext.mBodies.BodiesCollide(ioA, ioB)) return;
     if (inContext.mListener != nullptr &&
         inContext.mListener->OnContactValidate(ioA, ioB) == ContactValidation::Reject)
         return; // No record either: the pair is validated again next step

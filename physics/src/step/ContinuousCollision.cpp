@@ -107,7 +107,8 @@ bool ContinuousCollision::Cast(const StepContext& inContext, Body& ioBody) const
                                     {
                                         if (inID == ioBody.GetID() || inEntry >= earliest) return earliest;
                                         const Body* other = inContext.mBodies.TryGetBody(inID);
-                                        if (other == nullptr || !other->IsInWorld() || other->IsSensor())
+                                        if (other == nullptr || !other->IsInWorld() || other->IsSensor() ||
+                                            !inContext.mBodies.BodiesCollide(ioBody, *other))
                                             return earliest;
                                         if (const std::optional<float> impact = TimeOfImpact(
                                                 shape, start, displacement, *other, allowed, tolerance))

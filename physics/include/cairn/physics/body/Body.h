@@ -24,6 +24,9 @@ public:
     bool IsDynamic() const { return mMotionType == MotionType::Dynamic; }
     bool IsKinematic() const { return mMotionType == MotionType::Kinematic; }
     ObjectLayer GetObjectLayer() const { return mObjectLayer; }
+    /// Its collision group and part (CollisionGroup.h; the group's table: BodyManager::BodiesCollide)
+    uint32_t GetCollisionGroupID() const { return mCollisionGroupID; }
+    uint32_t GetCollisionSubGroupID() const { return mCollisionSubGroupID; }
     bool IsInWorld() const { return mInWorld; }
     bool IsActive() const { return GetActiveIndex() != cInactive; }
 
@@ -120,6 +123,8 @@ private:
     /// Next body of the island this body fell asleep with: a ring. An id, not an index: a member removed and
     /// destroyed since leaves a stale link, and its slot may hold another body by now
     BodyID mSleepRingNext;
+    uint32_t mCollisionGroupID;    ///< CollisionGroup::cNoGroup: none
+    uint16_t mCollisionSubGroupID; ///< Below GroupFilterTable::cMaxSubGroups
     MotionType mMotionType;
     ObjectLayer mObjectLayer;
     uint8_t mNavMeshArea;

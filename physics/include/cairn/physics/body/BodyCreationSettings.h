@@ -2,6 +2,7 @@
 
 // Everything needed to create a body. Plain value type.
 
+#include "cairn/physics/body/CollisionGroup.h"
 #include "cairn/physics/body/Layers.h"
 #include "cairn/physics/body/MotionType.h"
 #include "cairn/physics/shapes/Shape.h"
@@ -22,6 +23,7 @@ struct BodyCreationSettings
     Vec3 mAngularVelocity = Vec3::Zero(); ///< rad/s, world space
     MotionType mMotionType = MotionType::Dynamic;
     ObjectLayer mObjectLayer = Layers::cMoving;
+    CollisionGroup mCollisionGroup;    ///< Within one object (a ragdoll): which of its parts collide
     float mDensity = 1000.0f;          ///< kg/m^3, used for the mass of dynamic bodies (at most cMaxBodyMass)
     float mFriction = 0.2f;            ///< Coulomb coefficient, >= 0 (combined as sqrt(a * b))
     float mRestitution = 0.0f;         ///< In [0, 1] (combined as max(a, b))

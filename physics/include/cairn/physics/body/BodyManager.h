@@ -111,6 +111,9 @@ public:
     /// Frees the shapes of destroyed bodies that no PoseReader can hold any more. Any thread (the updating
     /// thread calls it after each Update).
     void CollectRetiredShapes();
+    /// Whether two bodies' collision groups let them collide (CollisionGroup.h; their layers aside). The
+    /// caller holds both bodies' locks, or is the step.
+    bool BodiesCollide(const Body& inA, const Body& inB) const;
     /// The published poses, for PoseReader.
     const PublishedPoseStore& GetPublishedPoses() const { return *mPoses; }
 
@@ -146,6 +149,9 @@ private:
     uint32_t mMutexMask;                ///< Shards - 1 (a power of two minus one); set at construction
     std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
+    /// Each slot's body's group table (kept out of Body: a cold pointer the step reads only for two parts of
+    /// one group). Guarded per slot by its shard mutex
+    std::unique_ptr<std::shared_ptr<const GroupFilterTable>[]> mGroupFilters;
     std::unique_ptr<PublishedPoseStore> mPoses; ///< A record per slot; see PublishedPoseStore.h
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
     mutable PaddedMutex mStaticMutexes[cNumBodyMutexes]; ///< Also held by writers outside the step
