@@ -64,6 +64,8 @@ Status ValidateSettings(const PhysicsSettings& inSettings)
     if (!InRange(solver.mPenetrationSlop, 0.0f, 1.0f))
         return Invalid("mSolver.mPenetrationSlop must be in [0, 1] m");
     if (!InRange(solver.mBaumgarte, 0.0f, 1.0f)) return Invalid("mSolver.mBaumgarte must be in [0, 1]");
+    if (!InRange(solver.mJointBaumgarte, 0.0f, 1.0f))
+        return Invalid("mSolver.mJointBaumgarte must be in [0, 1]");
     if (!InRange(solver.mMaxPenetrationCorrection, 0.0f, 10.0f))
         return Invalid("mSolver.mMaxPenetrationCorrection must be in [0, 10] m");
     if (!InRange(solver.mRestitutionThreshold, 0.0f, 1e6f))

@@ -13,6 +13,11 @@ namespace cairn::physics
 
 namespace
 {
+/// A limit's row starts this near it (m, rad), speculative until reached: a limit met exactly (as the
+/// position pass leaves it) keeps its row, so the bodies' speed into it is stopped, not just their place
+constexpr float cLinearLimitBand = 0.01f;
+constexpr float cAngleLimitBand = 0.02f;
+
 SolverBody BlockOf(const Body* inBody)
 {
     // Not dynamic: the world and static bodies stand still, a kinematic body moves as it was told
@@ -157,8 +162,9 @@ void JointStage::Prepare(StepJoint& ioJoint)
         AxisJointPart::Side limitSide;
         float limitError = 0.0f;
         if ((joint.mLimitsMin > -cPi || joint.mLimitsMax < cPi) &&
-            AxisJointPart::LimitRow(angle, joint.mLimitsMin, joint.mLimitsMax, limitSide, limitError))
-            joint.mLimitPart.PrepareLimit(massA, massB, axisA, limitSide, limitError);
+            AxisJointPart::LimitRow(angle, joint.mLimitsMin, joint.mLimitsMax, cAngleLimitBand, limitSide,
+                                    limitError))
+            joint.mLimitPart.PrepareLimit(massA, massB, axisA, limitSide, limitError, mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
         // The motor, or the friction while it is off (a spin towards none), within its torque this step
@@ -190,8 +196,8 @@ void JointStage::Prepare(StepJoint& ioJoint)
         AxisJointPart::Side limitSide;
         float limitError = 0.0f;
         const float place = SliderPlace(joint, anchorA, anchorB, RotationOf(ioJoint.mA));
-        ioJoint.mRowActive =
-            AxisJointPart::LimitRow(place, joint.mLimitsMin, joint.mLimitsMax, limitSide, limitError);
+        ioJoint.mRowActive = AxisJointPart::LimitRow(place, joint.mLimitsMin, joint.mLimitsMax,
+                                                     cLinearLimitBand, limitSide, limitError);
         if (ioJoint.mRowActive)
         {
             ioJoint.mError = limitError;
@@ -225,18 +231,19 @@ void JointStage::Prepare(StepJoint& ioJoint)
         // The cone: a row along the direction (in A's frame) that takes the swing further out
         Vec3 outwards;
         float swingError = 0.0f;
-        if (SwingPastCone(RotationVector(swing), joint.mNormalHalfCone, joint.mPlaneHalfCone, outwards,
-                          swingError))
+        if (SwingPastCone(RotationVector(swing), joint.mNormalHalfCone, joint.mPlaneHalfCone, cAngleLimitBand,
+                          outwards, swingError))
             joint.mSwingPart.PrepareLimit(massA, massB, frameA * outwards, AxisJointPart::Side::Negative,
-                                          swingError);
+                                          swingError, mContext->mDeltaTime);
         else
             joint.mSwingPart.Deactivate();
         // The twist about B's limb axis, within its range
         AxisJointPart::Side twistSide;
         float twistError = 0.0f;
-        if (AxisJointPart::LimitRow(TwistAngle(twist), joint.mLimitsMin, joint.mLimitsMax, twistSide,
-                                    twistError))
-            joint.mLimitPart.PrepareLimit(massA, massB, frameB * Vec3::UnitX(), twistSide, twistError);
+        if (AxisJointPart::LimitRow(TwistAngle(twist), joint.mLimitsMin, joint.mLimitsMax, cAngleLimitBand,
+                                    twistSide, twistError))
+            joint.mLimitPart.PrepareLimit(massA, massB, frameB * Vec3::UnitX(), twistSide, twistError,
+                                          mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
         const float bound = joint.mMaxFriction * mContext->mDeltaTime;
@@ -256,7 +263,8 @@ void JointStage::Prepare(StepJoint& ioJoint)
         const Vec3 axis = length > 1.0e-6f ? Vec3(between / length) : Vec3::UnitX();
         AxisJointPart::Side rowSide;
         float error = 0.0f;
-        if (!AxisJointPart::LimitRow(length, joint.mMinDistance, joint.mMaxDistance, rowSide, error))
+        if (!AxisJointPart::LimitRow(length, joint.mMinDistance, joint.mMaxDistance, cLinearLimitBand,
+                                     rowSide, error))
         {
             // Within its limits: no row this step (and no impulse to warm-start the next one from)
             ioJoint.mRowActive = false;
@@ -371,34 +379,35 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
                             data.mRotationPart.CorrectPositions(
                                 RotationJointPart::RotationError(RotationOf(joint.mA), RotationOf(joint.mB),
                                                                  data.mRelativeRotation),
-                                inSettings.mBaumgarte));
+                                inSettings.mJointBaumgarte));
             Prepare(joint);
         }
         if (data.mType == JointType::SwingTwist)
         {
-            ApplyCorrection(joint, data.mSwingPart.CorrectPositions(inSettings.mBaumgarte));
-            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mSwingPart.CorrectPositions(inSettings.mJointBaumgarte));
+            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mJointBaumgarte));
             Prepare(joint);
         }
         if (data.mType == JointType::Hinge)
         {
-            ApplyCorrection(joint, data.mHingePart.CorrectPositions(inSettings.mBaumgarte));
-            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mHingePart.CorrectPositions(inSettings.mJointBaumgarte));
+            ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mJointBaumgarte));
             Prepare(joint);
         }
         if (data.mType == JointType::Slider)
         {
             // Back onto the line, then within the limits at the place that puts it
-            ApplyCorrection(joint, data.mLinePart.CorrectPositions(inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mLinePart.CorrectPositions(inSettings.mJointBaumgarte));
             Prepare(joint);
             if (joint.mRowActive)
-                ApplyCorrection(joint, data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte));
+                ApplyCorrection(joint,
+                                data.mAxisPart.CorrectPositions(joint.mError, inSettings.mJointBaumgarte));
         }
         else if (data.mType != JointType::Distance)
-            ApplyCorrection(
-                joint, data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB, inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mPart.CorrectPositions(joint.mAnchorA, joint.mAnchorB,
+                                                               inSettings.mJointBaumgarte));
         else if (joint.mRowActive)
-            ApplyCorrection(joint, data.mAxisPart.CorrectPositions(joint.mError, inSettings.mBaumgarte));
+            ApplyCorrection(joint, data.mAxisPart.CorrectPositions(joint.mError, inSettings.mJointBaumgarte));
     }
 }
 

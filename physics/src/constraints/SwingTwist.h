@@ -42,22 +42,24 @@ inline float TwistAngle(const Quat& inTwist)
 }
 
 /// Whether the swing (its rotation vector, in the frame) is past the elliptic cone of half angles
-/// inNormalHalfAngle (about y) and inPlaneHalfAngle (about z); if so, the frame direction (unit, in the y-z
-/// plane) whose spin takes it further out, and how far past it is (rad, along the swing's own direction).
-inline bool SwingPastCone(const Vec3& inSwing, float inNormalHalfAngle, float inPlaneHalfAngle,
+/// inNormalHalfAngle (about y) and inPlaneHalfAngle (about z), or within inBand (rad) of its edge; if so, the
+/// frame direction (unit, in the y-z plane) whose spin takes it further out, and how far past the edge it is
+/// (rad, along the swing's own direction: below zero while inside).
+inline bool SwingPastCone(const Vec3& inSwing, float inNormalHalfAngle, float inPlaneHalfAngle, float inBand,
                           Vec3& outDirection, float& outError)
 {
     // A zero half angle is a thin ellipse, not a division by zero: the swing about that axis is held near 0
     const float a = std::max(inNormalHalfAngle, 1.0e-4f), b = std::max(inPlaneHalfAngle, 1.0e-4f);
     const float y = inSwing.y(), z = inSwing.z();
     const float scaled = std::hypot(y / a, z / b); // 1 on the cone's edge
-    if (scaled <= 1.0f) return false;
+    const float length = std::hypot(y, z);
+    // Past the edge along its own ray by this much (its edge point is the swing over scaled)
+    if (!(scaled > 1.0e-6f)) return false; // No swing: no direction, and far inside
+    const float past = length * (1.0f - 1.0f / scaled);
+    if (past <= -inBand) return false;
     // Outwards across the edge: the ellipse's gradient there
-    const Vec3 gradient(0.0f, y / (a * a), z / (b * b));
-    outDirection = gradient.normalized();
-    // The swing's length past the edge along its own ray, measured along the gradient
-    const Vec3 past = inSwing * (1.0f - 1.0f / scaled);
-    outError = past.dot(outDirection);
+    outDirection = Vec3(0.0f, y / (a * a), z / (b * b)).normalized();
+    outError = past * (Vec3(0.0f, y, z) / length).dot(outDirection);
     return true;
 }
 

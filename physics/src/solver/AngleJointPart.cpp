@@ -31,10 +31,13 @@ void AngleJointPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB,
 }
 
 void AngleJointPart::PrepareLimit(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
-                                  AxisJointPart::Side inSide, float inError)
+                                  AxisJointPart::Side inSide, float inError, float inDeltaTime)
 {
     Prepare(inA, inB, inAxis, 0.0f, -cLargeFloat, cLargeFloat, inSide, inError);
     mLimit = true;
+    if (inSide != AxisJointPart::Side::Both && !AxisJointPart::PushesAgainst(inSide, inError) &&
+        inDeltaTime > 0.0f)
+        mBias = inError / inDeltaTime; // Speculative: the spin that closes the gap left in this step
 }
 
 void AngleJointPart::PrepareSpring(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
@@ -78,7 +81,7 @@ PointJointPart::PoseCorrection AngleJointPart::CorrectPositions(float inFraction
     PointJointPart::PoseCorrection correction;
     // Only a limit has a position; an equality (equal limits) pushes against its error either way
     if (!mActive || !mLimit || !AxisJointPart::PushesAgainst(mSide, mError)) return correction;
-    const float impulse = -mEffectiveMass * inFraction * mError;
+    const float impulse = -mEffectiveMass * ClampCorrection(inFraction * mError, cMaxJointAngularCorrection);
     correction.mRotationA = -impulse * mAngularA;
     correction.mRotationB = impulse * mAngularB;
     return correction;

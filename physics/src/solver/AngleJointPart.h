@@ -22,9 +22,10 @@ public:
     void Prepare(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis, float inTargetSpeed,
                  float inMinImpulse, float inMaxImpulse, AxisJointPart::Side inSide, float inError);
     /// A limit's row (or, inSide Both, an equality: the angle held): no speed target, no bound but its side;
-    /// the position pass takes out inError.
+    /// the position pass takes out inError. A limit not reached yet (inError on its allowed side) is
+    /// speculative, as AxisJointPart's: the bodies may close the gap in this step of inDeltaTime, no more.
     void PrepareLimit(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,
-                      AxisJointPart::Side inSide, float inError);
+                      AxisJointPart::Side inSide, float inError, float inDeltaTime);
     /// A position motor's row: a spring of inFrequency (Hz, above 0) and damping ratio inDamping pulling the
     /// angle error inError (rad: the angle less the target) to zero, within [inMinImpulse, inMaxImpulse].
     void PrepareSpring(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis, float inError,

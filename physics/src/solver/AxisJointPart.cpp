@@ -47,6 +47,8 @@ void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
         mMassScale = soft.mMassScale;
         mImpulseScale = soft.mImpulseScale;
     }
+    else if (inSide != Side::Both && !PushesAgainst(inSide, inError) && inDeltaTime > 0.0f)
+        mBias = inError / inDeltaTime; // Speculative: the rate that closes the gap left in this step
     if (!mActive) mTotalImpulse = 0.0f;
 }
 
@@ -109,7 +111,7 @@ PointJointPart::PoseCorrection AxisJointPart::CorrectPositions(float inError, fl
     if (!mActive || mSoft || mMotor) return correction;
     // Only an error the row pushes against: too short for a lower limit, too long for an upper one
     if (!PushesAgainst(mSide, inError)) return correction;
-    const float impulse = -mEffectiveMass * inFraction * inError;
+    const float impulse = -mEffectiveMass * ClampCorrection(inFraction * inError, cMaxJointLinearCorrection);
     correction.mTranslationA = -(mInverseMassA * impulse) * mAxis;
     correction.mRotationA = -impulse * mAngularA;
     correction.mTranslationB = (mInverseMassB * impulse) * mAxis;

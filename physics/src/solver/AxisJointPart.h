@@ -53,14 +53,16 @@ public:
                  (inSide == Side::Negative && inError <= 0.0f));
     }
     /// The side and error of a row that keeps inValue within [inMin, inMax]: an equality when they are equal,
-    /// else the limit it is past; false (no row) while it is within them.
-    static bool LimitRow(float inValue, float inMin, float inMax, Side& outSide, float& outError)
+    /// else the limit it is past or within inBand of (the error then on the allowed side: the row lets it
+    /// close the rest of the way in the step, see Prepare); false (no row) while it is further within.
+    static bool LimitRow(float inValue, float inMin, float inMax, float inBand, Side& outSide,
+                         float& outError)
     {
         if (inMin == inMax)
             outSide = Side::Both;
-        else if (inValue < inMin)
+        else if (inValue < inMin + inBand && inValue - inMin <= inMax - inValue)
             outSide = Side::Positive;
-        else if (inValue > inMax)
+        else if (inValue > inMax - inBand)
             outSide = Side::Negative;
         else
             return false;
@@ -70,7 +72,10 @@ public:
 
     /// Sets the row along inAxis (unit, world space) for the arms and masses given, with the position error
     /// inError (the length now less the length wanted, m). inFrequency > 0 (Hz) makes it a spring with the
-    /// damping ratio inDamping; 0 a hard row. Inactive (and its impulse dropped) when neither side can move.
+    /// damping ratio inDamping; 0 a hard row. A hard limit not reached yet (the error on its allowed side) is
+    /// speculative: it lets the bodies close the gap in this step, and no more (a row that waits until the
+    /// limit is passed lets them through it, and the position pass moves them back without their speed).
+    /// Inactive (and its impulse dropped) when neither side can move.
     void Prepare(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB, const JointBodyMass& inB,
                  const Vec3& inAxis, float inError, Side inSide, float inFrequency, float inDamping,
                  float inDeltaTime);

@@ -56,7 +56,9 @@ PointJointPart::PoseCorrection HingeRotationJointPart::CorrectPositions(float in
 {
     PointJointPart::PoseCorrection correction;
     if (!mActive) return correction;
-    const Eigen::Vector2f impulse = -(mEffectiveMass * (inFraction * Eigen::Vector2f(mError[0], mError[1])));
+    const Eigen::Vector2f step = ClampCorrection(
+        Eigen::Vector2f(inFraction * Eigen::Vector2f(mError[0], mError[1])), cMaxJointAngularCorrection);
+    const Eigen::Vector2f impulse = -(mEffectiveMass * step);
     const Vec3 angular = mRow[0] * impulse[0] + mRow[1] * impulse[1];
     correction.mRotationA = -(mA.mInverseInertia * angular);
     correction.mRotationB = mB.mInverseInertia * angular;

@@ -68,7 +68,9 @@ PointJointPart::PoseCorrection LineJointPart::CorrectPositions(float inFraction)
 {
     PointJointPart::PoseCorrection correction;
     if (!mActive) return correction;
-    const Eigen::Vector2f impulse = -(mEffectiveMass * (inFraction * Eigen::Vector2f(mError[0], mError[1])));
+    const Eigen::Vector2f step = ClampCorrection(
+        Eigen::Vector2f(inFraction * Eigen::Vector2f(mError[0], mError[1])), cMaxJointLinearCorrection);
+    const Eigen::Vector2f impulse = -(mEffectiveMass * step);
     const Vec3 linear = mAcross[0] * impulse[0] + mAcross[1] * impulse[1];
     correction.mTranslationA = -mA.mInverseMass * linear;
     correction.mRotationA = -(mA.mInverseInertia * (mArmCrossA[0] * impulse[0] + mArmCrossA[1] * impulse[1]));

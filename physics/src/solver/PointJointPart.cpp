@@ -63,7 +63,8 @@ PointJointPart::PoseCorrection PointJointPart::CorrectPositions(const Vec3& inAn
     if (!mActive) return correction;
     // The same rows on positions: the "impulse" whose velocity change, applied for one unit of time, closes
     // inFraction of the gap
-    const Vec3 impulse = -(mEffectiveMass * (inFraction * (inAnchorB - inAnchorA)));
+    const Vec3 impulse = -(mEffectiveMass * ClampCorrection(Vec3(inFraction * (inAnchorB - inAnchorA)),
+                                                            cMaxJointLinearCorrection));
     correction.mTranslationA = -mA.mInverseMass * impulse;
     correction.mRotationA = -(mA.mInverseInertia * mArmA.cross(impulse));
     correction.mTranslationB = mB.mInverseMass * impulse;

@@ -25,6 +25,22 @@ struct JointBodyMass
     Mat3 mInverseInertia = Mat3::Zero();
 };
 
+/// The most one position iteration moves a joint's error (Box2D's maximum linear and angular corrections): a
+/// joint made far from its pose, or torn open by a hard hit, closes over several iterations instead of
+/// throwing its bodies.
+inline constexpr float cMaxJointLinearCorrection = 0.2f;   ///< m
+inline constexpr float cMaxJointAngularCorrection = 0.14f; ///< rad (8 degrees)
+/// inStep with its length at most inMax.
+template <class Vector> Vector ClampCorrection(const Vector& inStep, float inMax)
+{
+    const float length = inStep.norm();
+    return length > inMax ? Vector(inStep * (inMax / length)) : inStep;
+}
+inline float ClampCorrection(float inStep, float inMax)
+{
+    return inStep > inMax ? inMax : inStep < -inMax ? -inMax : inStep;
+}
+
 /// The inverse of a joint's 3x3 mass matrix inK into outInverse; false (and zero) when it has none. Singular
 /// relative to K's own scale, not by an absolute threshold: a heavy body's matrix is small, not singular.
 bool InvertJointMassMatrix(const Mat3& inK, Mat3& outInverse);

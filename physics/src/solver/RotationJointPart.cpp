@@ -45,7 +45,8 @@ PointJointPart::PoseCorrection RotationJointPart::CorrectPositions(const Vec3& i
 {
     PointJointPart::PoseCorrection correction;
     if (!mActive) return correction;
-    const Vec3 impulse = -(mEffectiveMass * (inFraction * inError));
+    const Vec3 impulse =
+        -(mEffectiveMass * ClampCorrection(Vec3(inFraction * inError), cMaxJointAngularCorrection));
     correction.mRotationA = -(mA.mInverseInertia * impulse);
     correction.mRotationB = mB.mInverseInertia * impulse;
     return correction;

@@ -5,6 +5,7 @@
 
 #include "JointFixture.h"
 #include "cairn/physics/body/BodyLock.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -184,6 +185,65 @@ TEST_F(JointTest, AChainOfJointedBodiesIsTheSameForAnyThreadCount)
     }
     // And the chain hangs together: each link within its rest length of the next
     EXPECT_LT(alone.front().y(), 3.0f); // It swung down
+}
+
+TEST_F(JointTest, AChainOfTwentyHangingFromAPointKeepsItsLengthWithinOnePercent)
+{
+    // Twenty capsules of 0.4 m joined end to end by point joints, hung from a point of the world and let fall
+    // from the horizontal: the whip at the bottom of the swing is where a sequential-impulse chain stretches.
+    // The target: within 1 % of its rest length after 10 s
+    const int links = 20;
+    const float linkLength = 0.4f, rest = float(links) * linkLength;
+    const Vec3 pivot(0.0f, 12.0f, 0.0f);
+    BodyID previous;
+    std::vector<BodyID> chain;
+    for (int i = 0; i < links; ++i)
+    {
+        BodyCreationSettings settings =
+            DynamicSettings(CapsuleShape::Create(0.15f, 0.05f).Value(),
+                            pivot + Vec3(linkLength * (float(i) + 0.5f), 0.0f, 0.0f));
+        settings.mRotation = Quat(Eigen::AngleAxisf(0.5f * std::numbers::pi_v<float>, Vec3::UnitZ()));
+        settings.mAllowSleeping = false;
+        const BodyID link = AddDynamic(settings);
+        PointConstraintSettings joint;
+        joint.mBodyA = previous; // The world for the first
+        joint.mBodyB = link;
+        joint.mPoint = pivot + Vec3(linkLength * float(i), 0.0f, 0.0f);
+        ASSERT_TRUE(Joints().AddPoint(joint).IsOk());
+        chain.push_back(link);
+        previous = link;
+    }
+    // The chain's length now: pivot to the first link's top, through each joint, to the last link's end
+    auto length = [&]
+    {
+        float total = 0.0f;
+        Vec3 from = pivot;
+        for (const BodyID& link : chain)
+        {
+            const Quat rotation = Bodies().GetRotation(link).Value();
+            const Vec3 centre = Position(link);
+            // The capsule lies along its local y: its joint ends are half a link either side of its centre;
+            // the end nearer the last joint is this link's top
+            const Vec3 half = rotation * Vec3(0.0f, 0.5f * linkLength, 0.0f);
+            const Vec3 top = (centre + half - from).norm() < (centre - half - from).norm()
+                                 ? Vec3(centre + half)
+                                 : Vec3(centre - half);
+            total += (top - from).norm() + linkLength;
+            from = 2.0f * centre - top;
+        }
+        return total;
+    };
+    float longest = 0.0f;
+    for (int step = 0; step < 600; ++step)
+    {
+        Step(1);
+        longest = std::max(longest, length());
+    }
+    EXPECT_NEAR(length(), rest, 0.01f * rest);
+    // At the whip's crack the links spin fast and their rows, which hold the anchors' velocities, let them
+    // drift along their arcs: 4 % at most with the joints' whole error taken out each position iteration
+    // (9 % with a fifth, the contacts' fraction)
+    EXPECT_LT(longest, 1.05f * rest);
 }
 
 TEST_F(JointTest, ADistanceSpringFollowsTheImplicitSpringStep)

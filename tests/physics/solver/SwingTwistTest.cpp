@@ -42,19 +42,24 @@ TEST(SwingTwistTest, TheConeIsAnEllipseOfTheTwoHalfAngles)
     Vec3 direction;
     float error = 0.0f;
     // Half angles 0.5 about y (towards the normal), 0.2 about z (in the plane)
-    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.49f, 0.0f), 0.5f, 0.2f, direction, error));
-    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.0f, -0.19f), 0.5f, 0.2f, direction, error));
-    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.3f, 0.1f), 0.5f, 0.2f, direction, error)); // 0.36 + 0.25 < 1
-    ASSERT_TRUE(SwingPastCone(Vec3(0.0f, 0.0f, -0.3f), 0.5f, 0.2f, direction, error));
+    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.49f, 0.0f), 0.5f, 0.2f, 0.0f, direction, error));
+    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.0f, -0.19f), 0.5f, 0.2f, 0.0f, direction, error));
+    EXPECT_FALSE(
+        SwingPastCone(Vec3(0.0f, 0.3f, 0.1f), 0.5f, 0.2f, 0.0f, direction, error)); // 0.36 + 0.25 < 1
+    ASSERT_TRUE(SwingPastCone(Vec3(0.0f, 0.0f, -0.3f), 0.5f, 0.2f, 0.0f, direction, error));
     EXPECT_LT((direction - Vec3(0.0f, 0.0f, -1.0f)).norm(), 1.0e-6f);
     EXPECT_NEAR(error, 0.1f, 1.0e-6f);
-    ASSERT_TRUE(SwingPastCone(Vec3(0.0f, 0.4f, 0.2f), 0.5f, 0.2f, direction, error));
+    ASSERT_TRUE(SwingPastCone(Vec3(0.0f, 0.4f, 0.2f), 0.5f, 0.2f, 0.0f, direction, error));
     EXPECT_GT(direction.z(), direction.y()); // The thin side's gradient is steeper
     EXPECT_GT(error, 0.0f);
     EXPECT_NEAR(direction.norm(), 1.0f, 1.0e-6f);
+    // Within the band of the edge, inside: a row already, its error below zero (the gap left)
+    ASSERT_TRUE(SwingPastCone(Vec3(0.0f, 0.0f, -0.19f), 0.5f, 0.2f, 0.02f, direction, error));
+    EXPECT_NEAR(error, -0.01f, 1.0e-6f);
+    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.0f, -0.17f), 0.5f, 0.2f, 0.02f, direction, error));
     // A zero half angle holds that swing at (nearly) nothing
-    EXPECT_TRUE(SwingPastCone(Vec3(0.0f, 0.01f, 0.0f), 0.0f, 0.5f, direction, error));
-    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.0f, 0.4f), 0.0f, 0.5f, direction, error));
+    EXPECT_TRUE(SwingPastCone(Vec3(0.0f, 0.01f, 0.0f), 0.0f, 0.5f, 0.0f, direction, error));
+    EXPECT_FALSE(SwingPastCone(Vec3(0.0f, 0.0f, 0.4f), 0.0f, 0.5f, 0.0f, direction, error));
 }
 
 } // namespace
