@@ -122,24 +122,37 @@ void JointStage::GroupByIsland(const StepContext& inContext)
         mIslandJoints[mCursor[mJointIsland[i]]++] = i;
 }
 
+namespace
+{
+/// A joint side's arm (centre of mass to anchor, world space), anchor and masses at its pose now; the world's
+/// side: its point, no arm, nothing that moves
+void SideOf(const Body* inBody, const Vec3& inLocal, Vec3& outArm, Vec3& outAnchor, JointBodyMass& outMass)
+{
+    outArm = inBody != nullptr ? Vec3(inBody->GetRotation() * inLocal) : Vec3::Zero();
+    outAnchor = inBody != nullptr ? Vec3(inBody->GetCenterOfMassPosition() + outArm) : inLocal;
+    outMass = {};
+    if (inBody != nullptr && inBody->IsDynamic())
+        outMass = {inBody->GetInverseMass(), inBody->GetInverseInertiaWorld()};
+}
+} // namespace
+
+void JointStage::PreparePoint(StepJoint& ioJoint)
+{
+    Joint& joint = *ioJoint.mJoint;
+    Vec3 armA, armB;
+    JointBodyMass massA, massB;
+    SideOf(ioJoint.mA, joint.mLocalA, armA, ioJoint.mAnchorA, massA);
+    SideOf(ioJoint.mB, joint.mLocalB, armB, ioJoint.mAnchorB, massB);
+    joint.mPart.Prepare(armA, massA, armB, massB);
+}
+
 void JointStage::Prepare(StepJoint& ioJoint)
 {
     Joint& joint = *ioJoint.mJoint;
-    // Each side's arm (centre of mass to anchor, world space), anchor and masses at its pose now; the world's
-    // side: its point, no arm, nothing that moves
-    auto side =
-        [](const Body* inBody, const Vec3& inLocal, Vec3& outArm, Vec3& outAnchor, JointBodyMass& outMass)
-    {
-        outArm = inBody != nullptr ? Vec3(inBody->GetRotation() * inLocal) : Vec3::Zero();
-        outAnchor = inBody != nullptr ? Vec3(inBody->GetCenterOfMassPosition() + outArm) : inLocal;
-        outMass = {};
-        if (inBody != nullptr && inBody->IsDynamic())
-            outMass = {inBody->GetInverseMass(), inBody->GetInverseInertiaWorld()};
-    };
     Vec3 armA, armB, anchorA, anchorB;
     JointBodyMass massA, massB;
-    side(ioJoint.mA, joint.mLocalA, armA, anchorA, massA);
-    side(ioJoint.mB, joint.mLocalB, armB, anchorB, massB);
+    SideOf(ioJoint.mA, joint.mLocalA, armA, anchorA, massA);
+    SideOf(ioJoint.mB, joint.mLocalB, armB, anchorB, massB);
     ioJoint.mAnchorA = anchorA;
     ioJoint.mAnchorB = anchorB;
     switch (joint.mType)
@@ -373,6 +386,8 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
         const Joint& data = *joint.mJoint;
         // The turns first (a rotation part's correction moves no centre), then the point or the length at the
         // anchors where they put them
+        // (What follows a turn needs only the point's rows again, at the anchors the turn moved: not the
+        // whole joint's)
         if (data.mType == JointType::Fixed || data.mType == JointType::Slider)
         {
             ApplyCorrection(joint,
@@ -380,19 +395,23 @@ void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSetti
                                 RotationJointPart::RotationError(RotationOf(joint.mA), RotationOf(joint.mB),
                                                                  data.mRelativeRotation),
                                 inSettings.mJointBaumgarte));
-            Prepare(joint);
+            if (data.mType == JointType::Slider)
+                Prepare(joint);
+            else
+                PreparePoint(joint);
         }
-        if (data.mType == JointType::SwingTwist)
+        // A swing-twist within its cone and range has no turn to take out: its point's rows stand
+        if (data.mType == JointType::SwingTwist && (data.mSwingPart.IsActive() || data.mLimitPart.IsActive()))
         {
             ApplyCorrection(joint, data.mSwingPart.CorrectPositions(inSettings.mJointBaumgarte));
             ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mJointBaumgarte));
-            Prepare(joint);
+            PreparePoint(joint);
         }
         if (data.mType == JointType::Hinge)
         {
             ApplyCorrection(joint, data.mHingePart.CorrectPositions(inSettings.mJointBaumgarte));
             ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mJointBaumgarte));
-            Prepare(joint);
+            PreparePoint(joint);
         }
         if (data.mType == JointType::Slider)
         {

@@ -65,6 +65,9 @@ private:
     /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
     /// and limit).
     void Prepare(StepJoint& ioJoint);
+    /// Only the point's rows (and the anchors) of a joint that has them: after a position iteration turned
+    /// its bodies.
+    void PreparePoint(StepJoint& ioJoint);
     /// inVisit(part) for each of the joint's velocity rows now in play, in solve order.
     template <class Visit> static void VisitVelocityRows(StepJoint& ioJoint, const Visit& inVisit);
     /// Moves the joint's dynamic bodies by a position iteration's correction.
