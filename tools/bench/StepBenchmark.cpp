@@ -1,6 +1,10 @@
 // cairn-bench-step: the physics step benchmarks of ../shared/bench/SPEC.md.
 //  step_pile2k   2,000 dynamic boxes fall onto the 20,020 static boxes: 600 steps of 1/60 s.
 //  step_pyramid  a 3D pyramid of 1,240 boxes on a static floor: 500 steps, sleeping disabled.
+//  step_ragdolls 160 humanoid ragdolls of 23 parts (3,680 bodies, 3,520 swing-twist joints) in 16 piles of
+//  10,
+//                dropped onto a rolling height field: 500 steps (issue 33's scene, after Jolt's
+//                PerformanceTest "Ragdoll": its piles and steps, this engine's humanoid and ground).
 // Prints ms per step (mean, p99, max) for each repetition and the median over repetitions, the mean time per
 // phase, and a checksum (sum of final body heights and contact points) that proves the work was done; for
 // each thread count of --threads (default 1,2: a job system of that many threads), then the speed-up. The
@@ -9,6 +13,8 @@
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/ragdoll/HumanoidRagdoll.h"
+#include "cairn/physics/shapes/HeightFieldShape.h"
 #include "common/BenchOptions.h"
 #include "common/BenchScenes.h"
 #include "common/FrameTimes.h"
@@ -18,6 +24,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -108,6 +115,53 @@ RunResult RunPyramid(jobs::JobSystem& ioJobs)
     return RunScene(*system, scene.mBoxes, 500, ioJobs);
 }
 
+RunResult RunRagdolls(jobs::JobSystem& ioJobs)
+{
+    const std::unique_ptr<PhysicsSystem> system =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-step", BenchSettings(true, gCandidateMargin));
+    // The ground: 64 x 64 cells of 1 m round the origin, waves 0.3 m high
+    const uint32_t samples = 65;
+    std::vector<float> heights(samples * samples);
+    for (uint32_t z = 0; z < samples; ++z)
+        for (uint32_t x = 0; x < samples; ++x)
+            heights[x + z * samples] = 0.15f * std::sin(0.5f * float(x)) * std::cos(0.4f * float(z));
+    BodyCreationSettings ground;
+    ground.mShape = HeightFieldShape::Create(samples, samples, 1.0f, heights).Value();
+    ground.mPosition = Vec3(-32.0f, 0.0f, -32.0f);
+    ground.mMotionType = MotionType::Static;
+    ground.mObjectLayer = Layers::cStatic;
+    ground.mFriction = 0.6f;
+    (void)system->GetBodyInterface().CreateAndAddBody(ground, Activation::DontActivate);
+    // 4 x 4 piles 4 m apart, 10 ragdolls each lying on its back 0.6 m above the last, each turned a tenth of
+    // a turn more about the vertical (Jolt's RagdollScene(4, 10, 0.6))
+    const RagdollSettings humanoid = MakeHumanoidRagdoll();
+    std::vector<BodyID> bodies;
+    uint32_t group = 1;
+    for (int row = 0; row < 4; ++row)
+        for (int col = 0; col < 4; ++col)
+            for (int i = 0; i < 10; ++i)
+            {
+                const Vec3 pile(4.0f * (float(col) - 1.5f), 0.0f, 4.0f * (float(row) - 1.5f));
+                const Quat rotation =
+                    Quat(Eigen::AngleAxisf(2.0f * 3.14159265f * float(i) / 10.0f, Vec3::UnitY())) *
+                    Quat(Eigen::AngleAxisf(-0.5f * 3.14159265f, Vec3::UnitX())); // On its back
+                // Its pelvis (about 1 m up the standing figure) at the pile's place, 0.6 m a ragdoll up
+                const Vec3 position =
+                    pile + Vec3(0.0f, 0.6f * float(i + 1), 0.0f) - rotation * Vec3(0.0f, 0.97f, 0.0f);
+                Result<Ragdoll> ragdoll =
+                    Ragdoll::Create(*system, humanoid, position, rotation, group++, Activation::Activate);
+                if (!ragdoll)
+                {
+                    std::fprintf(stderr, "cairn-bench-step: a ragdoll: %s\n",
+                                 ragdoll.GetError().mMessage.c_str());
+                    std::exit(1);
+                }
+                bodies.insert(bodies.end(), ragdoll.Value().GetBodies().begin(),
+                              ragdoll.Value().GetBodies().end());
+            }
+    return RunScene(*system, bodies, 500, ioJobs);
+}
+
 /// Prints the repetitions and returns the median of the mean step times.
 double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult>& inRuns)
 {
@@ -150,7 +204,7 @@ int main(int inArgc, char** inArgv)
 {
     tools::BenchOptions options;
     if (auto stop = tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-step: physics step figures",
-                                             {"step_pile2k", "step_pyramid"}, options, true,
+                                             {"step_pile2k", "step_pyramid", "step_ragdolls"}, options, true,
                                              [](CLI::App& ioApp)
                                              {
                                                  ioApp
@@ -208,6 +262,19 @@ int main(int inArgc, char** inArgv)
             means.push_back(Print("step_pyramid", threads, runs));
         }
         speedUps("step_pyramid", means);
+    }
+    if (only.empty() || only == "step_ragdolls")
+    {
+        std::vector<double> means;
+        for (uint32_t threads : threadCounts)
+        {
+            jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+            std::vector<RunResult> runs;
+            for (int i = 0; i < repetitions; ++i)
+                runs.push_back(RunRagdolls(jobSystem));
+            means.push_back(Print("step_ragdolls", threads, runs));
+        }
+        speedUps("step_ragdolls", means);
     }
     return 0;
 }
