@@ -93,6 +93,7 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     // 7. Solve (the constraints' ordering counted as solver time), positions integrated
     mIslandStage.Order(context, mContacts.GetConstraints(), mContacts.GetConstraintInfo(), mJoints);
     mSolver.Solve(context, mIslandStage.GetPlan(), uint32_t(mContacts.GetConstraints().size()), mJoints);
+    mJoints.BreakOverloaded();
     mContactCache.EndStep(mContacts.IsCacheInOrder());
     ioStatistics.mSolveMs += MillisecondsSince(phase);
 

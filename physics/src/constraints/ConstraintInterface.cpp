@@ -302,6 +302,29 @@ Result<float> ConstraintInterface::GetPosition(ConstraintID inID) const
                                            : SliderPlace(joint, anchorA, anchorB, rotationA);
 }
 
+Status ConstraintInterface::SetBreakThresholds(ConstraintID inID, float inForce, float inTorque)
+{
+    if (IsWrongThread()) return WrongThread();
+    if (!(inForce >= 0.0f) || !(inTorque >= 0.0f))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "break thresholds must be at least 0 (cLargeFloat: never)");
+    std::lock_guard lock(mManager.GetMutex());
+    Joint* joint = mManager.Find(inID);
+    if (joint == nullptr) return StaleID();
+    joint->mBreakForce = std::min(inForce, cLargeFloat);
+    joint->mBreakTorque = std::min(inTorque, cLargeFloat);
+    return Status::Ok();
+}
+
+Result<std::vector<BrokenConstraint>> ConstraintInterface::TakeBrokenConstraints()
+{
+    if (IsWrongThread()) return WrongThread();
+    std::lock_guard lock(mManager.GetMutex());
+    std::vector<BrokenConstraint> broken;
+    broken.swap(mManager.GetBroken());
+    return broken;
+}
+
 Status ConstraintInterface::Remove(ConstraintID inID)
 {
     if (IsWrongThread()) return WrongThread();

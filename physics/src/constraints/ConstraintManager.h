@@ -63,6 +63,9 @@ struct Joint
     float mLimitsMax = 0.0f;
     float mMaxFriction = 0.0f;
     MotorSettings mMotor;
+    // Breaking: the thresholds (N, N m) and what the last step held
+    float mBreakForce = cLargeFloat;
+    float mBreakTorque = cLargeFloat;
     HingeRotationJointPart mHingePart;
     AngleJointPart mLimitPart;
     AngleJointPart mMotorPart; ///< The hinge's motor, or its friction while the motor is off
@@ -119,6 +122,8 @@ public:
         --mNumInUse;
     }
     uint32_t GetNumInUse() const { return mNumInUse; }
+    /// The joints broken and not yet taken (the step appends, TakeBrokenConstraints empties it)
+    std::vector<BrokenConstraint>& GetBroken() { return mBroken; }
     /// Every slot, in use or not (the step walks them in slot order: the same order on every run).
     std::vector<Joint>& GetJoints() { return mJoints; }
 
@@ -127,6 +132,7 @@ private:
     std::vector<Joint> mJoints;
     std::vector<uint32_t> mFree;
     uint32_t mNumInUse = 0;
+    std::vector<BrokenConstraint> mBroken;
 };
 
 } // namespace cairn::physics

@@ -43,6 +43,7 @@ Quat RotationOf(const Body* inBody)
 void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioManager)
 {
     mContext = &inContext;
+    mManager = &ioManager;
     mStepJoints.clear();
     std::vector<Joint>& joints = ioManager.GetJoints();
     if (ioManager.GetNumInUse() == 0) return;
@@ -373,6 +374,47 @@ void JointStage::ApplyCorrection(StepJoint& ioJoint, const PointJointPart::PoseC
         Integration::CorrectPose(*ioJoint.mA, inCorrection.mTranslationA, inCorrection.mRotationA);
     if (ioJoint.mB != nullptr && ioJoint.mB->IsDynamic())
         Integration::CorrectPose(*ioJoint.mB, inCorrection.mTranslationB, inCorrection.mRotationB);
+}
+
+void JointStage::BreakOverloaded()
+{
+    if (mStepJoints.empty()) return;
+    const float inverseStep = 1.0f / mContext->mDeltaTime;
+    std::vector<Joint>& joints = mManager->GetJoints();
+    for (StepJoint& step : mStepJoints) // Slot order
+    {
+        Joint& joint = *step.mJoint;
+        if (joint.mBreakForce >= cLargeFloat && joint.mBreakTorque >= cLargeFloat) continue;
+        // The impulses this step held the joint with, as forces
+        Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
+        switch (joint.mType)
+        {
+        case JointType::Point:
+        case JointType::SwingTwist:
+            linear = joint.mPart.GetTotalImpulse();
+            break;
+        case JointType::Fixed:
+            linear = joint.mPart.GetTotalImpulse();
+            angular = joint.mRotationPart.GetTotalImpulse();
+            break;
+        case JointType::Hinge:
+            linear = joint.mPart.GetTotalImpulse();
+            angular = joint.mHingePart.GetTotalImpulse();
+            break;
+        case JointType::Slider:
+            linear = joint.mLinePart.GetTotalImpulse();
+            angular = joint.mRotationPart.GetTotalImpulse();
+            break;
+        case JointType::Distance:
+            linear = Vec3(joint.mAxisPart.GetTotalImpulse(), 0.0f, 0.0f);
+            break;
+        }
+        const float force = linear.norm() * inverseStep, torque = angular.norm() * inverseStep;
+        if (!(force > joint.mBreakForce || torque > joint.mBreakTorque)) continue;
+        joint.mEnabled = false; // Its bodies are free from the next step on
+        const uint32_t slot = uint32_t(&joint - joints.data());
+        mManager->GetBroken().push_back({ConstraintID(slot, joint.mSequence), force, torque});
+    }
 }
 
 void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSettings)

@@ -48,6 +48,10 @@ public:
     /// One position iteration, on the integrated poses.
     void SolvePositions(uint32_t inIsland, const SolverSettings& inSettings);
 
+    /// After the solve, on the updating thread: the joints whose force or torque this step was above their
+    /// thresholds are disabled and reported, in slot order.
+    void BreakOverloaded();
+
 private:
     struct StepJoint
     {
@@ -76,11 +80,12 @@ private:
     SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
 
     const StepContext* mContext = nullptr;
-    std::vector<StepJoint> mStepJoints;  ///< This step's joints, in slot order
-    std::vector<uint32_t> mJointStart;   ///< Per island, offsets into mIslandJoints
-    std::vector<uint32_t> mIslandJoints; ///< Indices into mStepJoints, by island
-    std::vector<uint32_t> mJointIsland;  ///< Scratch: per step joint
-    std::vector<uint32_t> mCursor;       ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
+    ConstraintManager* mManager = nullptr; ///< This step's (BeginStep's)
+    std::vector<StepJoint> mStepJoints;    ///< This step's joints, in slot order
+    std::vector<uint32_t> mJointStart;     ///< Per island, offsets into mIslandJoints
+    std::vector<uint32_t> mIslandJoints;   ///< Indices into mStepJoints, by island
+    std::vector<uint32_t> mJointIsland;    ///< Scratch: per step joint
+    std::vector<uint32_t> mCursor;         ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
 };
 
 } // namespace cairn::physics

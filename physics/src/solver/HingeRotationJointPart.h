@@ -24,6 +24,8 @@ public:
     void WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio = 1.0f);
     void SolveVelocity(SolverBody& ioA, SolverBody& ioB);
     void ResetImpulse() { mTotalImpulse.setZero(); }
+    /// The angular impulse accumulated this step on B (N m s, world space).
+    Vec3 GetTotalImpulse() const { return mRow[0] * mTotalImpulse[0] + mRow[1] * mTotalImpulse[1]; }
     /// A position iteration on the axes Prepare was given: the turns that take inFraction of their
     /// misalignment out (to first order).
     PointJointPart::PoseCorrection CorrectPositions(float inFraction) const;

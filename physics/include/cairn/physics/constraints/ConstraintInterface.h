@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <numbers>
+#include <vector>
 
 namespace cairn::physics
 {
@@ -154,6 +155,14 @@ struct DistanceConstraintSettings
     SpringSettings mLimitsSpring;
 };
 
+/// A joint that broke: the force and torque it held in the step it broke in (N, N m).
+struct BrokenConstraint
+{
+    ConstraintID mID;
+    float mForce = 0.0f;
+    float mTorque = 0.0f;
+};
+
 class ConstraintInterface
 {
 public:
@@ -191,6 +200,14 @@ public:
     /// A hinge's angle (rad, within [-pi, pi]) or a slider's place (m) now, as its limits measure them.
     /// Errors: a stale id or another type (InvalidArgument), a body of it gone (InvalidBodyID), WrongThread.
     Result<float> GetPosition(ConstraintID inID) const;
+    /// A joint breaks when the force (or the torque) it held in a step is above these (N, N m; cLargeFloat,
+    /// the default: never): at the step's end it is disabled and reported, once (TakeBrokenConstraints;
+    /// enable it again to mend it). The force is its point's or line's, or a distance joint's length row's;
+    /// the torque is what holds its rotation (fixed, slider) or its axis (hinge). Errors: a stale id, a
+    /// threshold NaN or below 0 (InvalidArgument), WrongThread.
+    Status SetBreakThresholds(ConstraintID inID, float inForce, float inTorque);
+    /// The joints that broke since the last call, in the order they broke (by step, then by id's slot).
+    Result<std::vector<BrokenConstraint>> TakeBrokenConstraints();
     /// Removes a joint; its id goes stale. Its bodies are woken (a body hanging from it falls).
     Status Remove(ConstraintID inID);
     /// A disabled joint does nothing and links no island; enabling starts it from no impulse. Its bodies are
