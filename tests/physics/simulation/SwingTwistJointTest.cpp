@@ -16,15 +16,18 @@ class SwingTwistJointTest : public JointTest
 {
 protected:
     /// An 8 kg limb (0.1 x 0.8 x 0.1 m) hanging from a socket at (0, 3, 0) on the world, its twist axis down
-    /// the limb, its plane axis x (so the normal axis is z), started turning at inSpin; undamped, awake
+    /// the limb, its plane axis x (so the normal axis is z), swung inTilt about z from hanging straight and
+    /// started turning at inSpin; undamped, awake
     BodyID AddLimb(const Vec3& inSpin, float inNormalHalfCone, float inPlaneHalfCone, float inTwistMin,
-                   float inTwistMax, float inFriction = 0.0f)
+                   float inTwistMax, float inFriction = 0.0f, float inTilt = 0.0f)
     {
+        const Quat tilt(Eigen::AngleAxisf(inTilt, Vec3::UnitZ()));
         BodyCreationSettings settings =
-            DynamicSettings(Box(Vec3(0.05f, 0.4f, 0.05f)), Vec3(0.0f, 3.0f - 0.4f, 0.0f));
+            DynamicSettings(Box(Vec3(0.05f, 0.4f, 0.05f)), cSocket + tilt * Vec3(0.0f, -0.4f, 0.0f));
+        settings.mRotation = tilt;
         settings.mLinearDamping = settings.mAngularDamping = 0.0f;
         settings.mAngularVelocity = inSpin;
-        settings.mLinearVelocity = inSpin.cross(Vec3(0.0f, -0.4f, 0.0f)); // The socket still
+        settings.mLinearVelocity = inSpin.cross(tilt * Vec3(0.0f, -0.4f, 0.0f)); // The socket still
         settings.mAllowSleeping = false;
         const BodyID limb = AddDynamic(settings);
         SwingTwistConstraintSettings joint;
@@ -96,21 +99,7 @@ TEST_F(SwingTwistJointTest, WithinItsLimitsALimbSwingsAsAPendulumAndFrictionSlow
     // A swing of 0.15 rad inside a cone of 0.6: a physical pendulum about the socket, I = m ((2h)^2 + w^2) /
     // 12 + m h^2 for a limb of half length h and width w, T = 2 pi sqrt(I / (m g h)) (1 + theta0^2 / 16)
     const float theta0 = 0.15f, h = 0.4f, w = 0.1f;
-    BodyCreationSettings settings = DynamicSettings(
-        Box(Vec3(0.05f, 0.4f, 0.05f)), cSocket + h * Vec3(std::sin(theta0), -std::cos(theta0), 0.0f));
-    settings.mRotation = Quat(Eigen::AngleAxisf(theta0, Vec3::UnitZ()));
-    settings.mLinearDamping = settings.mAngularDamping = 0.0f;
-    settings.mAllowSleeping = false;
-    const BodyID limb = AddDynamic(settings);
-    SwingTwistConstraintSettings joint;
-    joint.mBodyB = limb;
-    joint.mPoint = cSocket;
-    joint.mTwistAxis = Vec3(0.0f, -1.0f, 0.0f);
-    joint.mPlaneAxis = Vec3(1.0f, 0.0f, 0.0f);
-    joint.mNormalHalfConeAngle = joint.mPlaneHalfConeAngle = 0.6f;
-    joint.mTwistMinAngle = -0.5f;
-    joint.mTwistMaxAngle = 0.5f;
-    ASSERT_TRUE(Joints().AddSwingTwist(joint).IsOk());
+    const BodyID limb = AddLimb(Vec3::Zero(), 0.6f, 0.6f, -0.5f, 0.5f, 0.0f, theta0);
     std::vector<double> crossings;
     float previousX = Position(limb).x();
     for (int step = 1; step <= 240; ++step)
