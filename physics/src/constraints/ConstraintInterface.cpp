@@ -37,6 +37,11 @@ Error StaleID()
 {
     return {ErrorCode::InvalidArgument, "stale or unknown constraint id"};
 }
+/// A hinge or a slider: the joints with a motor and a position along their free motion.
+bool HasMotor(const Joint& inJoint)
+{
+    return inJoint.mType == JointType::Hinge || inJoint.mType == JointType::Slider;
+}
 /// The checks a hinge's (inAngles) or a slider's motor needs; a message names the joint.
 Status CheckMotor(const MotorSettings& inMotor, bool inAngles)
 {
@@ -255,7 +260,7 @@ Status ConstraintInterface::SetMotor(ConstraintID inID, const MotorSettings& inM
         std::lock_guard lock(mManager.GetMutex());
         Joint* joint = mManager.Find(inID);
         if (joint == nullptr) return StaleID();
-        if (joint->mType != JointType::Hinge && joint->mType != JointType::Slider)
+        if (!HasMotor(*joint))
             return MakeError(ErrorCode::InvalidArgument, "only a hinge or a slider has a motor");
         if (Status motor = CheckMotor(inMotor, joint->mType == JointType::Hinge); !motor) return motor;
         joint->mMotor = inMotor;
@@ -276,7 +281,7 @@ Result<float> ConstraintInterface::GetPosition(ConstraintID inID) const
         std::lock_guard lock(mManager.GetMutex());
         const Joint* found = mManager.Find(inID);
         if (found == nullptr) return StaleID();
-        if (found->mType != JointType::Hinge && found->mType != JointType::Slider)
+        if (!HasMotor(*found))
             return MakeError(ErrorCode::InvalidArgument, "only a hinge or a slider has a position");
         joint = *found;
     }

@@ -35,9 +35,7 @@ void AngleJointPart::PrepareLimit(const JointBodyMass& inA, const JointBodyMass&
 {
     Prepare(inA, inB, inAxis, 0.0f, -cLargeFloat, cLargeFloat, inSide, inError);
     mLimit = true;
-    if (inSide != AxisJointPart::Side::Both && !AxisJointPart::PushesAgainst(inSide, inError) &&
-        inDeltaTime > 0.0f)
-        mBias = inError / inDeltaTime; // Speculative: the spin that closes the gap left in this step
+    mBias = AxisJointPart::SpeculativeBias(inSide, inError, inDeltaTime);
 }
 
 void AngleJointPart::PrepareSpring(const JointBodyMass& inA, const JointBodyMass& inB, const Vec3& inAxis,

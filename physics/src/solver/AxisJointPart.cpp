@@ -47,8 +47,8 @@ void AxisJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
         mMassScale = soft.mMassScale;
         mImpulseScale = soft.mImpulseScale;
     }
-    else if (inSide != Side::Both && !PushesAgainst(inSide, inError) && inDeltaTime > 0.0f)
-        mBias = inError / inDeltaTime; // Speculative: the rate that closes the gap left in this step
+    else
+        mBias = SpeculativeBias(inSide, inError, inDeltaTime);
     if (!mActive) mTotalImpulse = 0.0f;
 }
 
@@ -59,10 +59,7 @@ void AxisJointPart::PrepareMotor(const Vec3& inArmA, const JointBodyMass& inA, c
     Prepare(inArmA, inA, inArmB, inB, inAxis, 0.0f, Side::Both, 0.0f, 0.0f, 0.0f);
     // The rate the row drives to zero is the speed less the target
     mBias = -inTargetSpeed;
-    mMinImpulse = inMinImpulse;
-    mMaxImpulse = inMaxImpulse;
-    mMotor = true;
-    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse); // The bound may have shrunk
+    BoundAsMotor(inMinImpulse, inMaxImpulse);
 }
 
 void AxisJointPart::PrepareSpringMotor(const Vec3& inArmA, const JointBodyMass& inA, const Vec3& inArmB,
@@ -71,10 +68,15 @@ void AxisJointPart::PrepareSpringMotor(const Vec3& inArmA, const JointBodyMass& 
                                        float inMinImpulse, float inMaxImpulse)
 {
     Prepare(inArmA, inA, inArmB, inB, inAxis, inError, Side::Both, inFrequency, inDamping, inDeltaTime);
+    BoundAsMotor(inMinImpulse, inMaxImpulse);
+}
+
+void AxisJointPart::BoundAsMotor(float inMinImpulse, float inMaxImpulse)
+{
     mMinImpulse = inMinImpulse;
     mMaxImpulse = inMaxImpulse;
     mMotor = true;
-    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse);
+    mTotalImpulse = std::clamp(mTotalImpulse, mMinImpulse, mMaxImpulse); // The bound may have shrunk
 }
 
 void AxisJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const

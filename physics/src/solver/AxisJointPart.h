@@ -52,6 +52,14 @@ public:
         return !((inSide == Side::Positive && inError >= 0.0f) ||
                  (inSide == Side::Negative && inError <= 0.0f));
     }
+    /// A hard limit row's velocity bias: for a limit not reached yet (inError on its allowed side), the rate
+    /// that closes the gap left in the step of inDeltaTime (speculative); none past it or for an equality.
+    static float SpeculativeBias(Side inSide, float inError, float inDeltaTime)
+    {
+        return inSide != Side::Both && !PushesAgainst(inSide, inError) && inDeltaTime > 0.0f
+                   ? inError / inDeltaTime
+                   : 0.0f;
+    }
     /// The side and error of a row that keeps inValue within [inMin, inMax]: an equality when they are equal,
     /// else the limit it is past or within inBand of (the error then on the allowed side: the row lets it
     /// close the rest of the way in the step, see Prepare); false (no row) while it is further within.
@@ -111,6 +119,9 @@ public:
 
 private:
     void Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const;
+    /// Makes the prepared row a motor's: its accumulated impulse within [inMinImpulse, inMaxImpulse], no
+    /// position pass.
+    void BoundAsMotor(float inMinImpulse, float inMaxImpulse);
 
     Vec3 mAxis = Vec3::UnitX();
     Vec3 mAngularA = Vec3::Zero(); ///< inv inertia A (rA x n)

@@ -1,6 +1,5 @@
 #include "solver/HingeRotationJointPart.h"
 
-#include <Eigen/LU>
 #include <cmath>
 
 namespace cairn::physics
@@ -22,10 +21,7 @@ void HingeRotationJointPart::Prepare(const JointBodyMass& inA, const JointBodyMa
     for (int i = 0; i < 2; ++i)
         for (int j = 0; j < 2; ++j)
             k(i, j) = mRow[i].dot(inverseInertia * mRow[j]);
-    const float determinant = k.determinant();
-    const float scale = k.cwiseAbs().maxCoeff();
-    mActive = scale > 0.0f && std::isfinite(determinant) && std::abs(determinant) > 1.0e-10f * scale * scale;
-    mEffectiveMass = mActive ? Eigen::Matrix2f(k.inverse()) : Eigen::Matrix2f::Zero();
+    mActive = InvertJointMassMatrix(k, mEffectiveMass);
     if (!mActive) mTotalImpulse.setZero();
 }
 

@@ -1,6 +1,5 @@
 #include "solver/LineJointPart.h"
 
-#include <Eigen/LU>
 #include <cmath>
 
 namespace cairn::physics
@@ -26,11 +25,7 @@ void LineJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const 
             k(i, j) = (i == j ? inA.mInverseMass + inB.mInverseMass : 0.0f) +
                       mArmCrossA[i].dot(inA.mInverseInertia * mArmCrossA[j]) +
                       mArmCrossB[i].dot(inB.mInverseInertia * mArmCrossB[j]);
-    // Singular relative to K's own scale, as InvertJointMassMatrix: a heavy body's K is small, not singular
-    const float determinant = k.determinant();
-    const float scale = k.cwiseAbs().maxCoeff();
-    mActive = scale > 0.0f && std::isfinite(determinant) && std::abs(determinant) > 1.0e-10f * scale * scale;
-    mEffectiveMass = mActive ? Eigen::Matrix2f(k.inverse()) : Eigen::Matrix2f::Zero();
+    mActive = InvertJointMassMatrix(k, mEffectiveMass);
     if (!mActive) mTotalImpulse.setZero();
 }
 

@@ -1,5 +1,6 @@
 #include "solver/PointJointPart.h"
 
+#include <Eigen/LU>
 #include <cmath>
 
 namespace cairn::physics
@@ -15,6 +16,16 @@ bool InvertJointMassMatrix(const Mat3& inK, Mat3& outInverse)
     const bool ok = invertible && scale > 0.0f && std::isfinite(determinant) &&
                     std::abs(determinant) > 1.0e-12f * scale * scale * scale && outInverse.allFinite();
     if (!ok) outInverse.setZero();
+    return ok;
+}
+
+bool InvertJointMassMatrix(const Eigen::Matrix2f& inK, Eigen::Matrix2f& outInverse)
+{
+    const float determinant = inK.determinant();
+    const float scale = inK.cwiseAbs().maxCoeff();
+    const bool ok =
+        scale > 0.0f && std::isfinite(determinant) && std::abs(determinant) > 1.0e-10f * scale * scale;
+    outInverse = ok ? Eigen::Matrix2f(inK.inverse()) : Eigen::Matrix2f::Zero();
     return ok;
 }
 

@@ -44,6 +44,8 @@ inline float ClampCorrection(float inStep, float inMax)
 /// The inverse of a joint's 3x3 mass matrix inK into outInverse; false (and zero) when it has none. Singular
 /// relative to K's own scale, not by an absolute threshold: a heavy body's matrix is small, not singular.
 bool InvertJointMassMatrix(const Mat3& inK, Mat3& outInverse);
+/// The same for a pair of rows' 2x2 mass matrix (a hinge's axis rows, a slider's line rows).
+bool InvertJointMassMatrix(const Eigen::Matrix2f& inK, Eigen::Matrix2f& outInverse);
 
 class PointJointPart
 {
