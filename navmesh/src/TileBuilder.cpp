@@ -1,9 +1,12 @@
 #include "cairn/navmesh/TileBuilder.h"
 
+#include "DetailHeights.h"
+
 #include <DetourAlloc.h>
 #include <DetourNavMesh.h>
 #include <DetourNavMeshBuilder.h>
 #include <Recast.h>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -27,6 +30,8 @@ struct RecastScratch
     rcContourSet* mContours = nullptr;
     rcPolyMesh* mPolyMesh = nullptr;
     rcPolyMeshDetail* mDetail = nullptr;
+    rcPolyMesh* mRoughPolygons = nullptr;
+    rcPolyMeshDetail* mFineDetail = nullptr;
     ~RecastScratch()
     {
         rcFreeHeightField(mSolid);
@@ -34,6 +39,8 @@ struct RecastScratch
         rcFreeContourSet(mContours);
         rcFreePolyMesh(mPolyMesh);
         rcFreePolyMeshDetail(mDetail);
+        rcFreePolyMesh(mRoughPolygons);
+        rcFreePolyMeshDetail(mFineDetail);
     }
 };
 
@@ -194,6 +201,34 @@ Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGri
         return RecastFailed(inTile, "build the detail mesh");
 
     rcPolyMesh& mesh = *scratch.mPolyMesh;
+    // Polygons whose detail surface strays more than a step from the voxels are sampled again, finer
+    DetailMeshArrays merged;
+    std::vector<float> errors = MeasureDetailErrors(mesh, *scratch.mDetail, *scratch.mCompact);
+    const auto overClimb = [&](float inError) { return inError > inProfile.mMaxClimb; };
+    std::vector<int> rough;
+    for (int p = 0; p < int(errors.size()); ++p)
+        if (overClimb(errors[size_t(p)])) rough.push_back(p);
+    if (config.detailSampleDist > 0.0f && !rough.empty())
+    {
+        const float fineDistance = std::max(config.cs, config.detailSampleDist / 3.0f);
+        scratch.mRoughPolygons = CopyPolygons(mesh, rough);
+        scratch.mFineDetail = rcAllocPolyMeshDetail();
+        if (scratch.mRoughPolygons == nullptr || scratch.mFineDetail == nullptr ||
+            !rcBuildPolyMeshDetail(&context, *scratch.mRoughPolygons, *scratch.mCompact, fineDistance,
+                                   config.detailSampleMaxError, *scratch.mFineDetail))
+            return RecastFailed(inTile, "build the fine detail mesh");
+        const std::vector<float> fineErrors =
+            MeasureDetailErrors(*scratch.mRoughPolygons, *scratch.mFineDetail, *scratch.mCompact);
+        merged = MergeDetailMeshes(*scratch.mDetail, errors, *scratch.mFineDetail, fineErrors, rough);
+        for (size_t k = 0; k < rough.size(); ++k)
+            if (fineErrors[k] < errors[size_t(rough[k])])
+            {
+                ++result.mResampledPolygons;
+                errors[size_t(rough[k])] = fineErrors[k];
+            }
+    }
+    result.mRoughPolygons = int(std::count_if(errors.begin(), errors.end(), overClimb));
+    result.mMaxDetailError = errors.empty() ? 0.0f : *std::max_element(errors.begin(), errors.end());
     result.mNumPolygons = mesh.npolys;
     result.mNumVertices = mesh.nverts;
     if (mesh.npolys == 0 || mesh.nverts == 0)
@@ -215,11 +250,22 @@ Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGri
     params.polyFlags = mesh.flags;
     params.polyCount = mesh.npolys;
     params.nvp = mesh.nvp;
-    params.detailMeshes = scratch.mDetail->meshes;
-    params.detailVerts = scratch.mDetail->verts;
-    params.detailVertsCount = scratch.mDetail->nverts;
-    params.detailTris = scratch.mDetail->tris;
-    params.detailTriCount = scratch.mDetail->ntris;
+    if (merged.mMeshes.empty())
+    {
+        params.detailMeshes = scratch.mDetail->meshes;
+        params.detailVerts = scratch.mDetail->verts;
+        params.detailVertsCount = scratch.mDetail->nverts;
+        params.detailTris = scratch.mDetail->tris;
+        params.detailTriCount = scratch.mDetail->ntris;
+    }
+    else
+    {
+        params.detailMeshes = merged.mMeshes.data();
+        params.detailVerts = merged.mVerts.data();
+        params.detailVertsCount = int(merged.mVerts.size() / 3);
+        params.detailTris = merged.mTris.data();
+        params.detailTriCount = int(merged.mTris.size() / 4);
+    }
     params.offMeshConVerts = linkVerts.data();
     params.offMeshConRad = linkRadii.data();
     params.offMeshConDir = linkDirections.data();

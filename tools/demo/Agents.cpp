@@ -197,11 +197,8 @@ bool Agents::StaticBodiesAt(const Vec3& inPosition, std::vector<BodyID>& outBodi
 {
     QueryFilter filter;
     filter.mObjectLayers = ObjectLayerMask(1) << Layers::cStatic;
-    // The agent's centre line at chest height. Not its whole radius: Recast's contours cut round the corners
-    // of obstacles by up to half a metre (cells and simplification), so agents brush corners, as in
-    // DetourCrowd
-    if (!mPhysics.GetWorldQuery().CollideSphere(inPosition + Vec3(0.0f, 1.0f, 0.0f), 0.05f, outBodies,
-                                                filter))
+    if (!mPhysics.GetWorldQuery().CollideSphere(inPosition + Vec3(0.0f, cChestProbeHeight, 0.0f),
+                                                cChestProbeRadius, outBodies, filter))
         return false;
     std::erase_if(outBodies, [&](const BodyID& inBody) { return mStreamer.IsTerrain(inBody); });
     return true;

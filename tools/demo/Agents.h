@@ -37,6 +37,12 @@ namespace cairn::demo
 {
 using namespace cairn::physics;
 
+/// The sphere whose overlap with a static body (not the terrain) counts an agent inside it: on the agent's
+/// centre line at chest height, over its feet. Not its whole radius: Recast's contours cut round the corners
+/// of obstacles by up to half a metre (cells and simplification), so agents brush corners, as in DetourCrowd.
+constexpr float cChestProbeHeight = 1.0f;
+constexpr float cChestProbeRadius = 0.05f;
+
 /// The goal of an agent that follows the player: the navmesh point nearest the player, or, while the player's
 /// tiles are not built yet, the one nearest the point inReach metres the player's way from the agent, on the
 /// ground that inGroundHeight(x, z) gives (the agent's own invoker radius reaches past it). Points are

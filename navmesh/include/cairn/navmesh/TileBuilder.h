@@ -47,6 +47,14 @@ struct BuiltTile
     int mNumPolygons = 0;
     int mNumVertices = 0;
     double mBuildMs = 0.0; ///< Time spent in Recast and Detour
+    /// m: the largest height difference between a polygon's detail surface (the height agents stand at) and
+    /// the voxels of its walkable surface, over the cells it covers
+    float mMaxDetailError = 0.0f;
+    /// Polygons whose detail surface strayed more than the agent's climb from the voxels (Recast smooths
+    /// steps inside a polygon into ramps, and two steps into a ramp deeper than a step) and were sampled
+    /// again at a third of the detail sample distance (one cell at least), keeping the finer surface
+    int mResampledPolygons = 0;
+    int mRoughPolygons = 0; ///< Polygons whose surface still strays more than the climb after that
 };
 
 /// Error unless inProfile is valid (AgentProfile::Validate) and inGrid is a grid of its tiles: the profile's
