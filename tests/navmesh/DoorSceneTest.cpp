@@ -1,8 +1,12 @@
 // A wall with a door: the path goes through the door; a box dropped into the doorway (dynamic, then asleep,
 // an obstacle) makes its tiles dirty, they are rebuilt in the background, and then no path gets through;
-// removing the box brings the path back.
+// removing the box brings the path back. A hinged door driven by its motor does the same: closed and at
+// rest it blocks the path, swung open and at rest it lets it through, its tiles rebuilt each time it stops.
 
 #include "NavMeshSceneFixture.h"
+#include "cairn/physics/constraints/ConstraintInterface.h"
+
+#include <numbers>
 
 namespace cairn::navmesh::test
 {
@@ -75,6 +79,73 @@ TEST_F(DoorSceneTest, BoxInTheDoorwayBlocksThePathUntilRemoved)
     ASSERT_TRUE(reopened) << reopened.GetError().mMessage;
     EXPECT_TRUE(reopened.Value().mReachedEnd);
     EXPECT_TRUE(GoesThroughDoor(reopened.Value()));
+}
+
+TEST_F(DoorSceneTest, AHingedDoorBlocksThePathWhenItStopsClosedAndFreesItWhenItStopsOpen)
+{
+    BuildRoom();
+    ASSERT_TRUE(RunUntilIdle());
+    // The door: a panel over the doorway (x in [-1, 1]) just off the wall's +z face and a few centimetres off
+    // the floor, hinged to the world at its edge x = -1 about the vertical, its motor holding it closed. It
+    // opens away from the wall (a negative angle), so that no part of it swings into the wall
+    BodyCreationSettings panel;
+    panel.mShape = BoxShape::Create(Vec3(1.0f, 1.2f, 0.05f)).Value();
+    panel.mPosition = Vec3(0.0f, 1.25f, 0.3f);
+    panel.mMotionType = MotionType::Dynamic;
+    panel.mObjectLayer = Layers::cMoving;
+    panel.mDensity = 100.0f; // A wooden door's 48 kg
+    const BodyID door = mPhysics->GetBodyInterface().CreateAndAddBody(panel, Activation::Activate).Value();
+    HingeConstraintSettings hinge;
+    hinge.mBodyB = door;
+    hinge.mPoint = Vec3(-1.0f, 1.25f, 0.3f);
+    hinge.mHingeAxis = Vec3(0.0f, 1.0f, 0.0f);
+    hinge.mLimitsMin = -0.5f * std::numbers::pi_v<float> - 0.1f;
+    hinge.mLimitsMax = 0.1f;
+    hinge.mMotor.mMode = MotorMode::Position;
+    hinge.mMotor.mTargetPosition = 0.0f;
+    hinge.mMotor.mMaxForce = 500.0f;
+    ConstraintInterface& joints = mPhysics->GetConstraintInterface();
+    const ConstraintID joint = joints.AddHinge(hinge).Value();
+
+    // Frames until the door sleeps (its motor brought it to rest), then until its tiles are built again
+    const auto settle = [&]
+    {
+        int frames = 0;
+        while (mPhysics->GetBodyInterface().IsActive(door).Value() && frames < 1200)
+        {
+            Frame();
+            ++frames;
+        }
+        ASSERT_FALSE(mPhysics->GetBodyInterface().IsActive(door).Value()) << "the door did not come to rest";
+        const uint64_t rebuildsBefore = mScheduler->GetStats().mRebuilds;
+        ASSERT_TRUE(RunUntilIdle());
+        EXPECT_GT(mScheduler->GetStats().mRebuilds, rebuildsBefore); // Its tiles were dirty and built again
+    };
+
+    settle();
+    EXPECT_NEAR(joints.GetPosition(joint).Value(), 0.0f, 0.05f);
+    Result<PathResult> closed = PathAcross();
+    ASSERT_TRUE(closed) << closed.GetError().mMessage;
+    EXPECT_FALSE(closed.Value().mReachedEnd);
+
+    // Opened by its motor (on a timer, in a game): a quarter turn, the panel along the wall's normal at x =
+    // -1
+    MotorSettings open = hinge.mMotor;
+    open.mTargetPosition = -0.5f * std::numbers::pi_v<float>;
+    ASSERT_TRUE(joints.SetMotor(joint, open).IsOk());
+    settle();
+    EXPECT_NEAR(joints.GetPosition(joint).Value(), open.mTargetPosition, 0.05f);
+    Result<PathResult> opened = PathAcross();
+    ASSERT_TRUE(opened) << opened.GetError().mMessage;
+    EXPECT_TRUE(opened.Value().mReachedEnd);
+    EXPECT_TRUE(GoesThroughDoor(opened.Value()));
+
+    // And closed again
+    ASSERT_TRUE(joints.SetMotor(joint, hinge.mMotor).IsOk());
+    settle();
+    Result<PathResult> closedAgain = PathAcross();
+    ASSERT_TRUE(closedAgain) << closedAgain.GetError().mMessage;
+    EXPECT_FALSE(closedAgain.Value().mReachedEnd);
 }
 
 TEST_F(DoorSceneTest, AnAwakeBoxIsNotAnObstacle)

@@ -5,9 +5,10 @@
 // together. Solved in the same sequential-impulse passes as the contacts (velocity rows warm-started from the
 // last step's impulse, drift taken out on the poses after integration).
 //
-// Joints so far: fixed (welded), point (ball and socket), distance (rod, rope, spring), hinge and slider
-// (each with limits, a velocity motor and friction). An island with a joint is solved by one thread, whole
-// (not colored, not grouped): the same result for any thread count.
+// Joints: fixed (welded), point (ball and socket), distance (rod, rope, spring), hinge and slider (each with
+// limits, a velocity or position motor and friction) and swing-twist (a cone and a twist range, for ragdolls).
+// An island with a joint is solved by one thread, whole (not colored, not grouped): the same result for any
+// thread count.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
 // (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
