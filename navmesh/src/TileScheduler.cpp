@@ -248,6 +248,7 @@ void TileScheduler::StartJob(const TileCoord& inTile, TileState& ioState)
     auto job = std::make_shared<TileJob>(mCollector, mWorld.GetProfile(), mWorld.GetGrid(),
                                          mSettings.mInclusion, inTile, mBorder, std::move(links));
     ioState.mJob = job;
+    ioState.mJobStartFrame = mFrame;
     ioState.mDirty = false; // Dirt from now on means this job's result is already stale: build again after
     ioState.mTask = mQueue.Submit(
         "navmesh tile " + std::to_string(inTile.mX) + "," + std::to_string(inTile.mZ), mSettings.mJobPriority,
@@ -301,6 +302,7 @@ bool TileScheduler::CollectFinished(const TileCoord& inTile, TileState& ioState,
             mStats.mFirstPublishTiles.push_back(inTile);
         }
         ioState.mEverPublished = true;
+        ioState.mPublication = Publication{ioState.mJobStartFrame, mFrame};
         ++mStats.mTilesPublished;
     }
     ioState.mJob.reset();
@@ -386,6 +388,19 @@ int TileScheduler::Update()
         mRefusedSeen = refused;
     }
     return changed;
+}
+
+uint64_t TileScheduler::GetFrame() const
+{
+    std::lock_guard lock(mMutex);
+    return mFrame;
+}
+
+std::optional<TileScheduler::Publication> TileScheduler::GetLastPublication(const TileCoord& inTile) const
+{
+    std::lock_guard lock(mMutex);
+    const auto it = mTiles.find(inTile);
+    return it == mTiles.end() ? std::nullopt : it->second.mPublication;
 }
 
 bool TileScheduler::IsIdle() const

@@ -28,6 +28,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -120,6 +121,19 @@ public:
     /// Needed tiles that have never been published (being built, or waiting for the budget).
     uint32_t CountNeededNeverPublished() const;
     Stats GetStats() const;
+    /// Update calls so far: the scheduler's frame. Any thread.
+    uint64_t GetFrame() const;
+    /// A tile's last publication: the frame whose Update started the build that was published (its geometry
+    /// was collected after that Update, so it holds what the physics world reported before it: a body that
+    /// fell asleep in an earlier frame), and the frame whose Update published it. Latency of a change seen at
+    /// frame F: the first publication with mBuildStartFrame > F, at mPublishFrame.
+    struct Publication
+    {
+        uint64_t mBuildStartFrame = 0;
+        uint64_t mPublishFrame = 0;
+    };
+    /// Nothing for a tile not kept (never needed, or dropped) or never published. Any thread.
+    std::optional<Publication> GetLastPublication(const TileCoord& inTile) const;
     /// Jobs started and not yet taken in by Update.
     uint32_t GetNumRunningJobs() const;
     /// True when a job has finished and waits for the next Update to publish its tile.
@@ -133,7 +147,9 @@ private:
         bool mEverPublished = false;
         uint64_t mNeededSinceFrame = 0; ///< For the first-publication latency
         uint64_t mLastNeededFrame = 0;
-        std::shared_ptr<TileJob> mJob; ///< Running job, or null
+        uint64_t mJobStartFrame = 0;             ///< Of the running job
+        std::optional<Publication> mPublication; ///< The last one
+        std::shared_ptr<TileJob> mJob;           ///< Running job, or null
         std::shared_ptr<jobs::BackgroundTask> mTask;
     };
     struct Invoker
