@@ -123,10 +123,10 @@ public:
     Stats GetStats() const;
     /// Update calls so far: the scheduler's frame. Any thread.
     uint64_t GetFrame() const;
-    /// A tile's last publication: the frame whose Update started the build that was published (its geometry
-    /// was collected after that Update, so it holds what the physics world reported before it: a body that
-    /// fell asleep in an earlier frame), and the frame whose Update published it. Latency of a change seen at
-    /// frame F: the first publication with mBuildStartFrame > F, at mPublishFrame.
+    /// A tile's last publication: the frame whose Update started the build that was published, and the frame
+    /// whose Update published it. A build collects its geometry after the Update that starts it, so a change
+    /// made before Update N (by the step before it, or by a call) is in every build started at frame N or
+    /// later: its latency to the navmesh is to the first publication with mBuildStartFrame >= N.
     struct Publication
     {
         uint64_t mBuildStartFrame = 0;
