@@ -128,11 +128,12 @@ rcPolyMesh* CopyPolygons(const rcPolyMesh& inMesh, std::span<const int> inPolygo
     return copy;
 }
 
-DetailMeshArrays MergeDetailMeshes(const rcPolyMeshDetail& inCoarse, const std::vector<float>& inCoarseErrors,
+DetailMeshArrays MergeDetailMeshes(const rcPolyMeshDetail& inCoarse, std::vector<float>& ioErrors,
                                    const rcPolyMeshDetail& inFine, const std::vector<float>& inFineErrors,
-                                   std::span<const int> inFinePolygons)
+                                   std::span<const int> inFinePolygons, int& outNumFromFine)
 {
     DetailMeshArrays merged;
+    outNumFromFine = 0;
     merged.mMeshes.reserve(size_t(inCoarse.nmeshes) * 4);
     size_t nextFine = 0; // inFinePolygons is in polygon order
     for (int p = 0; p < inCoarse.nmeshes; ++p)
@@ -141,10 +142,12 @@ DetailMeshArrays MergeDetailMeshes(const rcPolyMeshDetail& inCoarse, const std::
         int index = p;
         if (nextFine < inFinePolygons.size() && inFinePolygons[nextFine] == p)
         {
-            if (int(nextFine) < inFine.nmeshes && inFineErrors[nextFine] < inCoarseErrors[size_t(p)])
+            if (int(nextFine) < inFine.nmeshes && inFineErrors[nextFine] < ioErrors[size_t(p)])
             {
                 from = &inFine;
                 index = int(nextFine);
+                ioErrors[size_t(p)] = inFineErrors[nextFine];
+                ++outNumFromFine;
             }
             ++nextFine;
         }

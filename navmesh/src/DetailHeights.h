@@ -44,10 +44,11 @@ std::vector<float> MeasureDetailErrors(const rcPolyMesh& inMesh, const rcPolyMes
 rcPolyMesh* CopyPolygons(const rcPolyMesh& inMesh, std::span<const int> inPolygons);
 
 /// Polygon p's vertices and triangles from inFine where p is inFinePolygons[k] and inFineErrors[k] is below
-/// inCoarseErrors[p], else from inCoarse. inCoarse is the detail mesh of every polygon, inFine that of the
-/// polygons in inFinePolygons (ascending), in that order.
-DetailMeshArrays MergeDetailMeshes(const rcPolyMeshDetail& inCoarse, const std::vector<float>& inCoarseErrors,
+/// ioErrors[p] (then ioErrors[p] becomes inFineErrors[k]), else from inCoarse. inCoarse is the detail mesh of
+/// every polygon and ioErrors its errors, inFine that of the polygons in inFinePolygons (ascending), in that
+/// order. outNumFromFine: the polygons taken from inFine.
+DetailMeshArrays MergeDetailMeshes(const rcPolyMeshDetail& inCoarse, std::vector<float>& ioErrors,
                                    const rcPolyMeshDetail& inFine, const std::vector<float>& inFineErrors,
-                                   std::span<const int> inFinePolygons);
+                                   std::span<const int> inFinePolygons, int& outNumFromFine);
 
 } // namespace cairn::navmesh

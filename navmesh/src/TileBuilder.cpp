@@ -219,13 +219,8 @@ Result<BuiltTile> BuildTile(const AgentProfile& inProfile, const TileGrid& inGri
             return RecastFailed(inTile, "build the fine detail mesh");
         const std::vector<float> fineErrors =
             MeasureDetailErrors(*scratch.mRoughPolygons, *scratch.mFineDetail, *scratch.mCompact);
-        merged = MergeDetailMeshes(*scratch.mDetail, errors, *scratch.mFineDetail, fineErrors, rough);
-        for (size_t k = 0; k < rough.size(); ++k)
-            if (fineErrors[k] < errors[size_t(rough[k])])
-            {
-                ++result.mResampledPolygons;
-                errors[size_t(rough[k])] = fineErrors[k];
-            }
+        merged = MergeDetailMeshes(*scratch.mDetail, errors, *scratch.mFineDetail, fineErrors, rough,
+                                   result.mResampledPolygons);
     }
     result.mRoughPolygons = int(std::count_if(errors.begin(), errors.end(), overClimb));
     result.mMaxDetailError = errors.empty() ? 0.0f : *std::max_element(errors.begin(), errors.end());
