@@ -5,6 +5,7 @@
 
 #include "NavMeshSceneFixture.h"
 #include "cairn/physics/constraints/ConstraintInterface.h"
+#include "common/StaticFloor.h"
 
 #include <numbers>
 
@@ -88,11 +89,8 @@ TEST_F(DoorSceneTest, AHingedDoorBlocksThePathWhenItStopsClosedAndFreesItWhenItS
     // The door: a panel over the doorway (x in [-1, 1]) just off the wall's +z face and a few centimetres off
     // the floor, hinged to the world at its edge x = -1 about the vertical, its motor holding it closed. It
     // opens away from the wall (a negative angle), so that no part of it swings into the wall
-    BodyCreationSettings panel;
-    panel.mShape = BoxShape::Create(Vec3(1.0f, 1.2f, 0.05f)).Value();
-    panel.mPosition = Vec3(0.0f, 1.25f, 0.3f);
-    panel.mMotionType = MotionType::Dynamic;
-    panel.mObjectLayer = Layers::cMoving;
+    BodyCreationSettings panel =
+        cairn::test::BoxBodySettings(Vec3(0.0f, 1.25f, 0.3f), Vec3(1.0f, 1.2f, 0.05f), MotionType::Dynamic);
     panel.mDensity = 100.0f; // A wooden door's 48 kg
     const BodyID door = mPhysics->GetBodyInterface().CreateAndAddBody(panel, Activation::Activate).Value();
     HingeConstraintSettings hinge;
@@ -169,11 +167,8 @@ TEST_F(DoorSceneTest, AnAwakeBoxIsNotAnObstacle)
     ASSERT_TRUE(RunUntilIdle());
     // A box in the doorway that never sleeps: it may move at any time, so it is not in the navmesh, even
     // when its tiles are rebuilt
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(Vec3(0.6f, 0.75f, 0.18f)).Value();
-    settings.mPosition = Vec3(0, 0.75f, 0);
-    settings.mMotionType = MotionType::Dynamic;
-    settings.mObjectLayer = Layers::cMoving;
+    BodyCreationSettings settings =
+        cairn::test::BoxBodySettings(Vec3(0, 0.75f, 0), Vec3(0.6f, 0.75f, 0.18f), MotionType::Dynamic);
     settings.mAllowSleeping = false;
     const BodyID box = mPhysics->GetBodyInterface().CreateAndAddBody(settings, Activation::Activate).Value();
     mScheduler->MarkDirty(AABB(Vec3(-1, 0, -1), Vec3(1, 3, 1)));
