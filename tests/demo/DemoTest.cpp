@@ -1,7 +1,8 @@
 // The streaming open-world demo, run for 240 frames (4 s) in both broad-phase modes with a fast player
 // (so tiles stream in and out several times): no body lost or duplicated by streaming, every navmesh tile the
 // agents asked for built, no agent inside a wall or off its navmesh for over a second, no corridor through a
-// polygon that is gone, nothing reported wrong.
+// polygon that is gone, doors whose rest rebuilt their tiles with the doorway shut or open as the door stood,
+// nothing reported wrong.
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
@@ -61,6 +62,22 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(agents.mInsideStaticChecks, 0u) << inRun.mModeName;
     EXPECT_EQ(agents.mOffNavMeshOverOneSecond, 0u) << inRun.mModeName;
     EXPECT_EQ(agents.mCorridorsThroughGone, 0u) << inRun.mModeName;
+    // The huts' doors moved on their timers and their tiles were built again as they came to rest; the
+    // navmesh had each door where it stood: closed, no path through the doorway; open, one
+    const DoorStats& doors = inRun.mDoorStats;
+    std::printf("%s: doors %llu, commands %llu, rests %llu, tiles rebuilt %llu, doorway checks closed %llu "
+                "open %llu\n",
+                inRun.mModeName.c_str(), (unsigned long long)doors.mDoorsSeen,
+                (unsigned long long)doors.mCommands, (unsigned long long)doors.mRests,
+                (unsigned long long)doors.mRebuilds, (unsigned long long)doors.mClosedChecks,
+                (unsigned long long)doors.mOpenChecks);
+    EXPECT_GT(doors.mDoorsSeen, 0u) << inRun.mModeName;
+    EXPECT_GT(doors.mCommands, 0u) << inRun.mModeName;
+    EXPECT_GT(doors.mRebuilds, 0u) << inRun.mModeName;
+    EXPECT_EQ(doors.mLatencyFrames.size(), doors.mRebuilds) << inRun.mModeName;
+    EXPECT_GT(doors.mClosedChecks + doors.mOpenChecks, 0u) << inRun.mModeName;
+    EXPECT_EQ(doors.mClosedBlocked, doors.mClosedChecks) << inRun.mModeName;
+    EXPECT_EQ(doors.mOpenPassable, doors.mOpenChecks) << inRun.mModeName;
     for (const std::string& error : inRun.mErrors)
         ADD_FAILURE() << inRun.mModeName << ": " << error;
     // The run did what a demo does: streamed in and out, stepped, queried, built navmesh, walked

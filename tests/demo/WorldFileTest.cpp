@@ -19,12 +19,14 @@ TEST(WorldFileTest, TheShippedWorldIsTheDefaultWorld)
     loaded.mSeed = 99; // Every key of the file must overwrite what was there
     loaded.mPropsPerTile = 1;
     loaded.mThrowBalls = false;
+    loaded.mBuildingsPerTile = 7;
     const Status status = LoadDemoWorld(std::string(CAIRN_DATA_DIR) + "/demo/world.json", loaded);
     ASSERT_TRUE(status.IsOk()) << status.GetError().mMessage;
     const DemoSettings defaults;
     EXPECT_EQ(loaded.mSeed, defaults.mSeed);
     EXPECT_EQ(loaded.mPropsPerTile, defaults.mPropsPerTile);
     EXPECT_EQ(loaded.mDynamicPerTile, defaults.mDynamicPerTile);
+    EXPECT_EQ(loaded.mBuildingsPerTile, defaults.mBuildingsPerTile);
     EXPECT_EQ(loaded.mCollisionRadius, defaults.mCollisionRadius);
     EXPECT_EQ(loaded.mPlayerSpeed, defaults.mPlayerSpeed);
     EXPECT_EQ(loaded.mThrowBalls, defaults.mThrowBalls);
@@ -56,6 +58,11 @@ TEST(WorldFileTest, KeysNotNamedKeepTheirValuesAndAnErrorChangesNothing)
     EXPECT_NE(bad.GetError().mMessage.find("\"player_speed\": expected a number from"), std::string::npos)
         << bad.GetError().mMessage;
     EXPECT_EQ(settings.mAgents, before.mAgents) << "a refused file leaves the settings as they were";
+    const Status huts = LoadDemoWorld(files.Write("huts.json", R"({"buildings_per_tile": 17})"), settings);
+    ASSERT_FALSE(huts.IsOk());
+    EXPECT_NE(huts.GetError().mMessage.find("\"buildings_per_tile\": expected a whole number from 0 to 16"),
+              std::string::npos)
+        << huts.GetError().mMessage;
 }
 
 } // namespace

@@ -87,6 +87,7 @@ int main(int argc, char** argv)
         if (app.count("--seed") == 0) seedText = std::to_string(fromFile.mSeed);
         settings.mPropsPerTile = fromFile.mPropsPerTile;
         settings.mDynamicPerTile = fromFile.mDynamicPerTile;
+        settings.mBuildingsPerTile = fromFile.mBuildingsPerTile;
         settings.mCollisionRadius = fromFile.mCollisionRadius;
         settings.mPlayerSpeed = fromFile.mPlayerSpeed;
         settings.mThrowBalls = fromFile.mThrowBalls;

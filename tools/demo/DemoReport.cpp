@@ -306,11 +306,18 @@ SampleSummary SummarizeFrames(const std::vector<uint32_t>& inFrames)
     return Summarize(std::vector<double>(inFrames.begin(), inFrames.end()));
 }
 
+/// Doorway checks the navmesh failed: a path through a door at rest closed, or none through an open one.
+uint64_t DoorwaysNotAsTheirDoor(const DoorStats& inDoors)
+{
+    return (inDoors.mClosedChecks - inDoors.mClosedBlocked) + (inDoors.mOpenChecks - inDoors.mOpenPassable);
+}
+
 bool InvariantsHold(const DemoRunResult& inRun)
 {
     return inRun.mLostOrDuplicatedBodies == 0 && inRun.mTilesRequestedNeverBuilt == 0 &&
            inRun.mAgentStats.mInsideStatic == 0 && inRun.mAgentStats.mOffNavMeshOverOneSecond == 0 &&
-           inRun.mAgentStats.mCorridorsThroughGone == 0 && inRun.mErrors.empty();
+           inRun.mAgentStats.mCorridorsThroughGone == 0 && DoorwaysNotAsTheirDoor(inRun.mDoorStats) == 0 &&
+           inRun.mErrors.empty();
 }
 
 std::vector<Section> BuildSummary(const DemoRunResult& inRun)
@@ -427,6 +434,22 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                          {"latency frames p50", frames(latency.mP50)},
                          {"p99", frames(latency.mP99)},
                          {"max", frames(latency.mMax)}}});
+    const DoorStats& doors = inRun.mDoorStats;
+    const SampleSummary doorLatency = SummarizeFrames(doors.mLatencyFrames);
+    auto doorFrames = [&](double inValue)
+    { return doorLatency.mCount == 0 ? std::string("n/a") : Fixed(inValue, 0); };
+    sections.push_back(
+        {"doors",
+         {{"doors", Count(doors.mDoorsSeen)},
+          {"opened or closed", Count(doors.mCommands)},
+          {"came to rest", Count(doors.mRests)},
+          {"tiles rebuilt", Count(doors.mRebuilds)},
+          {"latency frames p50", doorFrames(doorLatency.mP50)},
+          {"p99", doorFrames(doorLatency.mP99)},
+          {"max", doorFrames(doorLatency.mMax)},
+          {"closed blocked the path", Count(doors.mClosedBlocked) + " of " + Count(doors.mClosedChecks)},
+          {"open let it through", Count(doors.mOpenPassable) + " of " + Count(doors.mOpenChecks)},
+          {"checks skipped", Count(doors.mChecksSkipped)}}});
     sections.push_back(
         {"navigation ms/frame",
          {{"main thread p50", Ms(navMain, navMain.mP50)},
@@ -481,6 +504,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                                                              Count(agents.mInsideStaticChecks) + " checks"},
                          {"off navmesh over 1 s", Count(agents.mOffNavMeshOverOneSecond)},
                          {"corridors through gone polygons", Count(agents.mCorridorsThroughGone)},
+                         {"doorways not as their door", Count(DoorwaysNotAsTheirDoor(inRun.mDoorStats))},
                          {"status", InvariantsHold(inRun) ? "OK" : "FAILED"}}});
     return sections;
 }

@@ -58,6 +58,30 @@ struct AgentStats
     std::vector<std::string> mErrors;
 };
 
+/// What the huts' doors did to the navmesh (Doors' figures, for the report).
+struct DoorStats
+{
+    uint64_t mDoorsSeen = 0; ///< Doors streamed in during the run
+    uint64_t mCommands = 0;  ///< Opens and closes on the doors' timers
+    uint64_t mRests = 0;     ///< Times a door came to rest (fell asleep), after a command or a knock
+    /// Tiles published from a build that started after a door came to rest over them, both profiles: the
+    /// door-caused rebuilds
+    uint64_t mRebuilds = 0;
+    /// Per rebuild: frames from the step the door fell asleep in to the sync point that published the tile
+    std::vector<uint32_t> mLatencyFrames;
+    uint64_t mDroppedBeforeRebuild = 0; ///< Tiles no invoker kept any more before their rebuild came
+    /// Paths through a doorway once its door's tiles were rebuilt (human profile), by the hinge's angle then:
+    /// a closed door must block the path, an open one let it through
+    uint64_t mClosedChecks = 0;
+    uint64_t mClosedBlocked = 0;
+    uint64_t mOpenChecks = 0;
+    uint64_t mOpenPassable = 0;
+    /// Checks not made: the door moved again before its tiles were published, stood ajar, or a path end was
+    /// off the navmesh (a neighbouring tile not built)
+    uint64_t mChecksSkipped = 0;
+    std::vector<std::string> mErrors;
+};
+
 /// Summary of a series of samples (milliseconds unless said otherwise).
 struct SampleSummary
 {
@@ -128,6 +152,7 @@ struct DemoRunResult
     std::vector<uint32_t> mNavTileLatencyFrames; ///< Request to publication, per tile
     int mAgents = 0;
     AgentStats mAgentStats;
+    DoorStats mDoorStats;
     /// The final navmesh of the human profile, for the map: each polygon's outline (x, z) and the build
     /// latency of its tile in frames (-1: not known, a tile built before the run)
     struct MapPolygon

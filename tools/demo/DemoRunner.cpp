@@ -1,6 +1,7 @@
 #include "DemoRunner.h"
 
 #include "Agents.h"
+#include "Doors.h"
 #include "GameObjects.h"
 #include "Projectiles.h"
 #include "TileStreamer.h"
@@ -184,6 +185,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     worldSettings.mSeed = inSettings.mSeed;
     worldSettings.mPropsPerTile = inSettings.mPropsPerTile;
     worldSettings.mDynamicPerTile = inSettings.mDynamicPerTile;
+    worldSettings.mBuildingsPerTile = inSettings.mBuildingsPerTile;
     worldSettings.mPlayerSpeed = inSettings.mPlayerSpeed;
     const WorldGenerator generator(worldSettings);
 
@@ -221,6 +223,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     agents->WatchThreads(std::move(navigationThreads));
 
     Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
+    Doors doors(physics, *streamer, {navMeshes.mNavMeshes[0].get(), navMeshes.mNavMeshes[1].get()},
+                {navMeshes.mSchedulers[0].get(), navMeshes.mSchedulers[1].get()});
     const float dt = 1.0f / 60.0f;
     const Clock::time_point begin = Clock::now();
     const double stealBefore = tools::GuestStealMs();
@@ -237,6 +241,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mMainThreadStreamHostTakenMs.push_back(streaming.mHostTakenMs);
 
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
+        doors.Command(seconds);
 
         // A frame pipeline: the game objects' queries and the step are two jobs that run at once (each waits
         // only for jobs it scheduled itself, so neither runs the other's work on its stack); the queries
@@ -267,10 +272,12 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mPhysicsHostTakenMs.push_back(stepping.mTimed.mHostTakenMs);
         result.mSteps.push_back(physics.GetLastStepStatistics());
         gameObjects->ApplyMoves(frameJobs, inSettings.mGameObjectJobs);
+        doors.AfterStep();
         if (Status focused = navMeshes.Focus(player, navMeshRadius); !focused && result.mErrors.size() < 20)
             result.mErrors.push_back("navmesh invoker: " + focused.GetError().mMessage);
         agents->Update(dt, player, frameJobs);
         navMeshes.Update();
+        doors.AfterNavMeshUpdate();
         result.mFrameMs.push_back(MillisecondsSince(frameStart));
 
         if (IsProgressFrame(inProgress, liveProgress, frame, inSettings.mFrames))
@@ -311,6 +318,10 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     navMeshes.mNavMeshes[0]->Read([&](const dtNavMesh& inNavMesh)
                                   { result.mNavMeshObj = navmesh::NavMeshToObj(inNavMesh); });
     result.mNavMap = NavMap(*navMeshes.mNavMeshes[0], navMeshes.mSchedulers[0]->GetStats());
+    doors.AfterNavMeshUpdate(); // The rebuilds the settling above published
+    result.mDoorStats = doors.GetStats();
+    for (const std::string& error : result.mDoorStats.mErrors)
+        result.mErrors.push_back("doors: " + error);
     agents->FinishStats();
     result.mAgentStats = agents->GetStats();
     for (const std::string& error : result.mAgentStats.mErrors)

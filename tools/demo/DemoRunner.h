@@ -1,10 +1,11 @@
 #pragma once
 
 // DemoRunner: one run of the streaming open-world demo in one broad-phase mode. The main thread's frame:
-//   streaming focus -> balls thrown by the player -> physics step (job system) -> game-object jobs (queries
-//   and moves on the job threads)
+//   streaming focus -> balls thrown by the player -> doors on their timers -> physics step (job
+//   system) beside the game-object query jobs -> their moves (job threads) -> doors at rest
 //   -> AI agents (goals and the two crowds: paths on a budget here, steering on the job threads) -> navmesh
-//   sync point (each profile's TileScheduler::Update) -> wait for the next 1/60 s tick.
+//   sync point (each profile's TileScheduler::Update) and the doors' rebuilds -> wait for the next 1/60 s
+//   tick.
 // The loading thread streams tiles in and out meanwhile, and background tile jobs build the navmesh.
 // Threads: RunDemo on one thread; it owns everything it makes.
 
@@ -49,6 +50,7 @@ struct DemoSettings
     float mCollisionRadius = 3.0f; ///< World tiles with collision around the player (29 tiles)
     int mPropsPerTile = 700;
     int mDynamicPerTile = 110;
+    int mBuildingsPerTile = 2; ///< Huts with a door on a timer (Buildings.h, Doors.h)
     float mPlayerSpeed = 8.0f; ///< m/s across the world
     bool mThrowBalls = true;   ///< The player throws balls that knock crates and stacks over
 };

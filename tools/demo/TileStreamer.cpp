@@ -2,6 +2,7 @@
 
 #include "common/FrameTimes.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -78,6 +79,29 @@ std::vector<WorldTile> TileStreamer::GetLoadedTiles() const
     for (const auto& [tile, high] : mLoadedLod)
         tiles.push_back(tile);
     return tiles;
+}
+
+bool TileStreamer::TakeDoorsIfChanged(uint64_t& ioVersion, std::vector<StreamedDoor>& outDoors) const
+{
+    std::unique_lock lock(mMutex, std::try_to_lock);
+    if (!lock.owns_lock() || ioVersion == mDoorsVersion) return false;
+    ioVersion = mDoorsVersion;
+    outDoors = mDoors;
+    return true;
+}
+
+void TileStreamer::PublishDoorsLocked()
+{
+    std::vector<StreamedDoor> doors;
+    for (const auto& [tile, loaded] : mTiles)
+        doors.insert(doors.end(), loaded.mDoors.begin(), loaded.mDoors.end());
+    const bool same = doors.size() == mDoors.size() &&
+                      std::equal(doors.begin(), doors.end(), mDoors.begin(),
+                                 [](const StreamedDoor& inA, const StreamedDoor& inB)
+                                 { return inA.mPanel == inB.mPanel && inA.mHinge == inB.mHinge; });
+    if (same) return;
+    mDoors = std::move(doors);
+    ++mDoorsVersion;
 }
 
 bool TileStreamer::IsTerrain(const BodyID& inBody) const
@@ -161,6 +185,52 @@ void TileStreamer::LoadTile(const WorldTile& inTile, LoadedTile& outTile)
         std::lock_guard lock(mTerrainMutex);
         mTerrain.insert(outTile.mStatic.front());
     }
+    AddDoors(content.mDoors, outTile);
+}
+
+void TileStreamer::AddDoors(std::vector<DoorSpec>& ioDoors, LoadedTile& ioTile)
+{
+    if (ioDoors.empty()) return;
+    std::vector<BodyCreationSettings> panels;
+    for (const DoorSpec& door : ioDoors)
+        panels.push_back(door.mPanel);
+    std::vector<BodyID> created;
+    if (!AddBatch(panels, Activation::DontActivate, created)) return;
+    if (created.size() != ioDoors.size()) // A panel refused: which is which is lost, so none gets a hinge
+    {
+        RemoveBodies(created);
+        return;
+    }
+    ConstraintInterface& joints = mPhysics.GetConstraintInterface();
+    for (size_t i = 0; i < ioDoors.size(); ++i)
+    {
+        HingeConstraintSettings hinge = ioDoors[i].mHinge;
+        hinge.mBodyB = created[i];
+        Result<ConstraintID> joint = joints.AddHinge(hinge);
+        if (!joint)
+        {
+            NoteError("door hinge: " + joint.GetError().mMessage);
+            std::vector<BodyID> panel{created[i]};
+            RemoveBodies(panel);
+            continue;
+        }
+        ioTile.mDoors.push_back({created[i], joint.Value(), ioDoors[i].mOutside, ioDoors[i].mInside,
+                                 ioDoors[i].mPeriod, ioDoors[i].mPhase});
+    }
+}
+
+void TileStreamer::RemoveDoors(LoadedTile& ioTile)
+{
+    ConstraintInterface& joints = mPhysics.GetConstraintInterface();
+    std::vector<BodyID> panels;
+    for (const StreamedDoor& door : ioTile.mDoors)
+    {
+        if (Status removed = joints.Remove(door.mHinge); !removed)
+            NoteError("remove door hinge: " + removed.GetError().mMessage);
+        panels.push_back(door.mPanel);
+    }
+    ioTile.mDoors.clear();
+    RemoveBodies(panels);
 }
 
 void TileStreamer::AddDynamic(const WorldTile& inTile, LoadedTile& ioTile)
@@ -215,6 +285,7 @@ void TileStreamer::ThreadMain()
             {
                 const Clock::time_point start = Clock::now();
                 RemoveBodies(it->second.mDynamic);
+                RemoveDoors(it->second);
                 RemoveBodies(it->second.mStatic);
                 const double ms = MillisecondsSince(start);
                 mTiles.erase(it);
@@ -270,13 +341,14 @@ void TileStreamer::ThreadMain()
         for (const auto& [tile, loaded] : mTiles)
         {
             statics += uint32_t(loaded.mStatic.size());
-            dynamics += uint32_t(loaded.mDynamic.size());
+            dynamics += uint32_t(loaded.mDynamic.size() + loaded.mDoors.size());
             mLoadedLod[tile] = !loaded.mDynamic.empty();
         }
         mStats.mStaticBodies = statics;
         mStats.mDynamicBodies = dynamics;
         mStats.mStaticPeak = std::max(mStats.mStaticPeak, statics);
         mStats.mDynamicPeak = std::max(mStats.mDynamicPeak, dynamics);
+        PublishDoorsLocked();
         // Settled when a pass found nothing to do for the focus it read (a newer focus clears it again)
         if (!changed && player == mPlayer && ahead == mAhead) mSettled = true;
     }
@@ -301,17 +373,24 @@ uint32_t TileStreamer::UnloadAllAndCheck()
     BodyInterface& bodies = mPhysics.GetBodyInterface();
     uint32_t problems = 0;
     std::set<BodyID> seen;
+    auto check = [&](const BodyID& inID)
+    {
+        Result<bool> added = bodies.IsAdded(inID);
+        if (!added || !added.Value() || !seen.insert(inID).second) ++problems;
+    };
     for (auto& [tile, loaded] : mTiles)
+    {
         for (const std::vector<BodyID>* list : {&loaded.mStatic, &loaded.mDynamic})
             for (const BodyID& id : *list)
-            {
-                Result<bool> added = bodies.IsAdded(id);
-                if (!added || !added.Value() || !seen.insert(id).second) ++problems;
-            }
+                check(id);
+        for (const StreamedDoor& door : loaded.mDoors)
+            check(door.mPanel);
+    }
     if (mPhysics.GetBodyManager().GetNumBodies() != mBodiesBefore + seen.size()) ++problems;
     for (auto& [tile, loaded] : mTiles)
     {
         RemoveBodies(loaded.mDynamic);
+        RemoveDoors(loaded);
         RemoveBodies(loaded.mStatic);
     }
     mTiles.clear();

@@ -6,11 +6,12 @@
 // them, prepares their broad-phase add off the main thread and finalizes it (an O(1) link into the broad
 // phase), and removes tiles that left the collision radius. Tiles within one tile of the player are high-LOD
 // and also get dynamic bodies (crates, stacks, debris; created asleep), removed again when the tile drops
-// back to medium LOD.
+// back to medium LOD. Huts' doors (Buildings.h) come with the tile's statics at every LOD: a dynamic panel
+// and its hinge to the world each, removed with the tile (the hinge first).
 //
-// Threads: SetFocus, GetStats, IsSettled from any thread (mMutex); everything else happens on the loading
-// thread, which owns mTiles. The physics world is used through BodyInterface, which may be called while the
-// world steps (adds wait for the step only on the loading thread).
+// Threads: SetFocus, GetStats, IsSettled, TakeDoorsIfChanged from any thread (mMutex); everything else
+// happens on the loading thread, which owns mTiles. The physics world is used through BodyInterface, which
+// may be called while the world steps (adds wait for the step only on the loading thread).
 
 #include "WorldGenerator.h"
 #include "cairn/physics/PhysicsSystem.h"
@@ -26,6 +27,17 @@
 namespace cairn::demo
 {
 using namespace cairn::physics;
+
+/// A door in the world, as the loading thread made it: for the main thread's Doors.
+struct StreamedDoor
+{
+    BodyID mPanel;
+    ConstraintID mHinge;
+    Vec3 mOutside = Vec3::Zero(); ///< DoorSpec's: ground points either side of the doorway
+    Vec3 mInside = Vec3::Zero();
+    float mPeriod = 0.0f; ///< DoorSpec's timer, s
+    float mPhase = 0.0f;
+};
 
 class TileStreamer
 {
@@ -68,12 +80,17 @@ public:
     uint32_t CountLostOrDuplicated() const;
     /// Whether inBody is a terrain body (the wall checks ignore the ground).
     bool IsTerrain(const BodyID& inBody) const;
+    /// The doors in the world now, when they changed since ioVersion (updated); false, with outDoors as it
+    /// was, when they did not or when the loading thread holds the lock (the caller never waits: it asks
+    /// again next frame). A door may be gone by the time its caller uses it: its ids go stale.
+    bool TakeDoorsIfChanged(uint64_t& ioVersion, std::vector<StreamedDoor>& outDoors) const;
 
 private:
     struct LoadedTile
     {
         std::vector<BodyID> mStatic;  ///< Terrain first, then props
         std::vector<BodyID> mDynamic; ///< Empty unless high-LOD
+        std::vector<StreamedDoor> mDoors;
     };
 
     void ThreadMain();
@@ -82,6 +99,12 @@ private:
     void LoadTile(const WorldTile& inTile, LoadedTile& outTile);
     void AddDynamic(const WorldTile& inTile, LoadedTile& ioTile);
     void RemoveBodies(std::vector<BodyID>& ioBodies);
+    /// Creates the doors' panels as one batch and hinges each to the world.
+    void AddDoors(std::vector<DoorSpec>& ioDoors, LoadedTile& ioTile);
+    /// Removes the hinges, then the panels.
+    void RemoveDoors(LoadedTile& ioTile);
+    /// The loaded tiles' doors into mDoors for the main thread; with mMutex held.
+    void PublishDoorsLocked();
     /// Creates, prepares and finalizes a batch; false (with an error noted) on failure.
     bool AddBatch(const std::vector<BodyCreationSettings>& inSettings, Activation inActivation,
                   std::vector<BodyID>& outIDs);
@@ -101,6 +124,8 @@ private:
     bool mSettled = false;
     Stats mStats;
     std::map<WorldTile, bool> mLoadedLod; ///< Copy of the loaded tiles and their LOD, for other threads
+    std::vector<StreamedDoor> mDoors;     ///< Copy of the loaded tiles' doors, for other threads
+    uint64_t mDoorsVersion = 1;           ///< Changes with mDoors
 
     std::map<WorldTile, LoadedTile> mTiles; ///< Loading thread only (and UnloadAllAndCheck after it stopped)
     mutable std::mutex mTerrainMutex;

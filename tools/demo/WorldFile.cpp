@@ -19,7 +19,9 @@ uint64_t EstimateMaxBodies(const DemoSettings& inSettings)
         for (int dx = -reach; dx <= reach; ++dx)
             if (float(dx * dx + dz * dz) <= inSettings.mCollisionRadius * inSettings.mCollisionRadius)
                 ++tiles;
-    const uint64_t perTile = 1 + uint64_t(inSettings.mPropsPerTile) + uint64_t(inSettings.mDynamicPerTile);
+    // A hut is five walls and a door
+    const uint64_t perTile = 1 + uint64_t(inSettings.mPropsPerTile) + uint64_t(inSettings.mDynamicPerTile) +
+                             6 * uint64_t(inSettings.mBuildingsPerTile);
     return 2 * tiles * perTile + inSettings.mGameObjects;
 }
 
@@ -75,6 +77,7 @@ Status LoadDemoWorld(const std::string& inPath, DemoSettings& ioSettings)
          }},
         {"props_per_tile", whole(0, 5000, settings.mPropsPerTile)},
         {"dynamic_per_tile", whole(0, 1000, settings.mDynamicPerTile)},
+        {"buildings_per_tile", whole(0, 16, settings.mBuildingsPerTile)},
         {"collision_radius", real(1.0f, 6.0f, settings.mCollisionRadius)},
         {"player_speed", real(0.0f, 100.0f, settings.mPlayerSpeed)},
         {"throw_balls",
@@ -107,7 +110,8 @@ Status LoadDemoWorld(const std::string& inPath, DemoSettings& ioSettings)
         return MakeError(ErrorCode::InvalidArgument,
                          inPath + ": the world would hold up to " + std::to_string(bodies) +
                              " bodies at once (tiles within collision_radius of the player and of the point "
-                             "ahead, each with its terrain, props_per_tile and dynamic_per_tile; and the "
+                             "ahead, each with its terrain, props_per_tile, dynamic_per_tile and "
+                             "buildings_per_tile huts; and the "
                              "game_objects), over the demo's " +
                              std::to_string(cDemoMaxBodies - cDemoSpareBodies));
     ioSettings = settings;

@@ -2,7 +2,8 @@
 
 // The demo's world as a JSON file (data/demo/world.json is the default), so that a world can be changed and
 // kept without a rebuild:
-//   { "seed": 1, "props_per_tile": 700, "dynamic_per_tile": 110, "collision_radius": 3.0,
+//   { "seed": 1, "props_per_tile": 700, "dynamic_per_tile": 110, "buildings_per_tile": 2,
+//   "collision_radius": 3.0,
 //     "player_speed": 8.0, "throw_balls": true, "agents": 8, "game_objects": 256, "game_object_jobs": 8,
 //     "collision_steps": 1, "candidate_margin": 0.25 }
 // Every key is optional (the settings' values stay); an unknown key is an error, so a typo is not ignored.

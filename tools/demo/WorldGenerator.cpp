@@ -383,6 +383,7 @@ WorldGenerator::WorldGenerator(const WorldSettings& inSettings) : mSettings(inSe
     mSettings.mTileSize = std::clamp(std::round(size), 8.0f, 1024.0f);
     mSettings.mPropsPerTile = std::clamp(mSettings.mPropsPerTile, 0, 100000);
     mSettings.mDynamicPerTile = std::clamp(mSettings.mDynamicPerTile, 0, 100000);
+    mSettings.mBuildingsPerTile = std::clamp(mSettings.mBuildingsPerTile, 0, 64);
     if (!std::isfinite(mSettings.mPlayerSpeed)) mSettings.mPlayerSpeed = 8.0f;
     mSettings.mPlayerSpeed = std::clamp(mSettings.mPlayerSpeed, -1000.0f, 1000.0f);
     mSeedHash = Mix64(mSettings.mSeed ^ 0x636169726e776f72ull);
@@ -617,16 +618,53 @@ TileContent WorldGenerator::GenerateTile(const WorldTile& inTile, bool inWithDyn
     content.mTerrain.mFriction = cStaticFriction;
     content.mTerrain.mNavMeshArea = 0;
 
-    // Props first; dynamic bodies draw from a stream of their own after them, so props are the same at every
-    // LOD
+    // Huts, then props; dynamic bodies draw from a stream of their own after them, so props are the same at
+    // every LOD
+    AddBuildings(context, tileSeed, content.mProps, content.mDoors);
     AddProps(context, content.mProps);
     if (inWithDynamic) AddDynamic(context, content.mDynamic);
     return content;
 }
 
+void WorldGenerator::AddBuildings(TileContext& ioContext, uint64_t inTileSeed,
+                                  std::vector<BodyCreationSettings>& outWalls,
+                                  std::vector<DoorSpec>& outDoors) const
+{
+    Pcg32 random(Hash(inTileSeed, 0x687574), 4);
+    const float radius = cBuildingFootprintRadius;
+    const auto ground = [&](float inX, float inZ)
+    { return ioContext.Height(inX - ioContext.mOriginX, inZ - ioContext.mOriginZ); };
+    std::vector<Candidate> footprint(1);
+    footprint[0].mShape = &GetBox(0, 0, 0); // Fits asks for a shape; only the footprint matters here
+    footprint[0].mFootRadius = radius;
+    // A handful of tries each: a tile with hills everywhere, or a small one, gets fewer huts
+    for (int tries = 0, built = 0;
+         built < mSettings.mBuildingsPerTile && tries < 20 * mSettings.mBuildingsPerTile; ++tries)
+    {
+        const float x = random.Range(radius, ioContext.mSize - radius);
+        const float z = random.Range(radius, ioContext.mSize - radius);
+        const Yaw yaw = RandomYaw(random);
+        const float period = random.Range(10.0f, 14.0f), phase = random.Range(0.0f, period);
+        footprint[0].mFootX = x;
+        footprint[0].mFootZ = z;
+        if (!ioContext.Fits(*this, footprint, cPropGap)) continue;
+        const BuildingSite site{ioContext.mOriginX + x, ioContext.mOriginZ + z, yaw.mCos, yaw.mSin,
+                                yaw.mRotation};
+        float lowest, highest;
+        GroundRange(site, ground, lowest, highest);
+        if (highest - lowest > cBuildingMaxGroundRise) continue;
+        DoorSpec door = MakeBuilding(mBuildingShapes, site, ground, lowest, cStaticFriction, outWalls);
+        door.mPeriod = period;
+        door.mPhase = phase;
+        outDoors.push_back(std::move(door));
+        ioContext.mGrid.Add(x, z, radius);
+        ++built;
+    }
+}
+
 void WorldGenerator::AddProps(TileContext& ioContext, std::vector<BodyCreationSettings>& outProps) const
 {
-    const size_t target = size_t(mSettings.mPropsPerTile);
+    const size_t target = size_t(mSettings.mPropsPerTile) + outProps.size();
     outProps.reserve(target);
     std::vector<Candidate> candidates;
     candidates.reserve(32);

@@ -10,7 +10,11 @@
 // and each call works on its own locals. Results are bit-identical for the same settings on any thread and,
 // as they use only integer hashing and IEEE float arithmetic (no <random> distributions, no libm
 // trigonometry), on any platform that does not contract float operations into FMAs.
+//
+// Buildings (Buildings.h: huts with a hinged door) are placed first, from a random stream of their own, so
+// that the props keep out of them; with mBuildingsPerTile 0 a tile's props are what they were before huts.
 
+#include "Buildings.h"
 #include "cairn/physics/body/BodyCreationSettings.h"
 
 #include <compare>
@@ -37,12 +41,14 @@ struct WorldSettings
     int mPropsPerTile = 700;   ///< Static props on each tile (boxes, convex hulls, small meshes)
     int mDynamicPerTile = 110; ///< Dynamic bodies on a high-LOD tile: crates, stacks, debris
     float mPlayerSpeed = 8.0f; ///< m/s along the player path
+    int mBuildingsPerTile = 2; ///< Huts with a door (fewer where the tile has no flat, free room for one)
 };
 
 struct TileContent
 {
     BodyCreationSettings mTerrain;              ///< A static height field covering the tile
-    std::vector<BodyCreationSettings> mProps;   ///< Static
+    std::vector<BodyCreationSettings> mProps;   ///< Static: the huts' walls, then the other props
+    std::vector<DoorSpec> mDoors;               ///< One per hut, at every LOD
     std::vector<BodyCreationSettings> mDynamic; ///< Dynamic, above the ground, asleep-ready
 };
 
@@ -95,6 +101,9 @@ private:
     /// The shared box shape of full sizes cBoxSizes[inX], [inY], [inZ].
     const ShapeRef& GetBox(int inX, int inY, int inZ) const;
 
+    /// Huts first, from a stream of their own (inTileSeed's): their footprints keep the props out.
+    void AddBuildings(TileContext& ioContext, uint64_t inTileSeed,
+                      std::vector<BodyCreationSettings>& outWalls, std::vector<DoorSpec>& outDoors) const;
     void AddProps(TileContext& ioContext, std::vector<BodyCreationSettings>& outProps) const;
     void AddDynamic(TileContext& ioContext, std::vector<BodyCreationSettings>& outDynamic) const;
     /// One cluster of props around (inX, inZ) (tile-local), appended to ioCandidates.
@@ -106,11 +115,12 @@ private:
     void MakeArch(TileContext& ioContext, float inX, float inZ, std::vector<Candidate>& ioCandidates) const;
 
     WorldSettings mSettings;
-    uint64_t mSeedHash = 0;        ///< The seed, mixed once
-    std::vector<ShapeRef> mBoxes;  ///< Every combination of cBoxSizes, index x + n * (y + n * z)
-    std::vector<Rock> mRocks;      ///< A handful of hull shapes
-    ShapeRef mRamp;                ///< A wedge mesh
-    ShapeRef mArch;                ///< A round arch mesh on two legs
+    uint64_t mSeedHash = 0;       ///< The seed, mixed once
+    std::vector<ShapeRef> mBoxes; ///< Every combination of cBoxSizes, index x + n * (y + n * z)
+    std::vector<Rock> mRocks;     ///< A handful of hull shapes
+    ShapeRef mRamp;               ///< A wedge mesh
+    ShapeRef mArch;               ///< A round arch mesh on two legs
+    BuildingShapes mBuildingShapes;
     std::vector<double> mPathArcs; ///< Arc length of the path from the start of a sine period, per sample
 };
 
