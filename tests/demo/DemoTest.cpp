@@ -2,7 +2,7 @@
 // (so tiles stream in and out several times): no body lost or duplicated by streaming, every navmesh tile the
 // agents asked for built, no agent inside a wall or off its navmesh for over a second, no corridor through a
 // polygon that is gone, doors whose rest rebuilt their tiles with the doorway shut or open as the door stood,
-// nothing reported wrong.
+// guards shot and gone limp, nothing reported wrong.
 
 #include "DemoReport.h"
 #include "DemoRunner.h"
@@ -78,6 +78,14 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(doors.mClosedChecks + doors.mOpenChecks, 0u) << inRun.mModeName;
     EXPECT_EQ(doors.mClosedBlocked, doors.mClosedChecks) << inRun.mModeName;
     EXPECT_EQ(doors.mOpenPassable, doors.mOpenChecks) << inRun.mModeName;
+    // Guards were shot at, and those hit went limp as ragdolls
+    const GuardStats& guards = inRun.mGuardStats;
+    std::printf("%s: guards %llu, shots %llu, hits %llu, at rest %llu\n", inRun.mModeName.c_str(),
+                (unsigned long long)guards.mPlaced, (unsigned long long)guards.mShots,
+                (unsigned long long)guards.mHits, (unsigned long long)guards.mAtRest);
+    EXPECT_GT(guards.mShots, 0u) << inRun.mModeName;
+    EXPECT_GT(guards.mHits, 0u) << inRun.mModeName;
+    EXPECT_EQ(guards.mMakeMs.size(), guards.mHits) << inRun.mModeName;
     for (const std::string& error : inRun.mErrors)
         ADD_FAILURE() << inRun.mModeName << ": " << error;
     // The run did what a demo does: streamed in and out, stepped, queried, built navmesh, walked

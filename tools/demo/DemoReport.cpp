@@ -450,6 +450,19 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
           {"closed blocked the path", Count(doors.mClosedBlocked) + " of " + Count(doors.mClosedChecks)},
           {"open let it through", Count(doors.mOpenPassable) + " of " + Count(doors.mOpenChecks)},
           {"checks skipped", Count(doors.mChecksSkipped)}}});
+    const GuardStats& guards = inRun.mGuardStats;
+    const SampleSummary make = Summarize(guards.mMakeMs);
+    const SampleSummary toRest = Summarize(guards.mSecondsToRest);
+    sections.push_back({"ragdolls",
+                        {{"guards stood", Count(guards.mPlaced)},
+                         {"shots", Count(guards.mShots)},
+                         {"hit, gone limp", Count(guards.mHits)},
+                         {"came to rest", Count(guards.mAtRest)},
+                         {"taken away moving", Count(guards.mRemovedBeforeRest)},
+                         {"make ms p50", Ms(make, make.mP50)},
+                         {"max", Ms(make, make.mMax)},
+                         {"s to rest p50", toRest.mCount == 0 ? std::string("n/a") : Fixed(toRest.mP50, 2)},
+                         {"max", toRest.mCount == 0 ? std::string("n/a") : Fixed(toRest.mMax, 2)}}});
     sections.push_back(
         {"navigation ms/frame",
          {{"main thread p50", Ms(navMain, navMain.mP50)},

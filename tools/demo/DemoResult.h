@@ -82,6 +82,19 @@ struct DoorStats
     std::vector<std::string> mErrors;
 };
 
+/// What the guards that go limp when hit did (Guards' figures, for the report).
+struct GuardStats
+{
+    uint64_t mPlaced = 0; ///< Guards stood on the path
+    uint64_t mShots = 0;  ///< Aimed balls
+    uint64_t mHits = 0;   ///< Guards a ball reached, made ragdolls
+    uint64_t mAtRest = 0; ///< Ragdolls that came to rest (every part asleep)
+    uint64_t mRemovedBeforeRest = 0;
+    std::vector<double> mMakeMs;        ///< Per hit: Ragdoll::Create (23 bodies in one batch, 22 joints), ms
+    std::vector<double> mSecondsToRest; ///< Per ragdoll at rest: from the hit
+    std::vector<std::string> mErrors;
+};
+
 /// Summary of a series of samples (milliseconds unless said otherwise).
 struct SampleSummary
 {
@@ -153,6 +166,7 @@ struct DemoRunResult
     int mAgents = 0;
     AgentStats mAgentStats;
     DoorStats mDoorStats;
+    GuardStats mGuardStats;
     /// The final navmesh of the human profile, for the map: each polygon's outline (x, z) and the build
     /// latency of its tile in frames (-1: not known, a tile built before the run)
     struct MapPolygon

@@ -3,6 +3,7 @@
 #include "Agents.h"
 #include "Doors.h"
 #include "GameObjects.h"
+#include "Guards.h"
 #include "Projectiles.h"
 #include "TileStreamer.h"
 #include "WorldGenerator.h"
@@ -223,6 +224,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     agents->WatchThreads(std::move(navigationThreads));
 
     Projectiles projectiles(physics, generator, inSettings.mSeed + 2);
+    Guards guards(physics, generator);
     Doors doors(physics, *streamer, {navMeshes.mNavMeshes[0].get(), navMeshes.mNavMeshes[1].get()},
                 {navMeshes.mSchedulers[0].get(), navMeshes.mSchedulers[1].get()});
     const float dt = 1.0f / 60.0f;
@@ -241,6 +243,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mMainThreadStreamHostTakenMs.push_back(streaming.mHostTakenMs);
 
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
+        guards.Update(frame, seconds, player, projectiles, inSettings.mThrowBalls);
         doors.Command(seconds);
 
         // A frame pipeline: the game objects' queries and the step are two jobs that run at once (each waits
@@ -273,6 +276,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mSteps.push_back(physics.GetLastStepStatistics());
         gameObjects->ApplyMoves(frameJobs, inSettings.mGameObjectJobs);
         doors.AfterStep();
+        guards.AfterStep(frame, projectiles);
         if (Status focused = navMeshes.Focus(player, navMeshRadius); !focused && result.mErrors.size() < 20)
             result.mErrors.push_back("navmesh invoker: " + focused.GetError().mMessage);
         agents->Update(dt, player, frameJobs);
@@ -298,7 +302,11 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     if (liveProgress) std::fprintf(inProgress, "\n");
     result.mGuestStealMs = tools::GuestStealMs() - stealBefore; // NaN where the guest does not count it
     result.mFrames = inSettings.mFrames;
-    projectiles.RemoveAll(); // Before the streamer counts the world's bodies
+    result.mGuardStats = guards.GetStats();
+    for (const std::string& error : result.mGuardStats.mErrors)
+        result.mErrors.push_back("guards: " + error);
+    guards.RemoveAll(); // Before the streamer counts the world's bodies
+    projectiles.RemoveAll();
 
     // Invariants: every tile the agents asked for gets built; no body lost or duplicated by streaming
     if (!RunUntil(

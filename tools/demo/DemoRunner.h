@@ -1,8 +1,8 @@
 #pragma once
 
 // DemoRunner: one run of the streaming open-world demo in one broad-phase mode. The main thread's frame:
-//   streaming focus -> balls thrown by the player -> doors on their timers -> physics step (job
-//   system) beside the game-object query jobs -> their moves (job threads) -> doors at rest
+//   streaming focus -> balls thrown by the player -> guards and doors on their timers -> physics step (job
+//   system) beside the game-object query jobs -> their moves (job threads) -> guards hit and doors at rest
 //   -> AI agents (goals and the two crowds: paths on a budget here, steering on the job threads) -> navmesh
 //   sync point (each profile's TileScheduler::Update) and the doors' rebuilds -> wait for the next 1/60 s
 //   tick.

@@ -18,7 +18,7 @@ constexpr float cSpeed = 14.0f;          ///< m/s
 
 Projectiles::Projectiles(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint64_t inSeed)
     : mPhysics(ioPhysics), mGenerator(inGenerator), mRandom(inSeed),
-      mShape(SphereShape::Create(0.35f).Value())
+      mShape(SphereShape::Create(cRadius).Value())
 {
 }
 
@@ -38,21 +38,38 @@ void Projectiles::Update(int inFrame, const Vec3& inPlayer)
     const float x = inPlayer.x() + d * std::cos(a), z = inPlayer.z() + d * std::sin(a);
     const Vec3 from = inPlayer + Vec3(0.0f, 2.0f, 0.0f);
     const Vec3 to(x, mGenerator.GetTerrainHeight(x, z) + 0.5f, z);
-    const float flight = (to - from).norm() / cSpeed;
+    Throw(inFrame, from, to, (to - from).norm() / cSpeed);
+}
+
+void Projectiles::ThrowAt(int inFrame, const Vec3& inFrom, const Vec3& inTarget)
+{
+    Throw(inFrame, inFrom, inTarget, cAimedFlightSeconds);
+}
+
+void Projectiles::Throw(int inFrame, const Vec3& inFrom, const Vec3& inTo, float inFlight)
+{
+    if (!(inFlight > 0.0f)) return;
     BodyCreationSettings settings;
     settings.mShape = mShape;
-    settings.mPosition = from;
+    settings.mPosition = inFrom;
     // Aimed to arrive after the flight time despite gravity
-    settings.mLinearVelocity = (to - from) / flight - 0.5f * flight * mPhysics.GetSettings().mGravity;
+    settings.mLinearVelocity = (inTo - inFrom) / inFlight - 0.5f * inFlight * mPhysics.GetSettings().mGravity;
     settings.mDensity = 3000.0f;
     settings.mObjectLayer = Layers::cMoving;
     settings.mFriction = 0.5f;
     // Fast and small: swept from where each step starts, so a ball never passes through a thin crate or wall
     settings.mMotionQuality = MotionQuality::LinearCast;
-    Result<BodyID> id = bodies.CreateAndAddBody(settings, Activation::Activate);
+    Result<BodyID> id = mPhysics.GetBodyInterface().CreateAndAddBody(settings, Activation::Activate);
     if (!id) return;
     mBalls.push_back({id.Value(), inFrame});
     ++mThrown;
+}
+
+void Projectiles::GetBalls(std::vector<BodyID>& outBalls) const
+{
+    outBalls.clear();
+    for (const Ball& ball : mBalls)
+        outBalls.push_back(ball.mBody);
 }
 
 void Projectiles::RemoveAll()
