@@ -19,12 +19,14 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 
-constexpr float cRadius = 0.3f;        ///< m, the standing capsule's
-constexpr float cStance = 0.35f;       ///< m from the middle that the ragdoll's feet and toes reach
-constexpr float cSideOffset = 1.2f;    ///< m from the path's middle: inside its prop-free corridor
-constexpr float cPlaceSpacing = 0.75f; ///< s of the player's walk between guards
-/// The player shoots at a guard it will reach in this many seconds (far enough for the ball to fly)
-constexpr float cShootFrom = 0.8f, cShootTo = 1.6f;
+constexpr float cRadius = 0.3f;     ///< m, the standing capsule's
+constexpr float cStance = 0.35f;    ///< m from the middle that the ragdoll's feet and toes reach
+constexpr float cSideOffset = 1.2f; ///< m from the path's middle: inside its prop-free corridor
+/// Guards stand at least this far ahead of the player when placed, this far apart along its path (m)
+constexpr float cPlaceAhead = 20.0f, cPlaceSpacing = 6.0f;
+/// The player shoots at a guard this far ahead (m along the path, at the player's speed): near enough that
+/// a hill between them seldom takes the ball, far enough to see it fly
+constexpr float cShootFrom = 6.0f, cShootTo = 14.0f;
 constexpr int cFramesBetweenShots = 45;    ///< At one guard, when a shot missed
 constexpr float cLeftBehindSeconds = 1.5f; ///< A standing guard the player passed this long ago goes
 /// And a limp one this far behind: streaming takes the ground away from under what the player leaves far
@@ -109,6 +111,15 @@ void Guards::Remove(Guard& ioGuard)
     ioGuard = Guard();
 }
 
+void Guards::GetLimpBodies(std::vector<BodyID>& outBodies) const
+{
+    outBodies.clear();
+    for (const Guard& guard : mGuards)
+        if (guard.mRagdoll)
+            outBodies.insert(outBodies.end(), guard.mRagdoll->GetBodies().begin(),
+                             guard.mRagdoll->GetBodies().end());
+}
+
 void Guards::RemoveAll()
 {
     for (Guard& guard : mGuards)
@@ -119,7 +130,9 @@ void Guards::Update(int inFrame, float inSeconds, const Vec3& inPlayer, Projecti
                     bool inShoot)
 {
     const int limpFrames = int(cLimpSeconds * 60.0f);
-    mNextPathTime = std::max(mNextPathTime, inSeconds + 3.0f);
+    // Distances along the path as the player's seconds (a player standing still gets guards a metre a second)
+    const float speed = std::max(1.0f, std::abs(mGenerator.GetSettings().mPlayerSpeed));
+    mNextPathTime = std::max(mNextPathTime, inSeconds + cPlaceAhead / speed);
     for (Guard& guard : mGuards)
     {
         const bool standing = !guard.mCapsule.IsInvalid();
@@ -132,11 +145,11 @@ void Guards::Update(int inFrame, float inSeconds, const Vec3& inPlayer, Projecti
         if (guard.mCapsule.IsInvalid() && !guard.mRagdoll)
         {
             Place(guard, mNextPathTime, mNextSide);
-            mNextPathTime += cPlaceSpacing;
+            mNextPathTime += cPlaceSpacing / speed;
             mNextSide = -mNextSide;
             continue;
         }
-        const float ahead = guard.mPathTime - inSeconds;
+        const float ahead = (guard.mPathTime - inSeconds) * mGenerator.GetSettings().mPlayerSpeed;
         if (inShoot && !guard.mCapsule.IsInvalid() && ahead >= cShootFrom && ahead <= cShootTo &&
             (guard.mShotFrame < 0 || inFrame - guard.mShotFrame > cFramesBetweenShots))
         {

@@ -2,12 +2,12 @@
 
 // Guards: characters along the player's path that go limp when a ball hits them. A standing guard is one
 // kinematic capsule on the path ahead of the player (a game's character controller; the path's corridor is
-// kept clear of props), and the player shoots at it as it comes near. When a ball comes within reach of the
-// capsule, the capsule gives way to a humanoid ragdoll in the same place (HumanoidRagdoll.h: 23 parts and 22
-// swing-twist joints), its bodies added as one broad-phase batch (Ragdoll::Create), pushed the way the ball
-// flew; it falls limp and its joints' limits and friction settle it. At rest its parts are sleeping dynamic
-// bodies: navmesh obstacles, whose tiles are rebuilt around them. A limp guard is taken away after
-// cLimpSeconds or once the player is 60 m past it, and a new one stands ahead.
+// kept clear of props), and the player shoots at it 6-14 m before it reaches it. When a ball comes within
+// reach of the capsule, the capsule gives way to a humanoid ragdoll in the same place (HumanoidRagdoll.h: 23
+// parts and 22 swing-twist joints), its bodies added as one broad-phase batch (Ragdoll::Create), pushed the
+// way the ball flew; it falls limp and its joints' limits and friction settle it. At rest its parts are
+// sleeping dynamic bodies: navmesh obstacles, whose tiles are rebuilt around them. A limp guard is taken away
+// after cLimpSeconds or once the player is 60 m past it, and a new one stands ahead.
 //
 // Threads: the main thread only, outside the physics step (it owns everything here).
 
@@ -45,6 +45,8 @@ public:
     void RemoveAll();
 
     const GuardStats& GetStats() const { return mStats; }
+    /// The bodies of the guards gone limp and not yet taken away (for checks).
+    void GetLimpBodies(std::vector<BodyID>& outBodies) const;
 
 private:
     struct Guard
@@ -69,7 +71,7 @@ private:
     RagdollSettings mRagdoll; ///< The humanoid, made once
     ShapeRef mCapsule;
     std::vector<Guard> mGuards;
-    float mNextPathTime = 3.0f; ///< Of the next guard placed
+    float mNextPathTime = 0.0f; ///< Of the next guard placed
     uint32_t mNextGroup = 1;    ///< Each ragdoll's collision group
     int mNextSide = 1;
     std::vector<BodyID> mBalls; ///< Scratch
