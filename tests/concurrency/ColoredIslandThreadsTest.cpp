@@ -1,20 +1,24 @@
 // A colored island (a pyramid of boxes on a floor, one island of a few hundred contacts) solved by every
 // thread of the job system at once: the colors' stages synchronise on counters, the parts of a color go to
 // whichever thread takes them first. And small islands solved four at a time, groups on all threads; and
-// several colored islands too small to need every thread, each solved by one thread at once. Under
+// several colored islands too small to need every thread, each solved by one thread at once; and jointed
+// islands colored with their joints (a pile of ragdolls; a hub whose joints overflow the colors). Under
 // ThreadSanitizer (this suite's label) that must show no race, and with 2 and 4 threads the bodies must end
 // exactly where one thread puts them.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/ragdoll/HumanoidRagdoll.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "common/MakePhysicsSystem.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
+#include <cmath>
 #include <gtest/gtest.h>
 #include <memory>
+#include <numbers>
 #include <thread>
 #include <vector>
 
@@ -36,7 +40,9 @@ enum class Scene
     SmallStacks,     ///< 40 stacks of one to three boxes (islands of up to four constraints)
     SeveralPyramids, ///< Six 5-layer pyramids apart, a bouncy ball on each: six colored islands, each under a
                      ///< quarter of the step
-    LoadedPlank ///< 144 boxes on one dynamic plank: its 145 contacts cannot all take one of the 64 colors
+    LoadedPlank, ///< 144 boxes on one dynamic plank: its 145 contacts cannot all take one of the 64 colors
+    RagdollPile, ///< Six humanoid ragdolls dropped onto each other: one island of 132 joints and the contacts
+    JointedHub   ///< 160 balls each jointed to one hub: joints that cannot all take one of the 64 colors
 };
 
 struct SceneWorld
@@ -115,6 +121,45 @@ SceneWorld MakeScene(Scene inScene)
         body.mRestitution = 0.8f;
         boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
     }
+    // Ragdolls lying on their backs, each turned a little more and 0.45 m above the last
+    const RagdollSettings humanoid = MakeHumanoidRagdoll();
+    for (uint32_t i = 0; inScene == Scene::RagdollPile && i < 6; ++i)
+    {
+        const Quat lying = Quat(Eigen::AngleAxisf(0.9f * float(i), Vec3::UnitY())) *
+                           Quat(Eigen::AngleAxisf(0.5f * std::numbers::pi_v<float>, Vec3::UnitZ()));
+        Result<Ragdoll> ragdoll =
+            Ragdoll::Create(*world.mSystem, humanoid, Vec3(0.1f * float(i), 0.5f + 0.45f * float(i), 0.0f),
+                            lying, i + 1, Activation::Activate);
+        EXPECT_TRUE(ragdoll.IsOk());
+        if (ragdoll)
+            boxes.insert(boxes.end(), ragdoll.Value().GetBodies().begin(), ragdoll.Value().GetBodies().end());
+    }
+    // A hub with rings of balls, each on a point joint to it: every joint shares the hub, so 64 take a color
+    // each and the other 96 form the island's serial range
+    if (inScene == Scene::JointedHub)
+    {
+        BodyCreationSettings hub;
+        hub.mShape = SphereShape::Create(0.5f).Value();
+        hub.mPosition = Vec3(0.0f, 6.0f, 0.0f);
+        hub.mObjectLayer = Layers::cMoving;
+        const BodyID hubID = bodies.CreateAndAddBody(hub, Activation::Activate).Value();
+        boxes.push_back(hubID);
+        for (int i = 0; i < 160; ++i)
+        {
+            BodyCreationSettings body;
+            body.mShape = ball;
+            // Five rings of 32, 0.8 m apart in height: the balls 0.69 m apart on a ring, none touching
+            const float turn = 0.1963495f * float(i / 5), height = 6.0f + 0.8f * float(i % 5) - 1.6f;
+            body.mPosition = Vec3(3.5f * std::cos(turn), height, 3.5f * std::sin(turn));
+            body.mObjectLayer = Layers::cMoving;
+            boxes.push_back(bodies.CreateAndAddBody(body, Activation::Activate).Value());
+            PointConstraintSettings joint;
+            joint.mBodyA = hubID;
+            joint.mBodyB = boxes.back();
+            joint.mPoint = 0.5f * (hub.mPosition + body.mPosition);
+            EXPECT_TRUE(world.mSystem->GetConstraintInterface().AddPoint(joint).IsOk());
+        }
+    }
     return world;
 }
 
@@ -157,17 +202,16 @@ void ExpectSamePoses(const std::vector<Pose>& inPoses, const std::vector<Pose>& 
             << inReference[i].mPosition.transpose();
 }
 
-/// Steps inScene without a job system and returns the last step's statistics; expects the same poses on 2
-/// and 4 job threads.
-StepStatistics ExpectSameOnTwoAndFourThreads(Scene inScene)
+/// Steps inScene inSteps times without a job system and returns the last step's statistics; expects the same
+/// poses on 2 and 4 job threads.
+StepStatistics ExpectSameOnTwoAndFourThreads(Scene inScene, int inSteps = 40)
 {
-    constexpr int cSteps = 40;
     StepStatistics stats;
-    const std::vector<Pose> reference = StepScene(inScene, 0, cSteps, stats);
+    const std::vector<Pose> reference = StepScene(inScene, 0, inSteps, stats);
     for (uint32_t threads : {2u, 4u})
     {
         StepStatistics unused;
-        ExpectSamePoses(StepScene(inScene, threads, cSteps, unused), reference,
+        ExpectSamePoses(StepScene(inScene, threads, inSteps, unused), reference,
                         threads == 2 ? "with 2 threads" : "with 4 threads");
     }
     return stats;
@@ -195,6 +239,20 @@ TEST(ColoredIslandThreadsTest, IslandsSolvedAloneSameResultOnOneTwoAndFourThread
     EXPECT_GE(stats.mNumIslands, 6u);
     EXPECT_LE(stats.mNumIslands, 12u);
     EXPECT_GE(stats.mNumManifolds, 6u * 128u);
+}
+
+TEST(ColoredIslandThreadsTest, JointedIslandsColoredWithTheirJointsSameResultOnOneTwoAndFourThreads)
+{
+    // Joints take part in the coloring (a color's joints and contacts share no dynamic body) and each part of
+    // a color solves its joints, then its contacts, in the velocity and position passes
+    for (const Scene scene : {Scene::RagdollPile, Scene::JointedHub})
+    {
+        SCOPED_TRACE(scene == Scene::RagdollPile ? "ragdoll pile" : "jointed hub");
+        // The pile is one island once the ragdolls have fallen onto each other
+        const StepStatistics stats =
+            ExpectSameOnTwoAndFourThreads(scene, scene == Scene::RagdollPile ? 120 : 40);
+        EXPECT_GE(stats.mNumColoredIslands, 1u);
+    }
 }
 
 TEST(ColoredIslandThreadsTest, TwoWorldsOnOneJobSystemAtOnce)

@@ -347,22 +347,29 @@ template <class Visit> void JointStage::VisitVelocityRows(StepJoint& ioJoint, co
     }
 }
 
-void JointStage::WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies)
+void JointStage::GetActiveIndices(uint32_t inJoint, uint32_t& outA, uint32_t& outB) const
 {
-    for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
+    const StepJoint& joint = mStepJoints[inJoint];
+    outA = IsActiveDynamic(joint.mA) ? joint.mA->GetActiveIndex() : UINT32_MAX;
+    outB = IsActiveDynamic(joint.mB) ? joint.mB->GetActiveIndex() : UINT32_MAX;
+}
+
+void JointStage::WarmStart(std::span<const uint32_t> inJoints, std::span<SolverBody> ioBodies)
+{
+    for (const uint32_t index : inJoints)
     {
-        StepJoint& joint = mStepJoints[mIslandJoints[j]];
+        StepJoint& joint = mStepJoints[index];
         Prepare(joint);
         VisitVelocityRows(joint, [&](auto& ioPart)
                           { ioPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
     }
 }
 
-void JointStage::SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodies)
+void JointStage::SolveVelocities(std::span<const uint32_t> inJoints, std::span<SolverBody> ioBodies)
 {
-    for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
+    for (const uint32_t index : inJoints)
     {
-        StepJoint& joint = mStepJoints[mIslandJoints[j]];
+        StepJoint& joint = mStepJoints[index];
         VisitVelocityRows(joint, [&](auto& ioPart)
                           { ioPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
     }
@@ -417,11 +424,11 @@ void JointStage::BreakOverloaded()
     }
 }
 
-void JointStage::SolvePositions(uint32_t inIsland, const SolverSettings& inSettings)
+void JointStage::SolvePositions(std::span<const uint32_t> inJoints, const SolverSettings& inSettings)
 {
-    for (uint32_t j = mJointStart[inIsland]; j < mJointStart[inIsland + 1]; ++j)
+    for (const uint32_t index : inJoints)
     {
-        StepJoint& joint = mStepJoints[mIslandJoints[j]];
+        StepJoint& joint = mStepJoints[index];
         // The rows again at the integrated poses (the arms turned with their bodies), then the part of the
         // error the position iterations take out
         Prepare(joint);

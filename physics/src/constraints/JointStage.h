@@ -5,11 +5,13 @@
 // chains of joints, in slot order); after the narrow phase it links the islands of the joints' two active
 // dynamic bodies; after the islands are numbered it groups the joints by island (slot order within one). The
 // solver then runs each island's joints in the island's passes: warm start and velocity rows before the
-// contacts', and position rows before the contacts' after integration.
+// contacts', and position rows before the contacts' after integration; in a large island colored for every
+// thread, a color's joints before its contacts, the colors in turn (IslandStage::ColorIsland).
 //
 // Threads: BeginStep, LinkIslands and GroupByIsland on the updating thread, while Update holds the joints'
 // mutex; the solve calls from the thread that solves the island, which writes only that island's joints and
-// its bodies.
+// its bodies; or, in a colored island, from the threads that solve a color's parts, each writing only its
+// part's joints and their bodies (a color's joints and contacts share no dynamic body).
 
 #include "constraints/ConstraintManager.h"
 #include "solver/SolverBody.h"
@@ -40,13 +42,25 @@ public:
     }
     uint32_t GetNumStepJoints() const { return uint32_t(mStepJoints.size()); }
 
-    // The solve of island inIsland, by the thread that solves it; ioBodies: the solver's velocity blocks by
-    // active index
+    /// The island's joints: indices of this step's joints, in slot order.
+    std::span<const uint32_t> GetIslandJoints(uint32_t inIsland) const
+    {
+        if (mStepJoints.empty()) return {};
+        return {mIslandJoints.data() + mJointStart[inIsland],
+                mIslandJoints.data() + mJointStart[inIsland + 1]};
+    }
+    /// The active indices of step joint inJoint's two bodies, UINT32_MAX for a side that is not an active
+    /// dynamic body (the world, static, kinematic): what a coloring keeps apart.
+    void GetActiveIndices(uint32_t inJoint, uint32_t& outA, uint32_t& outB) const;
+
+    // The solve of step joints inJoints (an island's, or a color's part of a colored island's), by the thread
+    // that solves them; ioBodies: the solver's velocity blocks by active index. Joints solved at once on
+    // other threads must share no dynamic body with these
     /// Sets the rows from the poses at the step's start and applies the last step's impulses.
-    void WarmStart(uint32_t inIsland, std::span<SolverBody> ioBodies);
-    void SolveVelocities(uint32_t inIsland, std::span<SolverBody> ioBodies);
+    void WarmStart(std::span<const uint32_t> inJoints, std::span<SolverBody> ioBodies);
+    void SolveVelocities(std::span<const uint32_t> inJoints, std::span<SolverBody> ioBodies);
     /// One position iteration, on the integrated poses.
-    void SolvePositions(uint32_t inIsland, const SolverSettings& inSettings);
+    void SolvePositions(std::span<const uint32_t> inJoints, const SolverSettings& inSettings);
 
     /// After the solve, on the updating thread: the joints whose force or torque this step was above their
     /// thresholds are disabled and reported, in slot order.

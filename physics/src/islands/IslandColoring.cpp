@@ -1,7 +1,8 @@
-// IslandStage's coloring of a large island: its constraints ordered by color, no two constraints of a color
-// sharing a dynamic body, so that every thread can solve a part of each color at once. A coloring is reused
-// while the island's constraints join the same bodies in the same order (a resting pile).
+// IslandStage's coloring of a large island: its constraints ordered by color and its joints listed by color,
+// no two of a color sharing a dynamic body, so that every thread can solve a part of each color at once. A
+// coloring is reused while the island's constraints join the same bodies in the same order (a resting pile).
 
+#include "constraints/JointStage.h"
 #include "islands/IslandStage.h"
 #include "math/RadixSort.h"
 #include "narrowphase/ContactsStage.h"
@@ -14,10 +15,12 @@ namespace cairn::physics
 {
 
 void IslandStage::ColorIsland(const StepContext& inContext, std::span<const ConstraintInfo> inInfo,
-                              uint32_t inIsland)
+                              const JointStage& inJoints, uint32_t inIsland)
 {
     const uint32_t begin = mPlan.mConstraintStart[inIsland], end = mPlan.mConstraintStart[inIsland + 1];
-    const uint32_t size = end - begin;
+    const uint32_t numContacts = end - begin;
+    const std::span<const uint32_t> joints = inJoints.GetIslandJoints(inIsland);
+    const uint32_t size = numContacts + uint32_t(joints.size());
     // This step's record; the previous step's of the same size is the candidate for reuse
     std::vector<ColoringRecord>& records = mColorings[mCurrentColorings];
     if (records.size() <= mNumColorings[mCurrentColorings]) records.emplace_back();
@@ -28,13 +31,22 @@ void IslandStage::ColorIsland(const StepContext& inContext, std::span<const Cons
             if (ColoringRecord& candidate = mColorings[1 - mCurrentColorings][r];
                 candidate.mBodyPairs.size() == size)
                 previous = &candidate;
-    // The coloring is a function of the constraints' bodies in solve order alone
+    // The coloring is a function of the constraints' bodies in solve order and the joints' in slot order
+    // alone: a joint is one more pair of bodies to keep apart
     record.mBodyPairs.resize(size);
     bool same = previous != nullptr;
     for (uint32_t i = 0; i < size; ++i)
     {
-        const ConstraintInfo& info = inInfo[mOrderItems[begin + i].mConstraint];
-        record.mBodyPairs[i] = uint64_t(info.mBodyA) << 32 | info.mBodyB;
+        uint32_t indexA, indexB;
+        if (i < numContacts)
+        {
+            const ConstraintInfo& info = inInfo[mOrderItems[begin + i].mConstraint];
+            indexA = info.mBodyA;
+            indexB = info.mBodyB;
+        }
+        else
+            inJoints.GetActiveIndices(joints[i - numContacts], indexA, indexB);
+        record.mBodyPairs[i] = uint64_t(indexA) << 32 | indexB;
         same = same && record.mBodyPairs[i] == previous->mBodyPairs[i];
     }
     if (same)
@@ -46,27 +58,33 @@ void IslandStage::ColorIsland(const StepContext& inContext, std::span<const Cons
     }
     else
         ComputeColoring(inContext, record);
-    const std::array<uint32_t, cSerialColor + 1>& count = record.mCount;
-    std::vector<ContactConstraint*>& constraints = mPlan.mIslandConstraints;
-    mColorScratch.resize(size);
-    for (uint32_t i = 0; i < size; ++i)
-        mColorScratch[i] = constraints[begin + record.mOrder[i]];
-    std::copy(mColorScratch.begin(), mColorScratch.end(), constraints.begin() + begin);
 
+    // The contacts into color order in place; the joints, by color, to the plan's list
+    std::vector<ContactConstraint*>& constraints = mPlan.mIslandConstraints;
+    mColorScratch.clear();
     mPlan.mIslandFirstColor[inIsland] = uint32_t(mPlan.mColorStart.size());
-    uint32_t offset = begin;
+    uint32_t position = 0;
     for (uint32_t color = 0; color <= cSerialColor; ++color)
     {
-        if (count[color] != 0)
-        {
-            mPlan.mColorStart.push_back(offset);
-            mPlan.mColorIsSerial.push_back(color == cSerialColor ? 1 : 0);
-            mPlan.mColorFirstBatch.push_back(mPlan.mNumWideBatches);
-            if (color != cSerialColor) mPlan.mNumWideBatches += (count[color] + 3) / 4;
-        }
-        offset += count[color];
+        const uint32_t count = record.mCount[color];
+        if (count == 0) continue;
+        const uint32_t contactsBefore = uint32_t(mColorScratch.size());
+        mPlan.mColorStart.push_back(begin + contactsBefore);
+        mPlan.mColorJointStart.push_back(uint32_t(mPlan.mColorJoints.size()));
+        for (const uint32_t item : std::span(record.mOrder).subspan(position, count))
+            if (item < numContacts)
+                mColorScratch.push_back(constraints[begin + item]);
+            else
+                mPlan.mColorJoints.push_back(joints[item - numContacts]);
+        position += count;
+        const uint32_t contacts = uint32_t(mColorScratch.size()) - contactsBefore;
+        mPlan.mColorIsSerial.push_back(color == cSerialColor ? 1 : 0);
+        mPlan.mColorFirstBatch.push_back(mPlan.mNumWideBatches);
+        if (color != cSerialColor) mPlan.mNumWideBatches += (contacts + 3) / 4;
     }
+    std::copy(mColorScratch.begin(), mColorScratch.end(), constraints.begin() + begin);
     mPlan.mColorStart.push_back(end);
+    mPlan.mColorJointStart.push_back(uint32_t(mPlan.mColorJoints.size()));
     mPlan.mColorIsSerial.push_back(0); // The end marker
     mPlan.mColorFirstBatch.push_back(mPlan.mNumWideBatches);
 }

@@ -61,8 +61,10 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
 
     // Only an island that holds a good share of the step's work is colored: smaller ones are better solved
     // whole, several at once. Both limits ignore the thread count, so results do not depend on it
+    // Joints count as constraints here: a large island of jointed bodies is colored as a pile is
     const uint32_t coloredMin =
-        std::max(cColoredIslandMinConstraints, uint32_t(inConstraints.size() / cColoredIslandMinShare));
+        std::max(cColoredIslandMinConstraints,
+                 uint32_t((inConstraints.size() + inJoints.GetNumStepJoints()) / cColoredIslandMinShare));
     // Islands by size, largest first (ties by number): the order both the colored ones and the others are
     // solved in. A counting sort: most islands are one or two bodies, and comparing thousands of them took a
     // tenth of a step of falling bodies
@@ -86,6 +88,8 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
     mPlan.mColorFirstBatch.clear();
     mPlan.mNumWideBatches = 0;
     mPlan.mColorIsSerial.clear();
+    mPlan.mColorJointStart.clear();
+    mPlan.mColorJoints.clear();
     mPlan.mColoredIslands.clear();
     // The other islands with at most cGroupMaxConstraints constraints are solved in groups (see below)
     const bool wide = CAIRN_WIDE_SOLVER && inContext.mSettings.mSolver.mWideColoredIslands;
@@ -97,16 +101,17 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
     for (uint32_t island : mIslandOrder)
     {
         const uint32_t numConstraints = constraintStart[island + 1] - constraintStart[island];
-        if (inJoints.HasJoints(island))
-            mPlan.mSolvedIslands.push_back(island); // Whole, by one thread: see Order's declaration
-        else if (numConstraints >= coloredMin)
+        const uint32_t numJoints = uint32_t(inJoints.GetIslandJoints(island).size());
+        if (numConstraints + numJoints >= coloredMin)
             mPlan.mColoredIslands.push_back(island);
+        else if (numJoints > 0)
+            mPlan.mSolvedIslands.push_back(island); // Whole, by one thread: see Order's declaration
         else if (wide && numConstraints >= cColoredIslandMinConstraints)
         {
             // Large, but not a share of the step that needs every thread: colored all the same, for the wide
             // solver, and solved by one thread (a pyramid's layers before they settle into one island were
             // solved by the scalar solver, a tenth of those steps)
-            ColorIsland(inContext, inInfo, island);
+            ColorIsland(inContext, inInfo, inJoints, island);
             mPlan.mSolvedIslands.push_back(island);
         }
         else if (numConstraints > 0)
@@ -116,7 +121,7 @@ void IslandStage::Order(const StepContext& inContext, std::span<ContactConstrain
                 mPlan.mUnconstrainedBodies.push_back(activeIndex);
     }
     for (uint32_t island : mPlan.mColoredIslands)
-        ColorIsland(inContext, inInfo, island);
+        ColorIsland(inContext, inInfo, inJoints, island);
 
     // What the other islands' solve runs over: the larger ones one by one (largest first), then the small
     // ones (a crate on the ground, two touching) four at a time in the wide solver's lanes, where one at a

@@ -26,8 +26,10 @@ class IslandStage
 public:
     /// Finalizes the islands (numbered by lowest body) and groups the constraints by island: O(N).
     void Build(const StepContext& inContext, std::span<const ConstraintInfo> inInfo);
-    /// The solver's order: hashed within each island; large islands colored.
-    /// An island with joints (inJoints) is solved whole by one thread (SolveIsland), whatever its size.
+    /// The solver's order: hashed within each island; large islands colored. An island with joints (inJoints)
+    /// is colored, its joints with its contacts, when it holds a quarter of the step's contacts and joints
+    /// (and at least cColoredIslandMinConstraints); a smaller one is solved whole by one thread
+    /// (SolveIsland).
     void Order(const StepContext& inContext, std::span<ContactConstraint* const> inConstraints,
                std::span<const ConstraintInfo> inInfo, const JointStage& inJoints);
 
@@ -68,13 +70,16 @@ private:
     /// the same bodies in most steps, and its coloring (greedy, then a sort) is serial work
     struct ColoringRecord
     {
-        std::vector<uint64_t> mBodyPairs; ///< Per constraint in solve order: active index A << 32 | B
-        std::vector<uint32_t> mOrder;     ///< Island positions in color order
-        std::array<uint32_t, cSerialColor + 1> mCount{}; ///< Constraints per color
+        /// Per constraint in solve order, then per joint in slot order: active index A << 32 | B
+        std::vector<uint64_t> mBodyPairs;
+        std::vector<uint32_t> mOrder;                    ///< Positions in mBodyPairs in color order
+        std::array<uint32_t, cSerialColor + 1> mCount{}; ///< Constraints and joints per color
     };
 
-    /// Orders a large island's constraints by color: within a color no two constraints share a dynamic body.
-    void ColorIsland(const StepContext& inContext, std::span<const ConstraintInfo> inInfo, uint32_t inIsland);
+    /// Orders a large island's constraints by color and lists its joints by color: within a color no two
+    /// constraints or joints share a dynamic body.
+    void ColorIsland(const StepContext& inContext, std::span<const ConstraintInfo> inInfo,
+                     const JointStage& inJoints, uint32_t inIsland);
     /// The greedy coloring of ioRecord.mBodyPairs: fills its order and counts.
     void ComputeColoring(const StepContext& inContext, ColoringRecord& ioRecord);
 

@@ -1,10 +1,10 @@
 #pragma once
 
 // SolvePlan: what the islands stage hands the solver. The step's constraints grouped by island, each island's
-// in solve order (a colored island's by color), which islands are solved how (by every thread, alone, or
-// four small ones together in the wide solver's lanes), and the colors. Written by IslandStage on the
-// updating thread; read by the solver's jobs, which also rewrite mIslandConstraints' entries (each task its
-// own islands') to point at the copies they solve.
+// in solve order (a colored island's by color, with its joints' colors beside them), which islands are solved
+// how (by every thread, alone, or four small ones together in the wide solver's lanes), and the colors.
+// Written by IslandStage on the updating thread; read by the solver's jobs, which also rewrite
+// mIslandConstraints' entries (each task its own islands') to point at the copies they solve.
 
 #include "solver/ContactConstraint.h"
 
@@ -49,6 +49,10 @@ struct SolvePlan
     std::vector<uint32_t>
         mColorStart; ///< Offsets into mIslandConstraints; a color ends where the next starts
     std::vector<uint8_t> mColorIsSerial; ///< Per mColorStart entry: 1 for the range of uncolored constraints
+    /// Per mColorStart entry: its joints' first entry in mColorJoints (a color's joints share no dynamic body
+    /// with each other nor with the color's contacts); the end marker: the island's end
+    std::vector<uint32_t> mColorJointStart;
+    std::vector<uint32_t> mColorJoints; ///< The colored islands' joints (JointStage's step indices) by color
     /// Per mColorStart entry: the color's first batch of four in the wide solver's batches (the end marker:
     /// the island's end). Every colored island has its own slice, so islands solved alone at once never share
     /// batches
@@ -66,6 +70,12 @@ struct SolvePlan
     {
         return {mIslandConstraints.data() + mColorStart[inColor],
                 mIslandConstraints.data() + mColorStart[inColor + 1]};
+    }
+    /// The joints of color inColor (of the colored islands).
+    std::span<const uint32_t> ColorJoints(uint32_t inColor) const
+    {
+        return {mColorJoints.data() + mColorJointStart[inColor],
+                mColorJoints.data() + mColorJointStart[inColor + 1]};
     }
     bool IsColored(uint32_t inIsland) const { return mIslandFirstColor[inIsland] != UINT32_MAX; }
 };

@@ -1,8 +1,9 @@
-// IslandSolver's colored islands: a color's constraints share no dynamic body, so every thread solves a part
-// of each color at once, the colors in turn (StepScheduler::RunStages); with the wide solver, four manifolds
-// at a time in SIMD lanes, packed straight from the narrow phase's buffers.
+// IslandSolver's colored islands: a color's constraints and joints share no dynamic body, so every thread
+// solves a part of each color at once, the colors in turn (StepScheduler::RunStages); with the wide solver,
+// four manifolds at a time in SIMD lanes, packed straight from the narrow phase's buffers.
 
 #include "body/Integration.h"
+#include "constraints/JointStage.h"
 #include "solver/IslandSolver.h"
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
@@ -24,9 +25,11 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
     // no two constraints share a dynamic body, so its parts may run at once (one per thread, the same region
     // for the same thread in every color); the range of constraints that found no color shares bodies and
     // runs as one part
-    // inItems: per entry of mPlan->mIslandConstraints (the constraints or their position constraints)
+    // inItems: per entry of mPlan->mIslandConstraints (the constraints or their position constraints). A
+    // color's joints are cut into the same parts and solved first in each (inSolveJoints(pass, joints)), as
+    // an island solved whole solves its joints before its contacts
     const uint32_t numColors = lastColor - firstColor + 1;
-    auto colorPasses = [&](int inPasses, auto inItems, const auto& inSolve)
+    auto colorPasses = [&](int inPasses, auto inItems, const auto& inSolve, const auto& inSolveJoints)
     {
         scheduler.RunStages(
             inAlone, uint32_t(std::max(inPasses, 0)) * numColors,
@@ -35,17 +38,19 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
                 const uint32_t color = firstColor + inStage % numColors;
                 return mPlan->mColorIsSerial[color] != 0
                            ? 1u
-                           : scheduler.PartsFor(uint32_t(mPlan->ColorConstraints(color).size()),
+                           : scheduler.PartsFor(uint32_t(mPlan->ColorConstraints(color).size() +
+                                                         mPlan->ColorJoints(color).size()),
                                                 StepCosts::cMinConstraintsPerPart);
             },
             [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
             {
                 const uint32_t color = firstColor + inStage % numColors;
-                inSolve(int(inStage / numColors),
-                        StepScheduler::PartOf(
-                            inItems.subspan(mPlan->mColorStart[color],
-                                            mPlan->mColorStart[color + 1] - mPlan->mColorStart[color]),
-                            inPart, inParts));
+                const int pass = int(inStage / numColors);
+                inSolveJoints(pass, StepScheduler::PartOf(mPlan->ColorJoints(color), inPart, inParts));
+                inSolve(pass, StepScheduler::PartOf(
+                                  inItems.subspan(mPlan->mColorStart[color],
+                                                  mPlan->mColorStart[color + 1] - mPlan->mColorStart[color]),
+                                  inPart, inParts));
             });
     };
     const std::span<ContactConstraint* const> constraints(mPlan->mIslandConstraints);
@@ -57,19 +62,29 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
     if (wide)
         SolveColoredVelocitiesWide(firstColor, lastColor, !bounces, inAlone); // The warm start too
     else
-        colorPasses(1 + solver.mVelocityIterations, constraints,
-                    [&](int inPass, std::span<ContactConstraint* const> inC)
-                    {
-                        if (inPass == 0)
-                            SequentialImpulseSolver::WarmStart(inC, solverBodies);
-                        else
-                            SequentialImpulseSolver::SolveVelocities(inC, solverBodies, inPass - 1);
-                    });
+        colorPasses(
+            1 + solver.mVelocityIterations, constraints,
+            [&](int inPass, std::span<ContactConstraint* const> inC)
+            {
+                if (inPass == 0)
+                    SequentialImpulseSolver::WarmStart(inC, solverBodies);
+                else
+                    SequentialImpulseSolver::SolveVelocities(inC, solverBodies, inPass - 1);
+            },
+            [&](int inPass, std::span<const uint32_t> inJ)
+            {
+                if (inPass == 0)
+                    mJoints->WarmStart(inJ, solverBodies);
+                else
+                    mJoints->SolveVelocities(inJ, solverBodies);
+            });
     // Only where something bounces: the pass costs a stage per color
     if (bounces)
-        colorPasses(1, constraints,
-                    [&](int, std::span<ContactConstraint* const> inC)
-                    { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies); });
+        colorPasses(
+            1, constraints,
+            [&](int, std::span<ContactConstraint* const> inC)
+            { SequentialImpulseSolver::ApplyRestitution(inC, solverBodies); },
+            [](int, std::span<const uint32_t>) {});
 
     const std::vector<uint32_t>& active = mContext->mActive;
     const std::span<const uint32_t> bodies = mContext->mIslands.GetBodies(inIsland);
@@ -79,9 +94,11 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
                                          for (uint32_t i = inBegin; i < inEnd; ++i)
                                              StoreVelocitiesAndIntegrate(mContext->BodyAt(active[bodies[i]]));
                                      });
-    colorPasses(solver.mPositionIterations, std::span<const PositionConstraint>(mPositionConstraints),
-                [&](int, std::span<const PositionConstraint> inC)
-                { SequentialImpulseSolver::SolvePositions(inC, solver); });
+    colorPasses(
+        solver.mPositionIterations, std::span<const PositionConstraint>(mPositionConstraints),
+        [&](int, std::span<const PositionConstraint> inC)
+        { SequentialImpulseSolver::SolvePositions(inC, solver); },
+        [&](int, std::span<const uint32_t> inJ) { mJoints->SolvePositions(inJ, solver); });
 
     if (wide && !bounces) return; // Stored already
     const std::span<ContactConstraint* const> all = mPlan->ConstraintsOf(inIsland);
@@ -182,12 +199,23 @@ void IslandSolver::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstC
         [&](uint32_t inStage)
         {
             const uint32_t color = inFirstColor + inStage % numColors;
-            return mPlan->mColorIsSerial[color] != 0 ? 1u : partsOfColor(color);
+            return mPlan->mColorIsSerial[color] != 0
+                       ? 1u
+                       : std::max(partsOfColor(color),
+                                  scheduler.PartsFor(uint32_t(mPlan->ColorJoints(color).size()),
+                                                     StepCosts::cMinConstraintsPerPart));
         },
         [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
         {
             const uint32_t color = inFirstColor + inStage % numColors;
             const int pass = int(inStage / numColors); // 0: the warm start; then iteration pass - 1
+            // The color's joints first, cut into the same parts (see SolveColoredIsland)
+            const std::span<const uint32_t> joints =
+                StepScheduler::PartOf(mPlan->ColorJoints(color), inPart, inParts);
+            if (pass == 0)
+                mJoints->WarmStart(joints, solverBodies);
+            else
+                mJoints->SolveVelocities(joints, solverBodies);
             if (mPlan->mColorIsSerial[color] != 0)
             {
                 const std::span<ContactConstraint* const> constraints = mPlan->ColorConstraints(color);

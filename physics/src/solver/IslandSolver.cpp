@@ -175,11 +175,11 @@ void IslandSolver::SolveIsland(uint32_t inIsland)
     const std::span<SolverBody> solverBodies(mSolverBodies);
     // Joints before contacts in each pass (as Jolt and Box2D): the contacts, solved last, keep bodies apart
     const bool joints = mJoints->HasJoints(inIsland);
-    if (joints) mJoints->WarmStart(inIsland, solverBodies);
+    if (joints) mJoints->WarmStart(mJoints->GetIslandJoints(inIsland), solverBodies);
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
     {
-        if (joints) mJoints->SolveVelocities(inIsland, solverBodies);
+        if (joints) mJoints->SolveVelocities(mJoints->GetIslandJoints(inIsland), solverBodies);
         SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, i);
     }
     FinishIsland(inIsland);
@@ -234,7 +234,7 @@ void IslandSolver::FinishIsland(uint32_t inIsland)
     const bool joints = mJoints->HasJoints(inIsland);
     for (int i = 0; i < solver.mPositionIterations; ++i)
     {
-        if (joints) mJoints->SolvePositions(inIsland, solver);
+        if (joints) mJoints->SolvePositions(mJoints->GetIslandJoints(inIsland), solver);
         SequentialImpulseSolver::SolvePositions(PositionConstraintsOf(inIsland), solver);
     }
 

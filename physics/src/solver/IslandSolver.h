@@ -35,7 +35,7 @@ class IslandSolver
 public:
     /// Solves every island of ioPlan, integrates kinematic bodies and the bodies alone in their islands.
     /// inNumConstraints: the step's.
-    /// ioJoints: the step's joints, solved in their islands' passes (islands with joints are solved whole).
+    /// ioJoints: the step's joints, solved in their islands' passes (a colored island's by color).
     void Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32_t inNumConstraints,
                JointStage& ioJoints);
 

@@ -103,8 +103,11 @@ TEST_F(RagdollTest, DroppedOnAHeightFieldItComesToRestWithoutJitterAndHoldsToget
 
 TEST_F(RagdollTest, APileOfRagdollsIsTheSameForAnyThreadCount)
 {
-    // Six ragdolls dropped onto each other: joints, contacts between ragdolls and with the floor, one island
-    auto run = [](jobs::JobSystem* ioJobs)
+    // Six ragdolls dropped onto each other: joints, contacts between ragdolls and with the floor, one island.
+    // It is the whole step's work, so it is colored, its joints with its contacts, and every thread solves
+    // parts of each color
+    uint32_t coloredSteps = 0;
+    auto run = [&](jobs::JobSystem* ioJobs)
     {
         std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem();
         (void)system->GetBodyInterface().CreateAndAddBody(StaticFloorSettings(20.0f),
@@ -123,10 +126,14 @@ TEST_F(RagdollTest, APileOfRagdollsIsTheSameForAnyThreadCount)
                 bodies.insert(bodies.end(), ragdoll.Value().GetBodies().begin(),
                               ragdoll.Value().GetBodies().end());
         }
+        coloredSteps = 0;
         for (int step = 0; step < 120; ++step)
+        {
             EXPECT_TRUE(
                 (ioJobs != nullptr ? system->Update(1.0f / 60.0f, 1, *ioJobs) : system->Update(1.0f / 60.0f))
                     .IsOk());
+            coloredSteps += system->GetLastStepStatistics().mNumColoredIslands > 0 ? 1 : 0;
+        }
         std::vector<Vec3> positions;
         for (const BodyID& id : bodies)
             positions.push_back(system->GetBodyInterface().GetPosition(id).Value());
@@ -134,6 +141,7 @@ TEST_F(RagdollTest, APileOfRagdollsIsTheSameForAnyThreadCount)
     };
     const std::vector<Vec3> alone = run(nullptr);
     ASSERT_EQ(alone.size(), 6u * 23u);
+    EXPECT_GT(coloredSteps, 60u); // Once the pile is one island
     for (uint32_t threads : {1u, 2u, 4u})
     {
         jobs::JobSystem::Settings settings;
@@ -143,6 +151,7 @@ TEST_F(RagdollTest, APileOfRagdollsIsTheSameForAnyThreadCount)
         ASSERT_EQ(withJobs.size(), alone.size());
         for (size_t i = 0; i < alone.size(); ++i)
             ASSERT_EQ(withJobs[i], alone[i]) << threads << " threads, body " << i;
+        EXPECT_GT(coloredSteps, 60u);
     }
 }
 

@@ -6,9 +6,10 @@
 // last step's impulse, drift taken out on the poses after integration).
 //
 // Joints: fixed (welded), point (ball and socket), distance (rod, rope, spring), hinge and slider (each with
-// limits, a velocity or position motor and friction) and swing-twist (a cone and a twist range, for ragdolls).
-// An island with a joint is solved by one thread, whole (not colored, not grouped): the same result for any
-// thread count.
+// limits, a velocity or position motor and friction) and swing-twist (a cone and a twist range, for
+// ragdolls). A large island (a quarter of the step's contacts and joints) is colored, its joints with its
+// contacts, and solved by every thread a color at a time; a smaller island with a joint is solved whole by
+// one thread. The same result for any thread count either way.
 //
 // Threads: every method from any thread, outside the physics step's callbacks and while holding no body lock
 // (WrongThread otherwise). A call made while Update runs waits for the step to end (the step holds the
