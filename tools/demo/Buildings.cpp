@@ -34,21 +34,24 @@ ShapeRef Box(float inX, float inY, float inZ)
     return box ? ShapeRef(std::move(box).Value()) : ShapeRef();
 }
 
-/// The highest ground over a rectangle of the building frame, sampled every half metre and at its edges
-float HighestGround(const BuildingSite& inSite, FunctionRef<float(float, float)> inGround, float inX0,
-                    float inZ0, float inX1, float inZ1)
+/// The lowest and highest ground over a rectangle of the building frame, sampled every inSpacing or closer,
+/// its edges included
+void SampleGround(const BuildingSite& inSite, FunctionRef<float(float, float)> inGround, float inX0,
+                  float inZ0, float inX1, float inZ1, float inSpacing, float& outLowest, float& outHighest)
 {
-    float highest = -cLargeFloat;
-    const int nx = int(std::ceil((inX1 - inX0) / 0.5f)), nz = int(std::ceil((inZ1 - inZ0) / 0.5f));
+    outLowest = cLargeFloat;
+    outHighest = -cLargeFloat;
+    const int nx = int(std::ceil((inX1 - inX0) / inSpacing)), nz = int(std::ceil((inZ1 - inZ0) / inSpacing));
     for (int i = 0; i <= nz; ++i)
         for (int j = 0; j <= nx; ++j)
         {
             float x, z;
             ToWorld(inSite, inX0 + (inX1 - inX0) * float(j) / float(nx),
                     inZ0 + (inZ1 - inZ0) * float(i) / float(nz), x, z);
-            highest = std::max(highest, inGround(x, z));
+            const float h = inGround(x, z);
+            outLowest = std::min(outLowest, h);
+            outHighest = std::max(outHighest, h);
         }
-    return highest;
 }
 } // namespace
 
@@ -72,19 +75,8 @@ BuildingShapes::BuildingShapes()
 void GroundRange(const BuildingSite& inSite, FunctionRef<float(float, float)> inGround, float& outLowest,
                  float& outHighest)
 {
-    outLowest = cLargeFloat;
-    outHighest = -cLargeFloat;
-    const int samples = int(std::ceil(2.0f * cBuildingHalfSize));
-    for (int i = 0; i <= samples; ++i)
-        for (int j = 0; j <= samples; ++j)
-        {
-            const float step = 2.0f * cBuildingHalfSize / float(samples);
-            float x, z;
-            ToWorld(inSite, -cBuildingHalfSize + step * float(j), -cBuildingHalfSize + step * float(i), x, z);
-            const float h = inGround(x, z);
-            outLowest = std::min(outLowest, h);
-            outHighest = std::max(outHighest, h);
-        }
+    SampleGround(inSite, inGround, -cBuildingHalfSize, -cBuildingHalfSize, cBuildingHalfSize,
+                 cBuildingHalfSize, 1.0f, outLowest, outHighest);
 }
 
 DoorSpec MakeBuilding(const BuildingShapes& inShapes, const BuildingSite& inSite,
@@ -116,9 +108,10 @@ DoorSpec MakeBuilding(const BuildingShapes& inShapes, const BuildingSite& inSite
 
     // The door clears the highest ground its swing covers: the quarter disc from the hinge into the room
     const float reach = 2.0f * cDoorwayHalfWidth;
-    const float bottom = HighestGround(inSite, inGround, -cDoorwayHalfWidth, -inner - cDoorThickness,
-                                       cDoorwayHalfWidth, -inner + reach) +
-                         0.03f;
+    float lowest, highest;
+    SampleGround(inSite, inGround, -cDoorwayHalfWidth, -inner - cDoorThickness, cDoorwayHalfWidth,
+                 -inner + reach, 0.5f, lowest, highest);
+    const float bottom = highest + 0.03f;
     DoorSpec door;
     door.mPanel.mShape = inShapes.mPanel;
     door.mPanel.mPosition =

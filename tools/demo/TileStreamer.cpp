@@ -92,15 +92,9 @@ bool TileStreamer::TakeDoorsIfChanged(uint64_t& ioVersion, std::vector<StreamedD
 
 void TileStreamer::PublishDoorsLocked()
 {
-    std::vector<StreamedDoor> doors;
+    mDoors.clear();
     for (const auto& [tile, loaded] : mTiles)
-        doors.insert(doors.end(), loaded.mDoors.begin(), loaded.mDoors.end());
-    const bool same = doors.size() == mDoors.size() &&
-                      std::equal(doors.begin(), doors.end(), mDoors.begin(),
-                                 [](const StreamedDoor& inA, const StreamedDoor& inB)
-                                 { return inA.mPanel == inB.mPanel && inA.mHinge == inB.mHinge; });
-    if (same) return;
-    mDoors = std::move(doors);
+        mDoors.insert(mDoors.end(), loaded.mDoors.begin(), loaded.mDoors.end());
     ++mDoorsVersion;
 }
 
@@ -348,7 +342,7 @@ void TileStreamer::ThreadMain()
         mStats.mDynamicBodies = dynamics;
         mStats.mStaticPeak = std::max(mStats.mStaticPeak, statics);
         mStats.mDynamicPeak = std::max(mStats.mDynamicPeak, dynamics);
-        PublishDoorsLocked();
+        if (changed) PublishDoorsLocked(); // A pass changes one tile at most: its doors may have come or gone
         // Settled when a pass found nothing to do for the focus it read (a newer focus clears it again)
         if (!changed && player == mPlayer && ahead == mAhead) mSettled = true;
     }

@@ -103,7 +103,7 @@ private:
     void AddDoors(std::vector<DoorSpec>& ioDoors, LoadedTile& ioTile);
     /// Removes the hinges, then the panels.
     void RemoveDoors(LoadedTile& ioTile);
-    /// The loaded tiles' doors into mDoors for the main thread; with mMutex held.
+    /// The loaded tiles' doors into mDoors for the main thread, a new version; with mMutex held.
     void PublishDoorsLocked();
     /// Creates, prepares and finalizes a batch; false (with an error noted) on failure.
     bool AddBatch(const std::vector<BodyCreationSettings>& inSettings, Activation inActivation,

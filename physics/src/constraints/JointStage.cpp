@@ -103,7 +103,7 @@ void JointStage::LinkIslands(const StepContext& inContext)
 
 void JointStage::GroupByIsland(const StepContext& inContext)
 {
-    if (mStepJoints.empty()) return; // HasJoints answers false without the table
+    if (mStepJoints.empty()) return; // GetIslandJoints answers none without the table
     const AtomicUnionFind& islands = inContext.mIslands;
     const uint32_t numIslands = islands.GetNumIslands();
     mJointStart.assign(numIslands + 1, 0);

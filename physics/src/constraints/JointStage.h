@@ -36,13 +36,10 @@ public:
     /// After the islands are finalized.
     void GroupByIsland(const StepContext& inContext);
 
-    bool HasJoints(uint32_t inIsland) const
-    {
-        return !mStepJoints.empty() && mJointStart[inIsland + 1] > mJointStart[inIsland];
-    }
     uint32_t GetNumStepJoints() const { return uint32_t(mStepJoints.size()); }
 
-    /// The island's joints: indices of this step's joints, in slot order.
+    /// The island's joints: indices of this step's joints, in slot order (none without the table: a step
+    /// without joints does not build it).
     std::span<const uint32_t> GetIslandJoints(uint32_t inIsland) const
     {
         if (mStepJoints.empty()) return {};

@@ -174,12 +174,12 @@ void IslandSolver::SolveIsland(uint32_t inIsland)
     const SolverSettings& solver = mContext->mSettings.mSolver;
     const std::span<SolverBody> solverBodies(mSolverBodies);
     // Joints before contacts in each pass (as Jolt and Box2D): the contacts, solved last, keep bodies apart
-    const bool joints = mJoints->HasJoints(inIsland);
-    if (joints) mJoints->WarmStart(mJoints->GetIslandJoints(inIsland), solverBodies);
+    const std::span<const uint32_t> joints = mJoints->GetIslandJoints(inIsland); // Most islands: none
+    mJoints->WarmStart(joints, solverBodies);
     SequentialImpulseSolver::WarmStart(constraints, solverBodies);
     for (int i = 0; i < solver.mVelocityIterations; ++i)
     {
-        if (joints) mJoints->SolveVelocities(mJoints->GetIslandJoints(inIsland), solverBodies);
+        mJoints->SolveVelocities(joints, solverBodies);
         SequentialImpulseSolver::SolveVelocities(constraints, solverBodies, i);
     }
     FinishIsland(inIsland);
@@ -231,10 +231,10 @@ void IslandSolver::FinishIsland(uint32_t inIsland)
     for (uint32_t activeIndex : mContext->mIslands.GetBodies(inIsland))
         StoreVelocitiesAndIntegrate(mContext->BodyAt(active[activeIndex]));
 
-    const bool joints = mJoints->HasJoints(inIsland);
+    const std::span<const uint32_t> joints = mJoints->GetIslandJoints(inIsland);
     for (int i = 0; i < solver.mPositionIterations; ++i)
     {
-        if (joints) mJoints->SolvePositions(mJoints->GetIslandJoints(inIsland), solver);
+        mJoints->SolvePositions(joints, solver);
         SequentialImpulseSolver::SolvePositions(PositionConstraintsOf(inIsland), solver);
     }
 
