@@ -147,7 +147,7 @@ void JointStage::PreparePoint(StepJoint& ioJoint)
     joint.mPart.Prepare(armA, massA, armB, massB);
 }
 
-void JointStage::Prepare(StepJoint& ioJoint)
+void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
 {
     Joint& joint = *ioJoint.mJoint;
     Vec3 armA, armB, anchorA, anchorB;
@@ -181,6 +181,7 @@ void JointStage::Prepare(StepJoint& ioJoint)
             joint.mLimitPart.PrepareLimit(massA, massB, axisA, limitSide, limitError, mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
+        if (inRows == Rows::WithPosition) break;
         // The motor, or the friction while it is off (a spin towards none), within its torque this step
         const MotorSettings& motor = joint.mMotor;
         const float torque = motor.mMode != MotorMode::Off ? motor.mMaxForce : joint.mMaxFriction;
@@ -220,6 +221,7 @@ void JointStage::Prepare(StepJoint& ioJoint)
         }
         else
             joint.mAxisPart.Deactivate();
+        if (inRows == Rows::WithPosition) break;
         const MotorSettings& motor = joint.mMotor;
         const float force = motor.mMode != MotorMode::Off ? motor.mMaxForce : joint.mMaxFriction;
         const float bound = force * mContext->mDeltaTime;
@@ -260,6 +262,7 @@ void JointStage::Prepare(StepJoint& ioJoint)
                                           mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
+        if (inRows == Rows::WithPosition) break;
         const float bound = joint.mMaxFriction * mContext->mDeltaTime;
         for (int axis = 0; axis < 3; ++axis)
             if (bound > 0.0f)
@@ -360,8 +363,9 @@ void JointStage::WarmStart(std::span<const uint32_t> inJoints, std::span<SolverB
     {
         StepJoint& joint = mStepJoints[index];
         Prepare(joint);
-        VisitVelocityRows(joint, [&](auto& ioPart)
-                          { ioPart.WarmStart(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
+        SolverBody& a = BlockA(joint, ioBodies);
+        SolverBody& b = BlockB(joint, ioBodies);
+        VisitVelocityRows(joint, [&](auto& ioPart) { ioPart.WarmStart(a, b); });
     }
 }
 
@@ -370,8 +374,11 @@ void JointStage::SolveVelocities(std::span<const uint32_t> inJoints, std::span<S
     for (const uint32_t index : inJoints)
     {
         StepJoint& joint = mStepJoints[index];
-        VisitVelocityRows(joint, [&](auto& ioPart)
-                          { ioPart.SolveVelocity(BlockA(joint, ioBodies), BlockB(joint, ioBodies)); });
+        // The blocks once per joint: the rows' writes to them could alias the bodies BlockA reads, so the
+        // compiler would look them up again for every row
+        SolverBody& a = BlockA(joint, ioBodies);
+        SolverBody& b = BlockB(joint, ioBodies);
+        VisitVelocityRows(joint, [&](auto& ioPart) { ioPart.SolveVelocity(a, b); });
     }
 }
 
@@ -431,7 +438,7 @@ void JointStage::SolvePositions(std::span<const uint32_t> inJoints, const Solver
         StepJoint& joint = mStepJoints[index];
         // The rows again at the integrated poses (the arms turned with their bodies), then the part of the
         // error the position iterations take out
-        Prepare(joint);
+        Prepare(joint, Rows::WithPosition);
         const Joint& data = *joint.mJoint;
         // The turns first (a rotation part's correction moves no centre), then the point or the length at the
         // anchors where they put them
@@ -445,7 +452,7 @@ void JointStage::SolvePositions(std::span<const uint32_t> inJoints, const Solver
                                                                  data.mRelativeRotation),
                                 inSettings.mJointBaumgarte));
             if (data.mType == JointType::Slider)
-                Prepare(joint);
+                Prepare(joint, Rows::WithPosition);
             else
                 PreparePoint(joint);
         }
@@ -466,7 +473,7 @@ void JointStage::SolvePositions(std::span<const uint32_t> inJoints, const Solver
         {
             // Back onto the line, then within the limits at the place that puts it
             ApplyCorrection(joint, data.mLinePart.CorrectPositions(inSettings.mJointBaumgarte));
-            Prepare(joint);
+            Prepare(joint, Rows::WithPosition);
             if (joint.mRowActive)
                 ApplyCorrection(joint,
                                 data.mAxisPart.CorrectPositions(joint.mError, inSettings.mJointBaumgarte));

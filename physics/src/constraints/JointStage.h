@@ -77,9 +77,17 @@ private:
         bool mRowActive = false; ///< A distance joint out of its limits (or a rod), a slider past a limit
         float mError = 0.0f;     ///< Its length (a slider's place) less the limit it is at
     };
+    /// Which rows a Prepare sets: all of them (the velocity passes), or only those with a position to take
+    /// out (a position iteration: no motor or friction row, whose next use is after the next step's
+    /// Prepare).
+    enum class Rows
+    {
+        All,
+        WithPosition
+    };
     /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
     /// and limit).
-    void Prepare(StepJoint& ioJoint);
+    void Prepare(StepJoint& ioJoint, Rows inRows = Rows::All);
     /// Only the point's rows (and the anchors) of a joint that has them: after a position iteration turned
     /// its bodies.
     void PreparePoint(StepJoint& ioJoint);
