@@ -366,8 +366,7 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
             joint->mLinePart.ResetImpulse();
             joint->mAxisMotorPart.ResetImpulse();
             joint->mSwingPart.ResetImpulse();
-            for (AngleJointPart& friction : joint->mFrictionParts)
-                friction.ResetImpulse();
+            joint->mFrictionPart.ResetImpulse();
         }
         joint->mEnabled = inEnabled;
         a = joint->mBodyA;

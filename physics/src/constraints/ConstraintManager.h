@@ -9,13 +9,13 @@
 
 #include "cairn/physics/constraints/ConstraintInterface.h"
 #include "solver/AngleJointPart.h"
+#include "solver/AngularFrictionPart.h"
 #include "solver/AxisJointPart.h"
 #include "solver/HingeRotationJointPart.h"
 #include "solver/LineJointPart.h"
 #include "solver/PointJointPart.h"
 #include "solver/RotationJointPart.h"
 
-#include <array>
 #include <mutex>
 #include <vector>
 
@@ -77,9 +77,9 @@ struct Joint
     Quat mLocalFrameB = Quat::Identity();
     float mNormalHalfCone = 0.0f;
     float mPlaneHalfCone = 0.0f;
-    AngleJointPart mSwingPart;                    ///< The cone, while the swing is past it
-    std::array<AngleJointPart, 3> mFrictionParts; ///< About the frame's axes
-    AxisJointPart mAxisMotorPart; ///< The slider's motor, or its friction while the motor is off
+    AngleJointPart mSwingPart;         ///< The cone, while the swing is past it
+    AngularFrictionPart mFrictionPart; ///< About the frame's axes
+    AxisJointPart mAxisMotorPart;      ///< The slider's motor, or its friction while the motor is off
 };
 
 class ConstraintManager

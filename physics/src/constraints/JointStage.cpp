@@ -263,13 +263,8 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
         else
             joint.mLimitPart.Deactivate();
         if (inRows == Rows::WithPosition) break;
-        const float bound = joint.mMaxFriction * mContext->mDeltaTime;
-        for (int axis = 0; axis < 3; ++axis)
-            if (bound > 0.0f)
-                joint.mFrictionParts[axis].Prepare(massA, massB, frameA * Vec3::Unit(axis), 0.0f, -bound,
-                                                   bound, AxisJointPart::Side::Both, 0.0f);
-            else
-                joint.mFrictionParts[axis].Deactivate();
+        joint.mFrictionPart.Prepare(massA, massB, frameA.toRotationMatrix(),
+                                    joint.mMaxFriction * mContext->mDeltaTime);
         break;
     }
     case JointType::Distance:
@@ -335,8 +330,7 @@ template <class Visit> void JointStage::VisitVelocityRows(StepJoint& ioJoint, co
     case JointType::SwingTwist:
         // The friction, then the cone and the twist's range, which have the last word on the turn, then the
         // point
-        for (AngleJointPart& friction : joint.mFrictionParts)
-            inVisit(friction);
+        inVisit(joint.mFrictionPart);
         inVisit(joint.mSwingPart);
         inVisit(joint.mLimitPart);
         inVisit(joint.mPart);
@@ -384,10 +378,16 @@ void JointStage::SolveVelocities(std::span<const uint32_t> inJoints, std::span<S
 
 void JointStage::ApplyCorrection(StepJoint& ioJoint, const PointJointPart::PoseCorrection& inCorrection)
 {
-    if (ioJoint.mA != nullptr && ioJoint.mA->IsDynamic())
-        Integration::CorrectPose(*ioJoint.mA, inCorrection.mTranslationA, inCorrection.mRotationA);
-    if (ioJoint.mB != nullptr && ioJoint.mB->IsDynamic())
-        Integration::CorrectPose(*ioJoint.mB, inCorrection.mTranslationB, inCorrection.mRotationB);
+    // A row with nothing to take out (a limit not reached) leaves the pose as it is: no turn by zero, whose
+    // renormalization would cost a quaternion product and move the rotation by a rounding
+    auto correct = [](Body* ioBody, const Vec3& inTranslation, const Vec3& inRotation)
+    {
+        if (ioBody != nullptr && ioBody->IsDynamic() &&
+            (inTranslation != Vec3::Zero() || inRotation != Vec3::Zero()))
+            Integration::CorrectPose(*ioBody, inTranslation, inRotation);
+    };
+    correct(ioJoint.mA, inCorrection.mTranslationA, inCorrection.mRotationA);
+    correct(ioJoint.mB, inCorrection.mTranslationB, inCorrection.mRotationB);
 }
 
 void JointStage::BreakOverloaded()

@@ -18,7 +18,8 @@ namespace cairn::physics
 /// inRelative = swing * twist: the twist about x, the swing about an axis in the y-z plane.
 inline void SplitSwingTwist(const Quat& inRelative, Quat& outSwing, Quat& outTwist)
 {
-    const float length = std::hypot(inRelative.w(), inRelative.x());
+    // Unit quaternion parts: no overflow for std::hypot to guard against, and its care costs
+    const float length = std::sqrt(inRelative.w() * inRelative.w() + inRelative.x() * inRelative.x());
     // A half turn of swing leaves no twist to speak of: none
     outTwist = length > 1.0e-6f ? Quat(inRelative.w() / length, inRelative.x() / length, 0.0f, 0.0f)
                                 : Quat::Identity();
@@ -51,8 +52,9 @@ inline bool SwingPastCone(const Vec3& inSwing, float inNormalHalfAngle, float in
     // A zero half angle is a thin ellipse, not a division by zero: the swing about that axis is held near 0
     const float a = std::max(inNormalHalfAngle, 1.0e-4f), b = std::max(inPlaneHalfAngle, 1.0e-4f);
     const float y = inSwing.y(), z = inSwing.z();
-    const float scaled = std::hypot(y / a, z / b); // 1 on the cone's edge
-    const float length = std::hypot(y, z);
+    // Angles and their ratios to half angles of at least 1e-4 rad: squares far from float's range
+    const float scaled = std::sqrt((y / a) * (y / a) + (z / b) * (z / b)); // 1 on the cone's edge
+    const float length = std::sqrt(y * y + z * z);
     // Past the edge along its own ray by this much (its edge point is the swing over scaled)
     if (!(scaled > 1.0e-6f)) return false; // No swing: no direction, and far inside
     const float past = length * (1.0f - 1.0f / scaled);

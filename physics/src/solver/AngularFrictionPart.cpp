@@ -1,0 +1,48 @@
+#include "solver/AngularFrictionPart.h"
+
+namespace cairn::physics
+{
+
+void AngularFrictionPart::Prepare(const JointBodyMass& inA, const JointBodyMass& inB, const Mat3& inFrame,
+                                  float inBound)
+{
+    Mat3 effectiveMass;
+    mActive =
+        inBound > 0.0f && InvertJointMassMatrix(inA.mInverseInertia + inB.mInverseInertia, effectiveMass);
+    if (!mActive)
+    {
+        mTotalImpulse.setZero();
+        return;
+    }
+    // The impulse J (frame axes) acts on the spins as the world torque impulse frame J; the one that stops a
+    // relative spin w is -K^-1 w in the world, frame^T of that in the frame (the frame is orthonormal)
+    mImpulsePerSpin = inFrame.transpose() * effectiveMass;
+    mSpinPerImpulseA = inA.mInverseInertia * inFrame;
+    mSpinPerImpulseB = inB.mInverseInertia * inFrame;
+    mBound = inBound;
+    mTotalImpulse = mTotalImpulse.cwiseMax(-inBound).cwiseMin(inBound);
+}
+
+void AngularFrictionPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inFrameImpulse) const
+{
+    ioA.mAngularVelocity -= mSpinPerImpulseA * inFrameImpulse;
+    ioB.mAngularVelocity += mSpinPerImpulseB * inFrameImpulse;
+}
+
+void AngularFrictionPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
+{
+    mTotalImpulse *= inRatio;
+    if (mActive) Apply(ioA, ioB, mTotalImpulse);
+}
+
+void AngularFrictionPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const Vec3 impulse = -(mImpulsePerSpin * (ioB.mAngularVelocity - ioA.mAngularVelocity));
+    const Vec3 total = (mTotalImpulse + impulse).cwiseMax(-mBound).cwiseMin(mBound);
+    const Vec3 applied = total - mTotalImpulse;
+    mTotalImpulse = total;
+    Apply(ioA, ioB, applied);
+}
+
+} // namespace cairn::physics
