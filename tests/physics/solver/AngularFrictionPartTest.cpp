@@ -4,6 +4,8 @@
 
 #include "solver/AngularFrictionPart.h"
 
+#include "physics/solver/SpinningBody.h"
+
 #include <gtest/gtest.h>
 #include <numbers>
 
@@ -11,16 +13,6 @@ namespace cairn::physics
 {
 namespace
 {
-
-SolverBody Spinning(const Vec3& inAngularVelocity)
-{
-    SolverBody body;
-    body.mLinearVelocity.setZero();
-    body.mInverseMass = 1.0f;
-    body.mAngularVelocity = inAngularVelocity;
-    body.mPadding = 0.0f;
-    return body;
-}
 
 const Mat3 cInertiaA = Vec3(2.0f, 3.0f, 4.0f).asDiagonal();
 const Mat3 cInertiaB = Vec3(0.5f, 1.0f, 0.2f).asDiagonal();

@@ -4,6 +4,8 @@
 
 #include "solver/RotationJointPart.h"
 
+#include "physics/solver/SpinningBody.h"
+
 #include <gtest/gtest.h>
 #include <numbers>
 
@@ -11,16 +13,6 @@ namespace cairn::physics
 {
 namespace
 {
-
-SolverBody Spinning(const Vec3& inAngularVelocity)
-{
-    SolverBody body;
-    body.mLinearVelocity.setZero();
-    body.mInverseMass = 1.0f;
-    body.mAngularVelocity = inAngularVelocity;
-    body.mPadding = 0.0f;
-    return body;
-}
 
 TEST(RotationJointPartTest, OneIterationStopsTheRelativeSpinAndKeepsAngularMomentum)
 {
