@@ -162,12 +162,13 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
         joint.mPart.Prepare(armA, massA, armB, massB);
         break;
     case JointType::Fixed:
-        joint.mPart.Prepare(armA, massA, armB, massB);
+        // A position iteration turns the bodies first and prepares the point after (PreparePoint)
+        if (inRows == Rows::All) joint.mPart.Prepare(armA, massA, armB, massB);
         joint.mRotationPart.Prepare(massA, massB);
         break;
     case JointType::Hinge:
     {
-        joint.mPart.Prepare(armA, massA, armB, massB);
+        if (inRows == Rows::All) joint.mPart.Prepare(armA, massA, armB, massB); // As the fixed joint's
         const Quat rotationA = RotationOf(ioJoint.mA), rotationB = RotationOf(ioJoint.mB);
         const Vec3 axisA = rotationA * joint.mLocalAxisA, axisB = rotationB * joint.mLocalAxisB;
         joint.mHingePart.Prepare(massA, massB, axisA, axisB);
@@ -239,7 +240,6 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
     }
     case JointType::SwingTwist:
     {
-        joint.mPart.Prepare(armA, massA, armB, massB);
         const Quat frameA = RotationOf(ioJoint.mA) * joint.mLocalFrameA;
         const Quat frameB = RotationOf(ioJoint.mB) * joint.mLocalFrameB;
         Quat swing, twist;
@@ -262,6 +262,9 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
                                           mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
+        // A position iteration with a limit to take out prepares the point after the turns (PreparePoint)
+        if (inRows == Rows::All || (!joint.mSwingPart.IsActive() && !joint.mLimitPart.IsActive()))
+            joint.mPart.Prepare(armA, massA, armB, massB);
         if (inRows == Rows::WithPosition) break;
         joint.mFrictionPart.Prepare(massA, massB, frameA.toRotationMatrix(),
                                     joint.mMaxFriction * mContext->mDeltaTime);
