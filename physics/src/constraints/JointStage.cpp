@@ -29,6 +29,13 @@ SolverBody BlockOf(const Body* inBody)
     return block;
 }
 
+/// Whether a swing-twist joint, as its last Prepare found it, is at its cone or its twist's range: a position
+/// iteration then turns its bodies and prepares its point rows after the turns (PreparePoint), not before
+bool SwingTwistAtALimit(const Joint& inJoint)
+{
+    return inJoint.mSwingPart.IsActive() || inJoint.mLimitPart.IsActive();
+}
+
 bool IsActiveDynamic(const Body* inBody)
 {
     return inBody != nullptr && inBody->IsDynamic() && inBody->IsActive();
@@ -262,9 +269,7 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
                                           mContext->mDeltaTime);
         else
             joint.mLimitPart.Deactivate();
-        // A position iteration with a limit to take out prepares the point after the turns (PreparePoint)
-        if (inRows == Rows::All || (!joint.mSwingPart.IsActive() && !joint.mLimitPart.IsActive()))
-            joint.mPart.Prepare(armA, massA, armB, massB);
+        if (inRows == Rows::All || !SwingTwistAtALimit(joint)) joint.mPart.Prepare(armA, massA, armB, massB);
         if (inRows == Rows::WithPosition) break;
         joint.mFrictionPart.Prepare(massA, massB, frameA.toRotationMatrix(),
                                     joint.mMaxFriction * mContext->mDeltaTime);
@@ -460,7 +465,7 @@ void JointStage::SolvePositions(std::span<const uint32_t> inJoints, const Solver
                 PreparePoint(joint);
         }
         // A swing-twist within its cone and range has no turn to take out: its point's rows stand
-        if (data.mType == JointType::SwingTwist && (data.mSwingPart.IsActive() || data.mLimitPart.IsActive()))
+        if (data.mType == JointType::SwingTwist && SwingTwistAtALimit(data))
         {
             ApplyCorrection(joint, data.mSwingPart.CorrectPositions(inSettings.mJointBaumgarte));
             ApplyCorrection(joint, data.mLimitPart.CorrectPositions(inSettings.mJointBaumgarte));

@@ -7,13 +7,12 @@ void AngularFrictionPart::Prepare(const JointBodyMass& inA, const JointBodyMass&
                                   float inBound)
 {
     Mat3 effectiveMass;
-    mActive =
-        inBound > 0.0f && InvertJointMassMatrix(inA.mInverseInertia + inB.mInverseInertia, effectiveMass);
-    if (!mActive)
+    if (!(inBound > 0.0f && InvertJointMassMatrix(inA.mInverseInertia + inB.mInverseInertia, effectiveMass)))
     {
-        mTotalImpulse.setZero();
+        Deactivate();
         return;
     }
+    mActive = true;
     // The impulse J (frame axes) acts on the spins as the world torque impulse frame J; the one that stops a
     // relative spin w is -K^-1 w in the world, frame^T of that in the frame (the frame is orthonormal)
     mImpulsePerSpin = inFrame.transpose() * effectiveMass;
