@@ -45,6 +45,7 @@ struct RunResult
     StepStatistics mPhaseSums;                           ///< Phase times summed over all steps
     double mHeightChecksum = 0.0;                        ///< Sum of final y of the dynamic bodies
     uint64_t mContactPoints = 0;                         ///< Contact points summed over all steps
+    uint64_t mManifolds = 0;                             ///< Contact manifolds summed over all steps
     uint64_t mBodyPairs = 0;                             ///< Broad-phase pairs summed over all steps
     uint64_t mReusedBodyPairs = 0;                       ///< ... of which took last step's manifolds over
     BroadPhaseQuadTree::CandidateCacheStats mCandidates; ///< How the pair search served static candidates
@@ -78,6 +79,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mPhaseSums.mSolveMs += stats.mSolveMs;
         result.mPhaseSums.mFinishMs += stats.mFinishMs;
         result.mContactPoints += stats.mNumContactPoints;
+        result.mManifolds += stats.mNumManifolds;
         result.mBodyPairs += stats.mNumBodyPairs;
         result.mReusedBodyPairs += stats.mNumReusedBodyPairs;
         result.mColoredIslands += stats.mNumColoredIslands;
@@ -173,23 +175,25 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             std::max<uint64_t>(run.mCandidates.mReused + run.mCandidates.mWalked + run.mCandidates.mRefilled +
                                    run.mCandidates.mUncached,
                                1);
-        std::printf(
-            "%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
-            "broadphase-update %.3f  "
-            "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
-            "contacts %llu  | pairs reused %.1f%%  | static candidates reused %.1f%% (%.1f%% walked, too "
-            "many)  | colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
-            inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
-            run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
-            run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
-            run.mPhaseSums.mFinishMs / run.mSteps, run.mHeightChecksum,
-            static_cast<unsigned long long>(run.mContactPoints),
-            100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
-            100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
-            100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
-            static_cast<unsigned long long>(run.mReusedColorings),
-            static_cast<unsigned long long>(run.mColoredIslands),
-            static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
+        std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
+                    "broadphase-update %.3f  "
+                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
+                    "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  | static "
+                    "candidates reused %.1f%% (%.1f%% walked, too "
+                    "many)  | colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
+                    inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
+                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
+                    run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
+                    run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
+                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints),
+                    static_cast<unsigned long long>(run.mManifolds),
+                    static_cast<unsigned long long>(run.mBodyPairs),
+                    100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
+                    100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
+                    100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
+                    static_cast<unsigned long long>(run.mReusedColorings),
+                    static_cast<unsigned long long>(run.mColoredIslands),
+                    static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

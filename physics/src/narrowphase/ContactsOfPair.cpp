@@ -5,6 +5,7 @@
 #include "body/Integration.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "narrowphase/ContactsStage.h"
+#include "narrowphase/ManifoldMerger.h"
 #include "solver/SequentialImpulseSolver.h"
 #include "step/StepContext.h"
 
@@ -53,15 +54,30 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
     record.mShapeGenerationA = ioA.mShapeGeneration;
     record.mShapeGenerationB = ioB.mShapeGeneration;
     if (!ReuseManifolds(inContext, inIntegration, ioA, ioB, record, ioOut))
-        CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
-                      [&](const ContactManifold& inManifold)
-                      {
-                          AddConstraint(
-                              inContext, inIntegration, ioA, ioB, inManifold,
-                              inContext.mContactCache.FindPrevious(
-                                  {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB}),
-                              ioOut);
-                      });
+    {
+        auto add = [&](const ContactManifold& inManifold)
+        {
+            AddConstraint(inContext, inIntegration, ioA, ioB, inManifold,
+                          inContext.mContactCache.FindPrevious(
+                              {ioA.GetID(), ioB.GetID(), inManifold.mSubShapeA, inManifold.mSubShapeB}),
+                          ioOut);
+        };
+        // A shape against a mesh or height field (or a compound) reports a manifold per triangle (or part):
+        // those that face the same way become one (see ManifoldMerger). Two convex shapes give one at most,
+        // and skip the merger's copies
+        if (!inContext.mSettings.mMergeManifolds || (ioA.mShape->IsConvex() && ioB.mShape->IsConvex()))
+            CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings, add);
+        else
+        {
+            ManifoldMerger merger;
+            CollideShapes(*ioA.mShape, ioA.GetTransform(), *ioB.mShape, ioB.GetTransform(), settings,
+                          [&](const ContactManifold& inManifold)
+                          {
+                              if (!merger.Add(inManifold)) add(inManifold);
+                          });
+            merger.ForEach(add);
+        }
+    }
     // Recorded even without manifolds: a pair that stays apart is not collided again either
     record.mNumManifolds = uint32_t(ioOut.mConstraints.size() - constraintsBefore);
     ioOut.mCachedPairs.push_back(record);

@@ -47,9 +47,11 @@ TEST_F(ContactCacheOrderTest, SleepingBodiesWokenInsideTheStep)
 TEST_F(ContactCacheOrderTest, CompoundsWithSeveralManifoldsPerPair)
 {
     // Each compound touches the floor with several parts: one body pair, several manifolds, in the order the
-    // parts were collided (sleeping off, so that they stay in the step)
+    // parts were collided (sleeping off, so that they stay in the step; merging off, else the parts'
+    // manifolds on the one floor become one)
     PhysicsSettings settings;
     settings.mAllowSleeping = false;
+    settings.mMergeManifolds = false;
     ResetWorld(settings);
     AddFloor();
     std::vector<CompoundShape::SubShape> parts;

@@ -46,6 +46,10 @@ struct PhysicsSettings
     /// enough that a contact point moves by at most a few millimetres on a metre-sized body
     float mPairCacheMaxDeltaPosition = 0.001f;
     float mPairCacheMaxDeltaAngle = 2.0f * cPi / 180.0f;
+    /// One body pair's manifolds whose normals are within 5 degrees of each other (a shape across several
+    /// triangles of a mesh or height field, a compound's parts on one floor) become one manifold of at most
+    /// four points, as with Jolt's mUseManifoldReduction; off: one manifold per triangle or part
+    bool mMergeManifolds = true;
     /// With a job system of two or more threads and a broad phase that allows it, a step with at least this
     /// many active bodies rebuilds the broad phase on another thread while it finds its pairs and contacts.
     /// Below, a small scene's rebuild is short and the step does it first, itself: running it beside cost
