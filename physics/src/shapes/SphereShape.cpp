@@ -25,6 +25,13 @@ AABB SphereShape::GetLocalBounds() const
     return AABB::FromCenterExtent(Vec3::Zero(), Vec3::Constant(mRadius));
 }
 
+AABB SphereShape::GetWorldBounds(const Transform& inTransform) const
+{
+    // The turned local box of a sphere is up to sqrt(3) times as wide as the sphere: every pair search and
+    // query around it would find bodies it cannot touch
+    return AABB::FromCenterExtent(inTransform.mPosition, Vec3::Constant(mRadius));
+}
+
 MassProperties SphereShape::GetMassProperties(float inDensity) const
 {
     MassProperties props;

@@ -320,3 +320,53 @@ TEST(CapsuleShapeTest, SupportAndFaces)
                                 }
                             });
 }
+
+namespace
+{
+/// The world box a convex shape's surface spans at inTransform, from its support points along the six axes:
+/// the tightest box there is.
+AABB SupportBox(const ConvexShape& inShape, const Transform& inTransform)
+{
+    AABB box;
+    for (int axis = 0; axis < 3; ++axis)
+        for (const float sign : {-1.0f, 1.0f})
+        {
+            const Vec3 direction = sign * Vec3::Unit(axis);
+            const Vec3 local = inShape.GetSupport(inTransform.mRotation.conjugate() * direction);
+            box.Encapsulate(AABB(inTransform * local, inTransform * local));
+        }
+    return box;
+}
+
+const Quat cTurns[] = {Quat::Identity(), Quat(Eigen::AngleAxisf(0.785398f, Vec3::UnitZ())),
+                       Quat(Eigen::AngleAxisf(1.1f, Vec3(1, 2, 3).normalized())),
+                       Quat(Eigen::AngleAxisf(2.9f, Vec3(-3, 1, 0.5f).normalized()))};
+} // namespace
+
+TEST(SphereShapeTest, WorldBoundsAreTheCentreGrownByTheRadiusAtAnyTurn)
+{
+    const auto sphere = SphereShape::Create(0.3f).Value();
+    for (const Quat& turn : cTurns)
+    {
+        const AABB box = sphere->GetWorldBounds({Vec3(1, 2, 3), turn});
+        ExpectVecNear(box.mMin, Vec3(0.7f, 1.7f, 2.7f), 1e-6f);
+        ExpectVecNear(box.mMax, Vec3(1.3f, 2.3f, 3.3f), 1e-6f);
+    }
+}
+
+TEST(CapsuleShapeTest, WorldBoundsAreTightAtAnyTurn)
+{
+    // The turned local box would be up to 1.7 times as wide; the support points bound the capsule exactly
+    const auto capsule = CapsuleShape::Create(0.4f, 0.1f).Value();
+    for (const Quat& turn : cTurns)
+    {
+        const Transform at{Vec3(-2, 0.5f, 4), turn};
+        const AABB box = capsule->GetWorldBounds(at);
+        const AABB tight = SupportBox(*capsule, at);
+        ExpectVecNear(box.mMin, tight.mMin, 1e-5f);
+        ExpectVecNear(box.mMax, tight.mMax, 1e-5f);
+    }
+    // A capsule made around Create keeps its inverted box, which bodies and queries refuse
+    const CapsuleShape inverted(-5.0f, 1.0f);
+    EXPECT_TRUE(inverted.GetWorldBounds({Vec3::Zero(), cTurns[2]}).IsEmpty());
+}

@@ -19,6 +19,8 @@ public:
     float GetRadius() const { return mRadius; }
 
     AABB GetLocalBounds() const override;
+    /// The box of the inner segment's two ends grown by the radius: tight at every rotation.
+    AABB GetWorldBounds(const Transform& inTransform) const override;
     MassProperties GetMassProperties(float inDensity) const override;
     bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;

@@ -17,6 +17,8 @@ public:
     float GetRadius() const { return mRadius; }
 
     AABB GetLocalBounds() const override;
+    /// The centre grown by the radius: a sphere's box does not turn with it.
+    AABB GetWorldBounds(const Transform& inTransform) const override;
     MassProperties GetMassProperties(float inDensity) const override;
     bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
