@@ -51,7 +51,7 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     mContinuous.BeginStep();
     mContacts.BeginStep();
     IslandSleep::WakeIslandsOfWokenBodies(context);
-    mJoints.BeginStep(context, mConstraints); // May wake bodies: before the islands are sized
+    mJoints.BeginStep(context, mConstraints, mIntegration); // May wake bodies: before the islands are sized
     mIslands.Reset(uint32_t(active.size()));
     update.RunHereUnlessStarted(); // After a few microseconds of other work: see there
 

@@ -47,9 +47,11 @@ Quat RotationOf(const Body* inBody)
 }
 } // namespace
 
-void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioManager)
+void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioManager,
+                           const Integration& inIntegration)
 {
     mContext = &inContext;
+    mIntegration = &inIntegration;
     mManager = &ioManager;
     mStepJoints.clear();
     std::vector<Joint>& joints = ioManager.GetJoints();
@@ -130,27 +132,24 @@ void JointStage::GroupByIsland(const StepContext& inContext)
         mIslandJoints[mCursor[mJointIsland[i]]++] = i;
 }
 
-namespace
-{
-/// A joint side's arm (centre of mass to anchor, world space), anchor and masses at its pose now; the world's
-/// side: its point, no arm, nothing that moves
-void SideOf(const Body* inBody, const Vec3& inLocal, Vec3& outArm, Vec3& outAnchor, JointBodyMass& outMass)
+void JointStage::SideOf(const Body* inBody, const Vec3& inLocal, Rows inRows, Vec3& outArm, Vec3& outAnchor,
+                        JointBodyMass& outMass) const
 {
     outArm = inBody != nullptr ? Vec3(inBody->GetRotation() * inLocal) : Vec3::Zero();
     outAnchor = inBody != nullptr ? Vec3(inBody->GetCenterOfMassPosition() + outArm) : inLocal;
     outMass = {};
     if (inBody != nullptr && inBody->IsDynamic())
-        outMass = {inBody->GetInverseMass(), inBody->GetInverseInertiaWorld()};
+        outMass = {inBody->GetInverseMass(), inRows == Rows::All ? mIntegration->InverseInertiaOf(*inBody)
+                                                                 : inBody->GetInverseInertiaWorld()};
 }
-} // namespace
 
 void JointStage::PreparePoint(StepJoint& ioJoint)
 {
     Joint& joint = *ioJoint.mJoint;
     Vec3 armA, armB;
     JointBodyMass massA, massB;
-    SideOf(ioJoint.mA, joint.mLocalA, armA, ioJoint.mAnchorA, massA);
-    SideOf(ioJoint.mB, joint.mLocalB, armB, ioJoint.mAnchorB, massB);
+    SideOf(ioJoint.mA, joint.mLocalA, Rows::WithPosition, armA, ioJoint.mAnchorA, massA);
+    SideOf(ioJoint.mB, joint.mLocalB, Rows::WithPosition, armB, ioJoint.mAnchorB, massB);
     joint.mPart.Prepare(armA, massA, armB, massB);
 }
 
@@ -159,8 +158,8 @@ void JointStage::Prepare(StepJoint& ioJoint, Rows inRows)
     Joint& joint = *ioJoint.mJoint;
     Vec3 armA, armB, anchorA, anchorB;
     JointBodyMass massA, massB;
-    SideOf(ioJoint.mA, joint.mLocalA, armA, anchorA, massA);
-    SideOf(ioJoint.mB, joint.mLocalB, armB, anchorB, massB);
+    SideOf(ioJoint.mA, joint.mLocalA, inRows, armA, anchorA, massA);
+    SideOf(ioJoint.mB, joint.mLocalB, inRows, armB, anchorB, massB);
     ioJoint.mAnchorA = anchorA;
     ioJoint.mAnchorB = anchorB;
     switch (joint.mType)

@@ -25,12 +25,16 @@ namespace cairn::physics
 struct SolverSettings;
 struct StepContext;
 class Body;
+class Integration;
 
 class JointStage
 {
 public:
-    /// Before the islands are reset for this step (active bodies may be added).
-    void BeginStep(const StepContext& inContext, ConstraintManager& ioManager);
+    /// Before the islands are reset for this step (active bodies may be added). inIntegration: the step's,
+    /// whose world inverse inertias, kept from the velocity half, the velocity passes' rows read (the bodies
+    /// have not turned since).
+    void BeginStep(const StepContext& inContext, ConstraintManager& ioManager,
+                   const Integration& inIntegration);
     /// After the narrow phase's last merge, before the islands are finalized.
     void LinkIslands(const StepContext& inContext);
     /// After the islands are finalized.
@@ -88,6 +92,11 @@ private:
     /// The joint's rows at its bodies' current poses (arms, anchors, masses; a distance joint's axis, error
     /// and limit).
     void Prepare(StepJoint& ioJoint, Rows inRows = Rows::All);
+    /// A joint side's arm (centre of mass to anchor, world space), anchor and masses at its pose now; the
+    /// world's side: its point, no arm, nothing that moves. inRows All: the body has not turned since the
+    /// velocity half, whose inverse inertia is read instead of computed again.
+    void SideOf(const Body* inBody, const Vec3& inLocal, Rows inRows, Vec3& outArm, Vec3& outAnchor,
+                JointBodyMass& outMass) const;
     /// Only the point's rows (and the anchors) of a joint that has them: after a position iteration turned
     /// its bodies.
     void PreparePoint(StepJoint& ioJoint);
@@ -99,12 +108,13 @@ private:
     SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
 
     const StepContext* mContext = nullptr;
-    ConstraintManager* mManager = nullptr; ///< This step's (BeginStep's)
-    std::vector<StepJoint> mStepJoints;    ///< This step's joints, in slot order
-    std::vector<uint32_t> mJointStart;     ///< Per island, offsets into mIslandJoints
-    std::vector<uint32_t> mIslandJoints;   ///< Indices into mStepJoints, by island
-    std::vector<uint32_t> mJointIsland;    ///< Scratch: per step joint
-    std::vector<uint32_t> mCursor;         ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
+    const Integration* mIntegration = nullptr; ///< This step's (BeginStep's)
+    ConstraintManager* mManager = nullptr;     ///< This step's (BeginStep's)
+    std::vector<StepJoint> mStepJoints;        ///< This step's joints, in slot order
+    std::vector<uint32_t> mJointStart;         ///< Per island, offsets into mIslandJoints
+    std::vector<uint32_t> mIslandJoints;       ///< Indices into mStepJoints, by island
+    std::vector<uint32_t> mJointIsland;        ///< Scratch: per step joint
+    std::vector<uint32_t> mCursor; ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
 };
 
 } // namespace cairn::physics
