@@ -178,9 +178,9 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
         std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
                     "broadphase-update %.3f  "
                     "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
-                    "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  | static "
-                    "candidates reused %.1f%% (%.1f%% walked, too "
-                    "many)  | colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
+                    "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  "
+                    "| static candidates reused %.1f%% (%.1f%% walked, too many)  "
+                    "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
                     inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
                     run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
                     run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,

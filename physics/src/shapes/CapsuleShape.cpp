@@ -109,11 +109,12 @@ AABB CapsuleShape::GetLocalBounds() const
 
 AABB CapsuleShape::GetWorldBounds(const Transform& inTransform) const
 {
-    // A capsule is its segment swept by a sphere, so its box is the segment's grown by the radius. The turned
-    // local box was much looser: a limb at 45 degrees had a box 1.4 to 1.7 times as wide on two axes, and a
-    // pile of ragdolls found twice the pairs Jolt finds (whose capsules are bounded the same way as here)
-    // A capsule made around Create (a negative or NaN size) keeps the box that tells it apart: inverted or NaN
+    // A capsule made around Create (a negative or NaN size) keeps the generic box, inverted or NaN, which
+    // bodies and queries refuse
     if (!(mHalfHeight >= 0.0f && mRadius > 0.0f)) return Shape::GetWorldBounds(inTransform);
+    // A capsule is its segment swept by a sphere, so its box is the segment's grown by the radius: the turned
+    // local box is up to 1.7 times as wide on two axes, and every pair search around a limb would find bodies
+    // it cannot touch
     const Vec3 halfSegment = inTransform.mRotation * Vec3(0.0f, mHalfHeight, 0.0f);
     return AABB::FromCenterExtent(inTransform.mPosition, halfSegment.cwiseAbs() + Vec3::Constant(mRadius));
 }
