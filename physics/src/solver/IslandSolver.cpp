@@ -41,52 +41,24 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
     // read front to back (the hardware prefetcher streams them), where through the pointers they were a cache
     // miss each (a third of the solver's time). Not the colored islands that the wide solver packs: their
     // iterations read the packed batches, which are made straight from the narrow phase's buffers, and the
-    // copy (4.7 MB read and written in a pyramid of 8,500 manifolds) was a tenth of that step
-    const bool packColored = CAIRN_WIDE_SOLVER && mContext->mSettings.mSolver.mWideColoredIslands;
+    // copy (4.7 MB read and written in a pyramid of 8,500 manifolds) was a tenth of that step. An island
+    // solved by one thread is copied by that thread as its solve begins, so that its iterations read what
+    // its own core just wrote; one that every thread solves is copied before, in a loop of its own
     mSolveOrder.resize(mPlan->mIslandConstraints.size());
     mPositionConstraints.resize(mPlan->mIslandConstraints.size());
+    mPackColored = CAIRN_WIDE_SOLVER && mContext->mSettings.mSolver.mWideColoredIslands;
     mCopyRanges.clear();
-    constexpr uint32_t cCopyTask = StepCosts::cCopyTask;
-    for (uint32_t island = 0; island < mContext->mIslands.GetNumIslands(); ++island)
-    {
-        if (packColored && mPlan->mIslandFirstColor[island] != UINT32_MAX) continue;
-        // Neighbouring islands share a task up to its size: most islands are a constraint or two
-        for (uint32_t begin = mPlan->mConstraintStart[island], end = mPlan->mConstraintStart[island + 1];
-             begin < end;)
-        {
-            const bool extend = !mCopyRanges.empty() && mCopyRanges.back().second == begin &&
-                                mCopyRanges.back().second - mCopyRanges.back().first < cCopyTask;
-            if (!extend) mCopyRanges.push_back({begin, begin});
-            begin = std::min(end, mCopyRanges.back().first + cCopyTask);
-            mCopyRanges.back().second = begin;
-        }
-    }
-    uint32_t numCopied = 0;
-    for (const auto& [begin, end] : mCopyRanges)
-        numCopied += end - begin;
-    scheduler.ParallelFor(
-        uint32_t(mCopyRanges.size()), 1,
-        StepScheduler::PerItem(uint64_t(StepCosts::cCopyNanoseconds) * numCopied, mCopyRanges.size()),
-        [&](uint32_t inBegin, uint32_t inEnd)
-        {
-            for (uint32_t range = inBegin; range < inEnd; ++range)
-            {
-                const auto [begin, end] = mCopyRanges[range];
-                // The sources are scattered over the narrow phase's chunks: fetching each one's cache
-                // lines a few constraints ahead overlaps the misses that the copy otherwise waits for
-                // in turn
-                constexpr uint32_t cAhead = 4;
-                for (uint32_t i = begin; i < std::min(end, begin + cAhead); ++i)
-                    PrefetchConstraint(mPlan->mIslandConstraints[i]);
-                for (uint32_t i = begin; i < end; ++i)
-                {
-                    if (i + cAhead < end) PrefetchConstraint(mPlan->mIslandConstraints[i + cAhead]);
-                    mSolveOrder[i] = *mPlan->mIslandConstraints[i];
-                    mPlan->mIslandConstraints[i] = &mSolveOrder[i];
-                    PrepareForSolve(i, numActive);
-                }
-            }
-        });
+    if (!mPackColored)
+        for (uint32_t island : mPlan->mColoredIslands)
+            for (uint32_t begin = mPlan->mConstraintStart[island], end = mPlan->mConstraintStart[island + 1];
+                 begin < end; begin = std::min(end, begin + StepCosts::cCopyTask))
+                mCopyRanges.push_back({begin, std::min(end, begin + StepCosts::cCopyTask)});
+    scheduler.ParallelFor(uint32_t(mCopyRanges.size()), 1, StepCosts::cCopyTask * StepCosts::cCopyNanoseconds,
+                          [&](uint32_t inBegin, uint32_t inEnd)
+                          {
+                              for (uint32_t range = inBegin; range < inEnd; ++range)
+                                  CopyIntoSolveOrder(mCopyRanges[range].first, mCopyRanges[range].second);
+                          });
 
     for (uint32_t index : active)
         if (Body& body = mContext->BodyAt(index); body.IsKinematic())
@@ -105,13 +77,19 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
     }
     scheduler.ParallelFor(
         uint32_t(mPlan->mSolveItems.size()), 1,
-        StepScheduler::PerItem(uint64_t(StepCosts::cSolveNanoseconds) * numItemConstraints,
+        StepScheduler::PerItem(uint64_t(StepCosts::cSolveNanoseconds + StepCosts::cCopyNanoseconds) *
+                                   numItemConstraints,
                                mPlan->mSolveItems.size()),
         [&](uint32_t inBegin, uint32_t inEnd)
         {
             for (uint32_t i = inBegin; i < inEnd; ++i)
             {
                 const SolvePlan::SolveItem& item = mPlan->mSolveItems[i];
+                for (uint32_t k = item.mFirst; k < item.mFirst + item.mCount; ++k)
+                    if (const uint32_t solved = mPlan->mSolvedIslands[k];
+                        !mPackColored || mPlan->mIslandFirstColor[solved] == UINT32_MAX) // Else packed
+                        CopyIntoSolveOrder(mPlan->mConstraintStart[solved],
+                                           mPlan->mConstraintStart[solved + 1]);
                 const uint32_t island = mPlan->mSolvedIslands[item.mFirst];
                 if (item.mGroup == UINT32_MAX && mPlan->mIslandFirstColor[island] != UINT32_MAX)
                     SolveColoredIsland(island, true);
@@ -142,6 +120,23 @@ void IslandSolver::LoadSolverBody(const Body& inBody, SolverBody& outBlock)
     outBlock.mAngularVelocity = inBody.mAngularVelocity;
     outBlock.mInverseMass = inBody.IsDynamic() ? inBody.mInvMass : 0.0f;
     outBlock.mPadding = 0.0f;
+}
+
+void IslandSolver::CopyIntoSolveOrder(uint32_t inBegin, uint32_t inEnd)
+{
+    const uint32_t numActive = uint32_t(mContext->mActive.size());
+    // The sources are scattered over the narrow phase's chunks: fetching each one's cache lines a few
+    // constraints ahead overlaps the misses that the copy otherwise waits for in turn
+    constexpr uint32_t cAhead = 4;
+    for (uint32_t i = inBegin; i < std::min(inEnd, inBegin + cAhead); ++i)
+        PrefetchConstraint(mPlan->mIslandConstraints[i]);
+    for (uint32_t i = inBegin; i < inEnd; ++i)
+    {
+        if (i + cAhead < inEnd) PrefetchConstraint(mPlan->mIslandConstraints[i + cAhead]);
+        mSolveOrder[i] = *mPlan->mIslandConstraints[i];
+        mPlan->mIslandConstraints[i] = &mSolveOrder[i];
+        PrepareForSolve(i, numActive);
+    }
 }
 
 void IslandSolver::PrepareForSolve(uint32_t inIndex, uint32_t inNumActive)

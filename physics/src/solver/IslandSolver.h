@@ -60,6 +60,9 @@ private:
     /// Binds constraint inIndex of the plan's island constraints to its solver blocks and makes its position
     /// constraint.
     void PrepareForSolve(uint32_t inIndex, uint32_t inNumActive);
+    /// Copies the plan's island constraints [inBegin, inEnd) into mSolveOrder, points the plan at the copies
+    /// and prepares each (PrepareForSolve).
+    void CopyIntoSolveOrder(uint32_t inBegin, uint32_t inEnd);
     /// Stores the constraints' impulses in the contact cache for next step's warm start.
     void StoreImpulses(std::span<ContactConstraint* const> inConstraints) const;
     static void LoadSolverBody(const Body& inBody, SolverBody& outBlock);
@@ -86,8 +89,11 @@ private:
     JointStage* mJoints = nullptr;         ///< During Solve only
 
     std::vector<ContactConstraint> mSolveOrder; ///< The other islands' constraints copied in solve order
-    /// Ranges of the plan's island constraints copied into mSolveOrder, each one task of the copy
+    /// Ranges of the plan's island constraints copied into mSolveOrder before the solve, each one task of the
+    /// copy: the colored islands that every thread solves, when they are copied (the others are copied by
+    /// the thread that solves them)
     std::vector<std::pair<uint32_t, uint32_t>> mCopyRanges;
+    bool mPackColored = false; ///< This step's colored islands are packed by the wide solver, not copied
     std::vector<PositionConstraint> mPositionConstraints; ///< Per entry of the plan's island constraints
     std::vector<SolverBody> mSolverBodies;                ///< Velocities being solved: see Solve
 #if CAIRN_WIDE_SOLVER

@@ -35,7 +35,8 @@ inline constexpr Loop cMergeCopies{4, 1'200};
 inline constexpr uint32_t cIslandsNanoseconds = 20;
 // The solver's velocity blocks, per active body
 inline constexpr Loop cLoadSolverBodies{512, 7};
-// Copying constraints into solve order, with their binding: tasks of up to cCopyTask constraints
+// Copying constraints into solve order, with their binding; a colored island that every thread solves is
+// copied before, in tasks of up to cCopyTask constraints
 inline constexpr uint32_t cCopyTask = 512;
 inline constexpr uint32_t cCopyNanoseconds = 110;
 // A constraint's iterations, integration and position passes in an island or a group of small ones
