@@ -5,6 +5,7 @@
 #include "constraints/JointGeometry.h"
 #include "constraints/SwingTwist.h"
 #include "step/StepContext.h"
+#include "step/StepCosts.h"
 
 #include <numbers>
 
@@ -54,6 +55,7 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
     mIntegration = &inIntegration;
     mManager = &ioManager;
     mStepJoints.clear();
+    mBreakableJoints.clear();
     std::vector<Joint>& joints = ioManager.GetJoints();
     if (ioManager.GetNumInUse() == 0) return;
     // A joint's bodies (null: the world); false while a side is gone or out of the world (the joint waits)
@@ -71,10 +73,14 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
                (inJoint.mBodyB.IsInvalid() || outB != nullptr);
     };
     // A sleeping dynamic body jointed to an active one wakes (and then its own jointed sleepers): in slot
-    // order, again until nothing wakes, so the same bodies wake on every run
+    // order, again until nothing wakes, so the same bodies wake on every run. The pass that wakes nothing
+    // takes the step's joints (a joint taken before a wake in the same pass may miss a side woken after it:
+    // that pass is taken again); most steps wake nobody and make one pass
     for (bool woke = true; woke;)
     {
         woke = false;
+        mStepJoints.clear();
+        mBreakableJoints.clear();
         for (Joint& joint : joints)
         {
             Body *a, *b;
@@ -86,28 +92,32 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
                     inContext.mBodies.ActivateBody(*sleeper);
                     woke |= sleeper->IsActive();
                 }
+            // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot
+            // be (it woke above), so both dynamic sides are awake here
+            if (!IsActiveDynamic(a) && !IsActiveDynamic(b)) continue;
+            if ((a != nullptr && a->IsDynamic() && !a->IsActive()) ||
+                (b != nullptr && b->IsDynamic() && !b->IsActive()))
+                continue; // Could not wake (defensive: ActivateBody refused)
+            if (joint.mBreakForce < cLargeFloat || joint.mBreakTorque < cLargeFloat)
+                mBreakableJoints.push_back(uint32_t(mStepJoints.size()));
+            mStepJoints.push_back(
+                {&joint, a, b, BlockOf(a), BlockOf(b), Vec3::Zero(), Vec3::Zero(), false, 0.0f});
         }
-    }
-    for (Joint& joint : joints)
-    {
-        Body *a, *b;
-        if (!joint.mInUse || !joint.mEnabled || !sides(joint, a, b)) continue;
-        // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot be
-        // (it woke above), so both dynamic sides are awake here
-        if (!IsActiveDynamic(a) && !IsActiveDynamic(b)) continue;
-        if ((a != nullptr && a->IsDynamic() && !a->IsActive()) ||
-            (b != nullptr && b->IsDynamic() && !b->IsActive()))
-            continue; // Could not wake (defensive: ActivateBody refused)
-        mStepJoints.push_back(
-            {&joint, a, b, BlockOf(a), BlockOf(b), Vec3::Zero(), Vec3::Zero(), false, 0.0f});
     }
 }
 
 void JointStage::LinkIslands(const StepContext& inContext)
 {
-    for (const StepJoint& joint : mStepJoints)
-        if (IsActiveDynamic(joint.mA) && IsActiveDynamic(joint.mB))
-            inContext.mIslands.Union(joint.mA->GetActiveIndex(), joint.mB->GetActiveIndex());
+    // The union-find takes links from any thread, in any order, with the same islands
+    inContext.mScheduler.ParallelFor(
+        uint32_t(mStepJoints.size()), StepCosts::cJointLinks.mGrain, StepCosts::cJointLinks.mItemNanoseconds,
+        [&](uint32_t inBegin, uint32_t inEnd)
+        {
+            for (uint32_t i = inBegin; i < inEnd; ++i)
+                if (const StepJoint& joint = mStepJoints[i];
+                    IsActiveDynamic(joint.mA) && IsActiveDynamic(joint.mB))
+                    inContext.mIslands.Union(joint.mA->GetActiveIndex(), joint.mB->GetActiveIndex());
+        });
 }
 
 void JointStage::GroupByIsland(const StepContext& inContext)
@@ -399,13 +409,12 @@ void JointStage::ApplyCorrection(StepJoint& ioJoint, const PointJointPart::PoseC
 
 void JointStage::BreakOverloaded()
 {
-    if (mStepJoints.empty()) return;
+    if (mBreakableJoints.empty()) return;
     const float inverseStep = 1.0f / mContext->mDeltaTime;
     std::vector<Joint>& joints = mManager->GetJoints();
-    for (StepJoint& step : mStepJoints) // Slot order
+    for (const uint32_t index : mBreakableJoints) // Slot order
     {
-        Joint& joint = *step.mJoint;
-        if (joint.mBreakForce >= cLargeFloat && joint.mBreakTorque >= cLargeFloat) continue;
+        Joint& joint = *mStepJoints[index].mJoint;
         // The impulses this step held the joint with, as forces
         Vec3 linear = Vec3::Zero(), angular = Vec3::Zero();
         switch (joint.mType)

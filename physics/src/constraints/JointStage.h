@@ -9,9 +9,10 @@
 // thread, a color's joints before its contacts, the colors in turn (IslandStage::ColorIsland).
 //
 // Threads: BeginStep, LinkIslands and GroupByIsland on the updating thread, while Update holds the joints'
-// mutex; the solve calls from the thread that solves the island, which writes only that island's joints and
-// its bodies; or, in a colored island, from the threads that solve a color's parts, each writing only its
-// part's joints and their bodies (a color's joints and contacts share no dynamic body).
+// mutex (LinkIslands' loop on the step's jobs, each joint by one of them); the solve calls from the thread
+// that solves the island, which writes only that island's joints and its bodies; or, in a colored island,
+// from the threads that solve a color's parts, each writing only its part's joints and their bodies (a
+// color's joints and contacts share no dynamic body).
 
 #include "constraints/ConstraintManager.h"
 #include "solver/SolverBody.h"
@@ -111,6 +112,7 @@ private:
     const Integration* mIntegration = nullptr; ///< This step's (BeginStep's)
     ConstraintManager* mManager = nullptr;     ///< This step's (BeginStep's)
     std::vector<StepJoint> mStepJoints;        ///< This step's joints, in slot order
+    std::vector<uint32_t> mBreakableJoints;    ///< Indices into mStepJoints of those with a threshold
     std::vector<uint32_t> mJointStart;         ///< Per island, offsets into mIslandJoints
     std::vector<uint32_t> mIslandJoints;       ///< Indices into mStepJoints, by island
     std::vector<uint32_t> mJointIsland;        ///< Scratch: per step joint
