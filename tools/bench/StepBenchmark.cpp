@@ -17,6 +17,7 @@
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "common/BenchOptions.h"
 #include "common/BenchScenes.h"
+#include "common/CoreToCoreLatency.h"
 #include "common/FrameTimes.h"
 #include "common/MachineInfo.h"
 #include "common/PhysicsSystemOrExit.h"
@@ -226,8 +227,9 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf("cairn-bench-step: build %s, %d repetitions; %s\n", buildType, repetitions,
-                tools::DescribeMachine().c_str());
+    std::printf("cairn-bench-step: build %s, %d repetitions; %s; core-to-core round trip %.0f ns\n",
+                buildType, repetitions, tools::DescribeMachine().c_str(),
+                tools::MeasureCoreToCoreRoundTripNanoseconds());
     auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
     {
         for (size_t t = 1; t < inMeans.size(); ++t)

@@ -116,6 +116,9 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo "# Many-core run, $started"
     echo
     echo "$cores cores, $model (kernel $(uname -r)). Threads $threads; query threads $queryThreads."
+    # The step benchmark's measure of a cache line's trip between two cores and back: what every line one
+    # thread writes and another reads next costs
+    grep -o -m1 "core-to-core round trip [0-9]* ns" "$out/step.txt" | sed 's/^c/C/; s/$/ (cairn-bench-step)./' || true
     echo
     echo "## Step scaling (cairn-bench-step, medians of 3; chart: scaling.svg)"
     echo
