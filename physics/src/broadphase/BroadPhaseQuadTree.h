@@ -101,8 +101,8 @@ public:
     /// what the candidate cache's own lookup does (a cache miss on the body's entry). The pyramid's floor
     /// (one static body) cost 1.7 % of its step in lookups.
     static constexpr uint32_t cMinCachedTreeBodies = 1024;
-    /// Slot margin of the bodies that moved since a tree's last rebuild (QuadTree::SetMovedSlotMargin): a
-    /// resting body's jitter stays inside, so its moves write no node.
+    /// Slot margin of the bodies that moved since a tree's last rebuild (QuadTree::SetMovedSlotMargin; less
+    /// for a small body): a resting body's jitter stays inside, so its moves write no node.
     static constexpr float cMovedSlotMargin = 0.05f;
     /// Stretch of a moved body's slot ahead of its motion, in moves since the last rebuild
     /// (QuadTree::SetMovedSlotReach): a box falling 10 cm a step then leaves its slot after 2, 5, then 11

@@ -186,13 +186,19 @@ public:
     void AdoptSecondLeaf(const MoveScope& inScope, uint32_t inIndex, uint32_t inLocation);
 
     /// Margin (m) by which a rebuild grows the slot of a body that moved since the previous rebuild (0: exact
-    /// slots). A body then moves inside its slot for a while without writing to any node (no cache line taken
-    /// from the other cores, no node marked changed for the next rebuild); queries test its exact bounds.
-    /// Update thread, or before the tree is shared.
+    /// slots), or cMovedSlotMarginShare of the body's box's smallest size where that is less. A body then
+    /// moves inside its slot for a while without writing to any node (no cache line taken from the other
+    /// cores, no node marked changed for the next rebuild); queries test its exact bounds. Update thread, or
+    /// before the tree is shared.
     void SetMovedSlotMargin(float inMargin)
     {
         mMovedSlotMargin = inMargin > 0.0f && inMargin < cLargeFloat ? inMargin : 0.0f;
     }
+    /// The most a moved slot's margin takes of the body's box's smallest size: the full margin around a small
+    /// body (a ragdoll's forearm) made its slot reach far more neighbours' than its box does, and every pair
+    /// walk that met the slot paid for a leaf test; a body that small moves less inside its slot before it
+    /// leaves it, and writes a node then.
+    static constexpr float cMovedSlotMarginShare = 0.15f;
     /// Longest stretch of a moved body's slot ahead of its motion (see SetMovedSlotReach).
     static constexpr float cMaxMovedSlotReach = 1.0f;
     /// How far ahead a rebuild stretches the slot of a body that moved since the previous rebuild, in

@@ -56,7 +56,9 @@ AABB UnionOfSlots(const QuadTree::Node& inNode)
 AABB QuadTree::MovedSlot(const AABB& inBounds, const AABB& inOldSlot, uint8_t inStretchedSides,
                          uint8_t& outStretchedSides) const
 {
-    AABB slot = inBounds.Expanded(mMovedSlotMargin);
+    const float margin =
+        std::min(mMovedSlotMargin, cMovedSlotMarginShare * (inBounds.mMax - inBounds.mMin).minCoeff());
+    AABB slot = inBounds.Expanded(margin);
     outStretchedSides = 0;
     if (mMovedSlotReach == 0.0f) return slot;
     for (int axis = 0; axis < 3; ++axis)
@@ -66,13 +68,11 @@ AABB QuadTree::MovedSlot(const AABB& inBounds, const AABB& inOldSlot, uint8_t in
         // body removed meanwhile) leaves no room on either side: its min is +large and its max -large. Room
         // under a quarter of the margin is taken for rounding (bounds + margin - bounds is not the margin
         // far from the origin), not for a move
-        const float leftAbove = (inStretchedSides & maxSide) != 0
-                                    ? 0.0f
-                                    : inOldSlot.mMax[axis] - inBounds.mMax[axis] - mMovedSlotMargin;
-        const float leftBelow = (inStretchedSides & minSide) != 0
-                                    ? 0.0f
-                                    : inBounds.mMin[axis] - inOldSlot.mMin[axis] - mMovedSlotMargin;
-        const float minRoom = 0.25f * mMovedSlotMargin;
+        const float leftAbove =
+            (inStretchedSides & maxSide) != 0 ? 0.0f : inOldSlot.mMax[axis] - inBounds.mMax[axis] - margin;
+        const float leftBelow =
+            (inStretchedSides & minSide) != 0 ? 0.0f : inBounds.mMin[axis] - inOldSlot.mMin[axis] - margin;
+        const float minRoom = 0.25f * margin;
         if (leftAbove > minRoom)
         {
             slot.mMin[axis] -= std::min(mMovedSlotReach * leftAbove, cMaxMovedSlotReach);

@@ -5,6 +5,7 @@
 
 #include "broadphase/BroadPhaseBruteForce.h"
 #include "broadphase/BroadPhaseQuadTree.h"
+#include "broadphase/QuadTree.h"
 #include "common/TestRandom.h"
 
 #include <algorithm>
@@ -30,9 +31,11 @@ AABB Shifted(const AABB& inBox, const Vec3& inDelta)
     return AABB(inBox.mMin + inDelta, inBox.mMax + inDelta);
 }
 
-/// inCount bodies of 0.8 m in a 60 m x 60 m field, added to both broad phases; the tested one updated.
+/// inCount bodies of inSize (m, 0.8 unless given) in a 60 m x 60 m field, added to both broad phases; the
+/// tested one updated.
 std::vector<BroadPhaseBody> AddField(uint32_t inCount, test::TestRandom& ioRandom,
-                                     BroadPhaseQuadTree& ioTested, BroadPhaseBruteForce& ioReference)
+                                     BroadPhaseQuadTree& ioTested, BroadPhaseBruteForce& ioReference,
+                                     float inSize = 0.8f)
 {
     std::vector<BroadPhaseBody> bodies;
     for (uint32_t i = 0; i < inCount; ++i)
@@ -40,7 +43,7 @@ std::vector<BroadPhaseBody> AddField(uint32_t inCount, test::TestRandom& ioRando
         const Vec3 centre(ioRandom.Uniform(0.0f, 60.0f), ioRandom.Uniform(0.0f, 4.0f),
                           ioRandom.Uniform(0.0f, 60.0f));
         bodies.push_back(
-            {BodyID(i, 1), AABB::FromCenterExtent(centre, Vec3::Constant(0.4f)), Layers::cMoving});
+            {BodyID(i, 1), AABB::FromCenterExtent(centre, Vec3::Constant(0.5f * inSize)), Layers::cMoving});
     }
     for (BroadPhase* broadPhase :
          {static_cast<BroadPhase*>(&ioTested), static_cast<BroadPhase*>(&ioReference)})
@@ -96,6 +99,50 @@ TEST(QuadTreeMovedSlotTest, SmallMovesAfterARebuildChangeNoNodeAndQueriesStayExa
     EXPECT_GT(tested.GetLastUpdateStats().mLayersRebuilt, 0u);
     expectExactQueries("after the second rebuild");
     EXPECT_TRUE(tested.Validate());
+}
+
+// A small body's margin is a share of its size (QuadTree::cMovedSlotMarginShare): 3 cm moves stay inside the
+// slots of 0.8 m bodies (a 5 cm margin), and take 8 cm bodies (a margin of 1.2 cm) out of theirs
+TEST(QuadTreeMovedSlotTest, ASmallBodysSlotMarginIsAShareOfItsSize)
+{
+    static_assert(BroadPhaseQuadTree::cMovedSlotMargin >= 0.04f,
+                  "3 cm moves must fit in a large body's margin");
+    for (const float size : {0.8f, 0.08f})
+    {
+        SCOPED_TRACE(size);
+        static_assert(QuadTree::cMovedSlotMarginShare * 0.08f < 0.02f,
+                      "a small body's margin must be under 2 cm");
+        test::TestRandom random(5);
+        BroadPhaseQuadTree tested(2000, LayerSetup::CreateDefault());
+        BroadPhaseBruteForce reference;
+        std::vector<BroadPhaseBody> moving = AddField(2000, random, tested, reference, size);
+        auto moveAll = [&](float inStep)
+        {
+            for (BroadPhaseBody& body : moving)
+                body.mBounds = Shifted(body.mBounds,
+                                       Vec3(random.Uniform(-inStep, inStep), random.Uniform(-inStep, inStep),
+                                            random.Uniform(-inStep, inStep)));
+            tested.NotifyBodiesAABBChanged(moving);
+            reference.NotifyBodiesAABBChanged(moving);
+            for (size_t i = 0; i < moving.size(); i += 7)
+                for (const float grow : {0.0f, 0.01f, 0.03f})
+                {
+                    const AABB box = moving[i].mBounds.Expanded(grow);
+                    ASSERT_EQ(BoxQuery(tested, box), BoxQuery(reference, box)) << "body " << i;
+                }
+        };
+        moveAll(0.3f); // A real move: the moved slots are made
+        tested.Update();
+        ASSERT_GT(tested.GetLastUpdateStats().mLayersRebuilt, 0u);
+        moveAll(0.03f);
+        tested.Update();
+        if (size > 0.5f)
+            EXPECT_EQ(tested.GetLastUpdateStats().mLayersRebuilt, 0u) << "3 cm moves left a 5 cm margin";
+        else
+            EXPECT_GT(tested.GetLastUpdateStats().mLayersRebuilt, 0u)
+                << "3 cm moves stayed in a 1.2 cm margin";
+        EXPECT_TRUE(tested.Validate());
+    }
 }
 
 /// Moves every body by inDelta in both broad phases and checks queries around some of them.
