@@ -46,9 +46,9 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
     // its own core just wrote; one that every thread solves is copied before, in a loop of its own
     mSolveOrder.resize(mPlan->mIslandConstraints.size());
     mPositionConstraints.resize(mPlan->mIslandConstraints.size());
-    mPackColored = CAIRN_WIDE_SOLVER && mContext->mSettings.mSolver.mWideColoredIslands;
+    const bool packColored = CAIRN_WIDE_SOLVER && mContext->mSettings.mSolver.mWideColoredIslands;
     mCopyRanges.clear();
-    if (!mPackColored)
+    if (!packColored)
         for (uint32_t island : mPlan->mColoredIslands)
             for (uint32_t begin = mPlan->mConstraintStart[island], end = mPlan->mConstraintStart[island + 1];
                  begin < end; begin = std::min(end, begin + StepCosts::cCopyTask))
@@ -87,7 +87,7 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
                 const SolvePlan::SolveItem& item = mPlan->mSolveItems[i];
                 for (uint32_t k = item.mFirst; k < item.mFirst + item.mCount; ++k)
                     if (const uint32_t solved = mPlan->mSolvedIslands[k];
-                        !mPackColored || mPlan->mIslandFirstColor[solved] == UINT32_MAX) // Else packed
+                        !packColored || mPlan->mIslandFirstColor[solved] == UINT32_MAX) // Else packed
                         CopyIntoSolveOrder(mPlan->mConstraintStart[solved],
                                            mPlan->mConstraintStart[solved + 1]);
                 const uint32_t island = mPlan->mSolvedIslands[item.mFirst];

@@ -93,7 +93,6 @@ private:
     /// copy: the colored islands that every thread solves, when they are copied (the others are copied by
     /// the thread that solves them)
     std::vector<std::pair<uint32_t, uint32_t>> mCopyRanges;
-    bool mPackColored = false; ///< This step's colored islands are packed by the wide solver, not copied
     std::vector<PositionConstraint> mPositionConstraints; ///< Per entry of the plan's island constraints
     std::vector<SolverBody> mSolverBodies;                ///< Velocities being solved: see Solve
 #if CAIRN_WIDE_SOLVER

@@ -1,8 +1,8 @@
 // The finish (bounds, broad-phase move, published pose) of every active body, whichever way the solve
 // reached it: a colored island that every thread solves, a group of small islands, an island with a joint, a
-// body alone, a kinematic body, and a linear-cast body that its cast moved back. Each must publish the pose it
-// ends the step with: a body left out publishes a stale pose (and never sleeps), and one finished before its
-// cast publishes a pose it no longer has.
+// body alone, a kinematic body, and a linear-cast body that its cast moved back. Each must publish the pose
+// it ends the step with: a body left out publishes a stale pose (and never sleeps), and one finished before
+// its cast publishes a pose it no longer has.
 
 #include "SimulationFixture.h"
 #include "cairn/physics/body/PublishedPose.h"
@@ -17,8 +17,6 @@ namespace cairn::test
 namespace
 {
 
-using FinishEveryBodyTest = SimulationFixture;
-
 /// Every body the solve reaches by a different path, in one world:
 struct MixedScene
 {
@@ -26,60 +24,6 @@ struct MixedScene
     std::vector<BodyID> mLoneBoxes; ///< Resting alone: each an island of one manifold
     BodyID mKinematic;
 };
-
-MixedScene BuildMixedScene(PhysicsSystem& ioSystem)
-{
-    BodyInterface& bodies = ioSystem.GetBodyInterface();
-    MixedScene scene;
-    BodyCreationSettings floor;
-    floor.mShape = BoxShape::Create(Vec3(50, 1, 50)).Value();
-    floor.mPosition = Vec3(0, -1, 0);
-    floor.mMotionType = MotionType::Static;
-    floor.mObjectLayer = Layers::cStatic;
-    (void)bodies.CreateAndAddBody(floor, Activation::DontActivate).Value();
-    auto dynamic = [&](const ShapeRef& inShape, const Vec3& inPosition)
-    {
-        BodyCreationSettings settings;
-        settings.mShape = inShape;
-        settings.mPosition = inPosition;
-        settings.mMotionType = MotionType::Dynamic;
-        settings.mObjectLayer = Layers::cMoving;
-        return settings;
-    };
-    auto add = [&](const BodyCreationSettings& inSettings)
-    {
-        const BodyID id = bodies.CreateAndAddBody(inSettings, Activation::Activate).Value();
-        scene.mBodies.push_back(id);
-        return id;
-    };
-    const ShapeRef box = BoxShape::Create(Vec3(0.25f, 0.25f, 0.25f)).Value();
-    // A stack of 150 boxes: one island of far more than a quarter of the step's constraints, colored and
-    // solved by every thread
-    for (int layer = 0; layer < 6; ++layer)
-        for (int x = 0; x < 5; ++x)
-            for (int z = 0; z < 5; ++z)
-                add(dynamic(box, Vec3(0.52f * float(x), 0.25f + 0.51f * float(layer), 0.52f * float(z))));
-    // Boxes resting alone, far apart: islands of one manifold, solved four to a group
-    for (int i = 0; i < 6; ++i)
-        scene.mLoneBoxes.push_back(add(dynamic(box, Vec3(10.0f + 2.0f * float(i), 0.25f, -10.0f))));
-    // Two boxes hinged together: an island with a joint, solved whole by one thread
-    const BodyID hingedA = add(dynamic(box, Vec3(-10.0f, 1.0f, 10.0f)));
-    const BodyID hingedB = add(dynamic(box, Vec3(-9.4f, 1.0f, 10.0f)));
-    HingeConstraintSettings hinge;
-    hinge.mBodyA = hingedA;
-    hinge.mBodyB = hingedB;
-    hinge.mPoint = Vec3(-9.7f, 1.0f, 10.0f);
-    hinge.mHingeAxis = Vec3(0, 0, 1);
-    (void)ioSystem.GetConstraintInterface().AddHinge(hinge).Value();
-    // Spheres falling from high up, touching nothing for a while: alone in their islands
-    for (int i = 0; i < 4; ++i)
-        add(dynamic(SphereShape::Create(0.2f).Value(), Vec3(-10.0f + 1.0f * float(i), 20.0f, -10.0f)));
-    // A kinematic body that is moved every step
-    BodyCreationSettings kinematic = dynamic(box, Vec3(10.0f, 2.0f, 10.0f));
-    kinematic.mMotionType = MotionType::Kinematic;
-    scene.mKinematic = add(kinematic);
-    return scene;
-}
 
 /// Whether every body of inBodies has its pose published.
 ::testing::AssertionResult EveryPoseIsPublished(PhysicsSystem& ioSystem, const std::vector<BodyID>& inBodies)
@@ -98,32 +42,75 @@ MixedScene BuildMixedScene(PhysicsSystem& ioSystem)
     return ::testing::AssertionSuccess();
 }
 
-/// Steps the mixed scene on inJobs (null: on this thread) and checks after every step that each body's
-/// published pose is its pose.
-void StepAndCheckEveryBody(jobs::JobInterface* inJobs)
+class FinishEveryBodyTest : public SimulationFixture
 {
-    const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem();
-    const MixedScene scene = BuildMixedScene(*system);
-    BodyInterface& bodies = system->GetBodyInterface();
-    uint32_t coloredSteps = 0;
-    for (int step = 0; step < 90; ++step)
+protected:
+    /// A fresh world holding the mixed scene.
+    MixedScene BuildMixedScene()
     {
-        const float angle = 0.05f * float(step + 1);
-        ASSERT_TRUE(bodies
-                        .MoveKinematic(scene.mKinematic, Vec3(10.0f + std::sin(angle), 2.0f, 10.0f),
-                                       Quat(Eigen::AngleAxisf(angle, Vec3::UnitY())), 1.0f / 60.0f)
-                        .IsOk());
-        const Status status =
-            inJobs != nullptr ? system->Update(1.0f / 60.0f, 1, *inJobs) : system->Update(1.0f / 60.0f, 1);
-        ASSERT_TRUE(status.IsOk());
-        coloredSteps += system->GetLastStepStatistics().mNumColoredIslands > 0 ? 1 : 0;
-        ASSERT_TRUE(EveryPoseIsPublished(*system, scene.mBodies)) << "after step " << step;
+        ResetWorld(PhysicsSettings());
+        MixedScene scene;
+        AddFloor();
+        auto add = [&](const BodyCreationSettings& inSettings)
+        {
+            const BodyID id = AddDynamic(inSettings);
+            scene.mBodies.push_back(id);
+            return id;
+        };
+        const ShapeRef box = Box(Vec3(0.25f, 0.25f, 0.25f));
+        // A stack of 150 boxes: one island of far more than a quarter of the step's constraints, colored and
+        // solved by every thread
+        for (int layer = 0; layer < 6; ++layer)
+            for (int x = 0; x < 5; ++x)
+                for (int z = 0; z < 5; ++z)
+                    add(DynamicSettings(
+                        box, Vec3(0.52f * float(x), 0.25f + 0.51f * float(layer), 0.52f * float(z))));
+        // Boxes resting alone, far apart: islands of one manifold, solved four to a group
+        for (int i = 0; i < 6; ++i)
+            scene.mLoneBoxes.push_back(
+                add(DynamicSettings(box, Vec3(10.0f + 2.0f * float(i), 0.25f, -10.0f))));
+        // Two boxes hinged together: an island with a joint, solved whole by one thread
+        HingeConstraintSettings hinge;
+        hinge.mBodyA = add(DynamicSettings(box, Vec3(-10.0f, 1.0f, 10.0f)));
+        hinge.mBodyB = add(DynamicSettings(box, Vec3(-9.4f, 1.0f, 10.0f)));
+        hinge.mPoint = Vec3(-9.7f, 1.0f, 10.0f);
+        hinge.mHingeAxis = Vec3(0, 0, 1);
+        (void)System().GetConstraintInterface().AddHinge(hinge).Value();
+        // Spheres falling from high up, touching nothing for a while: alone in their islands
+        for (int i = 0; i < 4; ++i)
+            add(DynamicSettings(Sphere(0.2f), Vec3(-10.0f + 1.0f * float(i), 20.0f, -10.0f)));
+        // A kinematic body that is moved every step
+        BodyCreationSettings kinematic = DynamicSettings(box, Vec3(10.0f, 2.0f, 10.0f));
+        kinematic.mMotionType = MotionType::Kinematic;
+        scene.mKinematic = add(kinematic);
+        return scene;
     }
-    // Their sleep timers are kept by the finish
-    for (const BodyID& id : scene.mLoneBoxes)
-        EXPECT_FALSE(bodies.IsActive(id).Value()) << "a box resting alone for 1.5 s should sleep";
-    EXPECT_GT(coloredSteps, 0u) << "the stack was never a colored island: the scene misses that path";
-}
+
+    /// Steps the mixed scene on inJobs (null: on this thread) and checks after every step that each body's
+    /// published pose is its pose.
+    void StepAndCheckEveryBody(jobs::JobInterface* inJobs)
+    {
+        const MixedScene scene = BuildMixedScene();
+        uint32_t coloredSteps = 0;
+        for (int step = 0; step < 90; ++step)
+        {
+            const float angle = 0.05f * float(step + 1);
+            ASSERT_TRUE(Bodies()
+                            .MoveKinematic(scene.mKinematic, Vec3(10.0f + std::sin(angle), 2.0f, 10.0f),
+                                           Quat(Eigen::AngleAxisf(angle, Vec3::UnitY())), cDeltaTime)
+                            .IsOk());
+            const Status status =
+                inJobs != nullptr ? System().Update(cDeltaTime, 1, *inJobs) : System().Update(cDeltaTime, 1);
+            ASSERT_TRUE(status.IsOk());
+            coloredSteps += System().GetLastStepStatistics().mNumColoredIslands > 0 ? 1 : 0;
+            ASSERT_TRUE(EveryPoseIsPublished(System(), scene.mBodies)) << "after step " << step;
+        }
+        // Their sleep timers are kept by the finish
+        for (const BodyID& id : scene.mLoneBoxes)
+            EXPECT_FALSE(IsActive(id)) << "a box resting alone for 1.5 s should sleep";
+        EXPECT_GT(coloredSteps, 0u) << "the stack was never a colored island: the scene misses that path";
+    }
+};
 
 } // namespace
 
