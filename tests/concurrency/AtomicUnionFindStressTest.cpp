@@ -27,7 +27,7 @@ using namespace cairn::physics;
 namespace
 {
 
-using test::Edge;
+using cairn::test::Edge;
 
 constexpr uint32_t cNumBodies = 100000;
 constexpr uint32_t cNumEdges = 300000;

@@ -27,7 +27,7 @@ namespace
 
 constexpr float cHalfWorld = 12.8f; // 2 x 2 tiles around the origin
 
-using test::BoxBodySettings;
+using cairn::test::BoxBodySettings;
 
 struct NavMeshUnderTest
 {

@@ -19,7 +19,7 @@ using namespace cairn::physics;
 namespace
 {
 
-using test::BoxBodySettings;
+using cairn::test::BoxBodySettings;
 
 struct DetailHeightsScene
 {

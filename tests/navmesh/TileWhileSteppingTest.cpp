@@ -44,7 +44,7 @@ using namespace cairn::physics;
 namespace
 {
 
-using test::BoxBodySettings;
+using cairn::test::BoxBodySettings;
 
 /// One tile build: what was collected and what Recast and Detour made of it.
 struct TileBuild

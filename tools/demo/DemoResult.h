@@ -58,6 +58,10 @@ struct AgentStats
     std::vector<std::string> mErrors;
 };
 
+/// The error lines a feature's figures keep (DoorStats, GuardStats): enough to tell what went wrong, and a
+/// fault repeated every frame does not grow the report
+constexpr size_t cMaxStatsErrors = 20;
+
 /// What the huts' doors did to the navmesh (Doors' figures, for the report).
 struct DoorStats
 {

@@ -32,7 +32,6 @@ using namespace cairn::physics;
 namespace
 {
 using Clock = std::chrono::steady_clock;
-using tools::MillisecondsSince;
 
 /// The navmesh of each agent profile (human, then large), built from the one physics world by a scheduler
 /// each, on the same background queue; an invoker each at the player keeps the agents' area built.
@@ -132,7 +131,7 @@ bool RunUntil(PhysicsSystem& ioPhysics, jobs::JobSystem& ioJobs, NavMeshProfiles
     const Clock::time_point start = Clock::now();
     while (!inDone())
     {
-        if (MillisecondsSince(start) > inMaxSeconds * 1000.0) return false;
+        if (tools::MillisecondsSince(start) > inMaxSeconds * 1000.0) return false;
         (void)ioPhysics.Update(1.0f / 60.0f, 1, ioJobs);
         ioNavMeshes.Update();
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -282,7 +281,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         agents->Update(dt, player, frameJobs);
         navMeshes.Update();
         doors.AfterNavMeshUpdate();
-        result.mFrameMs.push_back(MillisecondsSince(frameStart));
+        result.mFrameMs.push_back(tools::MillisecondsSince(frameStart));
 
         if (IsProgressFrame(inProgress, liveProgress, frame, inSettings.mFrames))
         {

@@ -20,7 +20,6 @@ constexpr float cThroughTolerance = 0.5f;
 /// How far the doorway's ground points may be snapped onto the navmesh: less than the wall is thick plus
 /// the agent's radius, so that a point in a shut room never snaps to the path outside it (half extents, m)
 const Vec3 cDoorwaySnap(0.5f, 2.0f, 0.5f);
-constexpr size_t cMaxErrors = 20;
 } // namespace
 
 Doors::Doors(PhysicsSystem& ioPhysics, const TileStreamer& inStreamer,
@@ -61,7 +60,7 @@ void Doors::Command(float inSeconds)
             // The loading thread may have removed the door's tile since the list was taken: its ids went
             // stale. A door still in the world that refuses its motor is a bug
             Result<bool> added = mPhysics.GetBodyInterface().IsAdded(panel);
-            if (added && added.Value() && mStats.mErrors.size() < cMaxErrors)
+            if (added && added.Value() && mStats.mErrors.size() < cMaxStatsErrors)
                 mStats.mErrors.push_back("door motor: " + commanded.GetError().mMessage);
         }
     }

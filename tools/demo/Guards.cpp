@@ -34,7 +34,6 @@ constexpr float cLeftBehindSeconds = 1.5f; ///< A standing guard the player pass
 constexpr float cLimpLeftBehind = 60.0f;
 constexpr float cReach = 0.15f;    ///< m a ball may be off the capsule and still hit it
 constexpr float cPushSpeed = 3.0f; ///< m/s: the hit's push on every part, the way the ball flew
-constexpr size_t cMaxErrors = 20;
 
 /// Distance from inPoint to the segment [inA, inB]
 float DistanceToSegment(const Vec3& inPoint, const Vec3& inA, const Vec3& inB)
@@ -86,7 +85,8 @@ void Guards::Place(Guard& ioGuard, float inPathTime, int inSide)
     Result<BodyID> id = mPhysics.GetBodyInterface().CreateAndAddBody(capsule, Activation::DontActivate);
     if (!id)
     {
-        if (mStats.mErrors.size() < cMaxErrors) mStats.mErrors.push_back("guard: " + id.GetError().mMessage);
+        if (mStats.mErrors.size() < cMaxStatsErrors)
+            mStats.mErrors.push_back("guard: " + id.GetError().mMessage);
         return;
     }
     ioGuard.mCapsule = id.Value();
@@ -105,7 +105,7 @@ void Guards::Remove(Guard& ioGuard)
     {
         mStats.mRemovedBeforeRest += ioGuard.mRested ? 0 : 1;
         if (Status destroyed = ioGuard.mRagdoll->Destroy(mPhysics);
-            !destroyed && mStats.mErrors.size() < cMaxErrors)
+            !destroyed && mStats.mErrors.size() < cMaxStatsErrors)
             mStats.mErrors.push_back("ragdoll destroy: " + destroyed.GetError().mMessage);
     }
     ioGuard = Guard();
@@ -173,7 +173,7 @@ void Guards::GoLimp(Guard& ioGuard, int inFrame, const Vec3& inBallVelocity)
     const double ms = tools::MillisecondsSince(start);
     if (!ragdoll)
     {
-        if (mStats.mErrors.size() < cMaxErrors)
+        if (mStats.mErrors.size() < cMaxStatsErrors)
             mStats.mErrors.push_back("ragdoll: " + ragdoll.GetError().mMessage);
         return;
     }

@@ -17,7 +17,6 @@ using namespace cairn::physics;
 namespace
 {
 using Clock = std::chrono::steady_clock;
-using tools::MillisecondsSince;
 
 } // namespace
 
@@ -159,7 +158,7 @@ bool TileStreamer::AddBatch(const std::vector<BodyCreationSettings>& inSettings,
     const Clock::time_point link = Clock::now();
     if (Status finalized = bodies.AddBodiesFinalize(batch.Value(), inActivation); !finalized)
         NoteError("finalize batch: " + finalized.GetError().mMessage);
-    const double linkMs = MillisecondsSince(link);
+    const double linkMs = tools::MillisecondsSince(link);
     std::lock_guard lock(mMutex);
     mStats.mStreamLinkMs.push_back(linkMs);
     return true;
@@ -281,7 +280,7 @@ void TileStreamer::ThreadMain()
                 RemoveBodies(it->second.mDynamic);
                 RemoveDoors(it->second);
                 RemoveBodies(it->second.mStatic);
-                const double ms = MillisecondsSince(start);
+                const double ms = tools::MillisecondsSince(start);
                 mTiles.erase(it);
                 std::lock_guard lock(mMutex);
                 mStats.mStreamOutMs.push_back(ms);
@@ -318,7 +317,7 @@ void TileStreamer::ThreadMain()
                     AddDynamic(tile, it->second);
                 else if (!high)
                     RemoveBodies(it->second.mDynamic);
-                const double ms = MillisecondsSince(start);
+                const double ms = tools::MillisecondsSince(start);
                 std::lock_guard lock(mMutex);
                 if (inserted)
                 {

@@ -1,12 +1,9 @@
 #include "PublishedPoseStore.h"
 
 #include "cairn/physics/LockWaits.h"
+#include "math/CpuPause.h"
 
 #include <thread>
-
-#if defined(__x86_64__) || defined(_M_X64)
-#include <immintrin.h>
-#endif
 
 namespace cairn::physics
 {
@@ -24,12 +21,6 @@ static_assert(sizeof(ObjectLayer) == 1 && sizeof(MotionType) == 1,
 /// Retired shapes waiting before a collection is forced from DestroyBody (a world nobody updates)
 constexpr size_t cCollectRetiredAt = 256;
 
-void Pause()
-{
-#if defined(__x86_64__) || defined(_M_X64)
-    _mm_pause();
-#endif
-}
 } // namespace
 
 PublishedPoseStore::PublishedPoseStore(uint32_t inMaxBodies)
@@ -82,7 +73,7 @@ bool PublishedPoseStore::Read(uint32_t inIndex, PublishedPose& outPose) const
         if (attempt % 64 == 0)
             std::this_thread::yield();
         else
-            Pause();
+            CpuPause();
     }
 }
 

@@ -2,27 +2,13 @@
 
 #include "PairCandidateCache.h"
 #include "broadphase/BroadPhaseOverlap.h"
+#include "math/CpuPause.h"
 
 #include <cassert>
 #include <thread>
 
-#if defined(__x86_64__) || defined(_M_X64)
-#include <immintrin.h>
-#endif
-
 namespace cairn::physics
 {
-
-namespace
-{
-/// A spin-wait hint to the core (and to its hyper-thread sibling).
-void Pause()
-{
-#if defined(__x86_64__) || defined(_M_X64)
-    _mm_pause();
-#endif
-}
-} // namespace
 
 /// A prepared batch: one private sub-tree per broad-phase layer. Owned by the caller until finalized/aborted.
 struct BroadPhaseQuadTree::Batch
@@ -259,7 +245,7 @@ void BroadPhaseQuadTree::WaitForEpoch(uint64_t inEpoch)
         if (attempt % 64 == 0)
             std::this_thread::yield();
         else
-            Pause();
+            CpuPause();
     }
 }
 

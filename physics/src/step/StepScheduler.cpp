@@ -1,9 +1,8 @@
 #include "StepScheduler.h"
 
+#include "math/CpuPause.h"
+
 #include <thread>
-#if defined(__SSE2__)
-#include <immintrin.h>
-#endif
 
 namespace cairn::physics
 {
@@ -27,9 +26,7 @@ void StepScheduler::WaitABit(uint32_t inSpins)
 {
     if (inSpins < 256)
     {
-#if defined(__SSE2__)
-        _mm_pause();
-#endif
+        CpuPause();
     }
     else
         std::this_thread::yield();

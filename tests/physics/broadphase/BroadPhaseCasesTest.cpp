@@ -2,9 +2,7 @@
 // faces, swept boxes, layer filters, pairs reported once, aborted batches and ignored bad input. Every case
 // runs before and after Update(), so the quad tree's linked sub-trees and its rebuilt trees both get tested.
 
-#include "broadphase/BroadPhaseBruteForce.h"
-#include "broadphase/BroadPhaseGlobalMutex.h"
-#include "broadphase/BroadPhaseQuadTree.h"
+#include "physics/broadphase/BroadPhaseKinds.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -17,40 +15,16 @@ using namespace cairn::physics;
 namespace
 {
 
-/// Creates a broad phase of type T for 1,000 bodies and the default layers.
-template <class T> std::unique_ptr<BroadPhase> Make();
-template <> std::unique_ptr<BroadPhase> Make<BroadPhaseBruteForce>()
-{
-    return std::make_unique<BroadPhaseBruteForce>();
-}
-
-/// The quad tree behind BroadPhaseGlobalMutex (BroadPhaseType::QuadTreeGlobalMutex), as its own type for the
-/// typed tests.
-struct QuadTreeGlobalMutex
-{
-};
-template <> std::unique_ptr<BroadPhase> Make<BroadPhaseQuadTree>()
-{
-    return std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault());
-}
-template <> std::unique_ptr<BroadPhase> Make<QuadTreeGlobalMutex>()
-{
-    return std::make_unique<BroadPhaseGlobalMutex>(
-        std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault()));
-}
-/// The oracle behind BroadPhaseGlobalMutex: the wrapper forwards to whatever it wraps.
-struct BruteForceGlobalMutex
-{
-};
-template <> std::unique_ptr<BroadPhase> Make<BruteForceGlobalMutex>()
-{
-    return std::make_unique<BroadPhaseGlobalMutex>(std::make_unique<BroadPhaseBruteForce>());
-}
+using test::cA;
+using test::cB;
+using test::cC;
+using test::cD;
+using test::cUnitBox;
 
 template <class T> class BroadPhaseCasesTest : public ::testing::Test
 {
 protected:
-    void SetUp() override { mBroadPhase = Make<T>(); }
+    void SetUp() override { mBroadPhase = test::MakeBroadPhase<T>(); }
 
     void Add(std::initializer_list<BroadPhaseBody> inBodies)
     {
@@ -103,15 +77,7 @@ protected:
     std::unique_ptr<BroadPhase> mBroadPhase;
 };
 
-using Implementations =
-    ::testing::Types<BroadPhaseBruteForce, BroadPhaseQuadTree, QuadTreeGlobalMutex, BruteForceGlobalMutex>;
-TYPED_TEST_SUITE(BroadPhaseCasesTest, Implementations);
-
-const AABB cUnitBox(Vec3(0, 0, 0), Vec3(1, 1, 1));
-const BodyID cA(1, 1);
-const BodyID cB(2, 1);
-const BodyID cC(3, 1);
-const BodyID cD(4, 1);
+TYPED_TEST_SUITE(BroadPhaseCasesTest, test::BroadPhaseKinds);
 
 TYPED_TEST(BroadPhaseCasesTest, TouchingCountsAsOverlapping)
 {

@@ -3,9 +3,7 @@
 // changes nothing, and the quad tree stays valid. Every case runs before and after Update(), as in
 // BroadPhaseCasesTest. The no-miss property under concurrent queries is tests/concurrency/LiveBodyChangeTest.
 
-#include "broadphase/BroadPhaseBruteForce.h"
-#include "broadphase/BroadPhaseGlobalMutex.h"
-#include "broadphase/BroadPhaseQuadTree.h"
+#include "physics/broadphase/BroadPhaseKinds.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -18,32 +16,10 @@ using namespace cairn::physics;
 namespace
 {
 
-/// The quad tree behind BroadPhaseGlobalMutex, and the oracle behind it, as types of their own.
-struct QuadTreeGlobalMutex
-{
-};
-struct BruteForceGlobalMutex
-{
-};
-
-template <class T> std::unique_ptr<BroadPhase> Make();
-template <> std::unique_ptr<BroadPhase> Make<BroadPhaseBruteForce>()
-{
-    return std::make_unique<BroadPhaseBruteForce>();
-}
-template <> std::unique_ptr<BroadPhase> Make<BroadPhaseQuadTree>()
-{
-    return std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault());
-}
-template <> std::unique_ptr<BroadPhase> Make<QuadTreeGlobalMutex>()
-{
-    return std::make_unique<BroadPhaseGlobalMutex>(
-        std::make_unique<BroadPhaseQuadTree>(1000, LayerSetup::CreateDefault()));
-}
-template <> std::unique_ptr<BroadPhase> Make<BruteForceGlobalMutex>()
-{
-    return std::make_unique<BroadPhaseGlobalMutex>(std::make_unique<BroadPhaseBruteForce>());
-}
+using test::cA;
+using test::cB;
+using test::cC;
+using test::cUnitBox;
 
 ObjectLayerMask Only(ObjectLayer inLayer)
 {
@@ -53,7 +29,7 @@ ObjectLayerMask Only(ObjectLayer inLayer)
 template <class T> class BroadPhaseChangeLayerTest : public ::testing::Test
 {
 protected:
-    void SetUp() override { mBroadPhase = Make<T>(); }
+    void SetUp() override { mBroadPhase = test::MakeBroadPhase<T>(); }
 
     void Add(std::initializer_list<BroadPhaseBody> inBodies)
     {
@@ -109,14 +85,7 @@ protected:
     int mCallbacks = 0;
 };
 
-using Implementations =
-    ::testing::Types<BroadPhaseBruteForce, BroadPhaseQuadTree, QuadTreeGlobalMutex, BruteForceGlobalMutex>;
-TYPED_TEST_SUITE(BroadPhaseChangeLayerTest, Implementations);
-
-const AABB cUnitBox(Vec3(0, 0, 0), Vec3(1, 1, 1));
-const BodyID cA(1, 1);
-const BodyID cB(2, 1);
-const BodyID cC(3, 1);
+TYPED_TEST_SUITE(BroadPhaseChangeLayerTest, test::BroadPhaseKinds);
 
 TYPED_TEST(BroadPhaseChangeLayerTest, BodyMovesToTheOtherBroadPhaseLayerAndBack)
 {

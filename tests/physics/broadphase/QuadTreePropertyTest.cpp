@@ -284,7 +284,11 @@ std::string ToString(const Vec3& inV)
 }
 std::string ToString(const AABB& inBox)
 {
-    return "[" + ToString(inBox.mMin) + " - " + ToString(inBox.mMax) + "]";
+    // A stream, not "[" + ...: inlined into a unity build's batch, that chain meets a false
+    // -Wstringop-overflow in GCC 12's std::string
+    std::ostringstream stream;
+    stream << "[" << ToString(inBox.mMin) << " - " << ToString(inBox.mMax) << "]";
+    return stream.str();
 }
 std::string MaskToString(ObjectLayerMask inMask)
 {

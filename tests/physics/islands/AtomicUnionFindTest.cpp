@@ -23,7 +23,7 @@ using namespace cairn::physics;
 namespace
 {
 
-using test::Edge;
+using cairn::test::Edge;
 
 /// The first difference between the finalized islands and the reference, or "" when they agree. Also checks
 /// that each island lists exactly its bodies, ascending, and that islands are ordered by their lowest body.

@@ -1,5 +1,6 @@
 // Each dedicated pair routine against the generic GJK/EPA answer on random overlapping configurations.
 
+#include "common/ShapeExpect.h"
 #include "narrowphase/CollideBoxBox.h"
 #include "narrowphase/CollideCapsuleCapsule.h"
 #include "narrowphase/CollideSphereBox.h"
@@ -19,6 +20,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::MaxPenetration;
 
 constexpr int cNumCases = 10000;
 constexpr float cNormalDotTolerance = 1.0e-2f; // 1 - dot(dedicated, GJK/EPA)
@@ -48,14 +50,6 @@ public:
 private:
     std::mt19937 mEngine;
 };
-
-float MaxPenetration(const ContactManifold& inManifold)
-{
-    float best = -cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        best = std::max(best, inManifold.mPoints[i].mPenetration);
-    return best;
-}
 
 // Counts of one agreement run
 struct Tally

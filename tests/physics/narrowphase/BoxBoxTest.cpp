@@ -1,6 +1,7 @@
 // Hand-made box-box cases with analytic answers: face-face manifolds, edge-edge, rotations, touching and
 // separated boxes, and the reduction of a clipped octagon to 4 points.
 
+#include "common/ShapeExpect.h"
 #include "narrowphase/CollideBoxBox.h"
 #include "narrowphase/ConvexContact.h"
 
@@ -12,14 +13,8 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
-
-constexpr float cEps = 1.0e-5f;
-
-void ExpectVec(const Vec3& inActual, const Vec3& inExpected, float inTolerance = cEps)
-{
-    EXPECT_LT((inActual - inExpected).norm(), inTolerance)
-        << "actual (" << inActual.transpose() << ") expected (" << inExpected.transpose() << ")";
-}
+using cairn::test::cEps;
+using cairn::test::ExpectVec;
 
 // True when some point of the manifold has mPositionOnB at inPoint
 bool HasPointOnB(const ContactManifold& inManifold, const Vec3& inPoint, float inTolerance = 1.0e-4f)

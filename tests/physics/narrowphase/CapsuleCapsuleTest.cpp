@@ -1,5 +1,6 @@
 // Hand-made capsule-capsule cases with analytic answers.
 
+#include "common/ShapeExpect.h"
 #include "narrowphase/CollideCapsuleCapsule.h"
 
 #include <algorithm>
@@ -10,14 +11,8 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
-
-constexpr float cEps = 1.0e-5f;
-
-void ExpectVec(const Vec3& inActual, const Vec3& inExpected, float inTolerance = cEps)
-{
-    EXPECT_LT((inActual - inExpected).norm(), inTolerance)
-        << "actual (" << inActual.transpose() << ") expected (" << inExpected.transpose() << ")";
-}
+using cairn::test::cEps;
+using cairn::test::ExpectVec;
 
 const Quat cAlongX(Eigen::AngleAxisf(0.5f * cPi, Vec3::UnitZ()));
 

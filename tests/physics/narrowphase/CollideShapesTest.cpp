@@ -10,6 +10,7 @@
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/ShapeExpect.h"
 
 #include <algorithm>
 #include <array>
@@ -22,6 +23,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::MaxPenetration;
 
 std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, const Shape& inB,
                                      const Transform& inTB, const CollideSettings& inSettings = {})
@@ -31,14 +33,6 @@ std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, co
                                     [&](const ContactManifold& inM) { result.push_back(inM); });
     EXPECT_EQ(count, int(result.size()));
     return result;
-}
-
-float MaxPenetration(const ContactManifold& inManifold)
-{
-    float best = -cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        best = std::max(best, inManifold.mPoints[i].mPenetration);
-    return best;
 }
 
 std::shared_ptr<const ConvexHullShape> MakeHullBox(const Vec3& inHalfExtent)

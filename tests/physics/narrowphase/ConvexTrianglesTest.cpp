@@ -6,6 +6,7 @@
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/ShapeExpect.h"
 #include "narrowphase/CollideConvexTriangles.h"
 
 #include <array>
@@ -17,6 +18,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::MaxPenetration;
 
 // A flat grid in the XZ plane at height 0, inCells x inCells cells of size inCellSize, facing +Y
 std::shared_ptr<const TriangleMeshShape> MakeGrid(int inCells, float inCellSize)
@@ -43,14 +45,6 @@ std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, co
     CollideShapes(inA, inTA, inB, inTB, inSettings,
                   [&](const ContactManifold& inM) { result.push_back(inM); });
     return result;
-}
-
-float MaxPenetration(const ContactManifold& inManifold)
-{
-    float best = -cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        best = std::max(best, inManifold.mPoints[i].mPenetration);
-    return best;
 }
 
 TEST(ConvexTrianglesTest, BoxOnFlatQuad)

@@ -4,6 +4,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "cairn/physics/shapes/ConvexHullShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "common/ShapeExpect.h"
 #include "narrowphase/ConvexContact.h"
 #include "narrowphase/Epa.h"
 
@@ -16,12 +17,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
-
-void ExpectVec(const Vec3& inActual, const Vec3& inExpected, float inTolerance)
-{
-    EXPECT_LT((inActual - inExpected).norm(), inTolerance)
-        << "actual (" << inActual.transpose() << ") expected (" << inExpected.transpose() << ")";
-}
+using cairn::test::ExpectVec;
 
 ConvexSupport Support(const ConvexShape& inShape, const Vec3& inPosition,
                       const Quat& inRotation = Quat::Identity())

@@ -1,5 +1,6 @@
 // Hand-made cases with analytic answers for sphere-sphere, sphere-box and sphere-capsule.
 
+#include "common/ShapeExpect.h"
 #include "narrowphase/CollideSphereBox.h"
 #include "narrowphase/CollideSphereCapsule.h"
 #include "narrowphase/CollideSphereSphere.h"
@@ -11,19 +12,9 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
-
-constexpr float cEps = 1.0e-5f;
-
-void ExpectVec(const Vec3& inActual, const Vec3& inExpected, float inTolerance = cEps)
-{
-    EXPECT_LT((inActual - inExpected).norm(), inTolerance)
-        << "actual (" << inActual.transpose() << ") expected (" << inExpected.transpose() << ")";
-}
-
-Transform At(const Vec3& inPosition, const Quat& inRotation = Quat::Identity())
-{
-    return {inPosition, inRotation};
-}
+using cairn::test::At;
+using cairn::test::cEps;
+using cairn::test::ExpectVec;
 
 TEST(SphereSphereTest, OverlapAlongX)
 {

@@ -3,6 +3,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/ShapeExpect.h"
 
 #include <gtest/gtest.h>
 #include <limits>
@@ -12,11 +13,7 @@ using namespace cairn::physics;
 
 namespace
 {
-
-Transform At(const Vec3& inPosition, const Quat& inRotation = Quat::Identity())
-{
-    return {inPosition, inRotation};
-}
+using cairn::test::At;
 
 std::shared_ptr<const CompoundShape> MakeCompound(std::vector<CompoundShape::SubShape> inSubShapes)
 {

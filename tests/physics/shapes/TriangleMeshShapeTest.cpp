@@ -39,7 +39,7 @@ void FlatGrid(int inQuads, std::vector<Vec3>& outVertices, std::vector<Indices>&
 }
 
 /// Every triangle of the shape by sub-shape id, from visiting its whole bounds.
-std::map<SubShapeID, Triangle> AllTriangles(const Shape& inShape)
+std::map<SubShapeID, Triangle> TrianglesByID(const Shape& inShape)
 {
     std::map<SubShapeID, Triangle> triangles;
     inShape.VisitTriangles(inShape.GetLocalBounds(), [&](const Triangle& t) { triangles[t.mSubShape] = t; });
@@ -206,7 +206,7 @@ TEST(TriangleMeshShapeTest, FlatGridInternalEdgesInactive)
     FlatGrid(2, vertices, triangles);
     const auto mesh = MakeMesh(vertices, triangles);
     ASSERT_NE(mesh, nullptr);
-    const auto all = AllTriangles(*mesh);
+    const auto all = TrianglesByID(*mesh);
     ASSERT_EQ(all.size(), 8u);
     int active = 0;
     for (const auto& [id, t] : all)
@@ -254,7 +254,7 @@ TEST(TriangleMeshShapeTest, ConvexRidgeActiveConcaveValleyInactive)
         }
         EXPECT_EQ(checked, 2);
     };
-    ridgeEdgeActive(AllTriangles(*mesh), true);
+    ridgeEdgeActive(TrianglesByID(*mesh), true);
 
     // Mirrored upside down (a valley, still facing up): the joint is concave, so the edge is inactive
     std::vector<Vec3> valley = ridge;
@@ -263,7 +263,7 @@ TEST(TriangleMeshShapeTest, ConvexRidgeActiveConcaveValleyInactive)
     // A mirror flips both the normal and the winding, so the same indices still face up
     const auto valleyMesh = MakeMesh(valley, roof);
     ASSERT_NE(valleyMesh, nullptr);
-    ridgeEdgeActive(AllTriangles(*valleyMesh), false);
+    ridgeEdgeActive(TrianglesByID(*valleyMesh), false);
 }
 
 TEST(TriangleMeshShapeTest, CollectTrianglesAtTransform)

@@ -1,0 +1,41 @@
+#pragma once
+
+// What the shape and narrow-phase tests share: a pose from a place and a turn, a vector's expectation with
+// the vectors in its message, and a manifold's deepest point.
+
+#include "cairn/physics/math/Math.h"
+#include "cairn/physics/math/Transform.h"
+#include "cairn/physics/narrowphase/ContactManifold.h"
+
+#include <algorithm>
+#include <gtest/gtest.h>
+
+namespace cairn::test
+{
+
+/// The analytic cases' tolerance: float rounding of a few operations on values near 1
+constexpr float cEps = 1.0e-5f;
+
+inline physics::Transform At(const physics::Vec3& inPosition,
+                             const physics::Quat& inRotation = physics::Quat::Identity())
+{
+    return {inPosition, inRotation};
+}
+
+inline void ExpectVec(const physics::Vec3& inActual, const physics::Vec3& inExpected,
+                      float inTolerance = cEps)
+{
+    EXPECT_LT((inActual - inExpected).norm(), inTolerance)
+        << "actual (" << inActual.transpose() << ") expected (" << inExpected.transpose() << ")";
+}
+
+/// The deepest of the manifold's points; -cLargeFloat for none
+inline float MaxPenetration(const physics::ContactManifold& inManifold)
+{
+    float best = -physics::cLargeFloat;
+    for (int i = 0; i < inManifold.mNumPoints; ++i)
+        best = std::max(best, inManifold.mPoints[i].mPenetration);
+    return best;
+}
+
+} // namespace cairn::test
