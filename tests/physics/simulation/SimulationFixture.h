@@ -2,7 +2,8 @@
 
 // A small world and helpers to build test scenes: every simulation test starts from here.
 // The world steps on this thread, or on a job system of CAIRN_TEST_PHYSICS_THREADS threads when that is set
-// (ctest runs the simulation tests once more with 1, 2 and 4 threads: tests/CMakeLists.txt).
+// (ctest runs the simulation tests once more with 1, 2 and 4 threads, a sanitizer build with 2 only:
+// tests/CMakeLists.txt).
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
