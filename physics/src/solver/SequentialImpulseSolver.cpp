@@ -152,6 +152,84 @@ struct BodyPair
     ioBodies.mB.mAngularVelocity += inLambda * inC.mInvIB_Normal;
 }
 
+#if defined(__SSE2__)
+/// A constraint's two solver bodies held in registers through its whole velocity iteration: every row of the
+/// manifold reads what the one before wrote, and in memory each of those reads waited on the store before it.
+/// The two blocks are never the same one (a static or kinematic side has a block of its own). Lane by lane
+/// the arithmetic is the scalar functions' below, in their order, so the velocities are the same bit for bit
+/// (the wide solver, which tests compare with this one, does the same sums).
+struct RegisterBodies
+{
+    RegisterBodies(const SolverBody& inA, const SolverBody& inB)
+        : mLinearA(_mm_load_ps(&inA.mLinearVelocity.x())), mAngularA(_mm_load_ps(&inA.mAngularVelocity.x())),
+          mLinearB(_mm_load_ps(&inB.mLinearVelocity.x())), mAngularB(_mm_load_ps(&inB.mAngularVelocity.x())),
+          mInverseMassA(inA.mInverseMass), mInverseMassB(inB.mInverseMass)
+    {
+    }
+    void Store(SolverBody& outA, SolverBody& outB) const
+    {
+        _mm_store_ps(&outA.mLinearVelocity.x(), mLinearA);
+        _mm_store_ps(&outA.mAngularVelocity.x(), mAngularA);
+        _mm_store_ps(&outB.mLinearVelocity.x(), mLinearB);
+        _mm_store_ps(&outB.mAngularVelocity.x(), mAngularB);
+    }
+
+    __m128 mLinearA, mAngularA, mLinearB,
+        mAngularB; ///< The blocks' rows: the fourth lanes are left as they were
+    float mInverseMassA, mInverseMassB;
+};
+
+/// A Vec3 field as a register, its fourth lane zeroed. The load reads the float after the field, which every
+/// Vec3 read here has in its struct.
+[[gnu::always_inline]] inline __m128 Load3(const Vec3& inV)
+{
+    return _mm_and_ps(_mm_loadu_ps(inV.data()), _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0)));
+}
+
+/// x + (y + z) of the register's first three lanes: Eigen's sum of a 3-vector dot product
+[[gnu::always_inline]] inline float Sum3(__m128 inV)
+{
+    const float y = _mm_cvtss_f32(_mm_shuffle_ps(inV, inV, _MM_SHUFFLE(1, 1, 1, 1)));
+    const float z = _mm_cvtss_f32(_mm_movehl_ps(inV, inV));
+    return _mm_cvtss_f32(inV) + (y + z);
+}
+
+[[gnu::always_inline]] inline float RelativeVelocity(const RegisterBodies& inBodies, const Vec3& inAxis,
+                                                     const AxisImpulse& inPart)
+{
+    const float along = Sum3(_mm_mul_ps(Load3(inAxis), _mm_sub_ps(inBodies.mLinearB, inBodies.mLinearA)));
+    const float turnB = Sum3(_mm_mul_ps(Load3(inPart.mRBxAxis), inBodies.mAngularB));
+    const float turnA = Sum3(_mm_mul_ps(Load3(inPart.mRAxAxis), inBodies.mAngularA));
+    return along + turnB - turnA;
+}
+
+[[gnu::always_inline]] inline void ApplyImpulse(RegisterBodies& ioBodies, const Vec3& inAxis,
+                                                const AxisImpulse& inPart, float inLambda)
+{
+    const __m128 axis = Load3(inAxis), lambda = _mm_set1_ps(inLambda);
+    ioBodies.mLinearA =
+        _mm_sub_ps(ioBodies.mLinearA, _mm_mul_ps(_mm_set1_ps(ioBodies.mInverseMassA * inLambda), axis));
+    ioBodies.mAngularA = _mm_sub_ps(ioBodies.mAngularA, _mm_mul_ps(lambda, Load3(inPart.mInvIA_RAxAxis)));
+    ioBodies.mLinearB =
+        _mm_add_ps(ioBodies.mLinearB, _mm_mul_ps(_mm_set1_ps(ioBodies.mInverseMassB * inLambda), axis));
+    ioBodies.mAngularB = _mm_add_ps(ioBodies.mAngularB, _mm_mul_ps(lambda, Load3(inPart.mInvIB_RBxAxis)));
+}
+
+[[gnu::always_inline]] inline float RelativeTwist(const ContactConstraint& inC,
+                                                  const RegisterBodies& inBodies)
+{
+    return Sum3(_mm_mul_ps(Load3(inC.mNormal), _mm_sub_ps(inBodies.mAngularB, inBodies.mAngularA)));
+}
+
+[[gnu::always_inline]] inline void ApplyTwist(const ContactConstraint& inC, RegisterBodies& ioBodies,
+                                              float inLambda)
+{
+    const __m128 lambda = _mm_set1_ps(inLambda);
+    ioBodies.mAngularA = _mm_sub_ps(ioBodies.mAngularA, _mm_mul_ps(lambda, Load3(inC.mInvIA_Normal)));
+    ioBodies.mAngularB = _mm_add_ps(ioBodies.mAngularB, _mm_mul_ps(lambda, Load3(inC.mInvIB_Normal)));
+}
+#endif
+
 float TotalNormalImpulse(const ContactConstraint& inC)
 {
     float total = 0.0f;
@@ -160,7 +238,7 @@ float TotalNormalImpulse(const ContactConstraint& inC)
     return total;
 }
 
-void SolvePatchFriction(ContactConstraint& ioC, const BodyPair& ioBodies)
+template <class Bodies> void SolvePatchFriction(ContactConstraint& ioC, Bodies& ioBodies)
 {
     PatchFriction& patch = ioC.mPatch;
     const float maxFriction = ioC.mFriction * TotalNormalImpulse(ioC);
@@ -193,7 +271,8 @@ void SolvePatchFriction(ContactConstraint& ioC, const BodyPair& ioBodies)
     patch.mTwistAccumulated = twist;
 }
 
-[[gnu::always_inline]] inline void SolveNormal(const ContactConstraint& inC, const BodyPair& ioBodies,
+template <class Bodies>
+[[gnu::always_inline]] inline void SolveNormal(const ContactConstraint& inC, Bodies& ioBodies,
                                                ContactConstraintPoint& ioP)
 {
     const float vn = RelativeVelocity(ioBodies, inC.mNormal, ioP.mNormal);
@@ -301,7 +380,11 @@ void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const
     const bool backwards = (inIteration & 1) != 0;
     for (ContactConstraint* c : ioConstraints)
     {
+#if defined(__SSE2__)
+        RegisterBodies bodies(ioBodies[c->mSolverBodyA], ioBodies[c->mSolverBodyB]);
+#else
         const BodyPair bodies = BodiesOf(*c, ioBodies);
+#endif
         // Friction first, against last iteration's normal impulse: normal is solved last so that
         // non-penetration, the more important constraint, wins when the two disagree
         SolvePatchFriction(*c, bodies);
@@ -311,6 +394,9 @@ void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const
         else
             for (int i = 0; i < c->mNumPoints; ++i)
                 SolveNormal(*c, bodies, c->mPoints[i]);
+#if defined(__SSE2__)
+        bodies.Store(ioBodies[c->mSolverBodyA], ioBodies[c->mSolverBodyB]);
+#endif
     }
 }
 
