@@ -49,29 +49,10 @@ void AngleJointPart::PrepareSpring(const JointBodyMass& inA, const JointBodyMass
     mImpulseScale = soft.mImpulseScale;
 }
 
-void AngleJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
-{
-    ioA.mAngularVelocity -= inImpulse * mAngularA;
-    ioB.mAngularVelocity += inImpulse * mAngularB;
-}
-
 void AngleJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
 {
     mTotalImpulse *= inRatio;
     if (mActive) Apply(ioA, ioB, mTotalImpulse);
-}
-
-void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
-{
-    if (!mActive) return;
-    const float spin = mAxis.dot(ioB.mAngularVelocity - ioA.mAngularVelocity);
-    const float impulse0 =
-        -mMassScale * mEffectiveMass * (spin - mTargetSpeed + mBias) - mImpulseScale * mTotalImpulse;
-    const float total =
-        AxisJointPart::ClampToSide(std::clamp(mTotalImpulse + impulse0, mMinImpulse, mMaxImpulse), mSide);
-    const float impulse = total - mTotalImpulse;
-    mTotalImpulse = total;
-    Apply(ioA, ioB, impulse);
 }
 
 PointJointPart::PoseCorrection AngleJointPart::CorrectPositions(float inFraction) const

@@ -66,4 +66,24 @@ private:
     bool mActive = false;
 };
 
+// Defined here so that JointStage, which calls them for every joint in every velocity iteration, inlines them
+inline void AngleJointPart::Apply(SolverBody& ioA, SolverBody& ioB, float inImpulse) const
+{
+    ioA.mAngularVelocity -= inImpulse * mAngularA;
+    ioB.mAngularVelocity += inImpulse * mAngularB;
+}
+
+inline void AngleJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const float spin = mAxis.dot(ioB.mAngularVelocity - ioA.mAngularVelocity);
+    const float impulse0 =
+        -mMassScale * mEffectiveMass * (spin - mTargetSpeed + mBias) - mImpulseScale * mTotalImpulse;
+    const float total =
+        AxisJointPart::ClampToSide(std::clamp(mTotalImpulse + impulse0, mMinImpulse, mMaxImpulse), mSide);
+    const float impulse = total - mTotalImpulse;
+    mTotalImpulse = total;
+    Apply(ioA, ioB, impulse);
+}
+
 } // namespace cairn::physics

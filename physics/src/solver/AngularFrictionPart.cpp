@@ -22,26 +22,10 @@ void AngularFrictionPart::Prepare(const JointBodyMass& inA, const JointBodyMass&
     mTotalImpulse = mTotalImpulse.cwiseMax(-inBound).cwiseMin(inBound);
 }
 
-void AngularFrictionPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inFrameImpulse) const
-{
-    ioA.mAngularVelocity -= mSpinPerImpulseA * inFrameImpulse;
-    ioB.mAngularVelocity += mSpinPerImpulseB * inFrameImpulse;
-}
-
 void AngularFrictionPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
 {
     mTotalImpulse *= inRatio;
     if (mActive) Apply(ioA, ioB, mTotalImpulse);
-}
-
-void AngularFrictionPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
-{
-    if (!mActive) return;
-    const Vec3 impulse = -(mImpulsePerSpin * (ioB.mAngularVelocity - ioA.mAngularVelocity));
-    const Vec3 total = (mTotalImpulse + impulse).cwiseMax(-mBound).cwiseMin(mBound);
-    const Vec3 applied = total - mTotalImpulse;
-    mTotalImpulse = total;
-    Apply(ioA, ioB, applied);
 }
 
 } // namespace cairn::physics

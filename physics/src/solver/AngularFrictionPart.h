@@ -44,4 +44,21 @@ private:
     bool mActive = false;
 };
 
+// Defined here so that JointStage, which calls them for every joint in every velocity iteration, inlines them
+inline void AngularFrictionPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inFrameImpulse) const
+{
+    ioA.mAngularVelocity -= mSpinPerImpulseA * inFrameImpulse;
+    ioB.mAngularVelocity += mSpinPerImpulseB * inFrameImpulse;
+}
+
+inline void AngularFrictionPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const Vec3 impulse = -(mImpulsePerSpin * (ioB.mAngularVelocity - ioA.mAngularVelocity));
+    const Vec3 total = (mTotalImpulse + impulse).cwiseMax(-mBound).cwiseMin(mBound);
+    const Vec3 applied = total - mTotalImpulse;
+    mTotalImpulse = total;
+    Apply(ioA, ioB, applied);
+}
+
 } // namespace cairn::physics

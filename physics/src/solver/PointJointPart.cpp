@@ -43,28 +43,10 @@ void PointJointPart::Prepare(const Vec3& inArmA, const JointBodyMass& inA, const
     mActive = InvertJointMassMatrix(k, mEffectiveMass);
 }
 
-void PointJointPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inImpulse) const
-{
-    ioA.mLinearVelocity -= mA.mInverseMass * inImpulse;
-    ioA.mAngularVelocity -= mA.mInverseInertia * mArmA.cross(inImpulse);
-    ioB.mLinearVelocity += mB.mInverseMass * inImpulse;
-    ioB.mAngularVelocity += mB.mInverseInertia * mArmB.cross(inImpulse);
-}
-
 void PointJointPart::WarmStart(SolverBody& ioA, SolverBody& ioB, float inRatio)
 {
     mTotalImpulse *= inRatio;
     if (mActive) Apply(ioA, ioB, mTotalImpulse);
-}
-
-void PointJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
-{
-    if (!mActive) return;
-    const Vec3 relative = ioB.mLinearVelocity + ioB.mAngularVelocity.cross(mArmB) - ioA.mLinearVelocity -
-                          ioA.mAngularVelocity.cross(mArmA);
-    const Vec3 impulse = -(mEffectiveMass * relative);
-    mTotalImpulse += impulse;
-    Apply(ioA, ioB, impulse);
 }
 
 PointJointPart::PoseCorrection PointJointPart::CorrectPositions(const Vec3& inAnchorA, const Vec3& inAnchorB,

@@ -88,4 +88,23 @@ private:
     bool mActive = false;
 };
 
+// Defined here so that JointStage, which calls them for every joint in every velocity iteration, inlines them
+inline void PointJointPart::Apply(SolverBody& ioA, SolverBody& ioB, const Vec3& inImpulse) const
+{
+    ioA.mLinearVelocity -= mA.mInverseMass * inImpulse;
+    ioA.mAngularVelocity -= mA.mInverseInertia * mArmA.cross(inImpulse);
+    ioB.mLinearVelocity += mB.mInverseMass * inImpulse;
+    ioB.mAngularVelocity += mB.mInverseInertia * mArmB.cross(inImpulse);
+}
+
+inline void PointJointPart::SolveVelocity(SolverBody& ioA, SolverBody& ioB)
+{
+    if (!mActive) return;
+    const Vec3 relative = ioB.mLinearVelocity + ioB.mAngularVelocity.cross(mArmB) - ioA.mLinearVelocity -
+                          ioA.mAngularVelocity.cross(mArmA);
+    const Vec3 impulse = -(mEffectiveMass * relative);
+    mTotalImpulse += impulse;
+    Apply(ioA, ioB, impulse);
+}
+
 } // namespace cairn::physics
