@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes each libFuzzer harness of tests/fuzz for a given time, from its seed corpus, and prints what each did.
 # Usage: bash tools/fuzz.sh [SECONDS] [HARNESS...]     (default: 30 s each, every harness)
-# Needs a build with the harnesses (CAIRN_BUILD_FUZZERS, as tools/run-tests.sh makes in build/asan; another
-# build folder with CAIRN_FUZZ_BUILD=...). Inputs the fuzzer adds go to <build>/fuzz-work/<harness>, never
+# Needs a build with the harnesses (CAIRN_BUILD_FUZZERS, as the asan preset makes in build/asan and
+# tools/run-tests.sh in build/ci/asan; another build folder with CAIRN_FUZZ_BUILD=...). Inputs the fuzzer adds go to <build>/fuzz-work/<harness>, never
 # to the repository's seeds; an input that fails is saved as <build>/fuzz-artifacts/<harness>/crash-...
 # (or timeout-, oom-), to be added to the seeds with its fix. Harnesses run as many at once as there are cores.
 # CAIRN_FUZZ_RUNS=N stops each harness after N executions instead (SECONDS then caps the time).
