@@ -174,8 +174,8 @@ struct RegisterBodies
         _mm_store_ps(&outB.mAngularVelocity.x(), mAngularB);
     }
 
-    __m128 mLinearA, mAngularA, mLinearB,
-        mAngularB; ///< The blocks' rows: the fourth lanes are left as they were
+    /// The blocks' rows; their fourth lanes (inverse mass, padding) are stored back as they were loaded
+    __m128 mLinearA, mAngularA, mLinearB, mAngularB;
     float mInverseMassA, mInverseMassB;
 };
 
@@ -380,10 +380,11 @@ void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const
     const bool backwards = (inIteration & 1) != 0;
     for (ContactConstraint* c : ioConstraints)
     {
+        const BodyPair blocks = BodiesOf(*c, ioBodies);
 #if defined(__SSE2__)
-        RegisterBodies bodies(ioBodies[c->mSolverBodyA], ioBodies[c->mSolverBodyB]);
+        RegisterBodies bodies(blocks.mA, blocks.mB);
 #else
-        const BodyPair bodies = BodiesOf(*c, ioBodies);
+        const BodyPair& bodies = blocks;
 #endif
         // Friction first, against last iteration's normal impulse: normal is solved last so that
         // non-penetration, the more important constraint, wins when the two disagree
@@ -395,7 +396,7 @@ void SequentialImpulseSolver::SolveVelocities(std::span<ContactConstraint* const
             for (int i = 0; i < c->mNumPoints; ++i)
                 SolveNormal(*c, bodies, c->mPoints[i]);
 #if defined(__SSE2__)
-        bodies.Store(ioBodies[c->mSolverBodyA], ioBodies[c->mSolverBodyB]);
+        bodies.Store(blocks.mA, blocks.mB);
 #endif
     }
 }

@@ -15,6 +15,7 @@ namespace
 {
 using cairn::test::cEps;
 using cairn::test::ExpectVec;
+using cairn::test::MaxPenetration;
 
 // True when some point of the manifold has mPositionOnB at inPoint
 bool HasPointOnB(const ContactManifold& inManifold, const Vec3& inPoint, float inTolerance = 1.0e-4f)
@@ -170,10 +171,7 @@ TEST(BoxBoxTest, OctagonIsReducedToFourKeepingTheDeepest)
     ConvexContact reference;
     ASSERT_TRUE(FindConvexContact(ConvexSupport::FromShape(*cube, {}), ConvexSupport::FromShape(*cube, t),
                                   0.0f, reference));
-    float deepest = -1.0f;
-    for (int i = 0; i < 4; ++i)
-        deepest = std::max(deepest, m.mPoints[i].mPenetration);
-    EXPECT_NEAR(deepest, reference.mPenetration, 1.0e-4f);
+    EXPECT_NEAR(MaxPenetration(m), reference.mPenetration, 1.0e-4f);
     // The 4 kept points span a large part of the octagon (area of the unit square overlap is ~0.83)
     // Area of a convex quadrilateral is half the cross product of its diagonals; the point order is unknown
     const auto p = [&](int inI) { return m.mPoints[inI].mPositionOnB; };

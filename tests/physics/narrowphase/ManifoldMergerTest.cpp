@@ -7,6 +7,7 @@
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "common/ShapeExpect.h"
 
 #include <array>
 #include <cmath>
@@ -18,6 +19,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::MaxPenetration;
 
 /// A one-point manifold: B's point inDepth below A's along inNormal (A's point at inOnA).
 ContactManifold OnePoint(const Vec3& inNormal, const Vec3& inOnA, float inDepth, SubShapeID inSubShapeB)
@@ -103,10 +105,7 @@ TEST(ManifoldMergerTest, ManyPointsAreReducedToFourKeepingTheDeepest)
     const std::vector<ContactManifold> out = Merged(merger);
     ASSERT_EQ(out.size(), 1u);
     ASSERT_EQ(out[0].mNumPoints, ContactManifold::cMaxPoints);
-    float deepest = 0.0f;
-    for (int i = 0; i < out[0].mNumPoints; ++i)
-        deepest = std::max(deepest, out[0].mPoints[i].mPenetration);
-    EXPECT_NEAR(deepest, 0.05f, 1.0e-6f);
+    EXPECT_NEAR(MaxPenetration(out[0]), 0.05f, 1.0e-6f);
 }
 
 TEST(ManifoldMergerTest, GroupsBeyondItsRoomAreHandedBack)
