@@ -81,25 +81,42 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     ioStatistics.mBroadPhaseUpdateMs += update.Finish(); // Its own time: beside the narrow phase when a task
     mLockWaitNanoseconds.fetch_add(update.GetLockWaitNanoseconds(),
                                    std::memory_order_relaxed); // See StepContext
-    ioStatistics.mNarrowPhaseMs += MillisecondsSince(phase);
+    uint64_t parallelBefore = 0;
+    // The phase's time less what the updating thread spent in the phase's parallel regions
+    auto serialPart = [&](double inPhaseMs)
+    {
+        const uint64_t parallel = mScheduler.GetParallelNanoseconds();
+        const double serialMs = inPhaseMs - double(parallel - parallelBefore) / 1.0e6;
+        parallelBefore = parallel;
+        return std::max(0.0, serialMs);
+    };
+    double phaseMs = MillisecondsSince(phase);
+    ioStatistics.mNarrowPhaseMs += phaseMs;
+    ioStatistics.mNarrowPhaseSerialMs += serialPart(phaseMs);
 
     // 6. Islands: serial, the solve's loops follow
     mScheduler.KeepWorkersSpinningFor(mContacts.GetConstraints().size() * StepCosts::cIslandsNanoseconds);
     mJoints.LinkIslands(context);
     mIslandStage.Build(context, mContacts.GetConstraintInfo());
     mJoints.GroupByIsland(context);
-    ioStatistics.mIslandsMs += MillisecondsSince(phase);
+    phaseMs = MillisecondsSince(phase);
+    ioStatistics.mIslandsMs += phaseMs;
+    ioStatistics.mIslandsSerialMs += serialPart(phaseMs);
 
     // 7. Solve (the constraints' ordering counted as solver time), positions integrated
     mIslandStage.Order(context, mContacts.GetConstraints(), mContacts.GetConstraintInfo(), mJoints);
     mSolver.Solve(context, mIslandStage.GetPlan(), uint32_t(mContacts.GetConstraints().size()), mJoints);
     mJoints.BreakOverloaded();
     mContactCache.EndStep(mContacts.IsCacheInOrder());
-    ioStatistics.mSolveMs += MillisecondsSince(phase);
+    phaseMs = MillisecondsSince(phase);
+    ioStatistics.mSolveMs += phaseMs;
+    ioStatistics.mSolveSerialMs += serialPart(phaseMs);
 
     // 7b. Linear casts: fast bodies stopped short of what they would have passed through
     ioStatistics.mNumLinearCastsMovedBack += mContinuous.Run(context);
-    ioStatistics.mContinuousMs += MillisecondsSince(phase);
+    phaseMs = MillisecondsSince(phase);
+    ioStatistics.mContinuousMs += phaseMs;
+    serialPart(phaseMs); // Serial whole (no loop): in mSerialMs only
 
     const ContactsStage::Counts& counts = mContacts.GetCounts();
     ioStatistics.mNumBodyPairs += counts.mNumBodyPairs;
@@ -127,9 +144,13 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     }
     else
         mEvents.Forget();
-    ioStatistics.mFinishMs += MillisecondsSince(phase);
+    phaseMs = MillisecondsSince(phase);
+    ioStatistics.mFinishMs += phaseMs;
+    ioStatistics.mFinishSerialMs += serialPart(phaseMs);
     ioStatistics.mNumActiveBodies = uint32_t(active.size());
-    ioStatistics.mTotalMs += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    const double totalMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    ioStatistics.mTotalMs += totalMs;
+    ioStatistics.mSerialMs += std::max(0.0, totalMs - double(mScheduler.GetParallelNanoseconds()) / 1.0e6);
     // Relaxed: every job that added to it was waited for
     ioStatistics.mLockWaitMs += double(mLockWaitNanoseconds.load(std::memory_order_relaxed)) / 1.0e6;
 }

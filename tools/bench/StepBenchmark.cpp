@@ -6,9 +6,10 @@
 //                dropped onto a rolling height field: 500 steps (issue 33's scene, after Jolt's
 //                PerformanceTest "Ragdoll": its piles and steps, this engine's humanoid and ground).
 // Prints ms per step (mean, p99, max) for each repetition and the median over repetitions, the mean time per
-// phase, and a checksum (sum of final body heights and contact points) that proves the work was done; for
-// each thread count of --threads (default 1,2: a job system of that many threads), then the speed-up. The
-// checksum must not change with the thread count (the step is deterministic across thread counts).
+// phase and of its serial part (the updating thread outside parallel loops: StepStatistics::mSerialMs), and a
+// checksum (sum of final body heights and contact points) that proves the work was done; for each thread
+// count of --threads (default 1,2: a job system of that many threads), then the speed-up. The checksum must
+// not change with the thread count (the step is deterministic across thread counts).
 
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
@@ -79,6 +80,12 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mPhaseSums.mIslandsMs += stats.mIslandsMs;
         result.mPhaseSums.mSolveMs += stats.mSolveMs;
         result.mPhaseSums.mFinishMs += stats.mFinishMs;
+        result.mPhaseSums.mTotalMs += stats.mTotalMs;
+        result.mPhaseSums.mNarrowPhaseSerialMs += stats.mNarrowPhaseSerialMs;
+        result.mPhaseSums.mIslandsSerialMs += stats.mIslandsSerialMs;
+        result.mPhaseSums.mSolveSerialMs += stats.mSolveSerialMs;
+        result.mPhaseSums.mFinishSerialMs += stats.mFinishSerialMs;
+        result.mPhaseSums.mSerialMs += stats.mSerialMs;
         result.mContactPoints += stats.mNumContactPoints;
         result.mManifolds += stats.mNumManifolds;
         result.mBodyPairs += stats.mNumBodyPairs;
@@ -176,25 +183,29 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             std::max<uint64_t>(run.mCandidates.mReused + run.mCandidates.mWalked + run.mCandidates.mRefilled +
                                    run.mCandidates.mUncached,
                                1);
-        std::printf("%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
-                    "broadphase-update %.3f  "
-                    "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
-                    "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  "
-                    "| static candidates reused %.1f%% (%.1f%% walked, too many)  "
-                    "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
-                    inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
-                    run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps,
-                    run.mPhaseSums.mNarrowPhaseMs / run.mSteps, run.mPhaseSums.mIslandsMs / run.mSteps,
-                    run.mPhaseSums.mSolveMs / run.mSteps, run.mPhaseSums.mFinishMs / run.mSteps,
-                    run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints),
-                    static_cast<unsigned long long>(run.mManifolds),
-                    static_cast<unsigned long long>(run.mBodyPairs),
-                    100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
-                    100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
-                    100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
-                    static_cast<unsigned long long>(run.mReusedColorings),
-                    static_cast<unsigned long long>(run.mColoredIslands),
-                    static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
+        std::printf(
+            "%s threads=%u rep %zu: mean %.3f ms  p99 %.3f ms  max %.3f ms  | per step: "
+            "broadphase-update %.3f  "
+            "narrow(+pairs) %.3f  islands %.3f  solve %.3f  finish %.3f ms  | serial %.3f ms (%.1f%%): "
+            "narrow %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
+            "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  "
+            "| static candidates reused %.1f%% (%.1f%% walked, too many)  "
+            "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
+            inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
+            run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
+            run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
+            run.mPhaseSums.mFinishMs / run.mSteps, run.mPhaseSums.mSerialMs / run.mSteps,
+            100.0 * run.mPhaseSums.mSerialMs / std::max(run.mPhaseSums.mTotalMs, 1e-9),
+            run.mPhaseSums.mNarrowPhaseSerialMs / run.mSteps, run.mPhaseSums.mIslandsSerialMs / run.mSteps,
+            run.mPhaseSums.mSolveSerialMs / run.mSteps, run.mPhaseSums.mFinishSerialMs / run.mSteps,
+            run.mHeightChecksum, static_cast<unsigned long long>(run.mContactPoints),
+            static_cast<unsigned long long>(run.mManifolds), static_cast<unsigned long long>(run.mBodyPairs),
+            100.0 * double(run.mReusedBodyPairs) / double(std::max<uint64_t>(run.mBodyPairs, 1)),
+            100.0 * double(run.mCandidates.mReused) / double(candidateQueries),
+            100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
+            static_cast<unsigned long long>(run.mReusedColorings),
+            static_cast<unsigned long long>(run.mColoredIslands),
+            static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

@@ -54,13 +54,22 @@ json_rows() { # <file> <counters...>
 
 echo "== step_pile2k and step_pyramid on $threads threads"
 "$bundle/run" cairn-bench-step --threads "$threads" --repetitions 3 >"$out/step.txt" 2>&1 || echo "run.sh: the step benchmark failed" >&2
-echo "scene,threads,mean_ms,p99_ms,speedup,checksum" >"$out/step.csv"
+# The serial part (StepStatistics::mSerialMs: the updating thread outside the parallel loops) and its phases,
+# averaged over the repetitions: the part that more threads cannot shorten, and where it is
+echo "scene,threads,mean_ms,p99_ms,speedup,checksum,serial_ms,serial_share,serial_narrow_ms,serial_islands_ms,serial_solve_ms,serial_finish_ms" \
+    >"$out/step.csv"
 awk '
-    / rep 0: / { scene = $1; t = $2; sub(/threads=/, "", t); c = $0; sub(/.*checksum /, "", c); sub(/ +\|.*/, "", c); checksum[scene "," t] = c }
-    / median of / { scene = $1; t = $2; sub(/threads=/, "", t)
+    / rep [0-9]+: / { scene = $1; t = $2; sub(/threads=/, "", t); key = scene "," t
+        if ($0 ~ / rep 0: /) { c = $0; sub(/.*checksum /, "", c); sub(/ +\|.*/, "", c); checksum[key] = c }
+        for (i = 1; i <= NF; ++i)
+            if ($i == "serial") { serial[key] += $(i + 1); share = $(i + 3); gsub(/[(%):]/, "", share); shares[key] += share
+                narrow[key] += $(i + 5); islands[key] += $(i + 7); solve[key] += $(i + 9); finish[key] += $(i + 11); ++reps[key] }
+    }
+    / median of / { scene = $1; t = $2; sub(/threads=/, "", t); key = scene "," t; n = (reps[key] > 0) ? reps[key] : 1
         for (i = 1; i <= NF; ++i) { if ($i == "mean") mean = $(i + 1); if ($i == "p99") p99 = $(i + 1) }
         if (t == 1) base[scene] = mean
-        printf "%s,%s,%s,%s,%.2f,\"%s\"\n", scene, t, mean, p99, (scene in base) ? base[scene] / mean : 0, checksum[scene "," t] }
+        printf "%s,%s,%s,%s,%.2f,\"%s\",%.3f,%.1f,%.3f,%.3f,%.3f,%.3f\n", scene, t, mean, p99, (scene in base) ? base[scene] / mean : 0,
+            checksum[key], serial[key] / n, shares[key] / n, narrow[key] / n, islands[key] / n, solve[key] / n, finish[key] / n }
 ' "$out/step.txt" >>"$out/step.csv"
 
 echo "== union-find on $threads threads"
@@ -122,9 +131,12 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo
     echo "## Step scaling (cairn-bench-step, medians of 3; chart: scaling.svg)"
     echo
-    echo "| scene | threads | mean ms | p99 ms | speed-up | checksum |"
-    echo "|---|---|---|---|---|---|"
-    awk -F, 'NR > 1 { gsub(/"/, "", $6); printf "| %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6 }' "$out/step.csv"
+    echo "Serial: the updating thread's time outside the step's parallel loops (StepStatistics::mSerialMs), in ms a"
+    echo "step and as a share of the step, then by phase: what more threads cannot shorten."
+    echo
+    echo "| scene | threads | mean ms | p99 ms | speed-up | checksum | serial ms (share) | serial narrow / islands / solve / finish ms |"
+    echo "|---|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { gsub(/"/, "", $6); printf "| %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12 }' "$out/step.csv"
     echo
     echo "## Union-find (cairn-bench-unionfind)"
     echo

@@ -33,14 +33,14 @@ void IslandSolver::SolveColoredIsland(uint32_t inIsland, bool inAlone)
     {
         scheduler.RunStages(
             inAlone, uint32_t(std::max(inPasses, 0)) * numColors,
-            [&](uint32_t inStage)
+            [&](uint32_t inStage, uint32_t inThreads)
             {
                 const uint32_t color = firstColor + inStage % numColors;
                 return mPlan->mColorIsSerial[color] != 0
                            ? 1u
-                           : scheduler.PartsFor(uint32_t(mPlan->ColorConstraints(color).size() +
-                                                         mPlan->ColorJoints(color).size()),
-                                                StepCosts::cMinConstraintsPerPart);
+                           : StepScheduler::PartsFor(uint32_t(mPlan->ColorConstraints(color).size() +
+                                                              mPlan->ColorJoints(color).size()),
+                                                     StepCosts::cMinConstraintsPerPart, inThreads);
             },
             [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
             {
@@ -147,23 +147,30 @@ void IslandSolver::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstC
         return std::span<WideContactBatch>(mWideBatches.data() + mPlan->mColorFirstBatch[inColor],
                                            mWideBatches.data() + mPlan->mColorFirstBatch[inColor + 1]);
     };
-    auto partsOfColor = [&](uint32_t inColor)
-    { return scheduler.PartsFor(uint32_t(batchesOf(inColor).size()), StepCosts::cMinBatchesPerPart); };
+    auto partsOfColor = [&](uint32_t inColor, uint32_t inThreads)
+    {
+        return StepScheduler::PartsFor(uint32_t(batchesOf(inColor).size()), StepCosts::cMinBatchesPerPart,
+                                       inThreads);
+    };
     auto forEachPartOfThreads = [&](const auto& inRunBatches)
     {
         const uint32_t threads = inAlone ? 1 : scheduler.GetNumThreads();
         if (threads == 1)
         {
-            inRunBatches(std::span<WideContactBatch>(mWideBatches.data() + islandFirstBatch, numBatches));
+            scheduler.RunWhole(inAlone,
+                               [&] {
+                                   inRunBatches(std::span<WideContactBatch>(
+                                       mWideBatches.data() + islandFirstBatch, numBatches));
+                               });
             return;
         }
-        scheduler.GetJobs()->ParallelFor(
-            threads, 1,
+        scheduler.ParallelForUnlessAlone(
+            false, threads, 1,
             [&](uint32_t inBegin, uint32_t inEnd)
             {
                 for (uint32_t part = inBegin; part < inEnd; ++part)
                     for (uint32_t color = inFirstColor; color <= inLastColor; ++color)
-                        if (const uint32_t parts = partsOfColor(color); part < parts)
+                        if (const uint32_t parts = partsOfColor(color, threads); part < parts)
                             inRunBatches(StepScheduler::PartOf(batchesOf(color), part, parts));
             });
     };
@@ -196,14 +203,14 @@ void IslandSolver::SolveColoredVelocitiesWide([[maybe_unused]] uint32_t inFirstC
     const uint32_t numColors = inLastColor - inFirstColor + 1;
     scheduler.RunStages(
         inAlone, (1 + uint32_t(mContext->mSettings.mSolver.mVelocityIterations)) * numColors,
-        [&](uint32_t inStage)
+        [&](uint32_t inStage, uint32_t inThreads)
         {
             const uint32_t color = inFirstColor + inStage % numColors;
             return mPlan->mColorIsSerial[color] != 0
                        ? 1u
-                       : std::max(partsOfColor(color),
-                                  scheduler.PartsFor(uint32_t(mPlan->ColorJoints(color).size()),
-                                                     StepCosts::cMinConstraintsPerPart));
+                       : std::max(partsOfColor(color, inThreads),
+                                  StepScheduler::PartsFor(uint32_t(mPlan->ColorJoints(color).size()),
+                                                          StepCosts::cMinConstraintsPerPart, inThreads));
         },
         [&](uint32_t inStage, uint32_t inPart, uint32_t inParts)
         {

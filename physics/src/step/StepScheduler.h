@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <thread>
 
 namespace cairn::physics
 {
@@ -23,8 +25,15 @@ public:
     /// The most threads RunStages gives a part each (a stage's claims are one bit per part).
     static constexpr uint32_t cMaxThreads = 64;
 
-    /// For one step: ioJobs (null: all on this thread) runs the parallel parts.
-    void BeginStep(jobs::JobInterface* ioJobs) { mJobs = ioJobs; }
+    /// For one step: ioJobs (null: all on this thread) runs the parallel parts. The calling thread is the
+    /// updating thread, whose time in parallel regions is counted (GetParallelNanoseconds).
+    void BeginStep(jobs::JobInterface* ioJobs)
+    {
+        mJobs = ioJobs;
+        mUpdatingThread = std::this_thread::get_id();
+        mRegionDepth = 0;
+        mParallelNanoseconds = 0;
+    }
     jobs::JobInterface* GetJobs() const { return mJobs; }
     uint32_t GetNumThreads() const
     {
@@ -37,6 +46,7 @@ public:
     template <class Body>
     void ParallelFor(uint32_t inCount, uint32_t inGrain, uint32_t inItemNanoseconds, const Body& inBody) const
     {
+        const ParallelRegion region(*this, inCount > inGrain);
         if (mJobs != nullptr && inCount > inGrain &&
             (mJobs->GetNumWorkersAsleep() == 0 ||
              uint64_t(inCount) * inItemNanoseconds >= cMinWakingNanoseconds))
@@ -51,10 +61,19 @@ public:
     template <class Body>
     void ParallelForUnlessAlone(bool inAlone, uint32_t inCount, uint32_t inGrain, const Body& inBody) const
     {
+        const ParallelRegion region(*this, !inAlone && inCount > inGrain);
         if (!inAlone && mJobs != nullptr && inCount > inGrain)
             mJobs->ParallelFor(inCount, inGrain, inBody);
         else if (inCount > 0)
             inBody(0u, inCount);
+    }
+
+    /// inBody() here, counted as parallel unless inAlone (GetParallelNanoseconds): a loop that its caller cut
+    /// by the thread count itself, run whole since there is one thread.
+    template <class Body> void RunWhole(bool inAlone, const Body& inBody) const
+    {
+        const ParallelRegion region(*this, !inAlone);
+        inBody();
     }
 
     /// Before a serial stretch of about inNanoseconds that a parallel loop follows: the workers spinning idle
@@ -68,24 +87,30 @@ public:
             mJobs->ExtendSpin(inNanoseconds);
     }
 
-    /// Runs inNumStages stages in order, every thread of the job system on each: stage s has inPartsOf(s)
-    /// parts (1 to the thread count) and inRunPart(s, part, parts) does one. A stage starts only when every
-    /// part of the one before has finished: the threads wait on a counter, not on a job per part (a colored
-    /// island's velocity iterations are a stage per color per iteration, over a hundred a step). Thread t
-    /// takes part t first, so it keeps its region of the island in every color; a part whose thread has not
-    /// come yet is taken by another, so no thread waits for one that the job system has not started. Which
-    /// thread runs a part changes nothing in the results. Called by the updating thread, outside any job;
-    /// or with inAlone, by any thread: it then runs every part itself, in order (a job that solves its island
-    /// by itself).
+    /// Runs inNumStages stages in order, every thread of the job system on each: stage s has
+    /// inPartsOf(s, threads) parts (1 to threads, the thread count: PartsFor) and inRunPart(s, part, parts)
+    /// does one. A stage that has one part with any number of threads is serial (GetParallelNanoseconds). A
+    /// stage starts only when every part of the one before has finished: the threads wait on a counter, not
+    /// on a job per part (a colored island's velocity iterations are a stage per color per iteration, over a
+    /// hundred a step). Thread t takes part t first, so it keeps its region of the island in every color; a
+    /// part whose thread has not come yet is taken by another, so no thread waits for one that the job system
+    /// has not started. Which thread runs a part changes nothing in the results. Called by the updating
+    /// thread, outside any job; or with inAlone, by any thread: it then runs every part itself, in order (a
+    /// job that solves its island by itself).
     template <class PartsOf, class RunPart>
     void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
         const uint32_t threads = inAlone ? 1 : GetNumThreads();
+        ParallelRegion region(*this, !inAlone);
         if (threads <= 1)
         {
             for (uint32_t stage = 0; stage < inNumStages; ++stage)
-                for (uint32_t part = 0, parts = inPartsOf(stage); part < parts; ++part)
+            {
+                const uint32_t parts = inPartsOf(stage, GetNumThreads());
+                const SerialStage serial(region, [&] { return inPartsOf(stage, cMaxThreads) == 1; });
+                for (uint32_t part = 0; part < parts; ++part)
                     inRunPart(stage, part, parts);
+            }
             return;
         }
         ResetStages(inNumStages);
@@ -93,7 +118,11 @@ public:
         {
             for (uint32_t stage = 0; stage < inNumStages; ++stage)
             {
-                const uint32_t parts = inPartsOf(stage);
+                const uint32_t parts = inPartsOf(stage, threads);
+                // The updating thread (thread 0) times a serial stage from its start to its end: the other
+                // threads only wait through it
+                const SerialStage serial(region,
+                                         [&] { return inThread == 0 && inPartsOf(stage, cMaxThreads) == 1; });
                 StageCounters& counters = mStages[stage];
                 auto tryRun = [&](uint32_t inPart)
                 {
@@ -133,11 +162,24 @@ public:
             mJobs->FinishTask(tasks[thread]);
     }
 
+    /// The updating thread's time inside the step's parallel regions since BeginStep: the rest of its time is
+    /// serial, what more threads cannot shorten. A region is a loop with more items than a chunk (whether or
+    /// not it was handed out: a sleeping worker is not woken for a cheap one) or RunStages less its stages of
+    /// one part; only the outermost counts (a loop nested in a region's part is in it). Counted on one thread
+    /// too, where the serial share is the step's Amdahl fraction. The updating thread, between steps or from
+    /// the step's serial code.
+    uint64_t GetParallelNanoseconds() const { return mParallelNanoseconds; }
+
     /// Parts for inCount items with at least inMinPerPart in each (below that a part costs more than it
     /// saves), at most one per thread.
     uint32_t PartsFor(uint32_t inCount, uint32_t inMinPerPart) const
     {
-        return std::min(GetNumThreads(), std::max(1u, inCount / inMinPerPart));
+        return PartsFor(inCount, inMinPerPart, GetNumThreads());
+    }
+    /// The same for inThreads threads.
+    static uint32_t PartsFor(uint32_t inCount, uint32_t inMinPerPart, uint32_t inThreads)
+    {
+        return std::min(inThreads, std::max(1u, inCount / inMinPerPart));
     }
     /// Part inPart of inItems cut into inParts contiguous parts of (nearly) equal size.
     template <class T> static std::span<T> PartOf(std::span<T> inItems, uint32_t inPart, uint32_t inParts)
@@ -161,6 +203,64 @@ private:
     /// Half of JobSystem's idle spin (JobSystem::cSpinMicroseconds): see KeepWorkersSpinningFor.
     static constexpr uint64_t cWorthExtendingNanoseconds = 25'000;
 
+    using Clock = std::chrono::steady_clock;
+    static uint64_t NanosecondsSince(Clock::time_point inStart)
+    {
+        return uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - inStart).count());
+    }
+    class SerialStage;
+    /// Counts its lifetime as parallel when the updating thread enters it outside any other region and
+    /// inParallel; on any other thread, or nested, it does nothing.
+    class ParallelRegion
+    {
+    public:
+        ParallelRegion(const StepScheduler& inScheduler, bool inParallel)
+            : mScheduler(inScheduler), mOutermost(std::this_thread::get_id() == inScheduler.mUpdatingThread &&
+                                                  inScheduler.mRegionDepth++ == 0),
+              mTimed(mOutermost && inParallel)
+        {
+            if (mTimed) mStart = Clock::now();
+        }
+        ~ParallelRegion()
+        {
+            if (mOutermost) --mScheduler.mRegionDepth;
+            if (mTimed) mScheduler.mParallelNanoseconds += NanosecondsSince(mStart) - mSerialNanoseconds;
+        }
+        ParallelRegion(const ParallelRegion&) = delete;
+        ParallelRegion& operator=(const ParallelRegion&) = delete;
+
+    private:
+        friend class SerialStage;
+        const StepScheduler& mScheduler;
+        const bool mOutermost; ///< Entered by the updating thread outside any other region
+        const bool mTimed;
+        Clock::time_point mStart;
+        uint64_t mSerialNanoseconds = 0; ///< Its stages of one part: see SerialStage
+    };
+    /// A stage of RunStages that its region does not count (serial), timed by the updating thread only, which
+    /// is the only one that touches the region. inIsSerial() is asked only of a timed region's stages.
+    class SerialStage
+    {
+    public:
+        template <class IsSerial>
+        SerialStage(ParallelRegion& inRegion, const IsSerial& inIsSerial)
+            : mRegion(inRegion), mTimed(inRegion.mTimed && inIsSerial())
+        {
+            if (mTimed) mStart = Clock::now();
+        }
+        ~SerialStage()
+        {
+            if (mTimed) mRegion.mSerialNanoseconds += NanosecondsSince(mStart);
+        }
+        SerialStage(const SerialStage&) = delete;
+        SerialStage& operator=(const SerialStage&) = delete;
+
+    private:
+        ParallelRegion& mRegion;
+        const bool mTimed;
+        Clock::time_point mStart;
+    };
+
     struct alignas(64) StageCounters
     {
         std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread
@@ -172,7 +272,12 @@ private:
     /// (two cores: the other part's thread may be waiting for this core).
     static void WaitABit(uint32_t inSpins);
 
-    jobs::JobInterface* mJobs = nullptr;      ///< During a step only
+    jobs::JobInterface* mJobs = nullptr; ///< During a step only
+    /// The updating thread's bookkeeping of its parallel regions (ParallelRegion), touched by it alone: the
+    /// loops are const to their callers, and this is not the scheduler's state but a measure of the step
+    std::thread::id mUpdatingThread;
+    mutable uint32_t mRegionDepth = 0;
+    mutable uint64_t mParallelNanoseconds = 0;
     std::unique_ptr<StageCounters[]> mStages; ///< RunStages' counters; threads: see RunStages
     uint32_t mStageCapacity = 0;
 };

@@ -44,6 +44,27 @@ TEST_F(StepPropertiesTest, BatchAddMakesBodiesSimulated)
         EXPECT_NEAR(Position(id).y(), 0.2f, 0.01f);
 }
 
+TEST_F(StepPropertiesTest, StatisticsGiveEachPhaseItsSerialPart)
+{
+    AddFloor();
+    for (int i = 0; i < 10; ++i)
+        for (int j = 0; j < 10; ++j)
+            AddDynamic(DynamicSettings(Box(Vec3(0.4f, 0.4f, 0.4f)),
+                                       Vec3(float(i), 0.5f + 0.1f * float(j), float(j))));
+    Step(30);
+    const StepStatistics stats = System().GetLastStepStatistics();
+    EXPECT_GT(stats.mSerialMs, 0.0);
+    EXPECT_LT(stats.mSerialMs, stats.mTotalMs) << "the step's loops were not counted as parallel";
+    EXPECT_LE(stats.mNarrowPhaseSerialMs, stats.mNarrowPhaseMs);
+    EXPECT_LE(stats.mIslandsSerialMs, stats.mIslandsMs);
+    EXPECT_LE(stats.mSolveSerialMs, stats.mSolveMs);
+    EXPECT_LT(stats.mSolveSerialMs, stats.mSolveMs) << "the solve's loops were not counted as parallel";
+    EXPECT_LE(stats.mFinishSerialMs, stats.mFinishMs);
+    EXPECT_LE(stats.mNarrowPhaseSerialMs + stats.mIslandsSerialMs + stats.mSolveSerialMs +
+                  stats.mFinishSerialMs,
+              stats.mSerialMs + 1e-6);
+}
+
 TEST_F(StepPropertiesTest, SameSceneGivesBitIdenticalResults)
 {
     auto run = [](std::vector<Vec3>& outPositions)

@@ -36,6 +36,16 @@ struct StepStatistics
     double mContinuousMs = 0.0; ///< The linear casts (MotionQuality::LinearCast bodies)
     double mFinishMs = 0.0;     ///< Bounds update, broad-phase notify and sleeping
     double mTotalMs = 0.0;
+    /// The updating thread's time outside the step's parallel loops and stages: what more threads cannot
+    /// shorten. A loop counts as parallel when it has more items than a chunk, even when it ran on one
+    /// thread, so on one thread mSerialMs / mTotalMs is the step's serial (Amdahl) fraction; with more
+    /// threads a growing share shows the phase that stops the scaling. Per phase (each a part of that phase's
+    /// time above; the linear casts are serial whole), then the step's
+    double mNarrowPhaseSerialMs = 0.0; ///< Includes waiting for a broad-phase update that runs beside
+    double mIslandsSerialMs = 0.0;
+    double mSolveSerialMs = 0.0;
+    double mFinishSerialMs = 0.0;
+    double mSerialMs = 0.0;
     /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
     /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex
     /// (in the pair search and the bounds notify too). A slow step with no wait here lost its time elsewhere
