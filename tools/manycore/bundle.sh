@@ -10,7 +10,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 out=${1:-$root/build/manycore-bundle}
 build=${CAIRN_BUNDLE_BUILD:-$root/build/release}
-programs=(cairn-bench-broadphase cairn-bench-step cairn-bench-unionfind cairn-demo)
+programs=(cairn-bench-broadphase cairn-bench-stages cairn-bench-step cairn-bench-unionfind cairn-demo)
 limit=$((64 * 1024 * 1024))
 
 if [ "${CAIRN_BUNDLE_NO_BUILD:-0}" != 1 ]; then

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
-# run-all.sh): step scaling, union-find, contended broad-phase queries and the demo, with CSVs, a scaling
-# chart and a Markdown summary written to RESULTS, the summary printed last. Needs bash, awk, grep, sed and
-# /proc (no packages); pins nothing and changes no machine setting.
+# run-all.sh): step scaling, union-find, the solve's stages, contended broad-phase queries and the demo, with
+# CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs bash, awk,
+# grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
 #        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,
 #        CAIRN_RUN_DEMO_FRAMES the demo's frames per mode (0: no demo).
@@ -80,6 +80,12 @@ echo "name,label,ns_per_union,wall_ns_per_union,find_loops_per_union,find_loops_
 json_rows "$out/unionfind.json" ns_per_union wall_ns_per_union find_loops_per_union find_loops_per_find \
     retries_per_union >>"$out/unionfind.csv"
 
+echo "== stages (the colored solve's meeting of all threads) on $threads threads"
+CAIRN_BENCH_THREADS=$threads "$bundle/run" cairn-bench-stages --benchmark_format=json \
+    --benchmark_out="$out/stages.json" >/dev/null 2>"$out/stages.err" || echo "run.sh: the stage benchmark failed" >&2
+echo "name,label,ns_per_stage,overhead_ns_per_stage,efficiency" >"$out/stages.csv"
+json_rows "$out/stages.json" ns_per_stage overhead_ns_per_stage efficiency >>"$out/stages.csv"
+
 echo "== contended queries, $queryThreads query threads and one mover"
 CAIRN_BENCH_QUERY_THREADS=$queryThreads "$bundle/run" cairn-bench-broadphase --benchmark_filter=bp_query_contended \
     --benchmark_format=json --benchmark_out="$out/contended.json" >/dev/null 2>"$out/contended.err" ||
@@ -143,6 +149,12 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo "| benchmark | graph | ns per union | wall ns per union | find loops per find | retries per union |"
     echo "|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %s | %.2f | %.2f | %.3f | %.4f |\n", $1, $2 "," $3, $4, $5, $7, $8 }' "$out/unionfind.csv" | sed 's/"//g'
+    echo
+    echo "## Stages (cairn-bench-stages: 1,024 stages of one part per thread, the work per stage shared out)"
+    echo
+    echo "| benchmark (work ns per stage / threads) | threads | ns per stage | overhead ns per stage | efficiency |"
+    echo "|---|---|---|---|---|"
+    awk -F, 'NR > 1 { printf "| %s | %s | %.0f | %.0f | %.2f |\n", $1, $2, $3, $4, $5 }' "$out/stages.csv" | sed 's/"//g'
     echo
     echo "## Contended queries (bp_query_contended: Q query threads and one mover; medians of 5)"
     echo
