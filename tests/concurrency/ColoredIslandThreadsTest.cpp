@@ -1,10 +1,10 @@
 // A colored island (a pyramid of boxes on a floor, one island of a few hundred contacts) solved by every
-// thread of the job system at once: the colors' stages synchronise on counters, the parts of a color go to
-// whichever thread takes them first. And small islands solved four at a time, groups on all threads; and
-// several colored islands too small to need every thread, each solved by one thread at once; and jointed
-// islands colored with their joints (a pile of ragdolls; a hub whose joints overflow the colors). Under
-// ThreadSanitizer (this suite's label) that must show no race, and with 2 and 4 threads the bodies must end
-// exactly where one thread puts them.
+// thread of the job system at once: the colors' stages synchronise on each part's progress, the parts of a
+// color go to whichever thread takes them first. And small islands solved four at a time, groups on all
+// threads; and several colored islands too small to need every thread, each solved by one thread at once; and
+// jointed islands colored with their joints (a pile of ragdolls; a hub whose joints overflow the colors).
+// Under ThreadSanitizer (this suite's label) that must show no race, and with 2 and 4 threads the bodies must
+// end exactly where one thread puts them.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"

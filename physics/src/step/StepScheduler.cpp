@@ -7,18 +7,13 @@
 namespace cairn::physics
 {
 
-void StepScheduler::ResetStages(uint32_t inNumStages)
+void StepScheduler::ResetParts(uint32_t inParts)
 {
-    if (mStageCapacity < inNumStages)
-    {
-        mStages = std::make_unique<StageCounters[]>(inNumStages);
-        mStageCapacity = inNumStages;
-    }
-    for (uint32_t stage = 0; stage < inNumStages; ++stage)
+    for (uint32_t part = 0; part < inParts; ++part)
     {
         // Relaxed: the helper tasks are started after this, and starting one orders these stores before it
-        mStages[stage].mClaimed.store(0, std::memory_order_relaxed);
-        mStages[stage].mDone.store(0, std::memory_order_relaxed);
+        mParts[part].mClaimed.store(0, std::memory_order_relaxed);
+        mParts[part].mDone.store(0, std::memory_order_relaxed);
     }
 }
 

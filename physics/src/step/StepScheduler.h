@@ -90,13 +90,13 @@ public:
     /// Runs inNumStages stages in order, every thread of the job system on each: stage s has
     /// inPartsOf(s, threads) parts (1 to threads, the thread count: PartsFor) and inRunPart(s, part, parts)
     /// does one. A stage that has one part with any number of threads is serial (GetParallelNanoseconds). A
-    /// stage starts only when every part of the one before has finished: the threads wait on a counter, not
-    /// on a job per part (a colored island's velocity iterations are a stage per color per iteration, over a
-    /// hundred a step). Thread t takes part t first, so it keeps its region of the island in every color; a
-    /// part whose thread has not come yet is taken by another, so no thread waits for one that the job system
-    /// has not started. Which thread runs a part changes nothing in the results. Called by the updating
-    /// thread, outside any job; or with inAlone, by any thread: it then runs every part itself, in order (a
-    /// job that solves its island by itself).
+    /// stage starts only when every part of the one before has finished: the threads wait on each part's
+    /// progress, not on a job per part (a colored island's velocity iterations are a stage per color per
+    /// iteration, over a hundred a step). Thread t takes part t first, so it keeps its region of the island
+    /// in every color; a part whose thread has not come yet is taken by another, so no thread waits for one
+    /// that the job system has not started. Which thread runs a part changes nothing in the results. Called
+    /// by the updating thread, outside any job; or with inAlone, by any thread: it then runs every part
+    /// itself, in order (a job that solves its island by itself).
     template <class PartsOf, class RunPart>
     void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
@@ -113,7 +113,7 @@ public:
             }
             return;
         }
-        ResetStages(inNumStages);
+        ResetParts(threads);
         auto team = [&](uint32_t inThread)
         {
             for (uint32_t stage = 0; stage < inNumStages; ++stage)
@@ -123,25 +123,29 @@ public:
                 // threads only wait through it
                 const SerialStage serial(region,
                                          [&] { return inThread == 0 && inPartsOf(stage, cMaxThreads) == 1; });
-                StageCounters& counters = mStages[stage];
+                const uint32_t mark = stage + 1; // What the parts' progress reads once they did this stage
                 auto tryRun = [&](uint32_t inPart)
                 {
-                    const uint64_t bit = uint64_t(1) << inPart;
+                    PartProgress& progress = mParts[inPart];
                     // Relaxed: a claim only decides who runs the part; the data the part reads was ordered by
-                    // the previous stage's completion (the acquire below)
-                    if ((counters.mClaimed.load(std::memory_order_relaxed) & bit) != 0 ||
-                        (counters.mClaimed.fetch_or(bit, std::memory_order_relaxed) & bit) != 0)
+                    // the previous stage's completion (the acquire below). A claim only ever rises, so a
+                    // failed exchange means another thread took the part for this stage
+                    uint32_t claimed = progress.mClaimed.load(std::memory_order_relaxed);
+                    if (claimed >= mark ||
+                        !progress.mClaimed.compare_exchange_strong(claimed, mark, std::memory_order_relaxed))
                         return;
                     inRunPart(stage, inPart, parts);
                     // Release: the part's writes happen before the reads of whoever sees the stage complete
-                    counters.mDone.fetch_add(1, std::memory_order_release);
+                    progress.mDone.store(mark, std::memory_order_release);
                 };
                 if (inThread < parts) tryRun(inThread);
                 for (uint32_t part = 0; part < parts; ++part)
                     if (part != inThread) tryRun(part);
-                // Acquire: pairs with every part's release, so the next stage sees all of this one's writes
-                for (uint32_t spins = 0; counters.mDone.load(std::memory_order_acquire) < parts; ++spins)
-                    WaitABit(spins);
+                // Acquire: pairs with each part's release, so the next stage sees all of this one's writes
+                for (uint32_t part = 0; part < parts; ++part)
+                    for (uint32_t spins = 0; mParts[part].mDone.load(std::memory_order_acquire) < mark;
+                         ++spins)
+                        WaitABit(spins);
             }
         };
         struct Member
@@ -237,14 +241,15 @@ private:
         Clock::time_point mStart;
         uint64_t mSerialNanoseconds = 0; ///< Its stages of one part: see SerialStage
     };
-    /// A stage of RunStages that its region does not count (serial), timed by the updating thread only, which
-    /// is the only one that touches the region. inIsSerial() is asked only of a timed region's stages.
+    /// A stage of RunStages that its region does not count (serial), timed by the updating thread only.
+    /// inIsSerial() is asked first, on every thread, and says false on the others: the region lives on the
+    /// updating thread's stack, among the lines it writes, and no other thread reads it.
     class SerialStage
     {
     public:
         template <class IsSerial>
         SerialStage(ParallelRegion& inRegion, const IsSerial& inIsSerial)
-            : mRegion(inRegion), mTimed(inRegion.mTimed && inIsSerial())
+            : mRegion(inRegion), mTimed(inIsSerial() && inRegion.mTimed)
         {
             if (mTimed) mStart = Clock::now();
         }
@@ -261,13 +266,18 @@ private:
         Clock::time_point mStart;
     };
 
-    struct alignas(64) StageCounters
+    /// A part's progress through the stages of one RunStages, on a line of its own: the threads claim their
+    /// own parts and mark them done at once, with no line that all of them write in turn. Values are the last
+    /// stage + 1 that claimed the part and that finished it: they only rise within a RunStages, so a thread
+    /// that is still a stage behind reads its own stage as claimed and done. Written by whichever thread runs
+    /// the part, read by every thread of the RunStages.
+    struct alignas(64) PartProgress
     {
-        std::atomic<uint64_t> mClaimed; ///< Bit per part: taken by a thread
-        std::atomic<uint32_t> mDone;    ///< Parts finished
+        std::atomic<uint32_t> mClaimed;
+        std::atomic<uint32_t> mDone;
     };
-    /// Makes room for inNumStages stages' counters and clears them. The updating thread, before the tasks.
-    void ResetStages(uint32_t inNumStages);
+    /// Clears the first inParts parts' progress. The updating thread, before the tasks.
+    void ResetParts(uint32_t inParts);
     /// A pause while another thread finishes its part: a CPU hint at first, then a yield of the time slice
     /// (two cores: the other part's thread may be waiting for this core).
     static void WaitABit(uint32_t inSpins);
@@ -275,11 +285,11 @@ private:
     jobs::JobInterface* mJobs = nullptr; ///< During a step only
     /// The updating thread's bookkeeping of its parallel regions (ParallelRegion), touched by it alone: the
     /// loops are const to their callers, and this is not the scheduler's state but a measure of the step
+    /// (a line apart from mJobs and mUpdatingThread, which every thread of a loop reads)
     std::thread::id mUpdatingThread;
-    mutable uint32_t mRegionDepth = 0;
+    alignas(64) mutable uint32_t mRegionDepth = 0;
     mutable uint64_t mParallelNanoseconds = 0;
-    std::unique_ptr<StageCounters[]> mStages; ///< RunStages' counters; threads: see RunStages
-    uint32_t mStageCapacity = 0;
+    PartProgress mParts[cMaxThreads]; ///< RunStages' progress; threads: see PartProgress
 };
 
 } // namespace cairn::physics
