@@ -452,17 +452,33 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
         const ObjectLayer layer = mBodies[inID.GetIndex()].mLayer.load(std::memory_order_relaxed);
         return mLayerSetup.IsValid(layer) && TreeOf(layer).Contains(inID);
     };
-    // Mark the active bodies that are present, so that a pair of two active bodies is reported only once
-    bool listedTwice = false;
-    for (BodyID id : inActiveBodies)
-        if (isPresent(id))
-        {
-            listedTwice |= mBodies[id.GetIndex()].mActiveInStep != 0;
-            mBodies[id.GetIndex()].mActiveInStep = 1;
-        }
+    // The loops over the active bodies run in ranges on the step's threads when it gives them: each body's
+    // table entry is a likely miss (the last step's moves wrote it from other threads), and on one thread the
+    // two passes that mark and unmark them were a serial stretch of every step
+    auto forRanges = [&](FunctionRef<void(uint32_t, uint32_t)> inRange)
+    {
+        if (inParallel != nullptr)
+            (*inParallel)(uint32_t(inActiveBodies.size()), inRange);
+        else
+            inRange(0, uint32_t(inActiveBodies.size()));
+    };
+    // Mark the active bodies that are present, so that a pair of two active bodies is reported only once. A
+    // body listed twice may be in two ranges: the marks are exchanged atomically, so one of them sees it
+    std::atomic<bool> listedTwice{false};
+    auto mark = [&](uint32_t inBegin, uint32_t inEnd)
+    {
+        bool twice = false;
+        for (uint32_t i = inBegin; i < inEnd; ++i)
+            if (const BodyID id = inActiveBodies[i]; isPresent(id))
+                // Relaxed: the ranges' ParallelRanges call returns before the marks are read
+                twice |= std::atomic_ref<uint8_t>(mBodies[id.GetIndex()].mActiveInStep)
+                             .exchange(1, std::memory_order_relaxed) != 0;
+        if (twice) listedTwice.store(true, std::memory_order_relaxed); // As above
+    };
+    forRanges(mark);
     // A body listed twice would have two threads write its cache entry: no cache then (a caller bug)
-    const uint32_t cachedTrees =
-        PrepareCachedTrees(uint32_t(inActiveBodies.size())) & (listedTwice ? 0u : ~0u);
+    const uint32_t cachedTrees = PrepareCachedTrees(uint32_t(inActiveBodies.size())) &
+                                 (listedTwice.load(std::memory_order_relaxed) ? 0u : ~0u);
     const uint64_t generation = mCandidateCacheGeneration;
     const float margin = mCandidateCacheMargin;
 
@@ -575,13 +591,18 @@ void BroadPhaseQuadTree::FindCollidingPairs(std::span<const BodyID> inActiveBodi
     };
     // The trees are queried from several threads at once (queries are lock-free); the marks above are only
     // read
-    if (inParallel != nullptr)
-        (*inParallel)(uint32_t(inActiveBodies.size()), findRange);
-    else
-        findRange(0, uint32_t(inActiveBodies.size()));
+    forRanges(findRange);
 
-    for (BodyID id : inActiveBodies)
-        if (!id.IsInvalid() && id.GetIndex() < mMaxBodies) mBodies[id.GetIndex()].mActiveInStep = 0;
+    auto unmark = [&](uint32_t inBegin, uint32_t inEnd)
+    {
+        for (uint32_t i = inBegin; i < inEnd; ++i)
+            if (const BodyID id = inActiveBodies[i]; !id.IsInvalid() && id.GetIndex() < mMaxBodies)
+                // Relaxed, atomic only for a body listed twice (two ranges): the next call's marks come after
+                // this ParallelRanges call returns
+                std::atomic_ref<uint8_t>(mBodies[id.GetIndex()].mActiveInStep)
+                    .store(0, std::memory_order_relaxed);
+    };
+    forRanges(unmark);
 }
 
 BroadPhaseQuadTree::CandidateCacheStats BroadPhaseQuadTree::GetCandidateCacheStats() const

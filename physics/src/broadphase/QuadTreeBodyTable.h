@@ -51,8 +51,10 @@ public:
         std::atomic<float> mBounds[6] = {0, 0, 0, 0, 0, 0}; ///< Exact min xyz, max xyz
         std::atomic<uint8_t> mLayer{0};                     ///< Object layer
         std::atomic<uint8_t> mTree{0xff};                   ///< Id of the tree whose node mLocation names
-        /// 1 while BroadPhaseQuadTree::FindCollidingPairs runs and the body is active. Plain: only the
-        /// physics step touches it, one call at a time; it fills padding, so it costs no memory.
+        /// 1 while BroadPhaseQuadTree::FindCollidingPairs runs and the body is active. Only the physics
+        /// step touches it, one call at a time: its ranges mark and unmark it through std::atomic_ref (a body
+        /// listed twice may be in two ranges), and its pair walks read it plainly in between. It fills
+        /// padding, so it costs no memory.
         mutable uint8_t mActiveInStep = 0;
         /// Sides of the body's slot that the last rebuild stretched ahead of its motion (bit 2a: the min side
         /// of axis a, bit 2a + 1: the max side), so that the next rebuild tells that stretch from the room
