@@ -138,11 +138,15 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo "## Step scaling (cairn-bench-step, medians of 3; chart: scaling.svg)"
     echo
     echo "Serial: the updating thread's time outside the step's parallel loops (StepStatistics::mSerialMs), in ms a"
-    echo "step and as a share of the step, then by phase: what more threads cannot shorten."
+    echo "step and as a share of the step, then by phase: what more threads cannot shorten. Amdahl: the speed-up"
+    echo "that the 1-thread run's serial share s allows on t threads, 1 / (s + (1 - s) / t); a speed-up well"
+    echo "below it lost its time in the parallel parts (waits, lines crossing between cores), not in serial code."
     echo
-    echo "| scene | threads | mean ms | p99 ms | speed-up | checksum | serial ms (share) | serial narrow / islands / solve / finish ms |"
-    echo "|---|---|---|---|---|---|---|---|"
-    awk -F, 'NR > 1 { gsub(/"/, "", $6); printf "| %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12 }' "$out/step.csv"
+    echo "| scene | threads | mean ms | p99 ms | speed-up | Amdahl | checksum | serial ms (share) | serial narrow / islands / solve / finish ms |"
+    echo "|---|---|---|---|---|---|---|---|---|"
+    awk -F, 'NR > 1 { gsub(/"/, "", $6); if ($2 == 1) s[$1] = $8 / 100
+        amdahl = ($1 in s) ? sprintf("%.2f", 1 / (s[$1] + (1 - s[$1]) / $2)) : "-"
+        printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s |\n", $1, $2, $3, $4, $5, amdahl, $6, $7, $8, $9, $10, $11, $12 }' "$out/step.csv"
     echo
     echo "## Union-find (cairn-bench-unionfind)"
     echo
