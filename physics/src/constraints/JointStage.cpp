@@ -7,7 +7,10 @@
 #include "step/StepContext.h"
 #include "step/StepCosts.h"
 
+#include <algorithm>
+#include <atomic>
 #include <numbers>
+#include <utility>
 
 namespace cairn::physics
 {
@@ -42,6 +45,18 @@ bool IsActiveDynamic(const Body* inBody)
     return inBody != nullptr && inBody->IsDynamic() && inBody->IsActive();
 }
 
+/// A dynamic body asleep with an active one on the joint's other side: it wakes at the step's start
+bool IsSleeperJointedToActive(const Body* inSleeper, const Body* inOther)
+{
+    return inSleeper != nullptr && inSleeper->IsDynamic() && !inSleeper->IsActive() && inOther != nullptr &&
+           inOther->IsActive();
+}
+
+bool IsBreakable(const Joint& inJoint)
+{
+    return inJoint.mBreakForce < cLargeFloat || inJoint.mBreakTorque < cLargeFloat;
+}
+
 Quat RotationOf(const Body* inBody)
 {
     return inBody != nullptr ? inBody->GetRotation() : Quat::Identity(); // The world does not turn
@@ -58,24 +73,11 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
     mBreakableJoints.clear();
     std::vector<Joint>& joints = ioManager.GetJoints();
     if (ioManager.GetNumInUse() == 0) return;
-    // A joint's bodies (null: the world); false while a side is gone or out of the world (the joint waits)
-    auto sides = [&](const Joint& inJoint, Body*& outA, Body*& outB)
-    {
-        auto bodyOf = [&](const BodyID& inID) -> Body*
-        {
-            if (inID.IsInvalid()) return nullptr;
-            Body* body = inContext.mBodies.TryGetBody(inID);
-            return body != nullptr && body->IsInWorld() ? body : nullptr;
-        };
-        outA = bodyOf(inJoint.mBodyA);
-        outB = bodyOf(inJoint.mBodyB);
-        return (inJoint.mBodyA.IsInvalid() || outA != nullptr) &&
-               (inJoint.mBodyB.IsInvalid() || outB != nullptr);
-    };
+    if (TakeJointsOnAllThreads(joints)) return;
     // A sleeping dynamic body jointed to an active one wakes (and then its own jointed sleepers): in slot
     // order, again until nothing wakes, so the same bodies wake on every run. The pass that wakes nothing
     // takes the step's joints (a joint taken before a wake in the same pass may miss a side woken after it:
-    // that pass is taken again); most steps wake nobody and make one pass
+    // that pass is taken again)
     for (bool woke = true; woke;)
     {
         woke = false;
@@ -83,27 +85,112 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
         mBreakableJoints.clear();
         for (Joint& joint : joints)
         {
-            Body *a, *b;
-            if (!joint.mInUse || !joint.mEnabled || !sides(joint, a, b)) continue;
-            for (auto [sleeper, other] : {std::pair(a, b), std::pair(b, a)})
-                if (sleeper != nullptr && sleeper->IsDynamic() && !sleeper->IsActive() && other != nullptr &&
-                    other->IsActive())
-                {
-                    inContext.mBodies.ActivateBody(*sleeper);
-                    woke |= sleeper->IsActive();
-                }
-            // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot
-            // be (it woke above), so both dynamic sides are awake here
-            if (!IsActiveDynamic(a) && !IsActiveDynamic(b)) continue;
-            if ((a != nullptr && a->IsDynamic() && !a->IsActive()) ||
-                (b != nullptr && b->IsDynamic() && !b->IsActive()))
-                continue; // Could not wake (defensive: ActivateBody refused)
-            if (joint.mBreakForce < cLargeFloat || joint.mBreakTorque < cLargeFloat)
-                mBreakableJoints.push_back(uint32_t(mStepJoints.size()));
+            Body *a = nullptr, *b = nullptr;
+            Verdict verdict = VerdictOf(joint, a, b);
+            if (verdict == Verdict::Wake)
+            {
+                for (auto [sleeper, other] : {std::pair(a, b), std::pair(b, a)})
+                    if (IsSleeperJointedToActive(sleeper, other))
+                    {
+                        inContext.mBodies.ActivateBody(*sleeper);
+                        woke |= sleeper->IsActive();
+                    }
+                verdict = VerdictOf(joint, a, b); // Wake again if ActivateBody refused (defensive): not taken
+            }
+            if (verdict != Verdict::Take) continue;
+            if (IsBreakable(joint)) mBreakableJoints.push_back(uint32_t(mStepJoints.size()));
             mStepJoints.push_back(
                 {&joint, a, b, BlockOf(a), BlockOf(b), Vec3::Zero(), Vec3::Zero(), false, 0.0f});
         }
     }
+}
+
+JointStage::Verdict JointStage::VerdictOf(const Joint& inJoint, Body*& outA, Body*& outB) const
+{
+    // A joint's bodies (null: the world); none while a side is gone or out of the world (the joint waits)
+    auto bodyOf = [&](const BodyID& inID) -> Body*
+    {
+        if (inID.IsInvalid()) return nullptr;
+        Body* body = mContext->mBodies.TryGetBody(inID);
+        return body != nullptr && body->IsInWorld() ? body : nullptr;
+    };
+    if (!inJoint.mInUse || !inJoint.mEnabled) return Verdict::Skip;
+    outA = bodyOf(inJoint.mBodyA);
+    outB = bodyOf(inJoint.mBodyB);
+    if ((!inJoint.mBodyA.IsInvalid() && outA == nullptr) || (!inJoint.mBodyB.IsInvalid() && outB == nullptr))
+        return Verdict::Skip;
+    if (IsSleeperJointedToActive(outA, outB) || IsSleeperJointedToActive(outB, outA)) return Verdict::Wake;
+    // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot be (it
+    // wakes first), so both dynamic sides are awake here
+    if (!IsActiveDynamic(outA) && !IsActiveDynamic(outB)) return Verdict::Skip;
+    if ((outA != nullptr && outA->IsDynamic() && !outA->IsActive()) ||
+        (outB != nullptr && outB->IsDynamic() && !outB->IsActive()))
+        return Verdict::Skip; // Could not wake (defensive: ActivateBody refused)
+    return Verdict::Take;
+}
+
+bool JointStage::TakeJointsOnAllThreads(std::vector<Joint>& ioJoints)
+{
+    // Most steps wake nobody: the step's joints are then a function of the joints and their bodies alone,
+    // found in chunks on the step's threads, counted first and then written in slot order where the counts
+    // put each chunk's (one serial pass over thousands of joints, a miss or two each, was a fifth of a
+    // ragdoll pile's serial time). A chunk that finds a body to wake leaves it all to the serial pass, which
+    // wakes in slot order
+    constexpr uint32_t grain = StepCosts::cJointsTaken.mGrain;
+    const uint32_t numChunks = uint32_t((ioJoints.size() + grain - 1) / grain);
+    mChunkCounts.assign(2 * size_t(numChunks), 0u); // Per chunk: joints taken, then breakable ones
+    std::atomic<bool> wakes{false};
+    const StepScheduler& scheduler = mContext->mScheduler;
+    auto chunkOf = [&](uint32_t inChunk)
+    {
+        const size_t first = size_t(inChunk) * grain;
+        return std::span<Joint>(ioJoints).subspan(first, std::min<size_t>(grain, ioJoints.size() - first));
+    };
+    scheduler.ParallelFor(numChunks, 1, grain * StepCosts::cJointsTaken.mItemNanoseconds,
+                          [&](uint32_t inBegin, uint32_t inEnd)
+                          {
+                              for (uint32_t chunk = inBegin; chunk < inEnd; ++chunk)
+                                  for (const Joint& joint : chunkOf(chunk))
+                                  {
+                                      Body *a = nullptr, *b = nullptr;
+                                      const Verdict verdict = VerdictOf(joint, a, b);
+                                      // Relaxed: read after the loop's ParallelFor returns
+                                      if (verdict == Verdict::Wake)
+                                          wakes.store(true, std::memory_order_relaxed);
+                                      if (verdict != Verdict::Take) continue;
+                                      ++mChunkCounts[2 * chunk];
+                                      if (IsBreakable(joint)) ++mChunkCounts[2 * chunk + 1];
+                                  }
+                          });
+    if (wakes.load(std::memory_order_relaxed)) return false; // As above
+    // Each chunk's first places, in slot order
+    uint32_t taken = 0, breakable = 0;
+    for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
+    {
+        taken += std::exchange(mChunkCounts[2 * chunk], taken);
+        breakable += std::exchange(mChunkCounts[2 * chunk + 1], breakable);
+    }
+    mStepJoints.resize(taken);
+    mBreakableJoints.resize(breakable);
+    scheduler.ParallelFor(numChunks, 1, grain * StepCosts::cJointsTaken.mItemNanoseconds,
+                          [&](uint32_t inBegin, uint32_t inEnd)
+                          {
+                              for (uint32_t chunk = inBegin; chunk < inEnd; ++chunk)
+                              {
+                                  uint32_t place = mChunkCounts[2 * chunk];
+                                  uint32_t breakablePlace = mChunkCounts[2 * chunk + 1];
+                                  for (Joint& joint : chunkOf(chunk))
+                                  {
+                                      Body *a = nullptr, *b = nullptr;
+                                      if (VerdictOf(joint, a, b) != Verdict::Take) continue;
+                                      if (IsBreakable(joint)) mBreakableJoints[breakablePlace++] = place;
+                                      mStepJoints[place++] = {&joint,       a,          b,
+                                                              BlockOf(a),   BlockOf(b), Vec3::Zero(),
+                                                              Vec3::Zero(), false,      0.0f};
+                                  }
+                              }
+                          });
+    return true;
 }
 
 void JointStage::LinkIslands(const StepContext& inContext)

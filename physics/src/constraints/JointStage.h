@@ -15,6 +15,7 @@
 // color's joints and contacts share no dynamic body).
 
 #include "constraints/ConstraintManager.h"
+#include "math/UninitializedAllocator.h"
 #include "solver/SolverBody.h"
 
 #include <span>
@@ -108,15 +109,32 @@ private:
     SolverBody& BlockA(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
     SolverBody& BlockB(StepJoint& ioJoint, std::span<SolverBody> ioBodies) const;
 
+    /// What a joint is this step (BeginStep): none of the step's, one of them, or one with a sleeping dynamic
+    /// body to wake first; outA and outB its bodies (null: the world). Reads the joint and its bodies only:
+    /// any of the step's threads.
+    enum class Verdict : uint8_t
+    {
+        Skip,
+        Take,
+        Wake
+    };
+    Verdict VerdictOf(const Joint& inJoint, Body*& outA, Body*& outB) const;
+    /// The step's joints, found on all the step's threads, when no joint has a body to wake; else false and
+    /// nothing taken (BeginStep's serial pass then wakes them in slot order).
+    bool TakeJointsOnAllThreads(std::vector<Joint>& ioJoints);
+
     const StepContext* mContext = nullptr;
     const Integration* mIntegration = nullptr; ///< This step's (BeginStep's)
     ConstraintManager* mManager = nullptr;     ///< This step's (BeginStep's)
-    std::vector<StepJoint> mStepJoints;        ///< This step's joints, in slot order
-    std::vector<uint32_t> mBreakableJoints;    ///< Indices into mStepJoints of those with a threshold
-    std::vector<uint32_t> mJointStart;         ///< Per island, offsets into mIslandJoints
-    std::vector<uint32_t> mIslandJoints;       ///< Indices into mStepJoints, by island
-    std::vector<uint32_t> mJointIsland;        ///< Scratch: per step joint
-    std::vector<uint32_t> mCursor; ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
+    /// This step's joints, in slot order. Grown unwritten (UninitializedAllocator): the chunks that take the
+    /// joints on all threads write every entry
+    std::vector<StepJoint, UninitializedAllocator<StepJoint>> mStepJoints;
+    std::vector<uint32_t> mBreakableJoints; ///< Indices into mStepJoints of those with a threshold
+    std::vector<uint32_t> mJointStart;      ///< Per island, offsets into mIslandJoints
+    std::vector<uint32_t> mIslandJoints;    ///< Indices into mStepJoints, by island
+    std::vector<uint32_t> mJointIsland;     ///< Scratch: per step joint
+    std::vector<uint32_t> mCursor;      ///< Scratch of GroupByIsland (kept: a warm step allocates nothing)
+    std::vector<uint32_t> mChunkCounts; ///< Scratch of TakeJointsOnAllThreads (kept, as above)
 };
 
 } // namespace cairn::physics

@@ -30,6 +30,8 @@ inline constexpr uint32_t cPairsPerChunk = 32;
 inline constexpr uint32_t cPairNanoseconds = 425;
 // The merge's copies, per chunk of the narrow phase
 inline constexpr Loop cMergeCopies{4, 1'200};
+// The step's joints taken at its start: a joint's state and its bodies' (JointStage::BeginStep)
+inline constexpr Loop cJointsTaken{256, 30};
 // The joints' island links: a union per joint
 inline constexpr Loop cJointLinks{256, 20};
 // Island finalization and the constraints' ordering, serial, per constraint (about 18 ns in a pyramid): the

@@ -132,6 +132,28 @@ TEST_F(JointTest, AJointMakesOneIslandThatSleepsAndWakesWhole)
     }
 }
 
+TEST_F(JointTest, ABodyAddedAsleepWithAJointToAnActiveOneWakes)
+{
+    // Adding a joint wakes its bodies, and a jointed island sleeps and wakes whole; a body that comes back
+    // into the world asleep, jointed to an active one, is woken by the joint alone, at the step's start
+    AddFloor();
+    const BodyID sleeper = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0.0f, 0.5f, 0.0f)));
+    const BodyID active = AddDynamic(DynamicSettings(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(3.0f, 5.0f, 0.0f)));
+    PointConstraintSettings joint;
+    joint.mBodyA = sleeper;
+    joint.mBodyB = active;
+    joint.mPoint = Vec3(1.5f, 3.0f, 0.0f);
+    ASSERT_TRUE(Joints().AddPoint(joint).IsOk());
+    ASSERT_TRUE(Bodies().RemoveBody(sleeper).IsOk());
+    Step(1); // The joint waits for its side out of the world
+    ASSERT_TRUE(Bodies().AddBody(sleeper, Activation::DontActivate).IsOk());
+    ASSERT_FALSE(IsActive(sleeper));
+    ASSERT_TRUE(IsActive(active));
+    Step(1);
+    EXPECT_TRUE(IsActive(sleeper));
+    EXPECT_EQ(System().GetLastStepStatistics().mNumIslands, 1u) << "the joint links the two, solved together";
+}
+
 TEST_F(JointTest, AChainOfJointedBodiesIsTheSameForAnyThreadCount)
 {
     // Spheres in a chain from a fixed point, swinging into a box on the floor: joints, contacts and both in
