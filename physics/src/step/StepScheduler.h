@@ -168,10 +168,10 @@ public:
 
     /// The updating thread's time inside the step's parallel regions since BeginStep: the rest of its time is
     /// serial, what more threads cannot shorten. A region is a loop with more items than a chunk (whether or
-    /// not it was handed out: a sleeping worker is not woken for a cheap one) or RunStages less its stages of
-    /// one part; only the outermost counts (a loop nested in a region's part is in it). Counted on one thread
-    /// too, where the serial share is the step's Amdahl fraction. The updating thread, between steps or from
-    /// the step's serial code.
+    /// not it was handed out: a sleeping worker is not woken for a cheap one) or RunStages less its serial
+    /// stages (one part for any thread count); only the outermost counts (a loop nested in a region's part is
+    /// in it). Counted on one thread too, where the serial share is the step's Amdahl fraction. The updating
+    /// thread, between steps or from the step's serial code.
     uint64_t GetParallelNanoseconds() const { return mParallelNanoseconds; }
 
     /// Parts for inCount items with at least inMinPerPart in each (below that a part costs more than it
