@@ -99,8 +99,7 @@ void JointStage::BeginStep(const StepContext& inContext, ConstraintManager& ioMa
             }
             if (verdict != Verdict::Take) continue;
             if (IsBreakable(joint)) mBreakableJoints.push_back(uint32_t(mStepJoints.size()));
-            mStepJoints.push_back(
-                {&joint, a, b, BlockOf(a), BlockOf(b), Vec3::Zero(), Vec3::Zero(), false, 0.0f});
+            mStepJoints.push_back({&joint, a, b, BlockOf(a), BlockOf(b)}); // The rest as a new joint's
         }
     }
 }
@@ -120,13 +119,9 @@ JointStage::Verdict JointStage::VerdictOf(const Joint& inJoint, Body*& outA, Bod
     if ((!inJoint.mBodyA.IsInvalid() && outA == nullptr) || (!inJoint.mBodyB.IsInvalid() && outB == nullptr))
         return Verdict::Skip;
     if (IsSleeperJointedToActive(outA, outB) || IsSleeperJointedToActive(outB, outA)) return Verdict::Wake;
-    // Solved only with an awake dynamic side; a dynamic side asleep while the other is active cannot be (it
-    // wakes first), so both dynamic sides are awake here
-    if (!IsActiveDynamic(outA) && !IsActiveDynamic(outB)) return Verdict::Skip;
-    if ((outA != nullptr && outA->IsDynamic() && !outA->IsActive()) ||
-        (outB != nullptr && outB->IsDynamic() && !outB->IsActive()))
-        return Verdict::Skip; // Could not wake (defensive: ActivateBody refused)
-    return Verdict::Take;
+    // Solved only with an awake dynamic side. A dynamic side asleep beside an active one was a Wake above
+    // (again when ActivateBody refused it), so a joint taken has both dynamic sides awake
+    return IsActiveDynamic(outA) || IsActiveDynamic(outB) ? Verdict::Take : Verdict::Skip;
 }
 
 bool JointStage::TakeJointsOnAllThreads(std::vector<Joint>& ioJoints)
@@ -172,24 +167,23 @@ bool JointStage::TakeJointsOnAllThreads(std::vector<Joint>& ioJoints)
     }
     mStepJoints.resize(taken);
     mBreakableJoints.resize(breakable);
-    scheduler.ParallelFor(numChunks, 1, grain * StepCosts::cJointsTaken.mItemNanoseconds,
-                          [&](uint32_t inBegin, uint32_t inEnd)
-                          {
-                              for (uint32_t chunk = inBegin; chunk < inEnd; ++chunk)
-                              {
-                                  uint32_t place = mChunkCounts[2 * chunk];
-                                  uint32_t breakablePlace = mChunkCounts[2 * chunk + 1];
-                                  for (Joint& joint : chunkOf(chunk))
-                                  {
-                                      Body *a = nullptr, *b = nullptr;
-                                      if (VerdictOf(joint, a, b) != Verdict::Take) continue;
-                                      if (IsBreakable(joint)) mBreakableJoints[breakablePlace++] = place;
-                                      mStepJoints[place++] = {&joint,       a,          b,
-                                                              BlockOf(a),   BlockOf(b), Vec3::Zero(),
-                                                              Vec3::Zero(), false,      0.0f};
-                                  }
-                              }
-                          });
+    scheduler.ParallelFor(
+        numChunks, 1, grain * StepCosts::cJointsTaken.mItemNanoseconds,
+        [&](uint32_t inBegin, uint32_t inEnd)
+        {
+            for (uint32_t chunk = inBegin; chunk < inEnd; ++chunk)
+            {
+                uint32_t place = mChunkCounts[2 * chunk];
+                uint32_t breakablePlace = mChunkCounts[2 * chunk + 1];
+                for (Joint& joint : chunkOf(chunk))
+                {
+                    Body *a = nullptr, *b = nullptr;
+                    if (VerdictOf(joint, a, b) != Verdict::Take) continue;
+                    if (IsBreakable(joint)) mBreakableJoints[breakablePlace++] = place;
+                    mStepJoints[place++] = {&joint, a, b, BlockOf(a), BlockOf(b)}; // As above
+                }
+            }
+        });
     return true;
 }
 

@@ -12,7 +12,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <thread>
 
@@ -239,7 +238,7 @@ private:
         const bool mOutermost; ///< Entered by the updating thread outside any other region
         const bool mTimed;
         Clock::time_point mStart;
-        uint64_t mSerialNanoseconds = 0; ///< Its stages of one part: see SerialStage
+        uint64_t mSerialNanoseconds = 0; ///< Its serial stages: see SerialStage
     };
     /// A stage of RunStages that its region does not count (serial), timed by the updating thread only.
     /// inIsSerial() is asked first, on every thread, and says false on the others: the region lives on the
