@@ -10,12 +10,12 @@
 
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/jobs/JobSystem.h"
+#include "common/BenchSpin.h"
 
 #include <algorithm>
 #include <atomic>
 #include <benchmark/benchmark.h>
 #include <chrono>
-#include <cmath>
 #include <thread>
 #include <vector>
 
@@ -23,17 +23,9 @@ using namespace cairn::jobs;
 
 namespace
 {
+using cairn::tools::Spin;
 
 using Clock = std::chrono::steady_clock;
-
-/// Arithmetic that the compiler cannot drop: about 1 ns an iteration.
-float Spin(uint32_t inIterations, float inSeed)
-{
-    float x = inSeed;
-    for (uint32_t i = 0; i < inIterations; ++i)
-        x = x * 0.999f + std::sqrt(x + float(i & 7));
-    return x;
-}
 
 JobSystem::Settings Threads(int64_t inThreads)
 {

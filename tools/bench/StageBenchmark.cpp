@@ -11,13 +11,13 @@
 // ns_per_stage.
 
 #include "cairn/jobs/JobSystem.h"
+#include "common/BenchSpin.h"
 #include "common/BenchThreads.h"
 #include "step/StepScheduler.h"
 
 #include <algorithm>
 #include <benchmark/benchmark.h>
 #include <chrono>
-#include <cmath>
 #include <memory>
 
 using namespace cairn;
@@ -25,18 +25,10 @@ using namespace cairn::physics;
 
 namespace
 {
+using tools::Spin;
 
 using Clock = std::chrono::steady_clock;
 constexpr uint32_t cStages = 1024;
-
-/// Arithmetic that the compiler cannot drop, one dependent chain: a fixed time per iteration.
-float Spin(uint32_t inIterations, float inSeed)
-{
-    float x = inSeed;
-    for (uint32_t i = 0; i < inIterations; ++i)
-        x = x * 0.999f + std::sqrt(x + float(i & 7));
-    return x;
-}
 
 /// Spin's nanoseconds per iteration on this machine, measured once on one thread.
 double NanosecondsPerIteration()
