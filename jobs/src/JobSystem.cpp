@@ -85,8 +85,8 @@ JobSystem::JobSystem() : JobSystem(Settings{}) {}
 
 JobSystem::JobSystem(const Settings& inSettings)
     : mSlots(std::make_unique<JobSlot[]>(std::max<uint32_t>(1, inSettings.mMaxJobs))),
-      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs), mSearchMarks(mMaxJobs, 0u),
-      mSearchStack(mMaxJobs)
+      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs),
+      mUseLoopBoard(inSettings.mUseLoopBoard), mSearchMarks(mMaxJobs, 0u), mSearchStack(mMaxJobs)
 {
     mFree.reserve(mMaxJobs);
     for (uint32_t i = mMaxJobs; i-- > 0;)
@@ -342,7 +342,12 @@ void JobSystem::Run(uint32_t inIndex)
     }
     FreeSlot(inIndex);
     mJobsRun.fetch_add(1, std::memory_order_relaxed); // Statistic only
-    // Seq_cst: as the generation bump above, against WaitIdle's sleepers
+    EndInFlight();
+}
+
+void JobSystem::EndInFlight()
+{
+    // Seq_cst: as the generation bump in Run, against WaitIdle's sleepers
     const bool nowIdle = mJobsInFlight.fetch_sub(1, std::memory_order_seq_cst) == 1;
     if (mNumWaiters.load(std::memory_order_seq_cst) > 0)
     {
@@ -472,27 +477,127 @@ bool JobSystem::WaitForFrameIdle(std::chrono::microseconds inTimeout) const
                           [&] { return mJobsInFlight.load(std::memory_order_acquire) == 0; });
 }
 
+bool JobSystem::TryTakeLoopBoard()
+{
+    // Relaxed load: a busy board is skipped without writing its line. Acquire exchange: the last owner's
+    // joiners have finished with the function and context (their count's release, acquired by that owner's
+    // CloseLoop before its release of the flag)
+    if (mLoopBusy.load(std::memory_order_relaxed) || mLoopBusy.exchange(true, std::memory_order_acquire))
+        return false;
+    // Relaxed: a counter, as in Publish
+    mJobsInFlight.fetch_add(1, std::memory_order_relaxed);
+    return true;
+}
+
+void JobSystem::OpenLoop(uint32_t inParts, LoopPartFunction inFunction, void* inContext)
+{
+    static_assert(cMaxThreads <= cLoopJoinedMask, "a loop's parts must fit the state's fields");
+    assert(inParts >= 2 && inParts <= cMaxThreads);
+    mLoopFunction = inFunction;
+    mLoopContext = inContext;
+    // Release: a joiner reads the function and context after its compare-exchange acquires this
+    mLoopState.store(cLoopOpen | uint64_t(inParts) << cLoopPartsShift, std::memory_order_release);
+    // Relaxed: a worker that falls asleep as the board opens may be missed, which costs the loop a helper,
+    // not a part (the owner takes the chunks of parts nobody joined); the next loop or job wakes it. A fence
+    // to rule that out would make every opening wait for the stores before it
+    const uint32_t asleep = mNumWorkersAsleep.load(std::memory_order_relaxed);
+    if (asleep > 0)
+    {
+        // Taking the mutex puts these wake-ups after a sleeper's look at the board or before it. A wake-up
+        // that reaches a thread waiting for a job instead also loses a helper only
+        {
+            std::lock_guard lock(mQueueMutex);
+        }
+        for (uint32_t i = std::min(asleep, inParts - 1); i > 0; --i)
+            mWake.notify_one();
+    }
+}
+
+void JobSystem::CloseLoop()
+{
+    // Relaxed: the joins and this close are ordered by the state's modification order alone; the parts'
+    // writes reach the owner through the done count below
+    uint64_t state = mLoopState.load(std::memory_order_relaxed);
+    while (!mLoopState.compare_exchange_weak(state, state & ~cLoopOpen, std::memory_order_relaxed))
+    {
+    }
+    const uint32_t joined = uint32_t(state & cLoopJoinedMask);
+    // Acquire: pairs with each joiner's release, so their parts' writes happen before the caller goes on.
+    // The joiners are running chunks they took before the owner ran out: a short wait. The count only
+    // rises (a reset at the opening would write a line that a joiner wrote last), so this loop's parts are
+    // done when it has risen by the parts joined
+    const uint32_t done = mLoopPartsDoneBefore + joined;
+    for (uint32_t spins = 0; mLoopPartsDone.load(std::memory_order_acquire) != done; ++spins)
+        if (spins < 256)
+            CpuRelax();
+        else
+            std::this_thread::yield(); // A joiner descheduled (more threads than cores)
+    mLoopPartsDoneBefore = done;
+    mLoopPartsJoined.fetch_add(joined, std::memory_order_relaxed); // Statistic only
+    EndInFlight();
+    // Release: the joiners' reads of the function and context happen before the next owner's writes
+    mLoopBusy.store(false, std::memory_order_release);
+}
+
+bool JobSystem::LoopHasRoom() const
+{
+    // Relaxed: a hint; TryJoinLoop's compare-exchange decides
+    const uint64_t state = mLoopState.load(std::memory_order_relaxed);
+    return (state & cLoopOpen) != 0 && (state & cLoopJoinedMask) + 1 < (state >> cLoopPartsShift & 0xff);
+}
+
+bool JobSystem::TryJoinLoop()
+{
+    uint64_t state = mLoopState.load(std::memory_order_relaxed); // Relaxed: the exchange below acquires
+    for (;;)
+    {
+        const uint64_t joined = state & cLoopJoinedMask, parts = state >> cLoopPartsShift & 0xff;
+        if ((state & cLoopOpen) == 0 || joined + 1 >= parts) return false;
+        // Acquire: the owner's function and context, written before its opening store (release). A failed
+        // exchange leaves without reading them
+        if (mLoopState.compare_exchange_weak(state, state + 1, std::memory_order_acquire,
+                                             std::memory_order_relaxed))
+            break;
+    }
+    const uint32_t part = uint32_t(state & cLoopJoinedMask) + 1;
+    // A run of its own, as a job's: a wait inside the part is isolated to the jobs the part schedules
+    const uint64_t outerRun = tCurrentRun;
+    tCurrentRun = NextRunId();
+    mLoopFunction(mLoopContext, part);
+    tCurrentRun = outerRun;
+    // Release: the part's writes, and this worker's reads of the board, happen before the owner's return
+    mLoopPartsDone.fetch_add(1, std::memory_order_release);
+    return true;
+}
+
 void JobSystem::WorkerMain()
 {
     tWorkerOf = this;
     for (;;)
     {
         uint32_t index;
-        if (TryPopReady(index))
+        // Relaxed: a hint that spares the mutex when nothing is queued (a worker going from loop to loop);
+        // a job it misses is seen by the spin or the sleep's check below
+        if (mNumReady.load(std::memory_order_relaxed) != 0 && TryPopReady(index))
         {
             Run(index);
             continue;
         }
+        if (TryJoinLoop()) continue;
         // Relaxed: hints; the wait below rechecks under the mutex
-        SpinUntil([] { return false; }); // Returns early when a job is queued
-        if (mNumReady.load(std::memory_order_relaxed) != 0) continue;
+        SpinUntil([this] { return LoopHasRoom(); }); // Returns early when a job is queued
+        if (mNumReady.load(std::memory_order_relaxed) != 0 || LoopHasRoom()) continue;
         std::unique_lock lock(mQueueMutex);
-        // Relaxed: read only as a hint (GetNumWorkersAsleep)
+        // Relaxed: read as a hint (GetNumWorkersAsleep, OpenLoop)
         mNumWorkersAsleep.fetch_add(1, std::memory_order_relaxed);
-        mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping; });
-        // Relaxed: as above
+        mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping || LoopHasRoom(); });
+        // Relaxed: a hint from here on
         mNumWorkersAsleep.fetch_sub(1, std::memory_order_relaxed);
-        if (mReadyCount == 0) return; // Stopping, and nothing left
+        if (mReadyCount == 0)
+        {
+            if (mStopping) return; // Nothing left (no loop is open while the system is destroyed)
+            continue;              // A loop on the board
+        }
         index = mReady[mReadyHead];
         mReadyHead = (mReadyHead + 1) % mMaxJobs;
         --mReadyCount;
@@ -509,6 +614,7 @@ JobSystem::Stats JobSystem::GetStats() const
     stats.mJobsRun = mJobsRun.load(std::memory_order_relaxed);
     stats.mJobsRunInline = mJobsRunInline.load(std::memory_order_relaxed);
     stats.mDependentOverflow = mDependentOverflow.load(std::memory_order_relaxed);
+    stats.mLoopPartsJoined = mLoopPartsJoined.load(std::memory_order_relaxed);
     return stats;
 }
 

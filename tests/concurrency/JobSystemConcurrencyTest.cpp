@@ -1,6 +1,7 @@
 // The job system under concurrent use, for ThreadSanitizer: several threads schedule job graphs into one pool
-// and wait on them while the pool's workers run them, and a background queue takes submissions,
-// cancellations and priority changes from several threads while frame jobs come and go.
+// and wait on them while the pool's workers run them, several run loops into it at once (the loop board and
+// the queue), and a background queue takes submissions, cancellations and priority changes from several
+// threads while frame jobs come and go.
 
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/jobs/JobSystem.h"
@@ -91,6 +92,36 @@ TEST(JobSystemConcurrencyTest, PlainDataWrittenByAPrerequisiteIsSeenByItsDepende
         jobs.Wait(reader);
         ASSERT_EQ(sum, 64 * round);
     }
+}
+
+TEST(JobSystemConcurrencyTest, LoopsFromSeveralThreadsSeeEveryPartsPlainWrites)
+{
+    // Three threads run loops into one pool at once: one holds the loop board, the others queue their parts
+    // as jobs, and the board changes hands hundreds of times. Each loop's parts write plain memory that its
+    // caller reads after the loop: a joiner's part not ordered before the caller's return (or a board's
+    // function and context rewritten while a joiner still reads them) is a TSan report
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    JobSystem jobs(settings);
+    auto caller = [&](int inSeed)
+    {
+        std::vector<int> data(48, 0);
+        for (int round = 1; round <= 300; ++round)
+        {
+            jobs.ParallelFor(uint32_t(data.size()), 1 + uint32_t(round % 5),
+                             [&](uint32_t inBegin, uint32_t inEnd)
+                             {
+                                 for (uint32_t i = inBegin; i < inEnd; ++i)
+                                     data[i] = round * inSeed;
+                             });
+            ASSERT_EQ(std::accumulate(data.begin(), data.end(), 0), int(data.size()) * round * inSeed);
+        }
+    };
+    std::thread first(caller, 1), second(caller, 2);
+    caller(3);
+    first.join();
+    second.join();
+    EXPECT_GT(jobs.GetStats().mLoopPartsJoined, 0u) << "no loop went through the board";
 }
 
 TEST(JobSystemConcurrencyTest, BackgroundQueueUnderConcurrentSubmitCancelAndFrames)

@@ -1,10 +1,13 @@
-// JobSystem: prerequisites order jobs, waiting threads help, ParallelFor covers every index once, a full pool
-// or too many dependents degrade to running in place instead of failing, and scheduling allocates nothing.
+// JobSystem: prerequisites order jobs, waiting threads help, ParallelFor covers every index once and hands
+// its parts to idle workers on the loop board (woken if asleep; queued as jobs when the board is taken), a
+// full pool or too many dependents degrade to running in place instead of failing, and scheduling allocates
+// nothing.
 
 #include "cairn/jobs/JobSystem.h"
 
 #include "common/AllocationCounter.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <gtest/gtest.h>
@@ -293,6 +296,124 @@ TEST(JobSystemSleepTest, AnExtendedSpinKeepsAnIdleWorkerAwakeUntilItEnds)
     EXPECT_GE(seenAsleep - extended, std::chrono::nanoseconds(JobSystem::cMaxSpinExtensionNanoseconds))
         << "the idle worker spins through the extension before it sleeps";
     jobs.Wait(job);
+}
+
+namespace
+{
+/// A ParallelFor of inParts chunks whose chunks each wait (up to 5 s) until every chunk has started: it
+/// finishes in time only when inParts threads run it at once. Returns whether they did, and the threads seen.
+bool RunPartsAtOnce(JobSystem& ioJobs, uint32_t inParts, std::vector<std::thread::id>& outThreads)
+{
+    std::atomic<uint32_t> started{0};
+    std::atomic<bool> allMet{true};
+    std::vector<std::thread::id> threads(inParts);
+    ioJobs.ParallelFor(inParts, 1,
+                       [&](uint32_t inBegin, uint32_t)
+                       {
+                           threads[inBegin] = std::this_thread::get_id();
+                           started.fetch_add(1);
+                           const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+                           while (started.load() < inParts)
+                               if (std::chrono::steady_clock::now() > deadline)
+                               {
+                                   allMet.store(false);
+                                   return;
+                               }
+                               else
+                                   std::this_thread::yield();
+                       });
+    outThreads = threads;
+    return allMet.load();
+}
+} // namespace
+
+TEST(JobSystemLoopBoardTest, IdleWorkersJoinALoopWithoutAJobEach)
+{
+    // The loop's parts go to idle workers through the board: every part runs at once on its own thread, and
+    // the queue runs no job for them
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    JobSystem jobs(settings);
+    const JobSystem::Stats before = jobs.GetStats();
+    std::vector<std::thread::id> threads;
+    ASSERT_TRUE(RunPartsAtOnce(jobs, 3, threads)) << "the parts did not run at once";
+    EXPECT_EQ(threads[0], std::this_thread::get_id()) << "the caller takes the first part";
+    std::sort(threads.begin(), threads.end());
+    EXPECT_EQ(std::unique(threads.begin(), threads.end()), threads.end()) << "three threads";
+    const JobSystem::Stats after = jobs.GetStats();
+    EXPECT_EQ(after.mJobsRun, before.mJobsRun) << "no job was queued for a part";
+    EXPECT_EQ(after.mLoopPartsJoined - before.mLoopPartsJoined, 2u);
+}
+
+TEST(JobSystemLoopBoardTest, WithoutTheBoardALoopsPartsAreQueuedAsJobs)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    settings.mUseLoopBoard = false;
+    JobSystem jobs(settings);
+    const JobSystem::Stats before = jobs.GetStats();
+    std::vector<std::thread::id> threads;
+    ASSERT_TRUE(RunPartsAtOnce(jobs, 3, threads)) << "the parts did not run at once";
+    const JobSystem::Stats after = jobs.GetStats();
+    EXPECT_EQ(after.mJobsRun - before.mJobsRun, 2u) << "a job for each part but the caller's";
+    EXPECT_EQ(after.mLoopPartsJoined, before.mLoopPartsJoined);
+}
+
+TEST(JobSystemLoopBoardTest, SleepingWorkersAreWokenForALoop)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    JobSystem jobs(settings);
+    ASSERT_EQ(WaitForWorkersAsleep(jobs, 2), 2u);
+    std::vector<std::thread::id> threads;
+    EXPECT_TRUE(RunPartsAtOnce(jobs, 3, threads)) << "a sleeping worker was not woken for its part";
+}
+
+TEST(JobSystemLoopBoardTest, ALoopCountsAsFrameWorkUntilItEnds)
+{
+    // Background queues stand aside while frame work is in flight, and WaitIdle waits for it: a loop on the
+    // board is frame work like a job
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    JobSystem jobs(settings);
+    std::atomic<uint32_t> leastInFlight{UINT32_MAX};
+    jobs.ParallelFor(64, 1,
+                     [&](uint32_t, uint32_t)
+                     {
+                         uint32_t least = leastInFlight.load();
+                         const uint32_t now = jobs.GetNumJobsInFlight();
+                         while (now < least && !leastInFlight.compare_exchange_weak(least, now))
+                         {
+                         }
+                     });
+    EXPECT_GE(leastInFlight.load(), 1u);
+    EXPECT_EQ(jobs.GetNumJobsInFlight(), 0u);
+    EXPECT_TRUE(jobs.WaitForFrameIdle(std::chrono::microseconds(0)));
+}
+
+TEST(JobSystemLoopBoardTest, ALoopStartedWhileTheBoardHoldsAnotherGoesThroughTheQueue)
+{
+    // Loops nested in a loop's parts (the caller's and the joiners') find the board taken: they run as
+    // jobs, and every index of every loop is still visited once
+    JobSystem::Settings settings;
+    settings.mNumThreads = 3;
+    JobSystem jobs(settings);
+    const JobSystem::Stats before = jobs.GetStats();
+    constexpr uint32_t cOuter = 3, cInner = 300;
+    std::vector<std::atomic<int>> visits(cOuter * cInner);
+    jobs.ParallelFor(cOuter, 1,
+                     [&](uint32_t inOuter, uint32_t)
+                     {
+                         jobs.ParallelFor(cInner, 10,
+                                          [&](uint32_t inBegin, uint32_t inEnd)
+                                          {
+                                              for (uint32_t i = inBegin; i < inEnd; ++i)
+                                                  visits[inOuter * cInner + i].fetch_add(1);
+                                          });
+                     });
+    for (uint32_t i = 0; i < cOuter * cInner; ++i)
+        ASSERT_EQ(visits[i].load(), 1) << "index " << i;
+    EXPECT_GT(jobs.GetStats().mJobsRun, before.mJobsRun) << "the nested loops' parts were queued";
 }
 
 TEST_P(JobSystemThreads, ParallelForWithUnevenChunksVisitsEveryIndexOnce)

@@ -3,7 +3,8 @@
 // JobSystem: the frame's worker pool. A job is a small callable with prerequisites (other jobs); it is queued
 // when the last of them finishes, and run by a worker or by a thread that waits (waiting threads help, so the
 // caller of Wait is one of the frame's threads and a pool of N threads has N - 1 workers). ParallelFor splits
-// a loop over the pool. Multi-frame work (navmesh tiles, streaming) goes to the BackgroundQueue instead,
+// a loop over the pool, handing its parts to idle workers on the loop board (no job, no lock) when no other
+// thread's loop holds it. Multi-frame work (navmesh tiles, streaming) goes to the BackgroundQueue instead,
 // which stands aside while frame jobs are in flight.
 //
 // Threads: every member function may be called from any thread, including from inside a job, except the
@@ -16,6 +17,7 @@
 //    the slot's mutex, which also orders a completion (generation bump) against a registration.
 //  - mFree (free slot indices): mFreeMutex. mReady (ready ring): mQueueMutex; workers and waiting threads
 //    sleep on mWake with it.
+//  - The loop board (mLoop*): lock-free, one owner at a time (mLoopBusy); see its members.
 //  - Counters: atomics, each with its memory order's reason where it is used.
 //
 // Capacity: at most Settings::mMaxJobs jobs exist at once (no allocation after construction). Scheduling when
@@ -75,6 +77,9 @@ public:
         /// caller. On a machine with idle time between frames the OS put a waking worker on the caller's
         /// core and took milliseconds to spread them again, so a short loop got no second core
         bool mPinWorkers = false;
+        /// ParallelFor hands its parts to idle workers on the loop board (see ParallelFor); false: always as
+        /// queued jobs, one per part. For measuring what the board saves, side by side on one machine
+        bool mUseLoopBoard = true;
     };
 
     struct Stats
@@ -82,6 +87,7 @@ public:
         uint64_t mJobsRun = 0;           ///< Jobs run through the queue
         uint64_t mJobsRunInline = 0;     ///< Jobs run at once because every slot was in use
         uint64_t mDependentOverflow = 0; ///< Prerequisites waited for because cMaxDependents was reached
+        uint64_t mLoopPartsJoined = 0;   ///< ParallelFor parts that workers took from the loop board
     };
 
     JobSystem(); ///< Default settings
@@ -164,6 +170,12 @@ public:
     /// each thread on its own part of the data (with two threads, the caller on the first half in every
     /// loop): neighbouring chunks handed to both threads in turn, as one shared cursor did, made them write
     /// the same cache lines (bodies, island links) and fetch each other's results.
+    ///
+    /// The parts are handed out on the loop board when it is free (one loop at a time, see OpenLoop):
+    /// idle workers join it with one compare-exchange each, where a job per part cost the caller a slot, a
+    /// queue push and a wake-up each, and every helper a pop under the queue's mutex, all of which the
+    /// threads of a many-core machine would take in turn. A helper that never comes costs nothing: the caller
+    /// takes its chunks. Otherwise (another thread's loop is on the board) the parts are queued as jobs.
     template <class Body> void ParallelFor(uint32_t inCount, uint32_t inGrain, const Body& inBody)
     {
         if (inCount == 0) return;
@@ -177,12 +189,16 @@ public:
                 inBody(uint32_t(begin), uint32_t(std::min<uint64_t>(inCount, begin + grain)));
             return;
         }
+        // The board is taken before the regions are made: its exchange would otherwise wait for their lines
+        // (last written by the threads that took from them in the loop before)
+        const bool onBoard = mUseLoopBoard && TryTakeLoopBoard();
         // Only the parts' regions are made (all cMaxThreads would be 4 KB written on every call)
         alignas(ChunkRegion) std::byte storage[sizeof(ChunkRegion) * cMaxThreads];
         ChunkRegion* regions = reinterpret_cast<ChunkRegion*>(storage);
         static_assert(std::is_trivially_destructible_v<ChunkRegion>, "the regions are never destroyed");
         for (uint32_t p = 0; p < parts; ++p)
-            // Made before the helper jobs are scheduled: scheduling orders them before the helpers' claims
+            // Made before the board opens or the helper jobs are scheduled: either orders them before the
+            // helpers' claims
             new (&regions[p]) ChunkRegion(ChunkRegion::Pack(chunks * p / parts, chunks * (p + 1) / parts));
         auto work = [regions, &inBody, parts, grain, inCount](uint32_t inPart)
         {
@@ -198,6 +214,17 @@ public:
                 while (regions[(inPart + other) % parts].TakeBack(chunk))
                     run(chunk);
         };
+        using Work = decltype(work);
+        if (onBoard)
+        {
+            OpenLoop(
+                parts, [](void* inWork, uint32_t inPart) { (*static_cast<const Work*>(inWork))(inPart); },
+                &work);
+            work(0);
+            CloseLoop();
+            return;
+        }
+        // The board holds another thread's loop: the parts go through the queue, as jobs
         JobHandle handles[cMaxThreads];
         for (uint32_t p = 1; p < parts; ++p)
             handles[p - 1] = Schedule("ParallelFor", [&work, p] { work(p); });
@@ -318,7 +345,27 @@ private:
     /// Removes entry inPosition (from the head) of the ready ring and returns its slot. mQueueMutex held.
     uint32_t TakeReadyAt(int inPosition);
     void Run(uint32_t inIndex);
+    /// A frame job or loop is over: mJobsInFlight drops, and the threads waiting for that are woken.
+    void EndInFlight();
     void WorkerMain();
+
+    /// Part inPart of the loop on the board, in its context.
+    using LoopPartFunction = void (*)(void* inContext, uint32_t inPart);
+    /// Takes the loop board for this thread's loop; false when it holds another thread's. The loop counts as
+    /// frame work from here to CloseLoop (background queues stand aside, WaitIdle waits for it).
+    bool TryTakeLoopBoard();
+    /// Puts a loop of inParts parts (2 to cMaxThreads) on the board taken, for idle workers to join, and
+    /// wakes sleeping workers for it (up to inParts - 1). The caller runs part 0 (and the chunks of parts
+    /// nobody joined), then calls CloseLoop. inContext must live until then.
+    void OpenLoop(uint32_t inParts, LoopPartFunction inFunction, void* inContext);
+    /// Closes the board to joins and waits for the workers that joined to finish their parts: the loop's
+    /// writes are then visible to the caller, and the board is free.
+    void CloseLoop();
+    /// A worker out of work: takes the next part of the loop on the board, if it has one nobody took, and
+    /// runs it; false when there is none.
+    bool TryJoinLoop();
+    /// The board holds an open loop with a part nobody took. A hint for spinning and sleeping workers.
+    bool LoopHasRoom() const;
     /// Spins for up to about cSpinMicroseconds while inDone() is false and nothing is queued; true if
     /// inDone().
     template <class Done> bool SpinUntil(const Done& inDone) const;
@@ -337,13 +384,16 @@ private:
     uint32_t mReadyCount = 0;           ///< mQueueMutex
     bool mStopping = false;             ///< mQueueMutex
 
-    std::atomic<uint32_t> mJobsInFlight{0};
+    /// A line apart from what spinning threads poll (mNumReady, mSpinExtendedUntil): every job and loop
+    /// writes it, and a line that other cores read must first be taken back from them
+    alignas(64) std::atomic<uint32_t> mJobsInFlight{0};
     std::atomic<uint32_t> mNumWaiters{0}; ///< Threads asleep in Wait/WaitIdle (or about to be)
     /// Workers asleep in WorkerMain's wait (changed under mQueueMutex)
-    std::atomic<uint32_t> mNumWorkersAsleep{0};
+    alignas(64) std::atomic<uint32_t> mNumWorkersAsleep{0};
     /// ExtendSpin's deadline: steady_clock ticks since its epoch. Any thread; read by spinners
     std::atomic<std::chrono::steady_clock::rep> mSpinExtendedUntil{0};
     bool mMoreThreadsThanCores = false; ///< Set by the constructor: ExtendSpin does nothing
+    const bool mUseLoopBoard;           ///< Settings::mUseLoopBoard
     size_t mNumStuckWorkers = 0;        ///< mQueueMutex: workers in a wait inside a job with nothing to run
     /// The prerequisite search of waits inside jobs (see LeadsTo), sized mMaxJobs so that it never allocates:
     /// a slot is marked when its mark equals mSearchEpoch. All three under mQueueMutex
@@ -354,7 +404,25 @@ private:
     mutable std::mutex mIdleMutex;
     mutable std::condition_variable mIdle; ///< Notified when mJobsInFlight drops to zero
 
-    std::atomic<uint64_t> mJobsRun{0};
+    /// The loop board (ParallelFor, OpenLoop). mLoopBusy: taken by the thread whose loop it holds, with an
+    /// exchange, released by its CloseLoop; that thread alone writes the function, context and count, while
+    /// no worker is on the board. mLoopState: open flag, parts and parts joined (see cLoop*): its owner opens
+    /// it with a store and closes it, idle workers join by compare-exchange and read the function and context
+    /// only after their join succeeded. mLoopPartsDone: the joiners' finished parts, counted up by them (it
+    /// wraps), read by the owner. Three lines: the owner's own (mLoopBusy), the one that joiners poll and
+    /// take (the state, with the function and context that they read next), and the count
+    alignas(64) std::atomic<bool> mLoopBusy{false};
+    uint32_t mLoopPartsDoneBefore = 0;         ///< mLoopPartsDone as the board's last loop closed
+    std::atomic<uint64_t> mLoopPartsJoined{0}; ///< Statistic (Stats), added to by owners
+    alignas(64) std::atomic<uint64_t> mLoopState{0};
+    LoopPartFunction mLoopFunction = nullptr;
+    void* mLoopContext = nullptr;
+    alignas(64) std::atomic<uint32_t> mLoopPartsDone{0};
+    static constexpr uint64_t cLoopJoinedMask = 0xff; ///< Parts taken by workers (part 0 is the owner's)
+    static constexpr uint32_t cLoopPartsShift = 8;    ///< Then the loop's parts, 8 bits
+    static constexpr uint64_t cLoopOpen = uint64_t(1) << 16;
+
+    alignas(64) std::atomic<uint64_t> mJobsRun{0};
     std::atomic<uint64_t> mJobsRunInline{0};
     std::atomic<uint64_t> mDependentOverflow{0};
 
