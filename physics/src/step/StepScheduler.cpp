@@ -11,10 +11,12 @@ void StepScheduler::ResetParts(uint32_t inParts)
 {
     for (uint32_t part = 0; part < inParts; ++part)
     {
-        // Relaxed: the helper tasks are started after this, and starting one orders these stores before it
+        // Relaxed: the loop of the threads starts after this, and handing out its parts orders these stores
+        // before them
         mParts[part].mClaimed.store(0, std::memory_order_relaxed);
         mParts[part].mDone.store(0, std::memory_order_relaxed);
     }
+    mStagesOver.store(false, std::memory_order_relaxed); // Relaxed: as above
 }
 
 void StepScheduler::WaitABit(uint32_t inSpins)

@@ -91,11 +91,13 @@ public:
     /// does one. A stage that has one part with any number of threads is serial (GetParallelNanoseconds). A
     /// stage starts only when every part of the one before has finished: the threads wait on each part's
     /// progress, not on a job per part (a colored island's velocity iterations are a stage per color per
-    /// iteration, over a hundred a step). Thread t takes part t first, so it keeps its region of the island
-    /// in every color; a part whose thread has not come yet is taken by another, so no thread waits for one
-    /// that the job system has not started. Which thread runs a part changes nothing in the results. Called
-    /// by the updating thread, outside any job; or with inAlone, by any thread: it then runs every part
-    /// itself, in order (a job that solves its island by itself).
+    /// iteration, over a hundred a step). The threads are the chunks of one ParallelFor, a chunk per thread,
+    /// the caller's first. Thread t takes part t first, so it keeps its region of the island in every color;
+    /// a part whose thread has not come yet is taken by another, so no thread waits for one that the job
+    /// system has not started (and a thread that comes after the last stage leaves at once). Which thread
+    /// runs a part changes nothing in the results. Called by the updating thread, outside any job; or with
+    /// inAlone, by any thread: it then runs every part itself, in order (a job that solves its island by
+    /// itself).
     template <class PartsOf, class RunPart>
     void RunStages(bool inAlone, uint32_t inNumStages, const PartsOf& inPartsOf, const RunPart& inRunPart)
     {
@@ -115,13 +117,17 @@ public:
         ResetParts(threads);
         auto team = [&](uint32_t inThread)
         {
+            // Relaxed: a thread that comes after the stages are over leaves at once; one that reads false
+            // finds every part claimed and done, and leaves later
+            if (mStagesOver.load(std::memory_order_relaxed)) return;
+            const bool updating = std::this_thread::get_id() == mUpdatingThread;
             for (uint32_t stage = 0; stage < inNumStages; ++stage)
             {
                 const uint32_t parts = inPartsOf(stage, threads);
-                // The updating thread (thread 0) times a serial stage from its start to its end: the other
-                // threads only wait through it
+                // The updating thread times a serial stage from its start to its end: the other threads only
+                // wait through it
                 const SerialStage serial(region,
-                                         [&] { return inThread == 0 && inPartsOf(stage, cMaxThreads) == 1; });
+                                         [&] { return updating && inPartsOf(stage, cMaxThreads) == 1; });
                 const uint32_t mark = stage + 1; // What the parts' progress reads once they did this stage
                 auto tryRun = [&](uint32_t inPart)
                 {
@@ -146,23 +152,16 @@ public:
                          ++spins)
                         WaitABit(spins);
             }
+            mStagesOver.store(true, std::memory_order_relaxed); // Relaxed: see above
         };
-        struct Member
-        {
-            decltype(team)* mTeam;
-            uint32_t mThread;
-            void operator()() const { (*mTeam)(mThread); }
-        };
-        Member members[cMaxThreads];
-        jobs::TaskHandle tasks[cMaxThreads];
-        for (uint32_t thread = 1; thread < threads; ++thread)
-        {
-            members[thread] = {&team, thread};
-            tasks[thread] = mJobs->StartTask("stages", members[thread]);
-        }
-        team(0);
-        for (uint32_t thread = 1; thread < threads; ++thread)
-            mJobs->FinishTask(tasks[thread]);
+        // A chunk per thread: the job system hands them out as it hands out any loop's parts (one
+        // compare-exchange each on JobSystem's loop board), the caller's first
+        mJobs->ParallelFor(threads, 1,
+                           [&](uint32_t inBegin, uint32_t inEnd)
+                           {
+                               for (uint32_t thread = inBegin; thread < inEnd; ++thread)
+                                   team(thread);
+                           });
     }
 
     /// The updating thread's time inside the step's parallel regions since BeginStep: the rest of its time is
@@ -275,7 +274,8 @@ private:
         std::atomic<uint32_t> mClaimed;
         std::atomic<uint32_t> mDone;
     };
-    /// Clears the first inParts parts' progress. The updating thread, before the tasks.
+    /// Clears the first inParts parts' progress and mStagesOver. The updating thread, before the threads'
+    /// loop.
     void ResetParts(uint32_t inParts);
     /// A pause while another thread finishes its part: a CPU hint at first, then a yield of the time slice
     /// (two cores: the other part's thread may be waiting for this core).
@@ -289,6 +289,9 @@ private:
     alignas(64) mutable uint32_t mRegionDepth = 0;
     mutable uint64_t mParallelNanoseconds = 0;
     PartProgress mParts[cMaxThreads]; ///< RunStages' progress; threads: see PartProgress
+    /// RunStages' last stage is over: set by each thread that saw it end, read by threads joining late; a
+    /// line of its own (a write and a read per thread each RunStages)
+    alignas(64) std::atomic<bool> mStagesOver{false};
 };
 
 } // namespace cairn::physics

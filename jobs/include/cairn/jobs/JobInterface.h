@@ -34,8 +34,9 @@ public:
     virtual ~JobInterface() = default;
 
     /// Threads that work on a ParallelFor, the caller included: the step cuts its loops into about this many
-    /// parts, and starts GetNumThreads() - 1 tasks at most for a stage that every thread must take part in.
-    /// 1: everything runs on the calling thread.
+    /// parts, and runs stages that every thread takes part in as a ParallelFor of one chunk per thread (a
+    /// chunk takes the parts of chunks not started yet, so any order of running them is correct). 1:
+    /// everything runs on the calling thread.
     virtual uint32_t GetNumThreads() const = 0;
     /// Threads asleep for want of work now (0 if the scheduler cannot tell): a loop of little work is then
     /// run on the caller rather than paying for a wake. A hint; any answer gives the same results.
