@@ -9,7 +9,8 @@
 // phase and of its serial part (the updating thread outside parallel loops: StepStatistics::mSerialMs), and a
 // checksum (sum of final body heights and contact points) that proves the work was done; for each thread
 // count of --threads (default 1,2: a job system of that many threads), then the speed-up. The checksum must
-// not change with the thread count (the step is deterministic across thread counts).
+// not change with the thread count (the step is deterministic across thread counts). --queued-loops turns the
+// job system's loop board off (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
 
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
@@ -60,6 +61,16 @@ struct RunResult
 /// The broad phase's margin for cached static candidates (--candidate-margin); the engine's default unless
 /// given.
 float gCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;
+bool gQueuedLoops = false;
+
+/// The job system a run steps with: inThreads threads, the loop board as --queued-loops says.
+jobs::JobSystem::Settings JobSettings(uint32_t inThreads)
+{
+    jobs::JobSystem::Settings settings;
+    settings.mNumThreads = inThreads;
+    settings.mUseLoopBoard = !gQueuedLoops;
+    return settings;
+}
 
 RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic, int inSteps,
                    jobs::JobSystem& ioJobs)
@@ -228,6 +239,9 @@ int main(int inArgc, char** inArgv)
                                                                  "Broad-phase static candidate margin (m), 0 "
                                                                  "turns the cache off")
                                                      ->check(CLI::Range(0.0f, 100.0f));
+                                                 ioApp.add_flag("--queued-loops", gQueuedLoops,
+                                                                "The job system's loops as a queued job per "
+                                                                "part (its loop board off)");
                                              }))
         return *stop;
     const int repetitions = options.mRepetitions;
@@ -238,9 +252,9 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf("cairn-bench-step: build %s, %d repetitions; %s; core-to-core round trip %.0f ns\n",
-                buildType, repetitions, tools::DescribeMachine().c_str(),
-                tools::MeasureCoreToCoreRoundTripNanoseconds());
+    std::printf("cairn-bench-step: build %s, %d repetitions%s; %s; core-to-core round trip %.0f ns\n",
+                buildType, repetitions, gQueuedLoops ? ", queued loops" : "",
+                tools::DescribeMachine().c_str(), tools::MeasureCoreToCoreRoundTripNanoseconds());
     auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
     {
         for (size_t t = 1; t < inMeans.size(); ++t)
@@ -258,7 +272,7 @@ int main(int inArgc, char** inArgv)
             std::vector<double> means;
             for (uint32_t threads : threadCounts)
             {
-                jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+                jobs::JobSystem jobSystem(JobSettings(threads));
                 std::vector<RunResult> runs;
                 for (int i = 0; i < repetitions; ++i)
                     runs.push_back(RunPile2k(data.Value(), jobSystem));
@@ -272,7 +286,7 @@ int main(int inArgc, char** inArgv)
         std::vector<double> means;
         for (uint32_t threads : threadCounts)
         {
-            jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+            jobs::JobSystem jobSystem(JobSettings(threads));
             std::vector<RunResult> runs;
             for (int i = 0; i < repetitions; ++i)
                 runs.push_back(RunPyramid(jobSystem));
@@ -285,7 +299,7 @@ int main(int inArgc, char** inArgv)
         std::vector<double> means;
         for (uint32_t threads : threadCounts)
         {
-            jobs::JobSystem jobSystem(jobs::JobSystem::Settings{threads});
+            jobs::JobSystem jobSystem(JobSettings(threads));
             std::vector<RunResult> runs;
             for (int i = 0; i < repetitions; ++i)
                 runs.push_back(RunRagdolls(jobSystem));

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
-# run-all.sh): step scaling, union-find, the solve's stages, contended broad-phase queries and the demo, with
-# CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs bash, awk,
-# grep, sed and /proc (no packages); pins nothing and changes no machine setting.
+# run-all.sh): step scaling, union-find, the step's stages and loops, contended broad-phase queries and the
+# demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
+# bash, awk, grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
 #        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,
 #        CAIRN_RUN_DEMO_FRAMES the demo's frames per mode (0: no demo).
@@ -72,6 +72,22 @@ awk '
             checksum[key], serial[key] / n, shares[key] / n, narrow[key] / n, islands[key] / n, solve[key] / n, finish[key] / n }
 ' "$out/step.txt" >>"$out/step.csv"
 
+# The same scenes at the top thread count with the job system's loop board on and off (off: a queued job per
+# part of a loop, as before the board), alternated run by run: what the board saves where many threads take
+# parts, measured in one sitting
+topThreads=$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)
+echo "== step_pile2k and step_pyramid on $topThreads threads, loop board on and off"
+: >"$out/step_board.txt"
+: >"$out/step_queued.txt"
+for round in 1 2 3; do
+    for scene in step_pile2k step_pyramid; do
+        "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" >>"$out/step_board.txt" 2>&1 ||
+            echo "run.sh: the step benchmark failed (board)" >&2
+        "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" --queued-loops \
+            >>"$out/step_queued.txt" 2>&1 || echo "run.sh: the step benchmark failed (queued loops)" >&2
+    done
+done
+
 echo "== union-find on $threads threads"
 CAIRN_BENCH_THREADS=$threads "$bundle/run" cairn-bench-unionfind --benchmark_format=json \
     --benchmark_out="$out/unionfind.json" >/dev/null 2>"$out/unionfind.err" || echo "run.sh: union-find failed" >&2
@@ -80,7 +96,7 @@ echo "name,label,ns_per_union,wall_ns_per_union,find_loops_per_union,find_loops_
 json_rows "$out/unionfind.json" ns_per_union wall_ns_per_union find_loops_per_union find_loops_per_find \
     retries_per_union >>"$out/unionfind.csv"
 
-echo "== stages (the colored solve's meeting of all threads) on $threads threads"
+echo "== stages and loops (the step's hand-offs to all threads) on $threads threads"
 CAIRN_BENCH_THREADS=$threads "$bundle/run" cairn-bench-stages --benchmark_format=json \
     --benchmark_out="$out/stages.json" >/dev/null 2>"$out/stages.err" || echo "run.sh: the stage benchmark failed" >&2
 echo "name,label,ns_per_stage,overhead_ns_per_stage,efficiency" >"$out/stages.csv"
@@ -148,15 +164,32 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
         amdahl = ($1 in s) ? sprintf("%.2f", 1 / (s[$1] + (1 - s[$1]) / $2)) : "-"
         printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s |\n", $1, $2, $3, $4, $5, amdahl, $6, $7, $8, $9, $10, $11, $12 }' "$out/step.csv"
     echo
+    echo "## The loop board at $topThreads threads (cairn-bench-step, on and off (--queued-loops) alternated, medians of 3 runs)"
+    echo
+    echo "| scene | board: mean ms | queued: mean ms | queued / board | board: serial ms | queued: serial ms |"
+    echo "|---|---|---|---|---|---|"
+    awk '
+        function median(list,   n, v, i, j, t) { n = split(list, v, " ")
+            for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
+            return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
+        FNR == 1 { file++ }
+        / rep 0: / { scenes[$1] = 1
+            for (i = 1; i <= NF; ++i) { if ($i == "mean") means[file, $1] = means[file, $1] " " $(i + 1)
+                if ($i == "serial") serials[file, $1] = serials[file, $1] " " $(i + 1) } }
+        END { for (s in scenes) { b = median(means[1, s]); q = median(means[2, s])
+            printf "| %s | %.3f | %.3f | %.2f | %.3f | %.3f |\n", s, b, q, (b > 0 ? q / b : 0), median(serials[1, s]), median(serials[2, s]) } }' \
+        "$out/step_board.txt" "$out/step_queued.txt"
+    echo
     echo "## Union-find (cairn-bench-unionfind)"
     echo
     echo "| benchmark | graph | ns per union | wall ns per union | find loops per find | retries per union |"
     echo "|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %s | %.2f | %.2f | %.3f | %.4f |\n", $1, $2 "," $3, $4, $5, $7, $8 }' "$out/unionfind.csv" | sed 's/"//g'
     echo
-    echo "## Stages (cairn-bench-stages: 1,024 stages of one part per thread, the work per stage shared out)"
+    echo "## Stages and loops (cairn-bench-stages: 1,024 RunStages stages or ParallelFor loops of one part per thread, the"
+    echo "work of each shared out; a settled pyramid's step makes some 200 stages, every step a dozen or more loops)"
     echo
-    echo "| benchmark (work ns per stage / threads) | threads | ns per stage | overhead ns per stage | efficiency |"
+    echo "| benchmark (work ns each / threads) | threads | ns each | overhead ns each | efficiency |"
     echo "|---|---|---|---|---|"
     awk -F, 'NR > 1 { printf "| %s | %s | %.0f | %.0f | %.2f |\n", $1, $2, $3, $4, $5 }' "$out/stages.csv" | sed 's/"//g'
     echo
