@@ -491,7 +491,9 @@ bool JobSystem::TryTakeLoopBoard()
 
 void JobSystem::OpenLoop(uint32_t inParts, LoopPartFunction inFunction, void* inContext)
 {
-    static_assert(cMaxThreads <= cLoopJoinedMask, "a loop's parts must fit the state's fields");
+    // Workers add to the joined field only after seeing it below the parts less one, so it never passes the
+    // parts plus the workers
+    static_assert(2 * cMaxThreads <= cLoopJoinedMask, "a loop's joins must fit the state's fields");
     assert(inParts >= 2 && inParts <= cMaxThreads);
     mLoopFunction = inFunction;
     mLoopContext = inContext;
@@ -515,12 +517,9 @@ void JobSystem::OpenLoop(uint32_t inParts, LoopPartFunction inFunction, void* in
 
 void JobSystem::CloseLoop()
 {
-    // Relaxed: the joins and this close are ordered by the state's modification order alone; the parts'
-    // writes reach the owner through the done count below
-    uint64_t state = mLoopState.load(std::memory_order_relaxed);
-    while (!mLoopState.compare_exchange_weak(state, state & ~cLoopOpen, std::memory_order_relaxed))
-    {
-    }
+    // Relaxed: the joins and this close are ordered by the state's modification order alone (a join after
+    // it finds the board shut and touches nothing); the parts' writes reach the owner through the done count
+    const uint64_t state = mLoopState.fetch_and(~cLoopOpen, std::memory_order_relaxed);
     const uint32_t joined = uint32_t(state & cLoopJoinedMask);
     // Acquire: pairs with each joiner's release, so their parts' writes happen before the caller goes on.
     // The joiners are running chunks they took before the owner ran out: a short wait. The count only
@@ -533,7 +532,8 @@ void JobSystem::CloseLoop()
         else
             std::this_thread::yield(); // A joiner descheduled (more threads than cores)
     mLoopPartsDoneBefore = done;
-    mLoopPartsJoined.fetch_add(joined, std::memory_order_relaxed); // Statistic only
+    const uint32_t parts = uint32_t(state >> cLoopPartsShift & 0xff);
+    mLoopPartsJoined.fetch_add(std::min(joined, parts - 1), std::memory_order_relaxed); // Statistic only
     EndInFlight();
     // Release: the joiners' reads of the function and context happen before the next owner's writes
     mLoopBusy.store(false, std::memory_order_release);
@@ -548,26 +548,29 @@ bool JobSystem::LoopHasRoom() const
 
 bool JobSystem::TryJoinLoop()
 {
-    uint64_t state = mLoopState.load(std::memory_order_relaxed); // Relaxed: the exchange below acquires
-    for (;;)
-    {
-        const uint64_t joined = state & cLoopJoinedMask, parts = state >> cLoopPartsShift & 0xff;
-        if ((state & cLoopOpen) == 0 || joined + 1 >= parts) return false;
-        // Acquire: the owner's function and context, written before its opening store (release). A failed
-        // exchange leaves without reading them
-        if (mLoopState.compare_exchange_weak(state, state + 1, std::memory_order_acquire,
-                                             std::memory_order_relaxed))
-            break;
-    }
+    if (!LoopHasRoom()) return false;
+    // One add, not a compare-exchange: the idle workers of a many-core machine see a loop open at once, and
+    // a compare-exchange that fails takes the line again, each worker about as many times as there are
+    // joiners before it. Acquire: the owner's function and context, written before its opening store
+    // (release); read only when the board was open. The joined field has room for every worker's add beyond
+    // the loop's parts (cLoopJoinedMask)
+    const uint64_t state = mLoopState.fetch_add(1, std::memory_order_acquire);
+    if ((state & cLoopOpen) == 0) return false; // Shut (the add lands in a closed state, which nobody reads)
     const uint32_t part = uint32_t(state & cLoopJoinedMask) + 1;
-    // A run of its own, as a job's: a wait inside the part is isolated to the jobs the part schedules
-    const uint64_t outerRun = tCurrentRun;
-    tCurrentRun = NextRunId();
-    mLoopFunction(mLoopContext, part);
-    tCurrentRun = outerRun;
-    // Release: the part's writes, and this worker's reads of the board, happen before the owner's return
+    const bool hasPart = part < (state >> cLoopPartsShift & 0xff);
+    if (hasPart)
+    {
+        // A run of its own, as a job's: a wait inside the part is isolated to the jobs the part schedules
+        const uint64_t outerRun = tCurrentRun;
+        tCurrentRun = NextRunId();
+        mLoopFunction(mLoopContext, part);
+        tCurrentRun = outerRun;
+    }
+    // Counted joined by the owner's close whether or not a part was left (other workers took the last ones
+    // between this worker's look and its add). Release: the part's writes, and this worker's reads of the
+    // board, happen before the owner's return
     mLoopPartsDone.fetch_add(1, std::memory_order_release);
-    return true;
+    return hasPart;
 }
 
 void JobSystem::WorkerMain()

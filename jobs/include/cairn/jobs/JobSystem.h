@@ -362,7 +362,7 @@ private:
     /// writes are then visible to the caller, and the board is free.
     void CloseLoop();
     /// A worker out of work: takes the next part of the loop on the board, if it has one nobody took, and
-    /// runs it; false when there is none.
+    /// runs it; false when there is none (or other workers took the last one first).
     bool TryJoinLoop();
     /// The board holds an open loop with a part nobody took. A hint for spinning and sleeping workers.
     bool LoopHasRoom() const;
@@ -406,11 +406,12 @@ private:
 
     /// The loop board (ParallelFor, OpenLoop). mLoopBusy: taken by the thread whose loop it holds, with an
     /// exchange, released by its CloseLoop; that thread alone writes the function, context and count, while
-    /// no worker is on the board. mLoopState: open flag, parts and parts joined (see cLoop*): its owner opens
-    /// it with a store and closes it, idle workers join by compare-exchange and read the function and context
-    /// only after their join succeeded. mLoopPartsDone: the joiners' finished parts, counted up by them (it
-    /// wraps), read by the owner. Three lines: the owner's own (mLoopBusy), the one that joiners poll and
-    /// take (the state, with the function and context that they read next), and the count
+    /// no worker is on the board. mLoopState: open flag, parts and workers joined (see cLoop*): its owner
+    /// opens it with a store and shuts it, idle workers join by adding to it and read the function and
+    /// context only when their add found it open. mLoopPartsDone: the joiners' finished parts (or joins that
+    /// found no part left), counted up by them (it wraps), read by the owner. Three lines: the owner's own
+    /// (mLoopBusy), the one that joiners poll and take (the state, with the function and context that they
+    /// read next), and the count
     alignas(64) std::atomic<bool> mLoopBusy{false};
     uint32_t mLoopPartsDoneBefore = 0;         ///< mLoopPartsDone as the board's last loop closed
     std::atomic<uint64_t> mLoopPartsJoined{0}; ///< Statistic (Stats), added to by owners
@@ -418,8 +419,9 @@ private:
     LoopPartFunction mLoopFunction = nullptr;
     void* mLoopContext = nullptr;
     alignas(64) std::atomic<uint32_t> mLoopPartsDone{0};
-    static constexpr uint64_t cLoopJoinedMask = 0xff; ///< Parts taken by workers (part 0 is the owner's)
-    static constexpr uint32_t cLoopPartsShift = 8;    ///< Then the loop's parts, 8 bits
+    /// Workers joined (part 0 is the owner's; worker j takes part j + 1 if the loop has it)
+    static constexpr uint64_t cLoopJoinedMask = 0xff;
+    static constexpr uint32_t cLoopPartsShift = 8; ///< Then the loop's parts, 8 bits
     static constexpr uint64_t cLoopOpen = uint64_t(1) << 16;
 
     alignas(64) std::atomic<uint64_t> mJobsRun{0};
