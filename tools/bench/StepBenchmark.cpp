@@ -9,8 +9,9 @@
 // phase and of its serial part (the updating thread outside parallel loops: StepStatistics::mSerialMs), and a
 // checksum (sum of final body heights and contact points) that proves the work was done; for each thread
 // count of --threads (default 1,2: a job system of that many threads), then the speed-up. The checksum must
-// not change with the thread count (the step is deterministic across thread counts). --queued-loops turns the
-// job system's loop board off (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
+// not change with the thread count (the step is deterministic across thread counts), and how the job system
+// handed out the work (loop parts workers joined, queued jobs, per step). --queued-loops turns the job
+// system's loop board off (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
 
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
@@ -55,6 +56,11 @@ struct RunResult
     uint64_t mColoredIslands = 0;                        ///< Islands colored, summed over all steps
     uint64_t mReusedColorings = 0;                       ///< ... of which took the previous step's coloring
     uint64_t mReusedSolveOrders = 0;                     ///< Steps that took the previous step's solve order
+    /// How the job system handed out the run's work: loop parts that workers took from the loop board, and
+    /// jobs run through the queue (loops that found the board taken or off, the broad-phase update). Few
+    /// parts taken on many threads means the caller ran most loops alone
+    uint64_t mLoopPartsJoined = 0;
+    uint64_t mJobsRun = 0;
     int mSteps = 0;
 };
 
@@ -79,6 +85,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     result.mSteps = inSteps;
     std::vector<double> stepMs;
     stepMs.reserve(size_t(inSteps));
+    const jobs::JobSystem::Stats jobsBefore = ioJobs.GetStats();
     for (int step = 0; step < inSteps; ++step)
     {
         const auto start = std::chrono::steady_clock::now();
@@ -106,6 +113,9 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
         result.mReusedSolveOrders += stats.mNumSolveOrdersReused;
     }
     result.mStep = tools::Summarize(stepMs);
+    const jobs::JobSystem::Stats jobsAfter = ioJobs.GetStats();
+    result.mLoopPartsJoined = jobsAfter.mLoopPartsJoined - jobsBefore.mLoopPartsJoined;
+    result.mJobsRun = jobsAfter.mJobsRun - jobsBefore.mJobsRun;
     for (const BodyID& id : inDynamic)
         result.mHeightChecksum += ioSystem.GetBodyInterface().GetPosition(id).Value().y();
     if (const auto* quadTree = dynamic_cast<const BroadPhaseQuadTree*>(&ioSystem.GetBroadPhase()))
@@ -201,7 +211,8 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             "narrow %.3f  islands %.3f  solve %.3f  finish %.3f ms  | checksum heights %.3f "
             "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  "
             "| static candidates reused %.1f%% (%.1f%% walked, too many)  "
-            "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps\n",
+            "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps  "
+            "| per step: loop parts joined %.1f, queued jobs %.1f\n",
             inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
             run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
             run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
@@ -216,7 +227,8 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             100.0 * double(run.mCandidates.mWalked) / double(candidateQueries),
             static_cast<unsigned long long>(run.mReusedColorings),
             static_cast<unsigned long long>(run.mColoredIslands),
-            static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps);
+            static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps,
+            double(run.mLoopPartsJoined) / run.mSteps, double(run.mJobsRun) / run.mSteps);
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);
