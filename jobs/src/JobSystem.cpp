@@ -497,7 +497,7 @@ void JobSystem::OpenLoop(uint32_t inParts, LoopPartFunction inFunction, void* in
     assert(inParts >= 2 && inParts <= cMaxThreads);
     mLoopFunction = inFunction;
     mLoopContext = inContext;
-    // Release: a joiner reads the function and context after its compare-exchange acquires this
+    // Release: a joiner reads the function and context after its add acquires this
     mLoopState.store(cLoopOpen | uint64_t(inParts) << cLoopPartsShift, std::memory_order_release);
     // Relaxed: a worker that falls asleep as the board opens may be missed, which costs the loop a helper,
     // not a part (the owner takes the chunks of parts nobody joined); the next loop or job wakes it. A fence
@@ -541,7 +541,7 @@ void JobSystem::CloseLoop()
 
 bool JobSystem::LoopHasRoom() const
 {
-    // Relaxed: a hint; TryJoinLoop's compare-exchange decides
+    // Relaxed: a hint; TryJoinLoop's add decides
     const uint64_t state = mLoopState.load(std::memory_order_relaxed);
     return (state & cLoopOpen) != 0 && (state & cLoopJoinedMask) + 1 < (state >> cLoopPartsShift & 0xff);
 }

@@ -155,7 +155,7 @@ public:
             mStagesOver.store(true, std::memory_order_relaxed); // Relaxed: see above
         };
         // A chunk per thread: the job system hands them out as it hands out any loop's parts (one
-        // compare-exchange each on JobSystem's loop board), the caller's first
+        // atomic add each on JobSystem's loop board), the caller's first
         mJobs->ParallelFor(threads, 1,
                            [&](uint32_t inBegin, uint32_t inEnd)
                            {

@@ -172,7 +172,7 @@ public:
     /// the same cache lines (bodies, island links) and fetch each other's results.
     ///
     /// The parts are handed out on the loop board when it is free (one loop at a time, see OpenLoop):
-    /// idle workers join it with one compare-exchange each, where a job per part cost the caller a slot, a
+    /// idle workers join it with one atomic add each, where a job per part cost the caller a slot, a
     /// queue push and a wake-up each, and every helper a pop under the queue's mutex, all of which the
     /// threads of a many-core machine would take in turn. A helper that never comes costs nothing: the caller
     /// takes its chunks. Otherwise (another thread's loop is on the board) the parts are queued as jobs.
