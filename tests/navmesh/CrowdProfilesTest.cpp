@@ -61,8 +61,10 @@ TEST(CrowdProfilesTest, EachProfileWalksItsOwnNavMesh)
     AgentProfile human, large;
     large.mRadius = 1.5f;
     ProfileNavMesh humanMesh(*physics, human), largeMesh(*physics, large);
-    for (int frame = 0; frame < 3000 && !(humanMesh.mScheduler->IsIdle() && largeMesh.mScheduler->IsIdle());
-         ++frame)
+    // A bound against a hang only, as NavMeshSceneFixture::cIdleTimeout
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline &&
+           !(humanMesh.mScheduler->IsIdle() && largeMesh.mScheduler->IsIdle()))
     {
         humanMesh.mScheduler->Update();
         largeMesh.mScheduler->Update();

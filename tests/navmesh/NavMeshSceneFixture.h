@@ -70,10 +70,16 @@ protected:
         mScheduler->Update();
     }
 
-    /// Frames until the scheduler is idle (every needed tile built and published); false after inMaxFrames.
-    bool RunUntilIdle(int inMaxFrames = 2000)
+    /// A bound on waiting for the background builds, against a hang only, never a speed check: on a loaded
+    /// machine (ctest -j2 on CI's 2 cores, a build beside it) the one background thread gets a fraction of a
+    /// core, and a bound of 2,000 frames of 1 ms let a 64-tile town's first build fail
+    static constexpr std::chrono::seconds cIdleTimeout{120};
+
+    /// Frames until the scheduler is idle (every needed tile built and published); false after inTimeout.
+    bool RunUntilIdle(std::chrono::seconds inTimeout = cIdleTimeout)
     {
-        for (int frame = 0; frame < inMaxFrames; ++frame)
+        const auto deadline = std::chrono::steady_clock::now() + inTimeout;
+        while (std::chrono::steady_clock::now() < deadline)
         {
             Frame();
             if (mScheduler->IsIdle())

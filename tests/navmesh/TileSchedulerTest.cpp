@@ -33,7 +33,8 @@ TEST_F(TileSchedulerTest, AnInvokerGetsTheTilesWithinItsRadiusNearestFirstWithin
     // 2 m from the tile corner at the origin: a 5 m radius reaches the four tiles around the origin
     ASSERT_TRUE(mScheduler->AddInvoker(Vec3(2, 0, 2), 5.0f));
     std::vector<TileCoord> publishOrder;
-    for (int frame = 0; frame < 2000 && !mScheduler->IsIdle(); ++frame)
+    const auto deadline = std::chrono::steady_clock::now() + cIdleTimeout; // See there
+    while (std::chrono::steady_clock::now() < deadline && !mScheduler->IsIdle())
     {
         Frame();
         EXPECT_LE(mScheduler->GetNumRunningJobs(), 1u);
@@ -101,7 +102,8 @@ TEST_F(TileSchedulerTest, ATileIsPublishedOnlyAtTheSyncPoint)
     MakeNavMesh(1);
     // Jobs run and finish between Updates, but the navmesh changes only inside Update
     Frame();
-    for (int wait = 0; wait < 5000 && !mScheduler->HasFinishedJobs(); ++wait)
+    const auto deadline = std::chrono::steady_clock::now() + cIdleTimeout; // See there
+    while (std::chrono::steady_clock::now() < deadline && !mScheduler->HasFinishedJobs())
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     ASSERT_TRUE(mScheduler->HasFinishedJobs());
     EXPECT_EQ(mWorld->GetNumTiles(), 0);
