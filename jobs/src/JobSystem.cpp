@@ -593,6 +593,7 @@ void JobSystem::WorkerMain()
         std::unique_lock lock(mQueueMutex);
         // Relaxed: read as a hint (GetNumWorkersAsleep, OpenLoop)
         mNumWorkersAsleep.fetch_add(1, std::memory_order_relaxed);
+        mWorkerSleeps.fetch_add(1, std::memory_order_relaxed); // Statistic only
         mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping || LoopHasRoom(); });
         // Relaxed: a hint from here on
         mNumWorkersAsleep.fetch_sub(1, std::memory_order_relaxed);
@@ -618,6 +619,7 @@ JobSystem::Stats JobSystem::GetStats() const
     stats.mJobsRunInline = mJobsRunInline.load(std::memory_order_relaxed);
     stats.mDependentOverflow = mDependentOverflow.load(std::memory_order_relaxed);
     stats.mLoopPartsJoined = mLoopPartsJoined.load(std::memory_order_relaxed);
+    stats.mWorkerSleeps = mWorkerSleeps.load(std::memory_order_relaxed);
     return stats;
 }
 

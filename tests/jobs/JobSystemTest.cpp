@@ -250,11 +250,16 @@ TEST(JobSystemSleepTest, WorkersWithoutWorkAreCountedAsleepAndABusyOneIsNot)
     JobSystem jobs(settings);
     auto waitFor = [&](uint32_t inAsleep) { return WaitForWorkersAsleep(jobs, inAsleep); };
     EXPECT_EQ(waitFor(2), 2u) << "both workers sleep with nothing to do";
+    // Each went to sleep once at least (a spurious wake-up may add one); none counted is a statistic that
+    // counts nothing
+    const uint64_t sleepsBefore = jobs.GetStats().mWorkerSleeps;
+    EXPECT_GE(sleepsBefore, 2u);
     {
         WorkerHeld held(jobs); // One worker runs a job until released
         EXPECT_EQ(waitFor(1), 1u) << "the other one sleeps";
     }
     EXPECT_EQ(waitFor(2), 2u) << "the released worker sleeps again";
+    EXPECT_GT(jobs.GetStats().mWorkerSleeps, sleepsBefore) << "the released worker's sleep is counted";
 }
 
 TEST(JobSystemSleepTest, AnExtendedSpinKeepsAnIdleWorkerAwakeUntilItEnds)

@@ -10,7 +10,8 @@
 // checksum (sum of final body heights and contact points) that proves the work was done; for each thread
 // count of --threads (default 1,2: a job system of that many threads), then the speed-up. The checksum must
 // not change with the thread count (the step is deterministic across thread counts), and how the job system
-// handed out the work (loop parts workers joined, queued jobs, per step). --queued-loops turns the job
+// handed out the work (loop parts workers joined, queued jobs, and workers that ran out of work and slept,
+// per step). --queued-loops turns the job
 // system's loop board off (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
 
 #include "broadphase/BroadPhaseQuadTree.h"
@@ -61,6 +62,7 @@ struct RunResult
     /// parts taken on many threads means the caller ran most loops alone
     uint64_t mLoopPartsJoined = 0;
     uint64_t mJobsRun = 0;
+    uint64_t mWorkerSleeps = 0;
     int mSteps = 0;
 };
 
@@ -116,6 +118,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
     const jobs::JobSystem::Stats jobsAfter = ioJobs.GetStats();
     result.mLoopPartsJoined = jobsAfter.mLoopPartsJoined - jobsBefore.mLoopPartsJoined;
     result.mJobsRun = jobsAfter.mJobsRun - jobsBefore.mJobsRun;
+    result.mWorkerSleeps = jobsAfter.mWorkerSleeps - jobsBefore.mWorkerSleeps;
     for (const BodyID& id : inDynamic)
         result.mHeightChecksum += ioSystem.GetBodyInterface().GetPosition(id).Value().y();
     if (const auto* quadTree = dynamic_cast<const BroadPhaseQuadTree*>(&ioSystem.GetBroadPhase()))
@@ -212,7 +215,7 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             "contacts %llu  | manifolds %llu  body pairs %llu  | pairs reused %.1f%%  "
             "| static candidates reused %.1f%% (%.1f%% walked, too many)  "
             "| colorings reused %llu of %llu  | solve orders reused in %llu of %d steps  "
-            "| per step: loop parts joined %.1f, queued jobs %.1f\n",
+            "| per step: loop parts joined %.1f, queued jobs %.1f, worker sleeps %.2f\n",
             inName, inThreads, i, run.mStep.mMean, run.mStep.mP99, run.mStep.mMax,
             run.mPhaseSums.mBroadPhaseUpdateMs / run.mSteps, run.mPhaseSums.mNarrowPhaseMs / run.mSteps,
             run.mPhaseSums.mIslandsMs / run.mSteps, run.mPhaseSums.mSolveMs / run.mSteps,
@@ -228,7 +231,8 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
             static_cast<unsigned long long>(run.mReusedColorings),
             static_cast<unsigned long long>(run.mColoredIslands),
             static_cast<unsigned long long>(run.mReusedSolveOrders), run.mSteps,
-            double(run.mLoopPartsJoined) / run.mSteps, double(run.mJobsRun) / run.mSteps);
+            double(run.mLoopPartsJoined) / run.mSteps, double(run.mJobsRun) / run.mSteps,
+            double(run.mWorkerSleeps) / run.mSteps);
         means.push_back(run.mStep.mMean);
         p99s.push_back(run.mStep.mP99);
         maxes.push_back(run.mStep.mMax);

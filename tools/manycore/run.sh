@@ -56,7 +56,7 @@ echo "== step_pile2k and step_pyramid on $threads threads"
 "$bundle/run" cairn-bench-step --threads "$threads" --repetitions 3 >"$out/step.txt" 2>&1 || echo "run.sh: the step benchmark failed" >&2
 # The serial part (StepStatistics::mSerialMs: the updating thread outside the parallel loops) and its phases,
 # averaged over the repetitions: the part that more threads cannot shorten, and where it is
-echo "scene,threads,mean_ms,p99_ms,speedup,checksum,serial_ms,serial_share,serial_narrow_ms,serial_islands_ms,serial_solve_ms,serial_finish_ms,loop_parts_joined_per_step,queued_jobs_per_step" \
+echo "scene,threads,mean_ms,p99_ms,speedup,checksum,serial_ms,serial_share,serial_narrow_ms,serial_islands_ms,serial_solve_ms,serial_finish_ms,loop_parts_joined_per_step,queued_jobs_per_step,worker_sleeps_per_step" \
     >"$out/step.csv"
 awk '
     / rep [0-9]+: / { scene = $1; t = $2; sub(/threads=/, "", t); key = scene "," t
@@ -64,14 +64,15 @@ awk '
         for (i = 1; i <= NF; ++i)
             if ($i == "serial") { serial[key] += $(i + 1); share = $(i + 3); gsub(/[(%):]/, "", share); shares[key] += share
                 narrow[key] += $(i + 5); islands[key] += $(i + 7); solve[key] += $(i + 9); finish[key] += $(i + 11); ++reps[key] }
-        for (i = 1; i <= NF; ++i) { if ($i == "joined") joined[key] += $(i + 1); if ($i == "jobs") jobs[key] += $(i + 1) }
+        for (i = 1; i <= NF; ++i) { if ($i == "joined") joined[key] += $(i + 1); if ($i == "jobs") jobs[key] += $(i + 1)
+            if ($i == "sleeps") sleeps[key] += $(i + 1) }
     }
     / median of / { scene = $1; t = $2; sub(/threads=/, "", t); key = scene "," t; n = (reps[key] > 0) ? reps[key] : 1
         for (i = 1; i <= NF; ++i) { if ($i == "mean") mean = $(i + 1); if ($i == "p99") p99 = $(i + 1) }
         if (t == 1) base[scene] = mean
-        printf "%s,%s,%s,%s,%.2f,\"%s\",%.3f,%.1f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f\n", scene, t, mean, p99, (scene in base) ? base[scene] / mean : 0,
+        printf "%s,%s,%s,%s,%.2f,\"%s\",%.3f,%.1f,%.3f,%.3f,%.3f,%.3f,%.1f,%.1f,%.2f\n", scene, t, mean, p99, (scene in base) ? base[scene] / mean : 0,
             checksum[key], serial[key] / n, shares[key] / n, narrow[key] / n, islands[key] / n, solve[key] / n, finish[key] / n,
-            joined[key] / n, jobs[key] / n }
+            joined[key] / n, jobs[key] / n, sleeps[key] / n }
 ' "$out/step.txt" >>"$out/step.csv"
 
 # The same scenes at the top thread count with the job system's loop board on and off (off: a queued job per
@@ -162,12 +163,14 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo
     echo "Parts joined / jobs: per step, the loop parts that workers took from the job system's loop board and the"
     echo "jobs run through its queue; few parts joined on many threads means the updating thread ran most loops alone."
+    echo "Sleeps: per step, the times a worker ran out of work for cSpinMicroseconds and slept; each is a wake-up"
+    echo "later (tens of microseconds) before that worker helps again."
     echo
-    echo "| scene | threads | mean ms | p99 ms | speed-up | Amdahl | checksum | serial ms (share) | serial narrow / islands / solve / finish ms | parts joined / jobs |"
+    echo "| scene | threads | mean ms | p99 ms | speed-up | Amdahl | checksum | serial ms (share) | serial narrow / islands / solve / finish ms | parts joined / jobs / sleeps |"
     echo "|---|---|---|---|---|---|---|---|---|---|"
     awk -F, 'NR > 1 { gsub(/"/, "", $6); if ($2 == 1) s[$1] = $8 / 100
         amdahl = ($1 in s) ? sprintf("%.2f", 1 / (s[$1] + (1 - s[$1]) / $2)) : "-"
-        printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s | %s / %s |\n", $1, $2, $3, $4, $5, amdahl, $6, $7, $8, $9, $10, $11, $12, $13, $14 }' "$out/step.csv"
+        printf "| %s | %s | %s | %s | %s | %s | %s | %s (%s %%) | %s / %s / %s / %s | %s / %s / %s |\n", $1, $2, $3, $4, $5, amdahl, $6, $7, $8, $9, $10, $11, $12, $13, $14, $15 }' "$out/step.csv"
     echo
     echo "## The loop board at $topThreads threads (cairn-bench-step, on and off (--queued-loops) alternated, medians of 3 runs)"
     echo

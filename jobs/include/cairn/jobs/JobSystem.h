@@ -88,6 +88,9 @@ public:
         uint64_t mJobsRunInline = 0;     ///< Jobs run at once because every slot was in use
         uint64_t mDependentOverflow = 0; ///< Prerequisites waited for because cMaxDependents was reached
         uint64_t mLoopPartsJoined = 0;   ///< ParallelFor parts that workers took from the loop board
+        /// Times a worker ran out of work, spun cSpinMicroseconds and went to sleep: each costs a wake-up
+        /// later, tens of microseconds before that worker helps again
+        uint64_t mWorkerSleeps = 0;
     };
 
     JobSystem(); ///< Default settings
@@ -427,6 +430,7 @@ private:
     alignas(64) std::atomic<uint64_t> mJobsRun{0};
     std::atomic<uint64_t> mJobsRunInline{0};
     std::atomic<uint64_t> mDependentOverflow{0};
+    std::atomic<uint64_t> mWorkerSleeps{0}; ///< Statistic (Stats), added to by workers going to sleep
 
     std::vector<std::thread> mWorkers;
 };
