@@ -45,8 +45,11 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     Clock::time_point phase = Clock::now();
     const Clock::time_point start = phase;
 
-    // 1. The broad-phase update: beside the rounds below when it may, else now
-    BroadPhaseUpdate update(mBroadPhase, ioJobs, active.size() >= mSettings.mUpdateBesideStepMinActiveBodies);
+    // 1. The broad-phase update: beside the rounds below when it may, else now. The bar is per helper (see
+    // PhysicsSettings::mUpdateBesideStepMinActiveBodies)
+    const uint64_t helpers = ioJobs != nullptr ? std::max(ioJobs->GetNumThreads(), 1u) - 1 : 0;
+    BroadPhaseUpdate update(mBroadPhase, ioJobs,
+                            uint64_t(active.size()) * helpers >= mSettings.mUpdateBesideStepMinActiveBodies);
     mContactCache.BeginStep();
     mContinuous.BeginStep();
     mContacts.BeginStep();

@@ -11,8 +11,9 @@
 // count of --threads (default 1,2: a job system of that many threads), then the speed-up. The checksum must
 // not change with the thread count (the step is deterministic across thread counts), and how the job system
 // handed out the work (loop parts workers joined, queued jobs, and workers that ran out of work and slept,
-// per step). --queued-loops turns the job
-// system's loop board off (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
+// per step). --update-beside-from sets the active bodies a helper thread from which the broad-phase update
+// runs beside the step. --queued-loops turns the job system's loop board off
+// (JobSystem::Settings::mUseLoopBoard), to measure what it saves.
 
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/jobs/JobSystem.h"
@@ -70,6 +71,17 @@ struct RunResult
 /// given.
 float gCandidateMargin = PhysicsSettings().mBroadPhaseCandidateMargin;
 bool gQueuedLoops = false;
+/// PhysicsSettings::mUpdateBesideStepMinActiveBodies (--update-beside-from); the engine's default unless
+/// given.
+uint32_t gUpdateBesideFrom = PhysicsSettings().mUpdateBesideStepMinActiveBodies;
+
+/// The scenes' settings with the options above.
+PhysicsSettings StepSettings(bool inAllowSleeping)
+{
+    PhysicsSettings settings = BenchSettings(inAllowSleeping, gCandidateMargin);
+    settings.mUpdateBesideStepMinActiveBodies = gUpdateBesideFrom;
+    return settings;
+}
 
 /// The job system a run steps with: inThreads threads, the loop board as --queued-loops says.
 jobs::JobSystem::Settings JobSettings(uint32_t inThreads)
@@ -129,7 +141,7 @@ RunResult RunScene(PhysicsSystem& ioSystem, const std::vector<BodyID>& inDynamic
 RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 {
     const std::unique_ptr<PhysicsSystem> system =
-        tools::CreatePhysicsSystemOrExit("cairn-bench-step", BenchSettings(true, gCandidateMargin));
+        tools::CreatePhysicsSystemOrExit("cairn-bench-step", StepSettings(true));
     std::vector<BodyCreationSettings> statics, dynamics;
     for (const BenchBox& box : inData.mStatic)
         statics.push_back(BoxSettings(box.mCenter, box.mHalfExtent, box.mYaw, MotionType::Static, 0.5f));
@@ -143,8 +155,8 @@ RunResult RunPile2k(const SharedBenchData& inData, jobs::JobSystem& ioJobs)
 
 RunResult RunPyramid(jobs::JobSystem& ioJobs)
 {
-    const std::unique_ptr<PhysicsSystem> system = tools::CreatePhysicsSystemOrExit(
-        "cairn-bench-step", BenchSettings(tools::cPyramidAllowSleeping, gCandidateMargin));
+    const std::unique_ptr<PhysicsSystem> system =
+        tools::CreatePhysicsSystemOrExit("cairn-bench-step", StepSettings(tools::cPyramidAllowSleeping));
     const tools::PyramidScene scene = tools::AddPyramid(system->GetBodyInterface());
     return RunScene(*system, scene.mBoxes, 500, ioJobs);
 }
@@ -152,7 +164,7 @@ RunResult RunPyramid(jobs::JobSystem& ioJobs)
 RunResult RunRagdolls(jobs::JobSystem& ioJobs)
 {
     const std::unique_ptr<PhysicsSystem> system =
-        tools::CreatePhysicsSystemOrExit("cairn-bench-step", BenchSettings(true, gCandidateMargin));
+        tools::CreatePhysicsSystemOrExit("cairn-bench-step", StepSettings(true));
     // The ground: 64 x 64 cells of 1 m round the origin, waves 0.3 m high
     const uint32_t samples = 65;
     std::vector<float> heights(samples * samples);
@@ -246,19 +258,25 @@ double Print(const char* inName, uint32_t inThreads, const std::vector<RunResult
 int main(int inArgc, char** inArgv)
 {
     tools::BenchOptions options;
-    if (auto stop = tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-step: physics step figures",
-                                             {"step_pile2k", "step_pyramid", "step_ragdolls"}, options, true,
-                                             [](CLI::App& ioApp)
-                                             {
-                                                 ioApp
-                                                     .add_option("--candidate-margin", gCandidateMargin,
-                                                                 "Broad-phase static candidate margin (m), 0 "
-                                                                 "turns the cache off")
-                                                     ->check(CLI::Range(0.0f, 100.0f));
-                                                 ioApp.add_flag("--queued-loops", gQueuedLoops,
-                                                                "The job system's loops as a queued job per "
-                                                                "part (its loop board off)");
-                                             }))
+    if (auto stop =
+            tools::ParseBenchOptions(inArgc, inArgv, "cairn-bench-step: physics step figures",
+                                     {"step_pile2k", "step_pyramid", "step_ragdolls"}, options, true,
+                                     [](CLI::App& ioApp)
+                                     {
+                                         ioApp
+                                             .add_option("--candidate-margin", gCandidateMargin,
+                                                         "Broad-phase static candidate margin (m), 0 "
+                                                         "turns the cache off")
+                                             ->check(CLI::Range(0.0f, 100.0f));
+                                         ioApp.add_flag("--queued-loops", gQueuedLoops,
+                                                        "The job system's loops as a queued job per "
+                                                        "part (its loop board off)");
+                                         ioApp.add_option("--update-beside-from", gUpdateBesideFrom,
+                                                          "Active bodies per helper thread from which the "
+                                                          "broad-phase update runs beside the step "
+                                                          "(PhysicsSettings::"
+                                                          "mUpdateBesideStepMinActiveBodies)");
+                                     }))
         return *stop;
     const int repetitions = options.mRepetitions;
     const std::string& only = options.mOnly;
@@ -268,9 +286,11 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf("cairn-bench-step: build %s, %d repetitions%s; %s; core-to-core round trip %.0f ns\n",
-                buildType, repetitions, gQueuedLoops ? ", queued loops" : "",
-                tools::DescribeMachine().c_str(), tools::MeasureCoreToCoreRoundTripNanoseconds());
+    std::printf(
+        "cairn-bench-step: build %s, %d repetitions%s, update beside from %u active bodies a helper; %s; "
+        "core-to-core round trip %.0f ns\n",
+        buildType, repetitions, gQueuedLoops ? ", queued loops" : "", gUpdateBesideFrom,
+        tools::DescribeMachine().c_str(), tools::MeasureCoreToCoreRoundTripNanoseconds());
     auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
     {
         for (size_t t = 1; t < inMeans.size(); ++t)

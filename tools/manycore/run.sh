@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
-# run-all.sh): step scaling, union-find, the step's stages and loops, contended broad-phase queries and the
-# demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
+# run-all.sh): step scaling (at the top thread count also with the loop board off, and pile2k with the
+# broad-phase update's old flat bar), union-find, the step's stages and loops, contended broad-phase queries and
+# the demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
 # bash, awk, grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
 #        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,
@@ -79,9 +80,14 @@ awk '
 # part of a loop, as before the board), alternated run by run: what the board saves where many threads take
 # parts, measured in one sitting
 topThreads=$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)
-echo "== step_pile2k and step_pyramid on $topThreads threads, loop board on and off"
+# pile2k also with the broad-phase update's old bar, 1,024 active bodies whatever the thread count (the bar is
+# per helper thread: 69 active bodies on 16 threads): whether the update beside the step pays where pile2k's
+# steps of fewer than 1,024 active bodies did it first, serially
+flatBar=$((1024 * (topThreads - 1)))
+echo "== step_pile2k and step_pyramid on $topThreads threads, loop board on and off; pile2k's update bar flat"
 : >"$out/step_board.txt"
 : >"$out/step_queued.txt"
+: >"$out/step_flat_bar.txt"
 for round in 1 2 3; do
     for scene in step_pile2k step_pyramid; do
         "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" >>"$out/step_board.txt" 2>&1 ||
@@ -89,6 +95,9 @@ for round in 1 2 3; do
         "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" --queued-loops \
             >>"$out/step_queued.txt" 2>&1 || echo "run.sh: the step benchmark failed (queued loops)" >&2
     done
+    "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only step_pile2k \
+        --update-beside-from "$flatBar" >>"$out/step_flat_bar.txt" 2>&1 ||
+        echo "run.sh: the step benchmark failed (flat update bar)" >&2
 done
 
 echo "== union-find on $threads threads"
@@ -187,6 +196,25 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
         END { for (s in scenes) { b = median(means[1, s]); q = median(means[2, s])
             printf "| %s | %.3f | %.3f | %.2f | %.3f | %.3f |\n", s, b, q, (b > 0 ? q / b : 0), median(serials[1, s]), median(serials[2, s]) } }' \
         "$out/step_board.txt" "$out/step_queued.txt"
+    echo
+    echo "## The broad-phase update's bar at $topThreads threads (cairn-bench-step, step_pile2k, alternated with the rows above, medians of 3 runs)"
+    echo
+    echo "Per helper: the update runs beside the step from 1,024 active bodies per helper thread (the default). Flat:"
+    echo "from 1,024 active bodies whatever the thread count (--update-beside-from $flatBar); below, the step does it"
+    echo "first, a serial stretch."
+    echo
+    echo "| scene | per helper: mean ms | flat: mean ms | flat / per helper | per helper: serial ms | flat: serial ms |"
+    echo "|---|---|---|---|---|---|"
+    awk '
+        function median(list,   n, v, i, j, t) { n = split(list, v, " ")
+            for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
+            return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
+        FNR == 1 { file++ }
+        /^step_pile2k .* rep 0: / { for (i = 1; i <= NF; ++i) { if ($i == "mean") means[file] = means[file] " " $(i + 1)
+                if ($i == "serial") serials[file] = serials[file] " " $(i + 1) } }
+        END { p = median(means[1]); f = median(means[2])
+            printf "| step_pile2k | %.3f | %.3f | %.2f | %.3f | %.3f |\n", p, f, (p > 0 ? f / p : 0), median(serials[1]), median(serials[2]) }' \
+        "$out/step_board.txt" "$out/step_flat_bar.txt"
     echo
     echo "## Union-find (cairn-bench-unionfind)"
     echo

@@ -1,7 +1,8 @@
 // Determinism of the parallel step: the same scene stepped 600 times gives bit-identical body states run
 // after run with the same number of threads, and the same states with no job system and with 1, 2 and 4
 // threads (pairs, contacts, waking and islands are made canonical, see PhysicsStep.h); and the same states
-// on a scheduler that is not cairn::jobs, through the step's job interface (jobs::JobInterface).
+// on a scheduler that is not cairn::jobs, through the step's job interface (jobs::JobInterface). And the
+// broad-phase update goes beside the step from fewer active bodies the more helper threads it has.
 
 #include "SimulationFixture.h"
 #include "cairn/jobs/JobInterface.h"
@@ -246,6 +247,46 @@ TEST(StepDeterminismTest, AnotherSchedulerThroughTheJobInterfaceGivesTheSameStat
         EXPECT_GT(jobs.GetNumLoopsOfAChunkPerThread(), 0u) << "colored islands solved by every thread";
         EXPECT_EQ(jobs.GetNumUnfinished(), 0u);
     }
+}
+
+/// Steps of a world of inBodies falling boxes (none asleep) whose update goes beside the step from
+/// inMinActive active bodies a helper, on a scheduler of inThreads threads: the updates it ran beside, as
+/// tasks.
+uint64_t UpdatesBesideTheStep(uint32_t inBodies, uint32_t inMinActive, uint32_t inThreads, int inSteps)
+{
+    PhysicsSettings settings;
+    settings.mAllowSleeping = false;
+    settings.mUpdateBesideStepMinActiveBodies = inMinActive;
+    const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
+    (void)bodies.CreateAndAddBody(test::StaticFloorSettings(40.0f), Activation::DontActivate);
+    const ShapeRef box = BoxShape::Create(Vec3(0.4f, 0.4f, 0.4f)).Value();
+    for (uint32_t i = 0; i < inBodies; ++i)
+    {
+        BodyCreationSettings falling;
+        falling.mShape = box;
+        falling.mPosition = Vec3(-15.0f + 1.5f * float(i % 20), 3.0f + 1.5f * float(i / 20), 0.0f);
+        falling.mMotionType = MotionType::Dynamic;
+        falling.mObjectLayer = Layers::cMoving;
+        EXPECT_TRUE(bodies.CreateAndAddBody(falling, Activation::Activate).IsOk());
+    }
+    ThreadPerTaskJobs jobs(inThreads);
+    for (int step = 0; step < inSteps; ++step)
+        EXPECT_TRUE(system->Update(1.0f / 60.0f, 1, jobs).IsOk());
+    EXPECT_EQ(jobs.GetNumUnfinished(), 0u);
+    return jobs.GetNumTasks("broad-phase update");
+}
+
+TEST(StepDeterminismTest, TheUpdateGoesBesideTheStepFromFewerActiveBodiesWithMoreHelpers)
+{
+    // 100 active bodies against a bar of 150 a helper: 100 on 2 threads (one helper), 200 on 3, 300 on 4
+    constexpr int cSteps = 10;
+    EXPECT_EQ(UpdatesBesideTheStep(100, 150, 2, cSteps), 0u) << "one helper: the step updates first, itself";
+    EXPECT_EQ(UpdatesBesideTheStep(100, 150, 3, cSteps), uint64_t(cSteps))
+        << "two helpers: beside every step";
+    EXPECT_EQ(UpdatesBesideTheStep(100, 150, 4, cSteps), uint64_t(cSteps));
+    EXPECT_EQ(UpdatesBesideTheStep(100, 0, 2, cSteps), uint64_t(cSteps))
+        << "a bar of 0: beside whenever it may";
 }
 
 } // namespace

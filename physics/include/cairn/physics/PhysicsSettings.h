@@ -50,11 +50,15 @@ struct PhysicsSettings
     /// triangles of a mesh or height field, a compound's parts on one floor) become one manifold of at most
     /// four points, as with Jolt's mUseManifoldReduction; off: one manifold per triangle or part
     bool mMergeManifolds = true;
-    /// With a job system of two or more threads and a broad phase that allows it, a step with at least this
-    /// many active bodies rebuilds the broad phase on another thread while it finds its pairs and contacts.
-    /// Below, a small scene's rebuild is short and the step does it first, itself: running it beside cost
-    /// more than it saved (a worker woken for it, pair queries on the tree not yet rebuilt; the demo's 0.2 ms
-    /// physics frames were 15-25 % slower with it, the 1,240- and 2,000-body benchmarks 3-6 % faster)
+    /// With a job system of two or more threads and a broad phase that allows it, a step whose active bodies
+    /// times its helper threads (the job system's threads less the updating one) reach this rebuilds the
+    /// broad phase on another thread while it finds its pairs and contacts: from 1,024 active bodies on 2
+    /// threads, 342 on 4, 69 on 16. Below, a small scene's rebuild is short and the step does it first,
+    /// itself: on 2 threads running it beside cost more than it saved (the step's only helper taken for it, a
+    /// worker woken for it, pair queries on the tree not yet rebuilt; the demo's 0.2 ms physics frames were
+    /// 15-25 % slower with it, the 1,240- and 2,000-body benchmarks 3-6 % faster). The bar falls with the
+    /// helpers: beside, the update takes one helper of many from the step's loops; done first, it is a serial
+    /// stretch that no thread count shortens. 0: beside whenever it may
     uint32_t mUpdateBesideStepMinActiveBodies = 1024;
     /// Quad-tree broad phase: the pair search remembers the static bodies (those of trees that did not
     /// change) within this margin (m) of each active body and reuses them while the body stays inside it; 0
