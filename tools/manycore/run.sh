@@ -53,6 +53,23 @@ json_rows() { # <file> <counters...>
         }' "$file"
 }
 
+# Table rows comparing two files of alternated cairn-bench-step runs (--repetitions 1 each), for each scene
+# that both hold: the medians of the runs' mean and serial ms in the first and the second, and their ratio
+compare_runs() { # <first> <second>
+    awk '
+        function median(list,   n, v, i, j, t) { n = split(list, v, " ")
+            for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
+            return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
+        FNR == 1 { file++ }
+        / rep 0: / { scenes[file, $1] = 1
+            for (i = 1; i <= NF; ++i) { if ($i == "mean") means[file, $1] = means[file, $1] " " $(i + 1)
+                if ($i == "serial") serials[file, $1] = serials[file, $1] " " $(i + 1) } }
+        END { for (key in scenes) { split(key, parts, SUBSEP); s = parts[2]; if (parts[1] != 1 || !((2, s) in scenes)) continue
+            a = median(means[1, s]); b = median(means[2, s])
+            printf "| %s | %.3f | %.3f | %.2f | %.3f | %.3f |\n", s, a, b, (a > 0 ? b / a : 0), median(serials[1, s]), median(serials[2, s]) } }' \
+        "$1" "$2"
+}
+
 echo "== step_pile2k and step_pyramid on $threads threads"
 "$bundle/run" cairn-bench-step --threads "$threads" --repetitions 3 >"$out/step.txt" 2>&1 || echo "run.sh: the step benchmark failed" >&2
 # The serial part (StepStatistics::mSerialMs: the updating thread outside the parallel loops) and its phases,
@@ -185,17 +202,7 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo
     echo "| scene | board: mean ms | queued: mean ms | queued / board | board: serial ms | queued: serial ms |"
     echo "|---|---|---|---|---|---|"
-    awk '
-        function median(list,   n, v, i, j, t) { n = split(list, v, " ")
-            for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
-            return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
-        FNR == 1 { file++ }
-        / rep 0: / { scenes[$1] = 1
-            for (i = 1; i <= NF; ++i) { if ($i == "mean") means[file, $1] = means[file, $1] " " $(i + 1)
-                if ($i == "serial") serials[file, $1] = serials[file, $1] " " $(i + 1) } }
-        END { for (s in scenes) { b = median(means[1, s]); q = median(means[2, s])
-            printf "| %s | %.3f | %.3f | %.2f | %.3f | %.3f |\n", s, b, q, (b > 0 ? q / b : 0), median(serials[1, s]), median(serials[2, s]) } }' \
-        "$out/step_board.txt" "$out/step_queued.txt"
+    compare_runs "$out/step_board.txt" "$out/step_queued.txt"
     echo
     echo "## The broad-phase update's bar at $topThreads threads (cairn-bench-step, step_pile2k, alternated with the rows above, medians of 3 runs)"
     echo
@@ -205,16 +212,7 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo
     echo "| scene | per helper: mean ms | flat: mean ms | flat / per helper | per helper: serial ms | flat: serial ms |"
     echo "|---|---|---|---|---|---|"
-    awk '
-        function median(list,   n, v, i, j, t) { n = split(list, v, " ")
-            for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
-            return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
-        FNR == 1 { file++ }
-        /^step_pile2k .* rep 0: / { for (i = 1; i <= NF; ++i) { if ($i == "mean") means[file] = means[file] " " $(i + 1)
-                if ($i == "serial") serials[file] = serials[file] " " $(i + 1) } }
-        END { p = median(means[1]); f = median(means[2])
-            printf "| step_pile2k | %.3f | %.3f | %.2f | %.3f | %.3f |\n", p, f, (p > 0 ? f / p : 0), median(serials[1]), median(serials[2]) }' \
-        "$out/step_board.txt" "$out/step_flat_bar.txt"
+    compare_runs "$out/step_board.txt" "$out/step_flat_bar.txt"
     echo
     echo "## Union-find (cairn-bench-unionfind)"
     echo
