@@ -593,8 +593,12 @@ void JobSystem::WorkerMain()
         std::unique_lock lock(mQueueMutex);
         // Relaxed: read as a hint (GetNumWorkersAsleep, OpenLoop)
         mNumWorkersAsleep.fetch_add(1, std::memory_order_relaxed);
-        mWorkerSleeps.fetch_add(1, std::memory_order_relaxed); // Statistic only
-        mWake.wait(lock, [&] { return mReadyCount > 0 || mStopping || LoopHasRoom(); });
+        const auto hasWork = [&] { return mReadyCount > 0 || mStopping || LoopHasRoom(); };
+        if (!hasWork())
+        {
+            mWorkerSleeps.fetch_add(1, std::memory_order_relaxed); // Statistic only: a sleep, not a look
+            mWake.wait(lock, hasWork);
+        }
         // Relaxed: a hint from here on
         mNumWorkersAsleep.fetch_sub(1, std::memory_order_relaxed);
         if (mReadyCount == 0)
