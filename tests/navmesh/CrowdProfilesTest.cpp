@@ -2,6 +2,7 @@
 // own navmesh built by the same tile pipeline from the same bodies and its own crowd. A wall with a 2 m gap
 // lets the human through and not the large agent, which goes as far as its navmesh reaches and stops there.
 
+#include "NavMeshSceneFixture.h"
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/navmesh/Crowd.h"
 #include "cairn/navmesh/TileScheduler.h"
@@ -61,8 +62,7 @@ TEST(CrowdProfilesTest, EachProfileWalksItsOwnNavMesh)
     AgentProfile human, large;
     large.mRadius = 1.5f;
     ProfileNavMesh humanMesh(*physics, human), largeMesh(*physics, large);
-    // A bound against a hang only, as NavMeshSceneFixture::cIdleTimeout
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    const auto deadline = std::chrono::steady_clock::now() + cIdleTimeout; // See there
     while (std::chrono::steady_clock::now() < deadline &&
            !(humanMesh.mScheduler->IsIdle() && largeMesh.mScheduler->IsIdle()))
     {

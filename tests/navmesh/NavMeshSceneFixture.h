@@ -19,6 +19,11 @@ namespace cairn::navmesh::test
 {
 using namespace cairn::physics;
 
+/// A bound on waiting for background tile builds, against a hang only, never a speed check: on a loaded
+/// machine (ctest -j2 on CI's 2 cores, a build beside it) the one background thread gets a fraction of a
+/// core, and a bound of 2,000 frames of 1 ms let a 64-tile town's first build fail.
+inline constexpr std::chrono::seconds cIdleTimeout{120};
+
 class NavMeshSceneFixture : public ::testing::Test
 {
 protected:
@@ -69,11 +74,6 @@ protected:
         ASSERT_TRUE(mPhysics->Update(1.0f / 60.0f).IsOk());
         mScheduler->Update();
     }
-
-    /// A bound on waiting for the background builds, against a hang only, never a speed check: on a loaded
-    /// machine (ctest -j2 on CI's 2 cores, a build beside it) the one background thread gets a fraction of a
-    /// core, and a bound of 2,000 frames of 1 ms let a 64-tile town's first build fail
-    static constexpr std::chrono::seconds cIdleTimeout{120};
 
     /// Frames until the scheduler is idle (every needed tile built and published); false after inTimeout.
     bool RunUntilIdle(std::chrono::seconds inTimeout = cIdleTimeout)
