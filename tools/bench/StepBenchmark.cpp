@@ -58,9 +58,10 @@ struct RunResult
     uint64_t mColoredIslands = 0;                        ///< Islands colored, summed over all steps
     uint64_t mReusedColorings = 0;                       ///< ... of which took the previous step's coloring
     uint64_t mReusedSolveOrders = 0;                     ///< Steps that took the previous step's solve order
-    /// How the job system handed out the run's work: loop parts that workers took from the loop board, and
-    /// jobs run through the queue (loops that found the board taken or off, the broad-phase update). Few
-    /// parts taken on many threads means the caller ran most loops alone
+    /// How the job system handed out the run's work: loop parts that workers took from the loop board, jobs
+    /// run through the queue (loops that found the board taken or off, the broad-phase update), and the times
+    /// a worker ran out of work and slept. Few parts taken on many threads means the caller ran most loops
+    /// alone
     uint64_t mLoopPartsJoined = 0;
     uint64_t mJobsRun = 0;
     uint64_t mWorkerSleeps = 0;
