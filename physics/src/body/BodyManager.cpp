@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
+#include <memory>
+#include <new>
 #include <string>
 
 namespace cairn::physics
@@ -69,22 +71,32 @@ bool BodyManager::BodiesCollide(const Body& inA, const Body& inB) const
     return table != nullptr && table->CanCollide(inA.GetCollisionSubGroupID(), inB.GetCollisionSubGroupID());
 }
 
+namespace
+{
+/// Memory for inCount objects, none constructed. Not value-initialized: the pages of slots a world never uses
+/// are never written, so they take no memory.
+template <class T> T* AllocateSlots(uint32_t inCount)
+{
+    return static_cast<T*>(::operator new(size_t(inCount) * sizeof(T), std::align_val_t(alignof(T))));
+}
+} // namespace
+
 BodyManager::BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes)
     : mMaxBodies(inMaxBodies), mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
-      mBodies(new Body[inMaxBodies]), mSlotInUse(new bool[inMaxBodies]()),
-      mGroupFilters(new std::shared_ptr<const GroupFilterTable>[inMaxBodies]),
+      mBodies(AllocateSlots<Body>(inMaxBodies)), mSlotInUse(new bool[inMaxBodies]()),
+      mGroupFilters(AllocateSlots<std::shared_ptr<const GroupFilterTable>>(inMaxBodies)),
       mPoses(std::make_unique<PublishedPoseStore>(inMaxBodies))
 {
-    // Hand out low indices first: they pack the hot part of the array
+    // Reserved whole, so that DestroyBody's push never allocates
     mFreeList.reserve(inMaxBodies);
-    for (uint32_t i = inMaxBodies; i > 0; --i)
-        mFreeList.push_back(i - 1);
-    for (uint32_t i = 0; i < inMaxBodies; ++i)
-        mBodies[i].mID = BodyID(i, 0);
     mActiveBodies.reserve(inMaxBodies);
 }
 
-BodyManager::~BodyManager() = default;
+BodyManager::~BodyManager()
+{
+    std::destroy_n(mBodies.get(), mSlotsConstructed);
+    std::destroy_n(mGroupFilters.get(), mSlotsConstructed);
+}
 
 uint32_t BodyManager::GetNumBodies() const
 {
@@ -100,20 +112,36 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
                          "CreateBody called inside the physics step or while holding a body lock");
 
     uint32_t index;
+    bool firstUse = false;
     {
         const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
-        if (mFreeList.empty())
+        // A freed slot first (its memory is warm), else the lowest never used: low indices pack the hot part
+        // of the array
+        if (!mFreeList.empty())
+        {
+            index = mFreeList.back();
+            mFreeList.pop_back();
+        }
+        else if (mSlotsConstructed < mMaxBodies)
+        {
+            // Constructed here, so that slots [0, mSlotsConstructed) always hold a Body. No body lock:
+            // nothing reads a slot before CreateBody marks it in use, under the body's locks
+            index = mSlotsConstructed;
+            std::construct_at(&mBodies[index]);
+            std::construct_at(&mGroupFilters[index]);
+            ++mSlotsConstructed;
+            firstUse = true;
+        }
+        else
             return MakeError(ErrorCode::OutOfCapacity,
                              "body manager is full (" + std::to_string(mMaxBodies) + " bodies)");
-        index = mFreeList.back();
-        mFreeList.pop_back();
         ++mNumBodies;
     }
 
     const auto lock = LockedCountingWait(GetMutexForBody(index), LockKind::Body);
     const auto staticLock = LockedCountingWait(GetStaticMutexForBody(index), LockKind::Body);
     Body& body = mBodies[index];
-    const BodyID id(index, body.mID.GetSequence());
+    const BodyID id(index, firstUse ? 0 : body.mID.GetSequence()); // A slot's ids start at sequence 0
     body.Init(id, inSettings);
     mGroupFilters[index] = inSettings.mCollisionGroup.mFilter;
     mSlotInUse[index] = true;

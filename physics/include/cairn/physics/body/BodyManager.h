@@ -30,6 +30,7 @@
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <shared_mutex>
 #include <span>
 #include <vector>
@@ -145,20 +146,33 @@ private:
     /// Active list with the step's privileges (it holds every body mutex).
     std::vector<uint32_t>& GetActiveBodiesForStep() { return mActiveBodies; }
 
+    /// Frees a per-slot array's memory (~BodyManager destroys what was constructed in it first).
+    template <class T> struct SlotStorageDeleter
+    {
+        void operator()(T* inSlots) const { ::operator delete(inSlots, std::align_val_t(alignof(T))); }
+    };
+    template <class T> using SlotStorage = std::unique_ptr<T[], SlotStorageDeleter<T>>;
+
     uint32_t mMaxBodies;
-    uint32_t mMutexMask;                ///< Shards - 1 (a power of two minus one); set at construction
-    std::unique_ptr<Body[]> mBodies;    ///< Guarded per body by its shard mutex
+    uint32_t mMutexMask; ///< Shards - 1 (a power of two minus one); set at construction
+    /// mMaxBodies slots of memory, in which CreateBody constructs a slot's Body (and its group table pointer
+    /// below) the first time it hands that slot out (slots go out in index order, a freed one first): a
+    /// world writes memory for the bodies it has held, not for its capacity (65,536 bodies by default: about
+    /// 18 MB). Nothing reads a slot from mSlotsConstructed on: its mSlotInUse is false. Guarded per body by
+    /// its shard mutex
+    SlotStorage<Body> mBodies;
     std::unique_ptr<bool[]> mSlotInUse; ///< Guarded per slot by its shard mutex
     /// Each slot's body's group table (kept out of Body: a cold pointer the step reads only for two parts of
     /// one group). Guarded per slot by its shard mutex
-    std::unique_ptr<std::shared_ptr<const GroupFilterTable>[]> mGroupFilters;
+    SlotStorage<std::shared_ptr<const GroupFilterTable>> mGroupFilters;
     std::unique_ptr<PublishedPoseStore> mPoses; ///< A record per slot; see PublishedPoseStore.h
     mutable PaddedMutex mBodyMutexes[cNumBodyMutexes];
     mutable PaddedMutex mStaticMutexes[cNumBodyMutexes]; ///< Also held by writers outside the step
     std::array<std::atomic<BodyChangeListener*>, cMaxChangeListeners> mChangeListeners{}; ///< Null: free
 
     mutable std::mutex mFreeListMutex;
-    std::vector<uint32_t> mFreeList; ///< Guarded by mFreeListMutex
+    std::vector<uint32_t> mFreeList; ///< Freed slots, the last freed on top. Guarded by mFreeListMutex
+    uint32_t mSlotsConstructed = 0;  ///< Slots [0, this) hold a Body. Guarded by mFreeListMutex
     uint32_t mNumBodies = 0;         ///< Guarded by mFreeListMutex
 
     std::mutex mActiveListMutex;
