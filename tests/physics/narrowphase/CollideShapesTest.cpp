@@ -23,17 +23,8 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::Collide;
 using cairn::test::MaxPenetration;
-
-std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, const Shape& inB,
-                                     const Transform& inTB, const CollideSettings& inSettings = {})
-{
-    std::vector<ContactManifold> result;
-    const int count = CollideShapes(inA, inTA, inB, inTB, inSettings,
-                                    [&](const ContactManifold& inM) { result.push_back(inM); });
-    EXPECT_EQ(count, int(result.size()));
-    return result;
-}
 
 std::shared_ptr<const ConvexHullShape> MakeHullBox(const Vec3& inHalfExtent)
 {

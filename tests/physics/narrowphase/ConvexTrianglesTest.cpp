@@ -18,6 +18,7 @@ namespace cairn
 using namespace cairn::physics;
 namespace
 {
+using cairn::test::Collide;
 using cairn::test::MaxPenetration;
 
 // A flat grid in the XZ plane at height 0, inCells x inCells cells of size inCellSize, facing +Y
@@ -36,15 +37,6 @@ std::shared_ptr<const TriangleMeshShape> MakeGrid(int inCells, float inCellSize)
             triangles.push_back({index(x + 1, z), index(x, z + 1), index(x + 1, z + 1)});
         }
     return TriangleMeshShape::Create(vertices, triangles).Value();
-}
-
-std::vector<ContactManifold> Collide(const Shape& inA, const Transform& inTA, const Shape& inB,
-                                     const Transform& inTB, const CollideSettings& inSettings = {})
-{
-    std::vector<ContactManifold> result;
-    CollideShapes(inA, inTA, inB, inTB, inSettings,
-                  [&](const ContactManifold& inM) { result.push_back(inM); });
-    return result;
 }
 
 TEST(ConvexTrianglesTest, BoxOnFlatQuad)
