@@ -112,7 +112,6 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
                          "CreateBody called inside the physics step or while holding a body lock");
 
     uint32_t index;
-    bool firstUse = false;
     {
         const auto lock = LockedCountingWait(mFreeListMutex, LockKind::Body);
         // A freed slot first (its memory is warm), else the lowest never used: low indices pack the hot part
@@ -124,13 +123,13 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
         }
         else if (mSlotsConstructed < mMaxBodies)
         {
-            // Constructed here, so that slots [0, mSlotsConstructed) always hold a Body. No body lock:
-            // nothing reads a slot before CreateBody marks it in use, under the body's locks
+            // Constructed here, so that slots [0, mSlotsConstructed) always hold a Body, its ids from
+            // sequence 0. No body lock: nothing reads a slot before CreateBody marks it in use, under the
+            // body's locks
             index = mSlotsConstructed;
-            std::construct_at(&mBodies[index]);
+            std::construct_at(&mBodies[index])->mID = BodyID(index, 0);
             std::construct_at(&mGroupFilters[index]);
             ++mSlotsConstructed;
-            firstUse = true;
         }
         else
             return MakeError(ErrorCode::OutOfCapacity,
@@ -141,7 +140,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
     const auto lock = LockedCountingWait(GetMutexForBody(index), LockKind::Body);
     const auto staticLock = LockedCountingWait(GetStaticMutexForBody(index), LockKind::Body);
     Body& body = mBodies[index];
-    const BodyID id(index, firstUse ? 0 : body.mID.GetSequence()); // A slot's ids start at sequence 0
+    const BodyID id(index, body.mID.GetSequence());
     body.Init(id, inSettings);
     mGroupFilters[index] = inSettings.mCollisionGroup.mFilter;
     mSlotInUse[index] = true;
