@@ -35,7 +35,7 @@ PhysicsStep::PhysicsStep(const PhysicsSettings& inSettings, const LayerSetup& in
 void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepStatistics& ioStatistics,
                       jobs::JobInterface* ioJobs)
 {
-    mScheduler.BeginStep(ioJobs);
+    mScheduler.BeginStep(ioJobs, mSettings.mMinChunksPerThread);
     mLockWaitNanoseconds.store(0, std::memory_order_relaxed); // Relaxed: no job of this step runs yet
     std::vector<uint32_t>& active = mBodies.GetActiveBodiesForStep();
     const StepContext context{
@@ -66,7 +66,8 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
         const std::span<const uint32_t> round(active.data() + begin, end - begin);
         mIntegration.BeginRound(end);
         mScheduler.ParallelFor(
-            uint32_t(round.size()), StepCosts::cVelocities.mGrain, StepCosts::cVelocities.mItemNanoseconds,
+            uint32_t(round.size()), mScheduler.GrainFor(round.size(), StepCosts::cVelocities),
+            StepCosts::cVelocities.mItemNanoseconds,
             [&](uint32_t inBegin, uint32_t inEnd)
             {
                 const std::span<const uint32_t> bodies = round.subspan(inBegin, inEnd - inBegin);

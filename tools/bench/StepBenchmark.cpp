@@ -75,12 +75,15 @@ bool gQueuedLoops = false;
 /// PhysicsSettings::mUpdateBesideStepMinActiveBodies (--update-beside-from); the engine's default unless
 /// given.
 uint32_t gUpdateBesideFrom = PhysicsSettings().mUpdateBesideStepMinActiveBodies;
+/// PhysicsSettings::mMinChunksPerThread (--min-chunks-per-thread); the engine's default unless given.
+uint32_t gMinChunksPerThread = PhysicsSettings().mMinChunksPerThread;
 
 /// The scenes' settings with the options above.
 PhysicsSettings StepSettings(bool inAllowSleeping)
 {
     PhysicsSettings settings = BenchSettings(inAllowSleeping, gCandidateMargin);
     settings.mUpdateBesideStepMinActiveBodies = gUpdateBesideFrom;
+    settings.mMinChunksPerThread = gMinChunksPerThread;
     return settings;
 }
 
@@ -277,6 +280,13 @@ int main(int inArgc, char** inArgv)
                                                           "broad-phase update runs beside the step "
                                                           "(PhysicsSettings::"
                                                           "mUpdateBesideStepMinActiveBodies)");
+                                         ioApp
+                                             .add_option("--min-chunks-per-thread", gMinChunksPerThread,
+                                                         "Chunks each thread should find in the step's "
+                                                         "loops, where the items allow "
+                                                         "(PhysicsSettings::mMinChunksPerThread); 0: each "
+                                                         "loop's own grain")
+                                             ->check(CLI::Range(0u, 64u));
                                      }))
         return *stop;
     const int repetitions = options.mRepetitions;
@@ -287,11 +297,12 @@ int main(int inArgc, char** inArgv)
 #else
     const char* buildType = "Debug (figures not representative)";
 #endif
-    std::printf(
-        "cairn-bench-step: build %s, %d repetitions%s, update beside from %u active bodies a helper; %s; "
-        "core-to-core round trip %.0f ns\n",
-        buildType, repetitions, gQueuedLoops ? ", queued loops" : "", gUpdateBesideFrom,
-        tools::DescribeMachine().c_str(), tools::MeasureCoreToCoreRoundTripNanoseconds());
+    std::printf("cairn-bench-step: build %s, %d repetitions%s, update beside from %u active bodies a helper, "
+                "at least "
+                "%u chunks a thread; %s; core-to-core round trip %.0f ns\n",
+                buildType, repetitions, gQueuedLoops ? ", queued loops" : "", gUpdateBesideFrom,
+                gMinChunksPerThread, tools::DescribeMachine().c_str(),
+                tools::MeasureCoreToCoreRoundTripNanoseconds());
     auto speedUps = [&](const char* inName, const std::vector<double>& inMeans)
     {
         for (size_t t = 1; t < inMeans.size(); ++t)

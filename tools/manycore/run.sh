@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
-# run-all.sh): step scaling (at the top thread count also with the loop board off, and pile2k with the
-# broad-phase update's old flat bar), union-find, the step's stages and loops, contended broad-phase queries and
+# run-all.sh): step scaling (at the top thread count also with the loop board off, with each loop's own grain,
+# and pile2k with the broad-phase update's old flat bar), union-find, the step's stages and loops, contended broad-phase queries and
 # the demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
 # bash, awk, grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
@@ -101,9 +101,13 @@ topThreads=$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)
 # per helper thread: 69 active bodies on 16 threads): whether the update beside the step pays where pile2k's
 # steps of fewer than 1,024 active bodies did it first, serially
 flatBar=$((1024 * (topThreads - 1)))
-echo "== step_pile2k and step_pyramid on $topThreads threads, loop board on and off; pile2k's update bar flat"
+# And each loop at its own grain, as before the loops were cut for the thread count (--min-chunks-per-thread 0;
+# the default gives each thread at least 4 chunks where the items allow)
+echo "== step_pile2k and step_pyramid on $topThreads threads, loop board on and off, loops at their own grain;"
+echo "   pile2k's update bar flat"
 : >"$out/step_board.txt"
 : >"$out/step_queued.txt"
+: >"$out/step_own_grain.txt"
 : >"$out/step_flat_bar.txt"
 for round in 1 2 3; do
     for scene in step_pile2k step_pyramid; do
@@ -111,6 +115,9 @@ for round in 1 2 3; do
             echo "run.sh: the step benchmark failed (board)" >&2
         "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" --queued-loops \
             >>"$out/step_queued.txt" 2>&1 || echo "run.sh: the step benchmark failed (queued loops)" >&2
+        "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only "$scene" \
+            --min-chunks-per-thread 0 >>"$out/step_own_grain.txt" 2>&1 ||
+            echo "run.sh: the step benchmark failed (own grain)" >&2
     done
     "$bundle/run" cairn-bench-step --threads "$topThreads" --repetitions 1 --only step_pile2k \
         --update-beside-from "$flatBar" >>"$out/step_flat_bar.txt" 2>&1 ||
@@ -203,6 +210,16 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo "| scene | board: mean ms | queued: mean ms | queued / board | board: serial ms | queued: serial ms |"
     echo "|---|---|---|---|---|---|"
     compare_runs "$out/step_board.txt" "$out/step_queued.txt"
+    echo
+    echo "## The loops' grain at $topThreads threads (cairn-bench-step, alternated with the rows above, medians of 3 runs)"
+    echo
+    echo "Cut: each loop over bodies, pairs or joints cut so that every thread has at least 4 chunks where the items"
+    echo "allow (the default; a chunk keeps 4 us of estimated work). Own: each loop at the grain it has on 2 threads"
+    echo "(--min-chunks-per-thread 0)."
+    echo
+    echo "| scene | cut: mean ms | own: mean ms | own / cut | cut: serial ms | own: serial ms |"
+    echo "|---|---|---|---|---|---|"
+    compare_runs "$out/step_board.txt" "$out/step_own_grain.txt"
     echo
     echo "## The broad-phase update's bar at $topThreads threads (cairn-bench-step, step_pile2k, alternated with the rows above, medians of 3 runs)"
     echo

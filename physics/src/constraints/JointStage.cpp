@@ -131,11 +131,11 @@ bool JointStage::TakeJointsOnAllThreads(std::vector<Joint>& ioJoints)
     // put each chunk's (one serial pass over thousands of joints, a miss or two each, was a fifth of a
     // ragdoll pile's serial time). A chunk that finds a body to wake leaves it all to the serial pass, which
     // wakes in slot order
-    constexpr uint32_t grain = StepCosts::cJointsTaken.mGrain;
+    const StepScheduler& scheduler = mContext->mScheduler;
+    const uint32_t grain = scheduler.GrainFor(ioJoints.size(), StepCosts::cJointsTaken); // Both loops' chunks
     const uint32_t numChunks = uint32_t((ioJoints.size() + grain - 1) / grain);
     mChunkCounts.assign(2 * size_t(numChunks), 0u); // Per chunk: joints taken, then breakable ones
     std::atomic<bool> wakes{false};
-    const StepScheduler& scheduler = mContext->mScheduler;
     auto chunkOf = [&](uint32_t inChunk)
     {
         const size_t first = size_t(inChunk) * grain;
@@ -191,7 +191,9 @@ void JointStage::LinkIslands(const StepContext& inContext)
 {
     // The union-find takes links from any thread, in any order, with the same islands
     inContext.mScheduler.ParallelFor(
-        uint32_t(mStepJoints.size()), StepCosts::cJointLinks.mGrain, StepCosts::cJointLinks.mItemNanoseconds,
+        uint32_t(mStepJoints.size()),
+        inContext.mScheduler.GrainFor(mStepJoints.size(), StepCosts::cJointLinks),
+        StepCosts::cJointLinks.mItemNanoseconds,
         [&](uint32_t inBegin, uint32_t inEnd)
         {
             for (uint32_t i = inBegin; i < inEnd; ++i)

@@ -44,14 +44,14 @@ void ContactsStage::FindPairs(const StepContext& inContext, size_t inBegin)
         sliceIDs.push_back(inContext.BodyAt(active[i]).GetID());
 
     // Each chunk of active bodies collects its pairs apart; the chunk of a pair is that of its active body
-    constexpr uint32_t cBodiesPerChunk = StepCosts::cPairs.mGrain;
-    const uint32_t numChunks = uint32_t((sliceIDs.size() + cBodiesPerChunk - 1) / cBodiesPerChunk);
+    const uint32_t bodiesPerChunk = inContext.mScheduler.GrainFor(sliceIDs.size(), StepCosts::cPairs);
+    const uint32_t numChunks = uint32_t((sliceIDs.size() + bodiesPerChunk - 1) / bodiesPerChunk);
     if (mPairChunks.size() < numChunks) mPairChunks.resize(numChunks);
     for (uint32_t chunk = 0; chunk < numChunks; ++chunk)
         mPairChunks[chunk].mPairs.clear();
     // Named: a FunctionRef only refers to its callable, which must outlive it (a temporary lambda would not)
     auto runRanges = [&](uint32_t inCount, FunctionRef<void(uint32_t, uint32_t)> inRange) {
-        inContext.mScheduler.ParallelFor(inCount, cBodiesPerChunk, StepCosts::cPairs.mItemNanoseconds,
+        inContext.mScheduler.ParallelFor(inCount, bodiesPerChunk, StepCosts::cPairs.mItemNanoseconds,
                                          inRange);
     };
     const ParallelRanges ranges = runRanges;
@@ -72,7 +72,7 @@ void ContactsStage::FindPairs(const StepContext& inContext, size_t inBegin)
             if (self == nullptr || other == nullptr || !other->IsInWorld() ||
                 (other->IsActive() && other->GetActiveIndex() < inBegin))
                 return;
-            mPairChunks[(self->GetActiveIndex() - inBegin) / cBodiesPerChunk].mPairs.push_back(
+            mPairChunks[(self->GetActiveIndex() - inBegin) / bodiesPerChunk].mPairs.push_back(
                 {std::min(inActive.GetIndex(), inOther.GetIndex()),
                  std::max(inActive.GetIndex(), inOther.GetIndex())});
         },
@@ -112,21 +112,22 @@ void ContactsStage::CollidePairs(const StepContext& inContext, const Integration
     // Chunks of pairs in parallel, each into its own output. Each round has chunks of its own: the
     // constraints stay where the narrow phase wrote them until the step ends (moving the chunk objects keeps
     // their buffers)
-    constexpr uint32_t cPairsPerChunk = StepCosts::cPairsPerChunk;
-    const uint32_t numChunks = uint32_t((mPairs.size() + cPairsPerChunk - 1) / cPairsPerChunk);
+    mPairsPerChunk = inContext.mScheduler.GrainFor(mPairs.size(), StepCosts::cNarrowPhase);
+    const uint32_t pairsPerChunk = mPairsPerChunk;
+    const uint32_t numChunks = uint32_t((mPairs.size() + pairsPerChunk - 1) / pairsPerChunk);
     mFirstChunk = mNumChunksUsed;
     mNumChunksUsed += numChunks;
     if (mNarrowPhaseChunks.size() < mNumChunksUsed) mNarrowPhaseChunks.resize(mNumChunksUsed);
     inContext.mScheduler.ParallelFor(
-        numChunks, 1, cPairsPerChunk * StepCosts::cPairNanoseconds,
+        numChunks, 1, pairsPerChunk * StepCosts::cNarrowPhase.mItemNanoseconds,
         [&](uint32_t inB, uint32_t inE)
         {
             for (uint32_t chunk = inB; chunk < inE; ++chunk)
             {
                 NarrowPhaseChunk& out = mNarrowPhaseChunks[mFirstChunk + chunk];
                 out.Clear();
-                const size_t last = std::min(mPairs.size(), size_t(chunk + 1) * cPairsPerChunk);
-                for (size_t p = size_t(chunk) * cPairsPerChunk; p < last; ++p)
+                const size_t last = std::min(mPairs.size(), size_t(chunk + 1) * pairsPerChunk);
+                for (size_t p = size_t(chunk) * pairsPerChunk; p < last; ++p)
                     CollidePair(inContext, inIntegration, inContext.BodyAt(mPairs[p].mA),
                                 inContext.BodyAt(mPairs[p].mB), out);
             }
@@ -172,7 +173,9 @@ void ContactsStage::Merge(const StepContext& inContext)
     mConstraints.resize(firstConstraint + numManifolds);
     mConstraintInfo.resize(firstConstraint + numManifolds);
     inContext.mScheduler.ParallelFor(
-        numChunks, StepCosts::cMergeCopies.mGrain, StepCosts::cMergeCopies.mItemNanoseconds,
+        numChunks,
+        std::max(1u, inContext.mScheduler.GrainFor(mPairs.size(), StepCosts::cMergeCopies) / mPairsPerChunk),
+        mPairsPerChunk * StepCosts::cMergeCopies.mItemNanoseconds,
         [&](uint32_t inB, uint32_t inE)
         {
             for (uint32_t chunk = inB; chunk < inE; ++chunk)

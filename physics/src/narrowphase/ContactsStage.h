@@ -143,6 +143,7 @@ private:
     std::vector<PairChunk> mPairChunks;               ///< Scratch: per chunk of active bodies
     std::vector<NarrowPhaseChunk> mNarrowPhaseChunks; ///< Scratch: per chunk of pairs, of every round
     uint32_t mFirstChunk = 0;                         ///< The round's first chunk in mNarrowPhaseChunks
+    uint32_t mPairsPerChunk = 1; ///< The round's narrow-phase chunks (StepScheduler::GrainFor)
     uint32_t mNumChunksUsed = 0; ///< Narrow-phase chunks used by this step's rounds so far
 
     /// This step's contacts, in the narrow phase's chunks, and a record per entry. Grown by the merge on the

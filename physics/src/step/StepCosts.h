@@ -3,15 +3,17 @@
 // StepCosts: the step's loops, how they are cut and what an item of each costs, in one table. The costs are
 // estimates measured on step_pile2k on one thread (cairn-bench-step); StepScheduler::ParallelFor hands a loop
 // to sleeping workers only when its estimate is worth their waking. The grains keep each chunk's work well
-// above a hand-off's cost. A change of machine changes the figures, never the results: no cost or grain
-// reaches the arithmetic.
+// above a hand-off's cost on 2 threads; on more, StepScheduler::GrainFor cuts a loop finer (never coarser) so
+// that each thread has several chunks. A change of machine changes the figures, never the results: no cost or
+// grain reaches the arithmetic.
 
 #include <cstdint>
 
 namespace cairn::physics::StepCosts
 {
 
-/// A loop over items cut into chunks of mGrain, each item costing about mItemNanoseconds.
+/// A loop over items cut into chunks of at most mGrain (StepScheduler::GrainFor), each item costing about
+/// mItemNanoseconds.
 struct Loop
 {
     uint32_t mGrain;
@@ -24,12 +26,10 @@ inline constexpr Loop cVelocities{256, 30};
 inline constexpr Loop cPairs{64, 300};
 // The pairs' gathering and sort, serial, per pair: the narrow phase's loop follows
 inline constexpr uint32_t cPairSortNanoseconds = 10;
-// Narrow phase: chunks of cPairsPerChunk pairs, each pair about cPairNanoseconds (pile2k's boxes; a box on a
-// height field takes more)
-inline constexpr uint32_t cPairsPerChunk = 32;
-inline constexpr uint32_t cPairNanoseconds = 425;
-// The merge's copies, per chunk of the narrow phase
-inline constexpr Loop cMergeCopies{4, 1'200};
+// Narrow phase: a body pair's shapes collided (pile2k's boxes; a box on a height field takes more)
+inline constexpr Loop cNarrowPhase{32, 425};
+// The merge's copies, per pair; a task copies whole chunks of the narrow phase
+inline constexpr Loop cMergeCopies{128, 38};
 // The step's joints taken at its start: a joint's state and its bodies' (JointStage::BeginStep)
 inline constexpr Loop cJointsTaken{256, 30};
 // The joints' island links: a union per joint

@@ -7,6 +7,7 @@
 // by the step's jobs (the others; see each).
 
 #include "cairn/jobs/JobInterface.h"
+#include "step/StepCosts.h"
 
 #include <algorithm>
 #include <atomic>
@@ -24,11 +25,14 @@ public:
     /// The most threads RunStages gives a part each (a stage's claims are one bit per part).
     static constexpr uint32_t cMaxThreads = 64;
 
-    /// For one step: ioJobs (null: all on this thread) runs the parallel parts. The calling thread is the
-    /// updating thread, whose time in parallel regions is counted (GetParallelNanoseconds).
-    void BeginStep(jobs::JobInterface* ioJobs)
+    /// For one step: ioJobs (null: all on this thread) runs the parallel parts, and GrainFor cuts a loop
+    /// finer until each thread has inMinChunksPerThread chunks (PhysicsSettings::mMinChunksPerThread; 0:
+    /// every loop keeps its own grain). The calling thread is the updating thread, whose time in parallel
+    /// regions is counted (GetParallelNanoseconds).
+    void BeginStep(jobs::JobInterface* ioJobs, uint32_t inMinChunksPerThread = 0)
     {
         mJobs = ioJobs;
+        mMinChunksPerThread = inMinChunksPerThread;
         mUpdatingThread = std::this_thread::get_id();
         mRegionDepth = 0;
         mParallelNanoseconds = 0;
@@ -37,6 +41,29 @@ public:
     uint32_t GetNumThreads() const
     {
         return mJobs == nullptr ? 1 : std::min(cMaxThreads, mJobs->GetNumThreads());
+    }
+
+    /// The least estimated work GrainFor puts in a chunk: taking a chunk is an atomic add on a line that
+    /// every thread of the loop writes, a fraction of a microsecond when they contend for it
+    static constexpr uint64_t cMinChunkNanoseconds = 4'000;
+
+    /// The grain for a loop of inCount items of inLoop (StepCosts.h): its own, or finer where that leaves
+    /// fewer than mMinChunksPerThread chunks for each thread, down to chunks of cMinChunkNanoseconds of
+    /// estimated work. The threads take chunks as they come free, which evens out chunks of unequal cost
+    /// only when each thread has several to take: the grains were set on 2 threads, where a pile's loops
+    /// had that, and on 16 its costliest loops had one or two chunks a thread. A function of the count and
+    /// the thread count only, so a loop that is cut twice (counted, then filled) gets the same chunks both
+    /// times; no chunk reaches the arithmetic. Any thread.
+    uint32_t GrainFor(size_t inCount, StepCosts::Loop inLoop) const
+    {
+        const uint32_t threads = GetNumThreads();
+        if (threads <= 1 || mMinChunksPerThread == 0 || inLoop.mGrain <= 1)
+            return std::max(1u, inLoop.mGrain);
+        const uint64_t chunks = uint64_t(threads) * mMinChunksPerThread;
+        const uint64_t even = (inCount + chunks - 1) / chunks;
+        const uint64_t smallest =
+            (cMinChunkNanoseconds + inLoop.mItemNanoseconds - 1) / std::max(1u, inLoop.mItemNanoseconds);
+        return uint32_t(std::clamp<uint64_t>(std::max(even, smallest), 1, inLoop.mGrain));
     }
 
     /// inBody(begin, end) over [0, inCount) in chunks of inGrain: on the job system's threads, unless a
@@ -282,6 +309,7 @@ private:
     static void WaitABit(uint32_t inSpins);
 
     jobs::JobInterface* mJobs = nullptr; ///< During a step only
+    uint32_t mMinChunksPerThread = 0;    ///< See BeginStep
     /// The updating thread's bookkeeping of its parallel regions (ParallelRegion), touched by it alone: the
     /// loops are const to their callers, and this is not the scheduler's state but a measure of the step
     /// (a line apart from mJobs and mUpdatingThread, which every thread of a loop reads)

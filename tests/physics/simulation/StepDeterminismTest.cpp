@@ -54,9 +54,11 @@ void AddCounts(const StepStatistics& inStep, StepStatistics& ioSum)
 /// falling asleep, some woken by late arrivals), stepped 600 times.
 /// inJobs: null for none. outStatistics: the step statistics summed over the steps.
 std::vector<BodyState> RunPile(jobs::JobInterface* inJobs, bool inUpdateBesideStep = false,
-                               StepStatistics* outStatistics = nullptr)
+                               StepStatistics* outStatistics = nullptr,
+                               uint32_t inMinChunksPerThread = PhysicsSettings().mMinChunksPerThread)
 {
     PhysicsSettings physicsSettings;
+    physicsSettings.mMinChunksPerThread = inMinChunksPerThread;
     // The broad-phase rebuild beside the pair search on this small scene too (by default from 1,024 bodies)
     if (inUpdateBesideStep) physicsSettings.mUpdateBesideStepMinActiveBodies = 0;
     const std::unique_ptr<PhysicsSystem> system = MakePhysicsSystem(physicsSettings);
@@ -150,7 +152,7 @@ TEST(StepDeterminismTest, ThreadCountDoesNotChangeTheResult)
 
 /// The least a scheduler can be: a thread for every task and for every part of a loop but the caller's, each
 /// joined when done. Counts what the step asked of it.
-class ThreadPerTaskJobs final : public jobs::JobInterface
+class ThreadPerTaskJobs : public jobs::JobInterface
 {
 public:
     explicit ThreadPerTaskJobs(uint32_t inThreads) : mThreads(inThreads) {}
@@ -247,6 +249,40 @@ TEST(StepDeterminismTest, AnotherSchedulerThroughTheJobInterfaceGivesTheSameStat
         EXPECT_GT(jobs.GetNumLoopsOfAChunkPerThread(), 0u) << "colored islands solved by every thread";
         EXPECT_EQ(jobs.GetNumUnfinished(), 0u);
     }
+}
+
+/// Says it has inThreads threads, and runs each loop on the caller, its chunks from the last to the first
+/// (tasks each on a thread of their own, as ThreadPerTaskJobs): the step cuts its loops for that many threads
+/// (StepScheduler::GrainFor), and no chunk may depend on the chunks before it having run. Counts the chunks
+/// of loops over items in groups (a grain over 1: GrainFor's; the loops of a part per item, such as a stage's
+/// parts, do not change with it).
+class ClaimedThreadsJobs final : public ThreadPerTaskJobs
+{
+public:
+    using ThreadPerTaskJobs::ThreadPerTaskJobs;
+    void ParallelFor(uint32_t inCount, uint32_t inGrain, RangeFunction inFunction, void* inContext) override
+    {
+        const uint32_t grain = std::max(1u, inGrain);
+        const uint32_t chunks = (inCount + grain - 1) / grain;
+        if (grain > 1) mNumChunks += chunks;
+        for (uint32_t chunk = chunks; chunk-- > 0;)
+            inFunction(chunk * grain, std::min(inCount, chunk * grain + grain), inContext);
+    }
+    uint64_t GetNumChunks() const { return mNumChunks; }
+
+private:
+    uint64_t mNumChunks = 0; ///< The loops run on the updating thread alone
+};
+
+TEST(StepDeterminismTest, LoopsCutForManyThreadsGiveTheSameStates)
+{
+    const std::vector<BodyState> reference = RunPile(nullptr);
+    ClaimedThreadsJobs cut(16), whole(16);
+    ExpectIdentical(reference, RunPile(&cut), "loops cut for 16 threads vs no job system");
+    ExpectIdentical(reference, RunPile(&whole, false, nullptr, 0),
+                    "each loop's own grain on 16 threads vs no job system");
+    // The pile's 321 bodies make a few chunks a loop at the loops' own grains
+    EXPECT_GT(cut.GetNumChunks(), 3 * whole.GetNumChunks()) << "the loops were cut finer for 16 threads";
 }
 
 /// Steps of a world of inBodies falling boxes (none asleep) whose update goes beside the step from

@@ -1,7 +1,7 @@
 // StepScheduler's count of the updating thread's time in parallel regions (StepStatistics::mSerialMs is the
 // rest): which loops and stages count, that nested ones count once, and that other threads add nothing.
 // Work is a sleep, so that each region's length is known; the checks compare with the wall clock around the
-// regions, never with a figure.
+// regions, never with a figure. And how GrainFor cuts a loop for the thread count.
 
 #include "step/StepScheduler.h"
 
@@ -39,7 +39,80 @@ std::unique_ptr<jobs::JobSystem> TwoThreads()
     settings.mNumThreads = 2;
     return std::make_unique<jobs::JobSystem>(settings);
 }
+
+/// Says it has inThreads threads and runs everything on the caller: GrainFor reads only the thread count.
+class ClaimedThreads final : public jobs::JobInterface
+{
+public:
+    explicit ClaimedThreads(uint32_t inThreads) : mThreads(inThreads) {}
+    uint32_t GetNumThreads() const override { return mThreads; }
+    void ParallelFor(uint32_t inCount, uint32_t inGrain, RangeFunction inFunction, void* inContext) override
+    {
+        for (uint32_t begin = 0; begin < inCount; begin += inGrain)
+            inFunction(begin, std::min(inCount, begin + inGrain), inContext);
+    }
+    jobs::TaskHandle StartTask(const char*, TaskFunction inFunction, void* inContext) override
+    {
+        inFunction(inContext);
+        return {1};
+    }
+    void FinishTask(jobs::TaskHandle) override {}
+
+private:
+    const uint32_t mThreads;
+};
+
+/// inLoop's grain for inCount items on inThreads claimed threads, at least inMinChunksPerThread chunks each.
+uint32_t GrainOn(uint32_t inThreads, uint32_t inMinChunksPerThread, size_t inCount, StepCosts::Loop inLoop)
+{
+    ClaimedThreads jobs(inThreads);
+    StepScheduler scheduler;
+    scheduler.BeginStep(&jobs, inMinChunksPerThread);
+    return scheduler.GrainFor(inCount, inLoop);
+}
 } // namespace
+
+TEST(StepSchedulerTest, GrainIsTheLoopsOwnOnOneThreadOrWhenTurnedOff)
+{
+    constexpr StepCosts::Loop loop{64, 300};
+    StepScheduler scheduler;
+    scheduler.BeginStep(nullptr, 4);
+    EXPECT_EQ(scheduler.GrainFor(1000, loop), 64u) << "no job system";
+    EXPECT_EQ(GrainOn(1, 4, 1000, loop), 64u) << "one thread";
+    EXPECT_EQ(GrainOn(16, 0, 1000, loop), 64u) << "turned off";
+}
+
+TEST(StepSchedulerTest, GrainGivesEachThreadSeveralChunksWhereTheItemsAllow)
+{
+    // 1,000 bodies' pair walks (300 ns each) on 16 threads: 64 chunks wanted, 16 bodies each (63 chunks)
+    EXPECT_EQ(GrainOn(16, 4, 1000, {64, 300}), 16u);
+    // On 2 threads the loop's own 16 chunks are already more than 8
+    EXPECT_EQ(GrainOn(2, 4, 1000, {64, 300}), 64u);
+    // 1,000 cheap items (30 ns): no chunk under cMinChunkNanoseconds of work, so 134 a chunk (8 chunks)
+    EXPECT_EQ(GrainOn(16, 4, 1000, {256, 30}), 134u);
+    // Ten items stay one chunk, a loop of one thread
+    EXPECT_EQ(GrainOn(16, 4, 10, {256, 30}), 134u);
+}
+
+TEST(StepSchedulerTest, GrainIsNeverCoarserThanTheLoopsNorFinerThanTheLeastWork)
+{
+    for (const uint32_t threads : {2u, 3u, 8u, 16u, 64u})
+        for (const size_t count : {size_t(0), size_t(1), size_t(100), size_t(5'000), size_t(1'000'000)})
+            for (const StepCosts::Loop loop : {StepCosts::Loop{1, 5'000}, StepCosts::Loop{32, 425},
+                                               StepCosts::Loop{256, 30}, StepCosts::Loop{512, 7}})
+            {
+                const uint32_t grain = GrainOn(threads, 4, count, loop);
+                SCOPED_TRACE(testing::Message() << threads << " threads, " << count << " items of grain "
+                                                << loop.mGrain << " at " << loop.mItemNanoseconds << " ns");
+                EXPECT_GE(grain, 1u);
+                EXPECT_LE(grain, loop.mGrain);
+                if (grain < loop.mGrain)
+                {
+                    EXPECT_GE(uint64_t(grain) * loop.mItemNanoseconds, StepScheduler::cMinChunkNanoseconds);
+                }
+                EXPECT_LE(grain, GrainOn(threads / 2, 4, count, loop)) << "more threads, never coarser";
+            }
+}
 
 TEST(StepSchedulerTest, LoopOfSeveralChunksCountsAsParallelOnOneThread)
 {
