@@ -80,11 +80,6 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
         mContacts.Merge(context);
         begin = end;
     }
-    // The update is the step's: done before the step's moves reach the broad phase (the finish) and before
-    // the next step's Update, which a rebuild still running would refuse
-    ioStatistics.mBroadPhaseUpdateMs += update.Finish(); // Its own time: beside the narrow phase when a task
-    mLockWaitNanoseconds.fetch_add(update.GetLockWaitNanoseconds(),
-                                   std::memory_order_relaxed); // See StepContext
     uint64_t parallelBefore = 0;
     // The phase's time less what the updating thread spent in the phase's parallel regions
     auto serialPart = [&](double inPhaseMs)
@@ -134,6 +129,15 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
     ioStatistics.mNumSolveOrdersReused += mIslandStage.WasSolveOrderReused() ? 1 : 0;
     ioStatistics.mLargestIsland =
         std::max(ioStatistics.mLargestIsland, mIslandStage.GetLargestIslandSize(context));
+
+    // The update is the step's: done before the step's moves reach the broad phase (the finish) and before
+    // the next step's Update, which a rebuild still running would refuse. Nothing before needs it: the pairs
+    // and the linear casts are queries, exact in any state of the trees. Waited for here rather than after
+    // the narrow phase, so that with many threads, whose rounds may end before it, the islands and the solve
+    // run meanwhile instead of the updating thread waiting
+    ioStatistics.mBroadPhaseUpdateMs += update.Finish(); // Its own time, beside the step when a task
+    mLockWaitNanoseconds.fetch_add(update.GetLockWaitNanoseconds(),
+                                   std::memory_order_relaxed); // See StepContext
 
     // 8. Finish: bounds, broad-phase moves and published poses; then the resting islands sleep
     mFinish.Run(context);

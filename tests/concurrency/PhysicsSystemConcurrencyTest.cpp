@@ -1,6 +1,7 @@
 // The physics step (on one thread, or on a job system of 2 threads) while other threads query the world, move
 // and push bodies, and add and remove them: nothing crashes, no data race (this suite runs under
-// ThreadSanitizer), and a query never misses the static floor, whatever the step is doing.
+// ThreadSanitizer), and a query never misses the static floor, whatever the step is doing. And the step's own
+// linear casts, which run beside its broad-phase update.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
@@ -143,6 +144,43 @@ INSTANTIATE_TEST_SUITE_P(PhysicsSystemConcurrencyTest, PhysicsSystemStepThreads,
                              return inInfo.param == 0 ? std::string("NoJobSystem")
                                                       : std::to_string(inInfo.param) + "JobThreads";
                          });
+
+TEST(PhysicsSystemConcurrencyTest, LinearCastsBesideTheBroadPhaseUpdateStopEveryFastBody)
+{
+    // The update runs as a task until the step's finish, so the step's casts walk trees that another thread
+    // may be rebuilding: no data race, and no fast body through the wall
+    jobs::JobSystem jobSystem(jobs::JobSystem::Settings{2});
+    PhysicsSettings settings;
+    settings.mGravity = Vec3::Zero();
+    settings.mUpdateBesideStepMinActiveBodies = 0;
+    const std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem(settings);
+    BodyInterface& bodies = system->GetBodyInterface();
+    BodyCreationSettings wall;
+    wall.mShape = BoxShape::Create(Vec3(0.05f, 20.0f, 20.0f)).Value();
+    wall.mMotionType = MotionType::Static;
+    wall.mObjectLayer = Layers::cStatic;
+    ASSERT_TRUE(bodies.CreateAndAddBody(wall, Activation::DontActivate).IsOk());
+    std::vector<BodyID> fast;
+    for (int i = 0; i < 64; ++i)
+    {
+        BodyCreationSettings ball;
+        ball.mShape = SphereShape::Create(0.2f).Value();
+        ball.mPosition = Vec3(-1.0f - 0.5f * float(i % 4), float(i / 4 % 4) - 1.5f, float(i / 16) - 1.5f);
+        ball.mLinearVelocity = Vec3(150.0f + float(i), 0.0f, 0.0f);
+        ball.mLinearDamping = 0.0f;
+        ball.mMotionQuality = MotionQuality::LinearCast;
+        fast.push_back(bodies.CreateAndAddBody(ball, Activation::Activate).Value());
+    }
+    uint32_t movedBack = 0;
+    for (int update = 0; update < 20; ++update)
+    {
+        ASSERT_TRUE(system->Update(1.0f / 60.0f, 1, jobSystem).IsOk());
+        movedBack += system->GetLastStepStatistics().mNumLinearCastsMovedBack;
+        for (const BodyID& id : fast)
+            ASSERT_LT(bodies.GetPosition(id).Value().x(), 0.0f) << "through the wall after update " << update;
+    }
+    EXPECT_GE(movedBack, fast.size()) << "the casts stopped the balls";
+}
 
 TEST(PhysicsSystemConcurrencyTest, SecondConcurrentUpdateIsRefused)
 {

@@ -2,9 +2,9 @@
 
 // BroadPhaseUpdate: a step's broad-phase update. With a job interface of two or more threads, a broad phase
 // whose pair search may run during its update (BroadPhase::CanFindPairsDuringUpdate) and a scene large
-// enough, it runs as a task while the updating thread integrates velocities and finds pairs and contacts on
-// the tree as it stands (queries are exact in any state of the tree, so the pairs are the same); otherwise at
-// once, on this thread. The task is finished by Finish, or by the destructor when the step leaves early (an
+// enough, it runs as a task while the updating thread integrates velocities, finds pairs and contacts on the
+// tree as it stands (queries are exact in any state of the tree, so the pairs are the same), builds islands
+// and solves; otherwise at once, on this thread. The task is finished by Finish, or by the destructor when the step leaves early (an
 // exception): it must not outlive the step's frame. What the task throws is caught there (a task must not
 // throw) and rethrown by Finish.
 //

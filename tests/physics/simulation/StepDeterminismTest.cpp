@@ -184,20 +184,21 @@ public:
         std::lock_guard lock(mMutex);
         const uint64_t id = ++mNumTasks;
         ++mNumTasksNamed[inName];
-        mTasks.emplace(id, std::thread(inFunction, inContext));
+        mTasks.emplace(id, Task{std::thread(inFunction, inContext), GetNumLoopsOfAChunkPerThread()});
         return {id};
     }
     void FinishTask(jobs::TaskHandle inTask) override
     {
-        std::thread thread;
+        Task finished;
         {
             std::lock_guard lock(mMutex);
             const auto task = mTasks.find(inTask.mValue);
             ASSERT_NE(task, mTasks.end()) << "a task finished twice or never started";
-            thread = std::move(task->second);
+            finished = std::move(task->second);
             mTasks.erase(task);
+            mStagesBesideTasks += GetNumLoopsOfAChunkPerThread() - finished.mStagesBefore;
         }
-        thread.join();
+        finished.mThread.join();
     }
 
     uint64_t GetNumLoops() const { return mNumLoops.load(std::memory_order_relaxed); } // Relaxed: a count
@@ -223,15 +224,28 @@ public:
         std::lock_guard lock(mMutex);
         return mTasks.size();
     }
+    /// Loops of one chunk per thread (stages) that began between a task's start and its finish: the step's
+    /// solve, run while its broad-phase update was outstanding.
+    uint64_t GetNumStagesBesideTasks() const
+    {
+        std::lock_guard lock(mMutex);
+        return mStagesBesideTasks;
+    }
 
 private:
+    struct Task
+    {
+        std::thread mThread;
+        uint64_t mStagesBefore = 0; ///< GetNumLoopsOfAChunkPerThread at its start
+    };
     const uint32_t mThreads;
     std::atomic<uint64_t> mNumLoops{0};
     std::atomic<uint64_t> mNumLoopsOfAChunkPerThread{0};
-    mutable std::mutex mMutex;              ///< Guards mTasks and mNumTasks: any thread starts tasks
-    std::map<uint64_t, std::thread> mTasks; ///< Started, not yet finished
-    uint64_t mNumTasks = 0;                 ///< Started in all
+    mutable std::mutex mMutex;       ///< Guards mTasks, the counts below: any thread starts tasks
+    std::map<uint64_t, Task> mTasks; ///< Started, not yet finished
+    uint64_t mNumTasks = 0;          ///< Started in all
     std::map<std::string, uint64_t> mNumTasksNamed;
+    uint64_t mStagesBesideTasks = 0;
 };
 
 TEST(StepDeterminismTest, AnotherSchedulerThroughTheJobInterfaceGivesTheSameStates)
@@ -247,6 +261,8 @@ TEST(StepDeterminismTest, AnotherSchedulerThroughTheJobInterfaceGivesTheSameStat
         EXPECT_GT(jobs.GetNumLoops(), 600u) << "the step's loops went to the scheduler";
         EXPECT_EQ(jobs.GetNumTasks("broad-phase update"), 600u) << "a task beside every step";
         EXPECT_GT(jobs.GetNumLoopsOfAChunkPerThread(), 0u) << "colored islands solved by every thread";
+        // The step waits for its update only before the finish: the solve's stages run beside it
+        EXPECT_GT(jobs.GetNumStagesBesideTasks(), 0u) << "the update was waited for before the solve";
         EXPECT_EQ(jobs.GetNumUnfinished(), 0u);
     }
 }

@@ -26,9 +26,9 @@ struct StepStatistics
     /// one before, so that its solve order was taken over instead of sorted (mReuseColorings)
     uint32_t mNumSolveOrdersReused = 0;
     uint32_t mNumLinearCastsMovedBack = 0; ///< LinearCast bodies stopped short of what they would touch
-    /// The broad-phase update's own time. With a job system of two or more threads it runs beside the forces,
-    /// the pairs and the narrow phase (see PhysicsStep), so it overlaps mNarrowPhaseMs and the phases add up
-    /// to more than mTotalMs
+    /// The broad-phase update's own time. With a job system of two or more threads it may run beside the
+    /// forces, the pairs, the narrow phase, the islands, the solve and the linear casts (see PhysicsStep), so
+    /// it overlaps their times and the phases add up to more than mTotalMs
     double mBroadPhaseUpdateMs = 0.0;
     double mNarrowPhaseMs = 0.0; ///< Forces, pairs and the narrow phase, from the step's start (see above)
     double mIslandsMs = 0.0;
@@ -41,10 +41,11 @@ struct StepStatistics
     /// thread, so on one thread mSerialMs / mTotalMs is the step's serial (Amdahl) fraction; with more
     /// threads a growing share shows the phase that stops the scaling. Per phase (each a part of that phase's
     /// time above; the linear casts are serial whole), then the step's
-    double mNarrowPhaseSerialMs = 0.0; ///< Includes waiting for a broad-phase update that runs beside
+    double mNarrowPhaseSerialMs = 0.0;
     double mIslandsSerialMs = 0.0;
     double mSolveSerialMs = 0.0;
-    double mFinishSerialMs = 0.0;
+    double mFinishSerialMs = 0.0; ///< Includes waiting for a broad-phase update that runs beside
+
     double mSerialMs = 0.0;
     /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
     /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex
