@@ -193,6 +193,8 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     echo "step and as a share of the step, then by phase: what more threads cannot shorten. Amdahl: the speed-up"
     echo "that the 1-thread run's serial share s allows on t threads, 1 / (s + (1 - s) / t); a speed-up well"
     echo "below it lost its time in the parallel parts (waits, lines crossing between cores), not in serial code."
+    echo "The finish's serial part includes any wait for the broad-phase update, which runs beside the step until its"
+    echo "finish (on 16 threads from 69 active bodies; its own time is the step benchmark's broadphase-update figure)."
     echo
     echo "Parts joined / jobs: per step, the loop parts that workers took from the job system's loop board and the"
     echo "jobs run through its queue; few parts joined on many threads means the updating thread ran most loops alone."
