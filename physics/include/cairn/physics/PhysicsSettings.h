@@ -63,8 +63,9 @@ struct PhysicsSettings
     /// The step's loops over bodies, pairs and joints are cut so that each of the job system's threads has at
     /// least this many chunks to take, where the items allow (a chunk keeps a few microseconds of work): a
     /// thread that took a costly chunk then finds the others took the rest, instead of the loop waiting on
-    /// its one chunk. Each loop's own grain caps its chunks (on 2 threads most loops already have more). No
-    /// result depends on it. 0: every loop keeps its own grain whatever the thread count, for measuring
+    /// its one chunk. A chunk is never larger than the loop's own grain, so on 2 threads the costliest loops
+    /// are cut as before. No result depends on it. 0: every loop keeps its own grain whatever the thread
+    /// count, for measuring
     uint32_t mMinChunksPerThread = 4;
     /// Quad-tree broad phase: the pair search remembers the static bodies (those of trees that did not
     /// change) within this margin (m) of each active body and reuses them while the body stays inside it; 0
