@@ -65,16 +65,15 @@ void PhysicsStep::Run(float inDeltaTime, const CollisionStepInfo& inStep, StepSt
         const size_t end = active.size();
         const std::span<const uint32_t> round(active.data() + begin, end - begin);
         mIntegration.BeginRound(end);
-        mScheduler.ParallelFor(
-            uint32_t(round.size()), mScheduler.GrainFor(round.size(), StepCosts::cVelocities),
-            StepCosts::cVelocities.mItemNanoseconds,
-            [&](uint32_t inBegin, uint32_t inEnd)
-            {
-                const std::span<const uint32_t> bodies = round.subspan(inBegin, inEnd - inBegin);
-                mIntegration.IntegrateVelocities(context, bodies);
-                SweptBoxes::CoverThisStep(context, bodies);
-                mContinuous.Count(context, bodies);
-            });
+        mScheduler.ParallelFor(uint32_t(round.size()), StepCosts::cVelocities,
+                               [&](uint32_t inBegin, uint32_t inEnd)
+                               {
+                                   const std::span<const uint32_t> bodies =
+                                       round.subspan(inBegin, inEnd - inBegin);
+                                   mIntegration.IntegrateVelocities(context, bodies);
+                                   SweptBoxes::CoverThisStep(context, bodies);
+                                   mContinuous.Count(context, bodies);
+                               });
         mContacts.FindPairs(context, begin);
         mContacts.CollidePairs(context, mIntegration);
         mContacts.Merge(context);

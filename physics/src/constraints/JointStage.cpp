@@ -190,17 +190,15 @@ bool JointStage::TakeJointsOnAllThreads(std::vector<Joint>& ioJoints)
 void JointStage::LinkIslands(const StepContext& inContext)
 {
     // The union-find takes links from any thread, in any order, with the same islands
-    inContext.mScheduler.ParallelFor(
-        uint32_t(mStepJoints.size()),
-        inContext.mScheduler.GrainFor(mStepJoints.size(), StepCosts::cJointLinks),
-        StepCosts::cJointLinks.mItemNanoseconds,
-        [&](uint32_t inBegin, uint32_t inEnd)
-        {
-            for (uint32_t i = inBegin; i < inEnd; ++i)
-                if (const StepJoint& joint = mStepJoints[i];
-                    IsActiveDynamic(joint.mA) && IsActiveDynamic(joint.mB))
-                    inContext.mIslands.Union(joint.mA->GetActiveIndex(), joint.mB->GetActiveIndex());
-        });
+    inContext.mScheduler.ParallelFor(uint32_t(mStepJoints.size()), StepCosts::cJointLinks,
+                                     [&](uint32_t inBegin, uint32_t inEnd)
+                                     {
+                                         for (uint32_t i = inBegin; i < inEnd; ++i)
+                                             if (const StepJoint& joint = mStepJoints[i];
+                                                 IsActiveDynamic(joint.mA) && IsActiveDynamic(joint.mB))
+                                                 inContext.mIslands.Union(joint.mA->GetActiveIndex(),
+                                                                          joint.mB->GetActiveIndex());
+                                     });
 }
 
 void JointStage::GroupByIsland(const StepContext& inContext)

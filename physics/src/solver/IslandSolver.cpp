@@ -32,8 +32,7 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
     // A kinematic body moves by its velocity alone: integrated here, while its lines are at hand, in the loop
     // that reads every active body anyway (a serial pass over them cost every step a miss per body). Nothing
     // before the islands' solve reads a pose
-    scheduler.ParallelFor(numActive, scheduler.GrainFor(numActive, StepCosts::cLoadSolverBodies),
-                          StepCosts::cLoadSolverBodies.mItemNanoseconds,
+    scheduler.ParallelFor(numActive, StepCosts::cLoadSolverBodies,
                           [&](uint32_t inBegin, uint32_t inEnd)
                           {
                               for (uint32_t i = inBegin; i < inEnd; ++i)
@@ -108,16 +107,14 @@ void IslandSolver::Solve(const StepContext& inContext, SolvePlan& ioPlan, uint32
         });
     // A body with nothing to solve keeps the velocity its forces gave it. One chunk per island made the
     // threads fight over the chunk cursor when thousands of bodies fall freely
-    scheduler.ParallelFor(
-        uint32_t(mPlan->mUnconstrainedBodies.size()),
-        scheduler.GrainFor(mPlan->mUnconstrainedBodies.size(), StepCosts::cUnconstrainedBodies),
-        StepCosts::cUnconstrainedBodies.mItemNanoseconds,
-        [&](uint32_t inBegin, uint32_t inEnd)
-        {
-            for (uint32_t i = inBegin; i < inEnd; ++i)
-                if (Body& body = mContext->BodyAt(active[mPlan->mUnconstrainedBodies[i]]); body.IsDynamic())
-                    Integration::IntegratePositions(body, mContext->mDeltaTime);
-        });
+    scheduler.ParallelFor(uint32_t(mPlan->mUnconstrainedBodies.size()), StepCosts::cUnconstrainedBodies,
+                          [&](uint32_t inBegin, uint32_t inEnd)
+                          {
+                              for (uint32_t i = inBegin; i < inEnd; ++i)
+                                  if (Body& body = mContext->BodyAt(active[mPlan->mUnconstrainedBodies[i]]);
+                                      body.IsDynamic())
+                                      Integration::IntegratePositions(body, mContext->mDeltaTime);
+                          });
 }
 
 void IslandSolver::LoadSolverBody(const Body& inBody, SolverBody& outBlock)

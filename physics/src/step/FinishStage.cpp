@@ -26,8 +26,7 @@ void FinishStage::Run(const StepContext& inContext)
     PublishedPoseStore& poses = inContext.mPoses;
     mPublishOrders.resize(active.size());
     inContext.mScheduler.ParallelFor(
-        uint32_t(active.size()), inContext.mScheduler.GrainFor(active.size(), StepCosts::cFinish),
-        StepCosts::cFinish.mItemNanoseconds,
+        uint32_t(active.size()), StepCosts::cFinish,
         [&](uint32_t inBegin, uint32_t inEnd)
         {
             // The broad phase must hold a body's published bounds at every moment (PublishedPose.h).

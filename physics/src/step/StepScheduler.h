@@ -66,6 +66,11 @@ public:
         return uint32_t(std::clamp<uint64_t>(std::max(even, smallest), 1, inLoop.mGrain));
     }
 
+    /// ParallelFor over inCount items of inLoop, cut by GrainFor.
+    template <class Body> void ParallelFor(uint32_t inCount, StepCosts::Loop inLoop, const Body& inBody) const
+    {
+        ParallelFor(inCount, GrainFor(inCount, inLoop), inLoop.mItemNanoseconds, inBody);
+    }
     /// inBody(begin, end) over [0, inCount) in chunks of inGrain: on the job system's threads, unless a
     /// worker sleeps and the items' estimated cost (inItemNanoseconds each, StepCosts.h) is under
     /// cMinWakingNanoseconds; else here. Any thread.
