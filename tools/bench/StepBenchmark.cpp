@@ -298,8 +298,7 @@ int main(int inArgc, char** inArgv)
     const char* buildType = "Debug (figures not representative)";
 #endif
     std::printf("cairn-bench-step: build %s, %d repetitions%s, update beside from %u active bodies a helper, "
-                "at least "
-                "%u chunks a thread; %s; core-to-core round trip %.0f ns\n",
+                "at least %u chunks a thread; %s; core-to-core round trip %.0f ns\n",
                 buildType, repetitions, gQueuedLoops ? ", queued loops" : "", gUpdateBesideFrom,
                 gMinChunksPerThread, tools::DescribeMachine().c_str(),
                 tools::MeasureCoreToCoreRoundTripNanoseconds());

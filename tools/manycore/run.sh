@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
 # run-all.sh): step scaling (at the top thread count also with the loop board off, with each loop's own grain,
-# and pile2k with the broad-phase update's old flat bar), union-find, the step's stages and loops, contended broad-phase queries and
-# the demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
+# and pile2k with the broad-phase update's old flat bar), union-find, the step's stages and loops, contended
+# broad-phase queries and the demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
 # bash, awk, grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
 #        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,

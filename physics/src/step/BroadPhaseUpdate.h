@@ -4,9 +4,9 @@
 // whose pair search may run during its update (BroadPhase::CanFindPairsDuringUpdate) and a scene large
 // enough, it runs as a task while the updating thread integrates velocities, finds pairs and contacts on the
 // tree as it stands (queries are exact in any state of the tree, so the pairs are the same), builds islands
-// and solves; otherwise at once, on this thread. The task is finished by Finish, or by the destructor when the step leaves early (an
-// exception): it must not outlive the step's frame. What the task throws is caught there (a task must not
-// throw) and rethrown by Finish.
+// and solves; otherwise at once, on this thread. The task is finished by Finish, or by the destructor when
+// the step leaves early (an exception): it must not outlive the step's frame. What the task throws is caught
+// there (a task must not throw) and rethrown by Finish.
 //
 // Threads: the updating thread, but for the task's body; the task writes mMilliseconds, mLockWaitNanoseconds
 // and mError, read after FinishTask (which orders them).

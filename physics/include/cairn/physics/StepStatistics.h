@@ -45,7 +45,6 @@ struct StepStatistics
     double mIslandsSerialMs = 0.0;
     double mSolveSerialMs = 0.0;
     double mFinishSerialMs = 0.0; ///< Includes waiting for a broad-phase update that runs beside
-
     double mSerialMs = 0.0;
     /// Time the update's threads spent blocked on the engine's locks (LockWaits): taking every body mutex at
     /// the start, the broad-phase update's rebuild commit, and with the global-mutex broad phase its mutex
