@@ -15,8 +15,12 @@ fail() {
 shared="${CAIRN_SHARED_DIR:-$repository/../shared}/bench"
 [ -f "$shared/SPEC.md" ] || { echo "SKIP: no $shared"; exit 77; }
 rm -rf "$work" && mkdir -p "$work/empty" || exit 2
-CAIRN_BUNDLE_NO_BUILD=1 CAIRN_BUNDLE_BUILD="$build" bash "$repository/tools/manycore/bundle.sh" "$work/bundle" \
-    >"$work/bundle.log" 2>&1 || fail "bundle.sh failed: $(cat "$work/bundle.log")"
+# A program from outside the build rides along as the Jolt harness will (CAIRN_BUNDLE_EXTRA): any dynamically
+# linked one does
+extra=$(type -P true) || fail "no true(1) to bundle as an outside program"
+CAIRN_BUNDLE_NO_BUILD=1 CAIRN_BUNDLE_BUILD="$build" CAIRN_BUNDLE_EXTRA="$extra" \
+    bash "$repository/tools/manycore/bundle.sh" "$work/bundle" >"$work/bundle.log" 2>&1 ||
+    fail "bundle.sh failed: $(cat "$work/bundle.log")"
 cp -r "$work/bundle" "$work/empty/bundle"
 copy="$work/empty/bundle"
 cd "$work/empty" || exit 2
@@ -32,5 +36,7 @@ done
 output=$(env -i "$copy/run" cairn-bench-unionfind --benchmark_min_time=0.01 --benchmark_filter='uf_union/0/1' 2>&1) ||
     fail "the bundled union-find benchmark failed: $output"
 echo "$output" | grep -q "ns_per_union=" || fail "no figures from the bundled benchmark: $output"
+[ -x "$copy/bin/true" ] || fail "the outside program (CAIRN_BUNDLE_EXTRA=$extra) is not in the bundle"
+output=$(env -i "$copy/run" true 2>&1) || fail "the bundled outside program failed: $output"
 echo "many-core bundle: $(tail -1 "$work/bundle.log")"
 echo "many-core bundle: all checks passed"

@@ -5,6 +5,8 @@
 # Usage: bash tools/manycore/bundle.sh [OUT]          (default OUT: build/manycore-bundle, ignored by git)
 #   CAIRN_BUNDLE_BUILD=<folder>  the Release build to take the programs from (default build/release)
 #   CAIRN_BUNDLE_NO_BUILD=1      do not build them first (the ctest case, which runs after the build)
+#   CAIRN_BUNDLE_EXTRA="<path>..." programs built outside the repository to bundle too, with their libraries:
+#                                issue 29's Jolt harness (jolt-bench-step, which run.sh runs when the bundle has it)
 # Then, on the machine: bash OUT/run-all.sh RESULTS_FOLDER   (or OUT/run PROGRAM ARGS... for one program)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
@@ -20,10 +22,15 @@ fi
 shared="${CAIRN_SHARED_DIR:-$root/../shared}/bench"
 [ -f "$shared/SPEC.md" ] || { echo "bundle.sh: $shared (the shared workload) is missing" >&2; exit 1; }
 
+extras=()
+for extra in ${CAIRN_BUNDLE_EXTRA:-}; do
+    [ -x "$extra" ] || { echo "bundle.sh: $extra (CAIRN_BUNDLE_EXTRA) is not an executable" >&2; exit 1; }
+    extras+=("$extra")
+done
+
 rm -rf "$out"
 mkdir -p "$out/bin" "$out/lib" "$out/shared"
-for program in "${programs[@]}"; do
-    binary="$build/tools/$program"
+for binary in "${programs[@]/#/$build/tools/}" "${extras[@]}"; do
     [ -x "$binary" ] || { echo "bundle.sh: $binary is not built" >&2; exit 1; }
     cp "$binary" "$out/bin/"
     # Every library the loader resolves ("name => path"), and the loader itself (a path alone)
@@ -58,4 +65,4 @@ if [ "$size" -gt "$limit" ]; then
     echo "bundle.sh: $out is $size bytes, over the 64 MiB a run may carry" >&2
     exit 1
 fi
-echo "bundle: $out, $((size / 1024)) KiB: ${programs[*]}; $(ls "$out/lib" | wc -l) libraries"
+echo "bundle: $out, $((size / 1024)) KiB: ${programs[*]} ${extras[*]##*/}; $(ls "$out/lib" | wc -l) libraries"

@@ -2,11 +2,13 @@
 # The 16-core run (issue 29), from the bundle only (tools/manycore/bundle.sh copies this script into it as
 # run-all.sh): step scaling (at the top thread count also with the loop board off, with each loop's own grain,
 # and pile2k with the broad-phase update's old flat bar), union-find, the step's stages and loops, contended
-# broad-phase queries and the demo, with CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
+# broad-phase queries, the demo and, where the bundle has Jolt's harness, Jolt's step beside Cairn's, with
+# CSVs, a scaling chart and a Markdown summary written to RESULTS, the summary printed last. Needs
 # bash, awk, grep, sed and /proc (no packages); pins nothing and changes no machine setting.
 # Usage: bash run-all.sh RESULTS     (in the bundle; from the repository: CAIRN_BUNDLE=<bundle> bash
 #        tools/manycore/run.sh RESULTS). CAIRN_RUN_THREADS / CAIRN_RUN_QUERY_THREADS override the sweeps,
-#        CAIRN_RUN_DEMO_FRAMES the demo's frames per mode (0: no demo).
+#        CAIRN_RUN_DEMO_FRAMES the demo's frames per mode (0: no demo), CAIRN_RUN_JOLT_UNTIL the seconds
+#        after which the Jolt harness is skipped.
 set -uo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 bundle=${CAIRN_BUNDLE:-$here}
@@ -154,6 +156,34 @@ if [ "$demoFrames" -gt 0 ]; then
         --output "$out/demo" >"$out/demo.txt" 2>&1 || echo "run.sh: the demo exited with an error" >&2
 fi
 
+# Jolt side by side: the same two scenes stepped by Jolt, through a harness of our own on its public API that
+# is built outside the repository with Jolt and bundled with CAIRN_BUNDLE_EXTRA (jolt-bench-step prints
+# cairn-bench-step's line format). Only when the bundle has it, and last, while the run has time left for it
+# (CAIRN_RUN_JOLT_UNTIL seconds since the start, default 420): Cairn's own figures come first
+joltUntil=${CAIRN_RUN_JOLT_UNTIL:-420}
+if [ -x "$bundle/bin/jolt-bench-step" ]; then
+    if [ "$SECONDS" -lt "$joltUntil" ]; then
+        echo "== Jolt: step_pile2k and step_pyramid on $threads threads (jolt-bench-step)"
+        "$bundle/run" jolt-bench-step --threads "$threads" --repetitions 3 >"$out/jolt_step.txt" 2>&1 ||
+            echo "run.sh: the Jolt harness failed" >&2
+        # Per scene and thread count: the median of the runs' mean and p99 ms, the speed-up over Jolt's own 1
+        # thread, and the first run's checksum
+        echo "scene,threads,mean_ms,p99_ms,speedup,checksum" >"$out/jolt_step.csv"
+        awk '
+            function median(list,   n, v, i, j, t) { n = split(list, v, " ")
+                for (i = 2; i <= n; ++i) for (j = i; j > 1 && v[j - 1] + 0 > v[j] + 0; --j) { t = v[j]; v[j] = v[j - 1]; v[j - 1] = t }
+                return n == 0 ? 0 : (n % 2 ? v[(n + 1) / 2] : (v[n / 2] + v[n / 2 + 1]) / 2) }
+            / rep [0-9]+: / { t = $2; sub(/threads=/, "", t); key = $1 "," t; if (!(key in seen)) { seen[key] = 1; order[++n] = key }
+                for (i = 1; i <= NF; ++i) { if ($i == "mean") means[key] = means[key] " " $(i + 1); if ($i == "p99") p99s[key] = p99s[key] " " $(i + 1)
+                    if ($i == "heights" && !(key in checksum)) checksum[key] = $(i + 1) } }
+            END { for (k = 1; k <= n; ++k) { split(order[k], p, ","); m = median(means[order[k]]); if (p[2] == 1) base[p[1]] = m
+                printf "%s,%.3f,%.3f,%.2f,%s\n", order[k], m, median(p99s[order[k]]), (p[1] in base && m > 0) ? base[p[1]] / m : 0, checksum[order[k]] } }
+        ' "$out/jolt_step.txt" >>"$out/jolt_step.csv"
+    else
+        echo "run.sh: no time left for the Jolt harness ($SECONDS s gone; CAIRN_RUN_JOLT_UNTIL is $joltUntil)" >&2
+    fi
+fi
+
 # The scaling chart: speed-up over 1 thread against threads, per scene, with the ideal line
 awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
     NR > 1 { scene[$1] = 1; x[$1, $2] = $2; y[$1, $2] = $5; ts[$2] = 1; if ($5 > top) top = $5 }
@@ -258,6 +288,19 @@ awk -F, -v maxT="$(echo "$threads" | tr ',' '\n' | sort -n | tail -1)" '
         echo '```'
         grep -iE "lock|query|wait|per thread|frame" "$out/demo.txt" | tail -30
         echo '```'
+    fi
+    if [ -s "$out/jolt_step.csv" ]; then
+        echo
+        echo "## Jolt side by side (jolt-bench-step on this machine, medians of 3; Cairn's columns from the step table)"
+        echo
+        grep -m1 "^jolt-bench-step:" "$out/jolt_step.txt" || true
+        echo
+        echo "| scene | threads | Cairn mean ms | Jolt mean ms | Cairn / Jolt | Cairn speed-up | Jolt speed-up | Jolt p99 ms | Jolt checksum |"
+        echo "|---|---|---|---|---|---|---|---|---|"
+        awk -F, 'FNR == 1 { file++; next } file == 1 { cairn[$1 "," $2] = $3; up[$1 "," $2] = $5; next }
+            { k = $1 "," $2; c = (k in cairn) ? cairn[k] : ""
+              printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, c, $3, (c != "" && $3 > 0) ? sprintf("%.2f", c / $3) : "-",
+                  (k in up) ? up[k] : "-", $5, $4, $6 }' "$out/step.csv" "$out/jolt_step.csv"
     fi
 } >"$out/summary.md"
 cat "$out/summary.md"
