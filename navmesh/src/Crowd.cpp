@@ -393,7 +393,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             auto search = [&]
             {
                 const Clock::time_point searchStart = Clock::now();
-                mPaths->UpdateWithin(inNavMesh);
+                (void)mPaths->UpdateWithin(inNavMesh); // The crowd's own queue, on its world: never refused
                 searchMs = since(searchStart);
             };
             auto move = [&](uint32_t inBegin, uint32_t inEnd)

@@ -66,12 +66,16 @@ Result<PathTicket> PathRequestQueue::Request(const Vec3& inStart, const Vec3& in
 int PathRequestQueue::Update()
 {
     int finished = 0;
-    mWorld.Read([&](const dtNavMesh& inNavMesh) { finished = UpdateWithin(inNavMesh); });
+    mWorld.Read([&](const dtNavMesh& inNavMesh) { finished = UpdateWithin(inNavMesh).Value(); });
     return finished;
 }
 
-int PathRequestQueue::UpdateWithin(const dtNavMesh& inNavMesh)
+Result<int> PathRequestQueue::UpdateWithin(const dtNavMesh& inNavMesh)
 {
+    // The queue's polygon references are its own world's: another world's navmesh would be read through them
+    if (&inNavMesh != mQuery->getAttachedNavMesh())
+        return MakeError(ErrorCode::InvalidArgument,
+                         "PathRequestQueue::UpdateWithin: the navmesh is not the queue's world's");
     const int finished = Search(inNavMesh);
     const std::lock_guard lock(mMutex);
     ++mStatistics.mUpdates;
@@ -127,10 +131,10 @@ int PathRequestQueue::Search(const dtNavMesh& inNavMesh)
             if (mStartRef == 0 || mEndRef == 0)
             {
                 const std::lock_guard lock(mMutex);
-                FinishActiveLocked(MakeError(ErrorCode::InvalidArgument,
-                                             mStartRef == 0 ? "path request: the start is not on the navmesh"
-                                                            : "path request: the end is not on the navmesh"));
-                ++finished;
+                finished += FinishActiveLocked(
+                    MakeError(ErrorCode::InvalidArgument,
+                              mStartRef == 0 ? "path request: the start is not on the navmesh"
+                                             : "path request: the end is not on the navmesh"));
                 continue;
             }
             mQuery->initSlicedFindPath(dtPolyRef(mStartRef), dtPolyRef(mEndRef), mStartPoint, mEndPoint,
@@ -161,17 +165,24 @@ int PathRequestQueue::Search(const dtNavMesh& inNavMesh)
             mSearchStarted = false;
             continue;
         }
-        FinishActiveLocked(
+        finished += FinishActiveLocked(
             found ? FinishPath(*mQuery, inNavMesh, corridor, numPolygons, dtPolyRef(mEndRef), mStartPoint,
                                mEndPoint, request.mFilter)
                   : Result<PathResult>(MakeError(ErrorCode::InvalidArgument, "path request: no path")));
-        ++finished;
     }
     return finished;
 }
 
-void PathRequestQueue::FinishActiveLocked(Result<PathResult>&& inResult)
+bool PathRequestQueue::FinishActiveLocked(Result<PathResult>&& inResult)
 {
+    // Cancelled during its last slice, which runs without the mutex: Cancel has counted it already, and its
+    // caller must not find a result for it
+    if (mCancelledActive == mActive->mTicket.mValue)
+    {
+        mCancelledActive = 0;
+        mActive.reset();
+        return false;
+    }
     const uint64_t wait = mStatistics.mUpdates - mActive->mRequestedAtUpdate;
     mStatistics.mWaitUpdatesSum += wait;
     mStatistics.mWaitUpdatesMax = std::max(mStatistics.mWaitUpdatesMax, wait);
@@ -180,6 +191,7 @@ void PathRequestQueue::FinishActiveLocked(Result<PathResult>&& inResult)
     --mStatistics.mPending;
     mFinished.emplace(mActive->mTicket.mValue, std::move(inResult));
     mActive.reset();
+    return true;
 }
 
 std::optional<Result<PathResult>> PathRequestQueue::TakeResult(PathTicket inTicket)

@@ -6,9 +6,15 @@
 
 #include "NavMeshSceneFixture.h"
 #include "TileChanges.h"
+#include "cairn/navmesh/TileBuilder.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <optional>
 #include <random>
+#include <thread>
 
 namespace cairn::navmesh::test
 {
@@ -210,6 +216,114 @@ TEST_F(PathRequestQueueTest, CancelTakeAndBadRequests)
               ErrorCode::InvalidArgument);
     settings.mIterationsPerUpdate = 0;
     EXPECT_FALSE(PathRequestQueue::Create(*mWorld, settings));
+}
+
+// UpdateWithin searches with the queue's own polygon references: handed another world's navmesh (a caller
+// inside the wrong world's Read) it refuses and searches nothing, and the request is served later as usual
+TEST_F(PathRequestQueueTest, UpdateWithinAnotherWorldsNavMeshIsRefused)
+{
+    BuildMaze();
+    std::unique_ptr<PathRequestQueue> queue = PathRequestQueue::Create(*mWorld).Value();
+    const PathTicket ticket = queue->Request(Vec3(-20, 0, -20), Vec3(20, 0, 20)).Value();
+    const std::unique_ptr<NavMeshWorld> other =
+        NavMeshWorld::Create(mWorld->GetGrid(), mWorld->GetProfile()).Value();
+    std::optional<Result<int>> refused;
+    other->Read([&](const dtNavMesh& inNavMesh) { refused = queue->UpdateWithin(inNavMesh); });
+    ASSERT_TRUE(refused.has_value());
+    ASSERT_FALSE(*refused);
+    EXPECT_EQ(refused->GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_TRUE(queue->IsPending(ticket));
+    EXPECT_EQ(queue->GetStatistics().mIterations, 0u);
+    std::vector<Result<PathResult>> results;
+    ServeAll(*queue, {ticket}, results);
+    EXPECT_TRUE(results[0]);
+}
+
+/// A navmesh of inTiles x inTiles tiles of flat ground (from the origin) with a 0.6 m pillar every 3 m, built
+/// straight from triangles: a path across it takes Detour thousands of iterations, the maze's a few dozen.
+std::unique_ptr<NavMeshWorld> MakePillarField(int inTiles)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -5, 20);
+    std::unique_ptr<NavMeshWorld> world = NavMeshWorld::Create(grid, profile).Value();
+    auto quad =
+        [](TileGeometry& ioGeometry, const Vec3& inA, const Vec3& inB, const Vec3& inC, const Vec3& inD)
+    {
+        ioGeometry.AddTriangle(inA, inB, inC, cDefaultArea);
+        ioGeometry.AddTriangle(inA, inC, inD, cDefaultArea);
+    };
+    std::vector<BuiltTile> tiles;
+    for (int z = 0; z < inTiles; ++z)
+        for (int x = 0; x < inTiles; ++x)
+        {
+            TileGeometry geometry;
+            const AABB bounds = grid.GetTileBoundsWithBorder({x, z}, 2.0f);
+            const float x0 = bounds.mMin.x(), x1 = bounds.mMax.x(), z0 = bounds.mMin.z(),
+                        z1 = bounds.mMax.z();
+            quad(geometry, Vec3(x0, 0, z0), Vec3(x0, 0, z1), Vec3(x1, 0, z1), Vec3(x1, 0, z0));
+            // Only a pillar's top, 1.2 m up (under the agent's headroom, over its climb): the ground under it
+            // is unwalkable, and the top too small to stand on
+            for (float px = 3.0f * std::ceil(x0 / 3.0f); px <= x1; px += 3.0f)
+                for (float pz = 3.0f * std::ceil(z0 / 3.0f); pz <= z1; pz += 3.0f)
+                    quad(geometry, Vec3(px - 0.3f, 1.2f, pz - 0.3f), Vec3(px - 0.3f, 1.2f, pz + 0.3f),
+                         Vec3(px + 0.3f, 1.2f, pz + 0.3f), Vec3(px + 0.3f, 1.2f, pz - 0.3f));
+            tiles.push_back(BuildTile(profile, grid, {x, z}, geometry).Value());
+        }
+    world->Publish(std::move(tiles));
+    return world;
+}
+
+// Cancel (any thread) lands while Update searches the request, often during its last slice, which runs
+// without the queue's mutex: a cancelled request leaves no result and the pending count never goes negative
+// (it once did: the request was counted as cancelled and as finished, and the queue then held one more
+// request than mMaxPending each time)
+TEST(PathRequestQueueCancelTest, CancelWhileSearchedLeavesNoResult)
+{
+    const std::unique_ptr<NavMeshWorld> world = MakePillarField(8);
+    PathRequestQueue::Settings settings;
+    settings.mIterationsPerUpdate = 1000000; // Each search in one Update: its last slice is all of it
+    std::unique_ptr<PathRequestQueue> queue = PathRequestQueue::Create(*world, settings).Value();
+    int cancelledWhileSearched = 0;
+    for (int trial = 0; trial < 300; ++trial)
+    {
+        // Corner to corner between the pillars, which needs thousands of iterations
+        const PathTicket ticket = queue->Request(Vec3(1.5f, 0, 1.5f), Vec3(100.5f, 0, 100.5f)).Value();
+        const uint64_t iterationsBefore = queue->GetStatistics().mIterations;
+        std::atomic<bool> updating{false};
+        bool cancelled = false;
+        std::thread canceller(
+            [&]
+            {
+                while (!updating.load(std::memory_order_acquire)) // Acquire: pairs with the store below
+                    std::this_thread::yield();
+                // Spread over the search: from at once to some way in
+                const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(trial % 60);
+                while (std::chrono::steady_clock::now() < until)
+                {
+                }
+                cancelled = queue->Cancel(ticket);
+            });
+        updating.store(true, std::memory_order_release); // Release: the ticket is queued before
+        queue->Update();
+        canceller.join();
+        const std::optional<Result<PathResult>> result = queue->TakeResult(ticket);
+        const PathRequestQueue::Statistics stats = queue->GetStatistics();
+        if (cancelled)
+        {
+            EXPECT_FALSE(result.has_value()) << "trial " << trial << ": a result for a cancelled request";
+            // Cancelled once the search had begun (it counted iterations), not while the request waited
+            cancelledWhileSearched += stats.mIterations > iterationsBefore ? 1 : 0;
+        }
+        else
+            EXPECT_TRUE(result.has_value()) << "trial " << trial << ": finished but no result";
+        // Each request ended once: finished, cancelled, or both (cancelled after it finished, which drops
+        // its result)
+        ASSERT_EQ(stats.mPending, 0) << "trial " << trial;
+        ASSERT_GE(stats.mServed + stats.mFailed + stats.mCancelled, stats.mRequested) << "trial " << trial;
+        ASSERT_LE(stats.mServed + stats.mFailed, stats.mRequested) << "trial " << trial;
+        if (HasFailure()) break;
+    }
+    EXPECT_GT(cancelledWhileSearched, 0) << "no Cancel landed: the test tested nothing";
 }
 
 } // namespace

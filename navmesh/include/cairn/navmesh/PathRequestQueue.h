@@ -86,8 +86,9 @@ public:
     int Update();
     /// Update for a caller that already reads the queue's world (inside its NavMeshWorld::Read, inNavMesh
     /// the navmesh it was handed), on any thread while that Read lasts: a crowd searches on a job thread
-    /// beside its steering that way.
-    int UpdateWithin(const dtNavMesh& inNavMesh);
+    /// beside its steering that way. Returns how many finished; an InvalidArgument error, searching nothing,
+    /// for another world's navmesh.
+    Result<int> UpdateWithin(const dtNavMesh& inNavMesh);
     /// A finished request's result, taken out (the ticket is forgotten); nothing while the request waits or
     /// is searched, nor for a ticket the queue does not know (never given, cancelled, or taken).
     std::optional<Result<PathResult>> TakeResult(PathTicket inTicket);
@@ -113,8 +114,9 @@ private:
     PathRequestQueue(const NavMeshWorld& inWorld, const Settings& inSettings);
     /// The search's part of an Update (under the navmesh's shared lock); returns how many finished.
     int Search(const dtNavMesh& inNavMesh);
-    /// Ends the active request with inResult (under mMutex).
-    void FinishActiveLocked(Result<PathResult>&& inResult);
+    /// Ends the active request with inResult (under mMutex); false, storing nothing, when Cancel dropped it
+    /// while it was searched.
+    bool FinishActiveLocked(Result<PathResult>&& inResult);
 
     const NavMeshWorld& mWorld;
     const Settings mSettings;
