@@ -2,23 +2,51 @@
 
 #include "cairn/navmesh/LevelMesh.h"
 
+#include <algorithm>
+#include <string>
 #include <unordered_map>
 
 namespace cairn::navmesh
 {
 using namespace cairn::physics;
 
-IndexedMesh IndexedMesh::ExtractTriangles(std::span<const uint32_t> inTriangles) const
+Status IndexedMesh::Validate() const
+{
+    for (size_t t = 0; t < mTriangles.size(); ++t)
+        for (const uint32_t vertex : mTriangles[t])
+            if (vertex >= mVertices.size())
+                return MakeError(ErrorCode::InvalidArgument, "level mesh: triangle " + std::to_string(t) +
+                                                                 " uses vertex " + std::to_string(vertex) +
+                                                                 " of " + std::to_string(mVertices.size()));
+    for (const MeshObject& object : mObjects)
+        // In 64 bits: a first triangle and a count near 2^32 must not wrap into range
+        if (uint64_t(object.mFirstTriangle) + object.mNumTriangles > mTriangles.size())
+            return MakeError(ErrorCode::InvalidArgument,
+                             "level mesh: object '" + object.mName + "' has triangles " +
+                                 std::to_string(object.mFirstTriangle) + " to " +
+                                 std::to_string(uint64_t(object.mFirstTriangle) + object.mNumTriangles) +
+                                 " of " + std::to_string(mTriangles.size()));
+    return Status::Ok();
+}
+
+Result<IndexedMesh> IndexedMesh::ExtractTriangles(std::span<const uint32_t> inTriangles) const
 {
     IndexedMesh part;
     std::unordered_map<uint32_t, uint32_t> newIndex; // Old vertex index -> index in the part
-    part.mTriangles.reserve(inTriangles.size());
+    part.mTriangles.reserve(std::min(inTriangles.size(), mTriangles.size()));
     for (uint32_t t : inTriangles)
     {
+        if (t >= mTriangles.size())
+            return MakeError(ErrorCode::InvalidArgument, "level mesh: triangle " + std::to_string(t) +
+                                                             " of " + std::to_string(mTriangles.size()));
         std::array<uint32_t, 3> triangle;
         for (size_t k = 0; k < 3; ++k)
         {
             const uint32_t old = mTriangles[t][k];
+            if (old >= mVertices.size())
+                return MakeError(ErrorCode::InvalidArgument, "level mesh: triangle " + std::to_string(t) +
+                                                                 " uses vertex " + std::to_string(old) +
+                                                                 " of " + std::to_string(mVertices.size()));
             auto [it, inserted] = newIndex.try_emplace(old, uint32_t(part.mVertices.size()));
             if (inserted) part.mVertices.push_back(mVertices[old]);
             triangle[k] = it->second;
@@ -55,8 +83,9 @@ Status AreaMapping::Validate() const
     return Status::Ok();
 }
 
-std::vector<LevelPart> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas)
+Result<std::vector<LevelPart>> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas)
 {
+    if (Status valid = inMesh.Validate(); !valid) return valid.GetError();
     std::vector<MeshObject> objects = inMesh.mObjects;
     if (objects.empty()) objects.push_back({"", 0, uint32_t(inMesh.mTriangles.size())});
     std::vector<LevelPart> parts;
@@ -80,7 +109,7 @@ std::vector<LevelPart> SplitIntoParts(const IndexedMesh& inMesh, const AreaMappi
             triangles[slot].push_back(t);
         }
         for (size_t a = 0; a < areas.size(); ++a)
-            parts.push_back({object.mName, areas[a], inMesh.ExtractTriangles(triangles[a])});
+            parts.push_back({object.mName, areas[a], inMesh.ExtractTriangles(triangles[a]).Value()}); // Valid
     }
     return parts;
 }

@@ -94,7 +94,7 @@ TEST_F(LevelPartsTest, PartsPerObjectAndArea)
     AreaMapping areas;
     areas.mMaterialAreas = {{"road", 1}};
     areas.mDefaultArea = 7; // grass is not named: the default
-    const std::vector<LevelPart> parts = SplitIntoParts(mesh, areas);
+    const std::vector<LevelPart> parts = SplitIntoParts(mesh, areas).Value();
     ASSERT_EQ(parts.size(), 3u);
     EXPECT_EQ(parts[0].mName, "Floor");
     EXPECT_EQ(parts[0].mArea, 1);
@@ -201,6 +201,41 @@ TEST_F(LevelPartsTest, GltfNodesAreObjectsWithTheirMaterials)
     ASSERT_FALSE(bad);
     EXPECT_NE(bad.GetError().mMessage.find("meshes[0].primitives[1]"), std::string::npos)
         << bad.GetError().mMessage;
+}
+
+// A mesh built by hand (not by a loader) may hold indices past its arrays: splitting it or taking triangles
+// out of it is an error that names them, where it used to read past the arrays
+TEST_F(LevelPartsTest, IndicesPastTheArraysAreErrors)
+{
+    IndexedMesh mesh;
+    mesh.mVertices = {Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 0)};
+    mesh.mTriangles = {{0, 1, 2}};
+    EXPECT_TRUE(mesh.Validate());
+    ASSERT_TRUE(SplitIntoParts(mesh, AreaMapping{}));
+
+    IndexedMesh longObject = mesh;
+    longObject.mObjects = {{"floor", 0, 50'000'000}};
+    // And one whose end wraps past 2^32 into range
+    IndexedMesh wrappingObject = mesh;
+    wrappingObject.mObjects = {{"floor", 0xffffffffu, 2}};
+    IndexedMesh farVertex = mesh;
+    farVertex.mTriangles.push_back({0, 1, 400'000'000});
+    for (const IndexedMesh* bad : {&longObject, &wrappingObject, &farVertex})
+    {
+        EXPECT_EQ(bad->Validate().GetError().mCode, ErrorCode::InvalidArgument);
+        const Result<std::vector<LevelPart>> parts = SplitIntoParts(*bad, AreaMapping{});
+        ASSERT_FALSE(parts);
+        EXPECT_EQ(parts.GetError().mCode, ErrorCode::InvalidArgument);
+        EXPECT_NE(parts.GetError().mMessage.find("level mesh:"), std::string::npos)
+            << parts.GetError().mMessage;
+    }
+
+    const uint32_t pastTheTriangles[] = {40'000'000};
+    EXPECT_EQ(mesh.ExtractTriangles(pastTheTriangles).GetError().mCode, ErrorCode::InvalidArgument);
+    const uint32_t withAFarVertex[] = {1};
+    EXPECT_EQ(farVertex.ExtractTriangles(withAFarVertex).GetError().mCode, ErrorCode::InvalidArgument);
+    const uint32_t first[] = {0};
+    EXPECT_EQ(farVertex.ExtractTriangles(first).Value().mVertices.size(), 3u);
 }
 
 } // namespace

@@ -25,7 +25,9 @@ Result<std::unique_ptr<FileLevelSource>> FileLevelSource::Load(const std::vector
         Result<navmesh::IndexedMesh> mesh = navmesh::LoadLevelMesh(path, inLimits);
         if (!mesh) return mesh.GetError();
         source->mBounds.Encapsulate(mesh.Value().GetBounds());
-        for (navmesh::LevelPart& part : navmesh::SplitIntoParts(mesh.Value(), inAreas))
+        Result<std::vector<navmesh::LevelPart>> parts = navmesh::SplitIntoParts(mesh.Value(), inAreas);
+        if (!parts) return MakeError(parts.GetError().mCode, path + ": " + parts.GetError().mMessage);
+        for (navmesh::LevelPart& part : parts.Value())
         {
             std::string where = path + (part.mName.empty() ? "" : ": object '" + part.mName + "'");
             auto shape = TriangleMeshShape::Create(part.mMesh.mVertices, part.mMesh.mTriangles);

@@ -39,9 +39,14 @@ struct IndexedMesh
     AABB GetBounds() const;
     /// Every triangle, as a tile build takes them, with area inArea.
     TileGeometry ToTileGeometry(uint8_t inArea = cDefaultArea) const;
+    /// Ok, or an InvalidArgument error naming the first triangle whose vertex index is past mVertices or the
+    /// first object whose triangles run past mTriangles. The loaders make only valid meshes; a mesh built by
+    /// hand is checked where it is used (ExtractTriangles, SplitIntoParts).
+    Status Validate() const;
     /// The triangles inTriangles (indices into mTriangles) as a mesh of their own, holding only the vertices
-    /// they use, in first-use order; no objects or materials.
-    IndexedMesh ExtractTriangles(std::span<const uint32_t> inTriangles) const;
+    /// they use, in first-use order; no objects or materials. Errors: a triangle index past mTriangles, or a
+    /// vertex index past mVertices (InvalidArgument).
+    Result<IndexedMesh> ExtractTriangles(std::span<const uint32_t> inTriangles) const;
     /// The name of triangle inTriangle's material, or an empty string when it has none.
     const std::string& GetMaterialName(uint32_t inTriangle) const;
 };
@@ -68,7 +73,8 @@ struct LevelPart
 
 /// Splits a level mesh into parts: each object, and within it each area that inAreas gives its materials,
 /// in the order of the objects and then of each area's first triangle. A mesh without objects is one.
-std::vector<LevelPart> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas);
+/// Errors: an invalid mesh (IndexedMesh::Validate).
+Result<std::vector<LevelPart>> SplitIntoParts(const IndexedMesh& inMesh, const AreaMapping& inAreas);
 
 /// What a level file may make a loader do: work and memory follow the file's size, and a hostile file (a
 /// node graph that instances one mesh 2^40 times, JSON nested 100,000 deep) is refused with the name of the
