@@ -1,5 +1,6 @@
 #include "cairn/physics/shapes/CompoundShape.h"
 
+#include <algorithm>
 #include <bit>
 #include <string>
 
@@ -23,6 +24,11 @@ Result<std::shared_ptr<const CompoundShape>> CompoundShape::Create(std::vector<S
             return MakeError(ErrorCode::InvalidArgument,
                              "CompoundShape: sub-shape " + std::to_string(i) +
                                  " has a non-finite position or a non-unit rotation");
+        if (sub.mShape->GetType() == ShapeType::Compound &&
+            static_cast<const CompoundShape&>(*sub.mShape).GetDepth() >= cMaxDepth)
+            return MakeError(ErrorCode::InvalidArgument, "CompoundShape: sub-shape " + std::to_string(i) +
+                                                             " nests compounds " + std::to_string(cMaxDepth) +
+                                                             " deep, the most allowed");
     }
     return std::shared_ptr<const CompoundShape>(std::make_shared<CompoundShape>(std::move(inSubShapes)));
 }
@@ -35,6 +41,8 @@ CompoundShape::CompoundShape(std::vector<SubShape> inSubShapes)
         // Create() accepts rotations within a small tolerance of unit length; store them exactly unit
         sub.mLocalTransform.mRotation.normalize();
         mBounds.Encapsulate(sub.mShape->GetWorldBounds(sub.mLocalTransform));
+        if (sub.mShape->GetType() == ShapeType::Compound)
+            mDepth = std::max(mDepth, static_cast<const CompoundShape&>(*sub.mShape).GetDepth() + 1);
     }
 }
 

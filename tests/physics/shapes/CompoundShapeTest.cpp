@@ -48,6 +48,26 @@ TEST(CompoundShapeTest, RejectsBadInput)
               ErrorCode::InvalidArgument);
 }
 
+// Compounds nested 20,000 deep overflowed the stack in the first query or step that walked them: nesting is
+// bounded where the shape is made
+TEST(CompoundShapeTest, NestingIsBoundedAtCreation)
+{
+    ShapeRef shape = SphereShape::Create(1.0f).Value();
+    for (uint32_t depth = 1; depth <= CompoundShape::cMaxDepth; ++depth)
+    {
+        const auto nested = CompoundShape::Create({{shape, Transform()}});
+        ASSERT_TRUE(nested) << "depth " << depth;
+        EXPECT_EQ(nested.Value()->GetDepth(), depth);
+        shape = nested.Value();
+    }
+    const auto tooDeep =
+        CompoundShape::Create({{SphereShape::Create(1.0f).Value(), Transform()}, {shape, Transform()}});
+    ASSERT_FALSE(tooDeep);
+    EXPECT_EQ(tooDeep.GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_NE(tooDeep.GetError().mMessage.find("sub-shape 1"), std::string::npos)
+        << tooDeep.GetError().mMessage;
+}
+
 TEST(CompoundShapeTest, TwoSpheresMassProperties)
 {
     const float r = 0.5f;

@@ -194,6 +194,22 @@ TEST_F(BadInputTest, BodySettingsThatWouldOverflowAreRejected)
     ExpectWorldUnchanged();
 }
 
+// A motion type outside the enum made a body that was added and active but never moved, and whose published
+// pose carried the stray bits into its layer
+TEST_F(BadInputTest, AMotionTypeOutsideTheEnumIsRejected)
+{
+    for (const uint8_t value : {3, 4, 0x41, 0xff})
+    {
+        BodyCreationSettings settings = DynamicSettings(Sphere(1), Vec3(5, 5, 5));
+        settings.mMotionType = MotionType(value);
+        const Result<BodyID> created = Bodies().CreateAndAddBody(settings, Activation::Activate);
+        ASSERT_FALSE(created) << "motion type " << int(value);
+        EXPECT_EQ(created.GetError().mCode, ErrorCode::InvalidArgument);
+        EXPECT_NE(created.GetError().mMessage.find("motion type"), std::string::npos);
+    }
+    ExpectWorldUnchanged();
+}
+
 TEST_F(BadInputTest, AShapeWithNoExtentIsRejected)
 {
     // Built around CapsuleShape::Create, which would refuse it: its bounds are inverted

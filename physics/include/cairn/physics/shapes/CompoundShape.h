@@ -23,10 +23,18 @@ public:
         Transform mLocalTransform; ///< Child space to compound space
     };
 
-    /// Fails for no children, a null child, or a non-finite / non-unit transform.
+    /// The most compounds nested in one another, this one included. Every query and collision walks a nested
+    /// compound by recursion, a few stack frames a level: a bound keeps that within any thread's stack (a
+    /// job thread's too); real assets nest a handful of levels.
+    static constexpr uint32_t cMaxDepth = 32;
+
+    /// Fails for no children, a null child, a non-finite / non-unit transform, or nesting deeper than
+    /// cMaxDepth.
     static Result<std::shared_ptr<const CompoundShape>> Create(std::vector<SubShape> inSubShapes);
 
     std::span<const SubShape> GetSubShapes() const { return mSubShapes; }
+    /// 1 for a compound of other shapes; one more than its deepest compound child otherwise.
+    uint32_t GetDepth() const { return mDepth; }
 
     /// The id of a manifold of child inChild (of inNumChildren) whose own id is inChildSubShape: the child
     /// index in the low bits (as many as inNumChildren needs), the child's id above them. An id too large to
@@ -47,6 +55,7 @@ public:
 private:
     std::vector<SubShape> mSubShapes;
     AABB mBounds;
+    uint32_t mDepth = 1;
 };
 
 } // namespace cairn::physics
