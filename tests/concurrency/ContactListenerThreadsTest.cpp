@@ -6,6 +6,7 @@
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/narrowphase/ContactListener.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
@@ -15,6 +16,7 @@
 #include <atomic>
 #include <gtest/gtest.h>
 #include <memory>
+#include <thread>
 #include <vector>
 
 namespace cairn
@@ -125,6 +127,77 @@ TEST(ContactListenerThreadsTest, ListenerOnJobThreadsGivesTheSameEventsAsOneThre
             ASSERT_EQ(one[i].mNormalImpulses[p], four[i].mNormalImpulses[p]) << "event " << i;
         }
     }
+}
+
+/// Breaks the listener's rule: calls back into the world from each callback, as a game's listener might by
+/// mistake. Counts what those calls returned, on the updating thread and on the others.
+class CallingBackListener : public ContactListener
+{
+public:
+    CallingBackListener(PhysicsSystem& ioSystem, std::thread::id inUpdatingThread)
+        : mSystem(ioSystem), mUpdatingThread(inUpdatingThread)
+    {
+    }
+    ContactValidation OnContactValidate(const Body& inA, const Body&) override
+    {
+        CallBack(inA.GetID());
+        return ContactValidation::Accept;
+    }
+    void OnContactAdded(const Body& inA, const Body&, const ContactManifold&, ContactSettings&) override
+    {
+        CallBack(inA.GetID());
+    }
+    void OnContactPersisted(const Body& inA, const Body&, const ContactManifold&, ContactSettings&) override
+    {
+        CallBack(inA.GetID());
+    }
+
+    // Relaxed: counts, read after Update returned (the step's jobs were waited for)
+    std::atomic<uint64_t> mCallsOnOtherThreads{0};
+    std::atomic<uint64_t> mCallsNotRefused{0};
+
+private:
+    void CallBack(const BodyID& inID)
+    {
+        if (std::this_thread::get_id() != mUpdatingThread)
+            mCallsOnOtherThreads.fetch_add(1, std::memory_order_relaxed);
+        const Result<Vec3> position = mSystem.GetBodyInterface().GetPosition(inID);
+        const BodyLockRead lock(mSystem.GetBodyManager(), inID);
+        const Status step = mSystem.Update(1.0f / 60.0f);
+        if (position || position.GetError().mCode != ErrorCode::WrongThread || lock.Succeeded() ||
+            !lock.WasWrongThread() || step || step.GetError().mCode != ErrorCode::WrongThread)
+            mCallsNotRefused.fetch_add(1, std::memory_order_relaxed);
+    }
+
+    PhysicsSystem& mSystem;
+    const std::thread::id mUpdatingThread;
+};
+
+// A listener that calls the world from the step's job threads gets WrongThread there, as on the updating
+// thread. Those calls used to wait for ever on the body locks the step holds (the flag that refuses them was
+// set on the updating thread only); with the bug this test hangs until its time-out
+TEST(ContactListenerThreadsTest, CallsBackIntoTheWorldAreRefusedOnEveryThread)
+{
+    jobs::JobSystem jobSystem(jobs::JobSystem::Settings{4});
+    std::unique_ptr<PhysicsSystem> system = test::MakePhysicsSystem(PhysicsSettings{});
+    CallingBackListener listener(*system, std::this_thread::get_id());
+    system->SetContactListener(&listener);
+    BodyInterface& bodies = system->GetBodyInterface();
+    ASSERT_TRUE(bodies.CreateAndAddBody(test::StaticFloorSettings(30.0f), Activation::DontActivate));
+    for (int i = 0; i < 400; ++i)
+    {
+        BodyCreationSettings body;
+        body.mShape = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+        body.mPosition = Vec3(float(i % 20) * 1.2f - 12.0f, 0.49f, float(i / 20) * 1.2f - 12.0f);
+        body.mMotionType = MotionType::Dynamic;
+        body.mObjectLayer = Layers::cMoving;
+        ASSERT_TRUE(bodies.CreateAndAddBody(body, Activation::Activate));
+    }
+    for (int update = 0; update < 10; ++update)
+        ASSERT_TRUE(system->Update(1.0f / 60.0f, 1, jobSystem));
+    EXPECT_GT(listener.mCallsOnOtherThreads.load(std::memory_order_relaxed), 0u)
+        << "no callback ran on a job thread: the test tested nothing";
+    EXPECT_EQ(listener.mCallsNotRefused.load(std::memory_order_relaxed), 0u);
 }
 
 } // namespace

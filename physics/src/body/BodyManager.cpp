@@ -1,6 +1,7 @@
 #include "cairn/physics/body/BodyManager.h"
 
 #include "PublishedPoseStore.h"
+#include "body/StepCallbackScope.h"
 #include "cairn/physics/LockWaits.h"
 
 #include <algorithm>
@@ -15,7 +16,8 @@ namespace cairn::physics
 
 namespace
 {
-// Set on the stepping thread while it holds every body mutex; read only by that same thread
+// Set on the stepping thread while it holds every body mutex, and on a step's job thread while it runs a game
+// callback (StepCallbackScope); read only by that same thread
 thread_local bool tInsideStep = false;
 // Body locks this thread holds through BodyLock; read and written only by that same thread
 thread_local uint32_t tBodyLocksHeld = 0;
@@ -298,6 +300,16 @@ void BodyManager::UnlockAllBodies() const
 bool BodyManager::IsInsideStep()
 {
     return tInsideStep;
+}
+
+StepCallbackScope::StepCallbackScope() : mWasInside(tInsideStep)
+{
+    tInsideStep = true;
+}
+
+StepCallbackScope::~StepCallbackScope()
+{
+    tInsideStep = mWasInside;
 }
 
 uint32_t BodyManager::GetBodyLocksHeldByThisThread()

@@ -3,6 +3,7 @@
 // bodies it wakes. Runs in the narrow phase's chunks, on any of the step's threads.
 
 #include "body/Integration.h"
+#include "body/StepCallbackScope.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "narrowphase/ContactsStage.h"
 #include "narrowphase/ManifoldMerger.h"
@@ -34,9 +35,12 @@ void ContactsStage::CollidePair(const StepContext& inContext, const Integration&
     if (!ioA.IsDynamic() && !ioB.IsDynamic()) return;
     // Two parts of one object that its group keeps apart (a ragdoll's jointed limbs): no contact, no record
     if (!inContext.mBodies.BodiesCollide(ioA, ioB)) return;
-    if (inContext.mListener != nullptr &&
-        inContext.mListener->OnContactValidate(ioA, ioB) == ContactValidation::Reject)
-        return; // No record either: the pair is validated again next step
+    if (inContext.mListener != nullptr)
+    {
+        const StepCallbackScope callback;
+        if (inContext.mListener->OnContactValidate(ioA, ioB) == ContactValidation::Reject)
+            return; // No record either: the pair is validated again next step
+    }
     if (ioA.IsSensor() || ioB.IsSensor())
     {
         CollideSensor(ioA, ioB, ioOut);
@@ -171,10 +175,13 @@ void ContactsStage::AddConstraint(const StepContext& inContext, const Integratio
     if (inContext.mListener != nullptr)
     {
         ContactSettings settings{c.mFriction, c.mRestitution};
-        if (inPrevious == nullptr)
-            inContext.mListener->OnContactAdded(ioA, ioB, inManifold, settings);
-        else
-            inContext.mListener->OnContactPersisted(ioA, ioB, inManifold, settings);
+        {
+            const StepCallbackScope callback;
+            if (inPrevious == nullptr)
+                inContext.mListener->OnContactAdded(ioA, ioB, inManifold, settings);
+            else
+                inContext.mListener->OnContactPersisted(ioA, ioB, inManifold, settings);
+        }
         // A listener's NaN or out-of-range value keeps the combined one: the step cannot report an error,
         // and a NaN friction would spread to every body of the island
         if (settings.mFriction >= 0.0f && settings.mFriction < cLargeFloat) c.mFriction = settings.mFriction;

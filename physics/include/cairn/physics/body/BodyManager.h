@@ -118,7 +118,8 @@ public:
     /// The published poses, for PoseReader.
     const PublishedPoseStore& GetPublishedPoses() const { return *mPoses; }
 
-    /// True on the thread that holds every body lock (inside a step): locking calls there would deadlock.
+    /// True on the thread that holds every body lock (inside a step), and on a step's job thread while it
+    /// runs a game callback (a ContactListener's): locking calls there would deadlock.
     static bool IsInsideStep();
     /// Body locks (BodyLockRead/Write) the calling thread holds now. A thread may hold one at a time: a
     /// second, or a step started while holding one, could deadlock against the step, which takes them all.

@@ -21,8 +21,9 @@
 // Threads. OnContactValidate, OnContactAdded and OnContactPersisted run inside the step, on the step's job
 // threads, several at once and in no fixed order: they must be thread-safe, may read the two bodies they are
 // given (their poses and velocities are this step's, before the solver), and must not call BodyInterface,
-// PhysicsSystem or WorldQuery (the step holds every body lock: the call would fail or wait forever), nor
-// keep the references. OnContactEvents runs on the thread that called Update, after each collision step,
+// ConstraintInterface, PhysicsSystem or WorldQuery (the step holds every body lock: such a call returns
+// ErrorCode::WrongThread on any of these threads, and a BodyLock does not lock: WasWrongThread), nor keep
+// the references. OnContactEvents runs on the thread that called Update, after each collision step,
 // with the same restrictions on the world; its events are in the order above.
 
 #include "cairn/physics/body/BodyID.h"
