@@ -24,6 +24,16 @@ thread_local uint64_t tRunIdBase = 0;
 thread_local uint64_t tRunCount = 0;
 /// The JobSystem this thread is a worker of (set by WorkerMain), or null.
 thread_local const JobSystem* tWorkerOf = nullptr;
+/// A job that this thread is running, on Run's stack, and the one it runs inside of (null: none): what a Wait
+/// on this thread could never see finish. This thread's own.
+struct RunningJob
+{
+    const JobSystem* mSystem;
+    uint32_t mIndex;
+    uint32_t mGeneration;
+    const RunningJob* mOuter;
+};
+thread_local const RunningJob* tRunningJob = nullptr;
 std::atomic<uint64_t> sNextThreadNumber{1};
 
 uint64_t NextRunId()
@@ -84,8 +94,8 @@ void JobSystem::ExtendSpin(uint64_t inNanoseconds)
 JobSystem::JobSystem() : JobSystem(Settings{}) {}
 
 JobSystem::JobSystem(const Settings& inSettings)
-    : mSlots(std::make_unique<JobSlot[]>(std::max<uint32_t>(1, inSettings.mMaxJobs))),
-      mMaxJobs(std::max<uint32_t>(1, inSettings.mMaxJobs)), mReady(mMaxJobs),
+    : mSlots(std::make_unique<JobSlot[]>(std::clamp<uint32_t>(inSettings.mMaxJobs, 1, cMaxJobsLimit))),
+      mMaxJobs(std::clamp<uint32_t>(inSettings.mMaxJobs, 1, cMaxJobsLimit)), mReady(mMaxJobs),
       mUseLoopBoard(inSettings.mUseLoopBoard), mSearchMarks(mMaxJobs, 0u), mSearchStack(mMaxJobs)
 {
     mFree.reserve(mMaxJobs);
@@ -319,7 +329,11 @@ void JobSystem::Run(uint32_t inIndex)
     JobSlot& slot = mSlots[inIndex];
     const uint64_t outerRun = tCurrentRun;
     tCurrentRun = NextRunId();
+    // Relaxed: the generation changes only when this run ends (below), on this thread
+    const RunningJob running{this, inIndex, slot.mGeneration.load(std::memory_order_relaxed), tRunningJob};
+    tRunningJob = &running;
     slot.mFunction();
+    tRunningJob = running.mOuter;
     tCurrentRun = outerRun;
     slot.mFunction.Reset();
     uint32_t dependents[cMaxDependents];
@@ -373,8 +387,12 @@ bool JobSystem::IsDone(const JobHandle& inJob) const
     return mSlots[inJob.mIndex].mGeneration.load(std::memory_order_seq_cst) != inJob.mGeneration;
 }
 
-void JobSystem::Wait(const JobHandle& inJob)
+bool JobSystem::Wait(const JobHandle& inJob)
 {
+    for (const RunningJob* running = tRunningJob; running != nullptr; running = running->mOuter)
+        if (running->mSystem == this && running->mIndex == inJob.mIndex &&
+            running->mGeneration == inJob.mGeneration)
+            return false; // It finishes only when this thread returns to it
     const uint64_t run = tCurrentRun;
     if (run == 0)
     {
@@ -389,7 +407,7 @@ void JobSystem::Wait(const JobHandle& inJob)
                 Run(index);
                 continue;
             }
-            if (SpinUntil([&] { return IsDone(inJob); })) return;
+            if (SpinUntil([&] { return IsDone(inJob); })) return true;
             if (mNumReady.load(std::memory_order_relaxed) != 0)
                 continue; // Relaxed: a hint, rechecked by the pop
             std::unique_lock lock(mQueueMutex);
@@ -400,7 +418,7 @@ void JobSystem::Wait(const JobHandle& inJob)
             // workers could sleep on with the job queued
             if (mReadyCount > 0 && IsDone(inJob)) mWake.notify_one();
         }
-        return;
+        return true;
     }
     // Inside a job: isolated (see the header). Every check is under the queue mutex; such waits are rare
     const uint32_t awaited = inJob.IsValid() ? inJob.mIndex : JobHandle::cInvalidIndex;
@@ -440,12 +458,15 @@ void JobSystem::Wait(const JobHandle& inJob)
         }
         mNumWaiters.fetch_sub(1, std::memory_order_relaxed); // Only ever compared with zero by Run
     }
+    return true;
 }
 
-void JobSystem::WaitAll(std::span<const JobHandle> inJobs)
+bool JobSystem::WaitAll(std::span<const JobHandle> inJobs)
 {
+    bool all = true;
     for (const JobHandle& job : inJobs)
-        Wait(job);
+        all = Wait(job) && all;
+    return all;
 }
 
 bool JobSystem::WaitIdle()

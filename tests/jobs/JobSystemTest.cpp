@@ -568,6 +568,49 @@ TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
     EXPECT_TRUE(jobs.WaitIdle());
 }
 
+// A job that waits for its own handle would wait for ever: it finishes only when that wait returns. The wait
+// is refused at once instead (false), and the job's wait for a job it scheduled still waits. On any thread
+// count: the job may run on a worker or on the waiting caller
+TEST_P(JobSystemThreads, AJobsWaitForItselfIsRefused)
+{
+    JobSystem jobs(MakeSettings());
+    std::atomic<JobHandle> self{JobHandle{}};
+    std::atomic<bool> published{false};
+    bool selfWait = true, childWait = false, childRan = false;
+    const JobHandle job = jobs.Schedule("waits for itself",
+                                        [&]
+                                        {
+                                            // Acquire: pairs with the release that publishes the handle
+                                            while (!published.load(std::memory_order_acquire))
+                                                std::this_thread::yield();
+                                            selfWait = jobs.Wait(self.load(std::memory_order_relaxed));
+                                            childWait =
+                                                jobs.Wait(jobs.Schedule("child", [&] { childRan = true; }));
+                                        });
+    self.store(job, std::memory_order_relaxed);
+    published.store(true, std::memory_order_release); // Release: the handle is stored before
+    EXPECT_TRUE(jobs.Wait(job));
+    EXPECT_FALSE(selfWait);
+    EXPECT_TRUE(childWait);
+    EXPECT_TRUE(childRan);
+    EXPECT_TRUE(jobs.Wait(JobHandle{})); // An invalid handle counts as done: true, not refused
+}
+
+// mMaxJobs is clamped like the thread count: 2^32 - 1 slots asked for hundreds of gigabytes and aborted
+TEST(JobSystemTest, AJobCountBeyondTheLimitIsClamped)
+{
+    JobSystem::Settings settings;
+    settings.mNumThreads = 2;
+    settings.mMaxJobs = 0xffffffffu;
+    JobSystem jobs(settings);
+    std::atomic<int> ran{0};
+    std::vector<JobHandle> handles;
+    for (int i = 0; i < 100; ++i)
+        handles.push_back(jobs.Schedule("count", [&] { ran.fetch_add(1, std::memory_order_relaxed); }));
+    EXPECT_TRUE(jobs.WaitAll(handles));
+    EXPECT_EQ(ran.load(std::memory_order_relaxed), 100); // Relaxed: WaitAll ordered the jobs before
+}
+
 TEST_P(JobSystemThreads, WaitIdleRunsEverything)
 {
     std::atomic<int> ran{0};

@@ -62,6 +62,9 @@ public:
     static constexpr size_t cFunctionCapacity = 64; ///< Bytes of captures a job may carry
     static constexpr uint32_t cMaxDependents = 16;  ///< Jobs that can wait on one job through the queue
     static constexpr uint32_t cMaxThreads = 64;
+    /// The most jobs Settings::mMaxJobs may ask for: some 200 bytes of slot and queue each, all made at
+    /// construction (a count of 2^32 asked for hundreds of gigabytes)
+    static constexpr uint32_t cMaxJobsLimit = 1u << 16;
     /// The workers' thread names begin so (cairn-job-1, cairn-job-2, ...; Linux), for profilers and for tools
     /// that watch the frame's threads
     static constexpr const char* cWorkerThreadNamePrefix = "cairn-job";
@@ -72,7 +75,8 @@ public:
     struct Settings
     {
         uint32_t mNumThreads = 0; ///< Threads that run frame jobs, the waiting caller included; 0: all cores
-        uint32_t mMaxJobs = 4096; ///< Jobs that may exist at once
+        /// Jobs that may exist at once, clamped to [1, cMaxJobsLimit]: each is a slot made at construction
+        uint32_t mMaxJobs = 4096;
         /// Worker i runs on the process's i-th allowed core only (wrapping round), leaving the first to the
         /// caller. On a machine with idle time between frames the OS put a waking worker on the caller's
         /// core and took milliseconds to spread them again, so a short loop got no second core
@@ -159,9 +163,12 @@ public:
     /// jobs scheduled inside that job, the awaited job itself and the jobs the awaited job depends on,
     /// through any number of prerequisites: an unrelated job run on this stack could wait for the job below
     /// it and never return (TBB calls this isolation). It runs other jobs only when every worker is stuck the
-    /// same way and none of those is queued.
-    void Wait(const JobHandle& inJob);
-    void WaitAll(std::span<const JobHandle> inJobs);
+    /// same way and none of those is queued. Returns true once the job has finished; false at once, waiting
+    /// for nothing, when the job is running on this thread's own stack (a job waiting for itself, or for a
+    /// job that it runs inside of): that wait could never end.
+    bool Wait(const JobHandle& inJob);
+    /// Wait for each; false when any of them was refused (see Wait).
+    bool WaitAll(std::span<const JobHandle> inJobs);
     /// Returns true when no frame job is queued or running, running queued jobs meanwhile. From inside a job
     /// it returns false at once: the calling job is in flight itself, so it would wait forever.
     bool WaitIdle();
