@@ -135,6 +135,21 @@ std::string NavMeshWorld::CheckTile(const TileCoord& inCoord, const BuiltTile& i
     if (header.x != inCoord.mX || header.y != inCoord.mZ || header.layer != 0)
         return "its data is tile " + std::to_string(header.x) + "," + std::to_string(header.y) + " (layer " +
                std::to_string(header.layer) + ")";
+    // Detour also places a tile's polygons by the header's box: a tile built on another grid (another origin
+    // or tile size) under this coordinate would answer queries far from where it is listed. The box is the
+    // tile's own area and its border (BuildTile); a cell of slack either way
+    const AABB bounds = mGrid.GetTileBounds(inCoord);
+    const float border = float(mProfile.GetBorderCells()) * mProfile.mCellSize, slack = mProfile.mCellSize;
+    auto spans = [&](float inMin, float inMax, float inTileMin, float inTileMax)
+    {
+        return inMin >= inTileMin - border - slack && inMin <= inTileMin + slack &&
+               inMax >= inTileMax - slack && inMax <= inTileMax + border + slack;
+    };
+    if (!spans(header.bmin[0], header.bmax[0], bounds.mMin.x(), bounds.mMax.x()) ||
+        !spans(header.bmin[2], header.bmax[2], bounds.mMin.z(), bounds.mMax.z()))
+        return "its box (x " + std::to_string(header.bmin[0]) + " to " + std::to_string(header.bmax[0]) +
+               ", z " + std::to_string(header.bmin[2]) + " to " + std::to_string(header.bmax[2]) +
+               ") is not that tile's on this world's grid (built on another grid?)";
     const int maxPolygons = mMaxTilePolygons;
     const int polygons = std::max(inTile.mNumPolygons, header.polyCount);
     if (polygons > maxPolygons)

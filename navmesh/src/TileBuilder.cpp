@@ -74,6 +74,15 @@ Status ValidateProfileAndGrid(const AgentProfile& inProfile, const TileGrid& inG
         return MakeError(
             ErrorCode::InvalidArgument,
             "navmesh: the tile grid's origin and height range must be finite, min y below max y");
+    // Recast keeps a span's top in RC_SPAN_HEIGHT_BITS bits of cells: a taller range clamps every floor above
+    // it to that height, a navmesh that builds without a word and stands where nothing is
+    const float maxRange = float(RC_SPAN_MAX_HEIGHT) * inProfile.mCellHeight;
+    if (!(inGrid.GetMaxY() - inGrid.GetMinY() <= maxRange))
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: the tile grid's height range (" +
+                                                         std::to_string(inGrid.GetMaxY() - inGrid.GetMinY()) +
+                                                         " m) is over the " + std::to_string(maxRange) +
+                                                         " m that Recast's spans hold at a cell height of " +
+                                                         std::to_string(inProfile.mCellHeight) + " m");
     return Status::Ok();
 }
 

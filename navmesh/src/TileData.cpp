@@ -250,6 +250,10 @@ Result<dtNavMeshParams> MakeNavMeshParams(const TileGrid& inGrid, int inMaxTiles
     params.tileHeight = inGrid.GetTileSize();
     params.maxTiles = 1 << tileBits;
     params.maxPolys = 1 << polyBits;
+    // What a navmesh file must meet, a world made in memory too: tiles narrower than cMinTileSize made one
+    // crowd agent's snap to the navmesh visit millions of tile slots (seconds a frame)
+    if (const std::string problem = CheckNavMeshParams(params); !problem.empty())
+        return MakeError(ErrorCode::InvalidArgument, "navmesh: " + problem);
     return params;
 }
 

@@ -61,6 +61,68 @@ TEST(NavMeshBadInputTest, AGridThatDoesNotMatchTheProfileIsRefused)
         << "min y above max y";
 }
 
+// Recast keeps a span's top in 13 bits of cells (1,638 m at 0.2 m cells): a grid taller than that built a
+// floor at y = 2,000 at y = 1,638.2, without a word, and no query found it
+TEST(NavMeshBadInputTest, AHeightRangeRecastsSpansCannotHoldIsRefused)
+{
+    const AgentProfile profile;
+    EXPECT_TRUE(NavMeshWorld::Create(TileGrid(0, 0, profile.mTileSize, 0, 1600), profile));
+    const TileGrid tall(0, 0, profile.mTileSize, 0, 2100);
+    const auto world = NavMeshWorld::Create(tall, profile);
+    ASSERT_FALSE(world);
+    EXPECT_EQ(world.GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_NE(world.GetError().mMessage.find("height range"), std::string::npos) << world.GetError().mMessage;
+    TileGeometry floor;
+    floor.AddTriangle(Vec3(-20, 2000, -20), Vec3(-20, 2000, 40), Vec3(40, 2000, 40), cDefaultArea);
+    EXPECT_EQ(BuildTile(profile, tall, {0, 0}, floor).GetError().mCode, ErrorCode::InvalidArgument);
+}
+
+// The profile accepts tiles of any positive size; a world of tiles under a quarter metre made a crowd agent's
+// snap to the navmesh (2 m each way) visit millions of tile slots, seconds a frame. A navmesh file is held
+// to the same least tile size
+TEST(NavMeshBadInputTest, TilesTooSmallForDetoursQueriesAreRefused)
+{
+    AgentProfile tiny;
+    tiny.mCellSize = 1e-5f;
+    tiny.mTileSize = 8e-5f;
+    tiny.mRadius = 5e-5f;
+    ASSERT_TRUE(tiny.Validate()) << tiny.Validate().GetError().mMessage;
+    const auto world = NavMeshWorld::Create(TileGrid(0, 0, tiny.mTileSize, -1, 10), tiny);
+    ASSERT_FALSE(world);
+    EXPECT_NE(world.GetError().mMessage.find("tile size"), std::string::npos) << world.GetError().mMessage;
+}
+
+// A tile built on another grid (another origin) but handed in under a coordinate of this world's: Detour
+// places it by its header's box, so it answered a query at (6, 0, 6) with a point 700 m away. Refused
+TEST(NavMeshBadInputTest, ATileBuiltOnAnotherGridIsRefused)
+{
+    const AgentProfile profile;
+    const TileGrid grid(0, 0, profile.mTileSize, -5, 20);
+    const std::unique_ptr<NavMeshWorld> world = NavMeshWorld::Create(grid, profile).Value();
+    auto floorOver = [&](const TileGrid& inGrid)
+    {
+        const AABB bounds = inGrid.GetTileBoundsWithBorder({0, 0}, 2.0f);
+        TileGeometry geometry;
+        geometry.AddTriangle(Vec3(bounds.mMin.x(), 0, bounds.mMin.z()),
+                             Vec3(bounds.mMin.x(), 0, bounds.mMax.z()),
+                             Vec3(bounds.mMax.x(), 0, bounds.mMax.z()), cDefaultArea);
+        geometry.AddTriangle(Vec3(bounds.mMin.x(), 0, bounds.mMin.z()),
+                             Vec3(bounds.mMax.x(), 0, bounds.mMax.z()),
+                             Vec3(bounds.mMax.x(), 0, bounds.mMin.z()), cDefaultArea);
+        return BuildTile(profile, inGrid, {0, 0}, geometry).Value();
+    };
+    for (const float offset : {500.0f, profile.mTileSize, -0.5f * profile.mTileSize})
+    {
+        const TileGrid other(offset, offset, profile.mTileSize, -5, 20);
+        EXPECT_EQ(world->Publish(Changes(floorOver(other))), 0) << "grid moved by " << offset << " m";
+    }
+    std::string reason;
+    EXPECT_EQ(world->GetRefusedTiles(&reason), 3u);
+    EXPECT_NE(reason.find("grid"), std::string::npos) << reason;
+    EXPECT_EQ(world->Publish(Changes(floorOver(grid))), 1) << "its own grid's tile";
+    EXPECT_TRUE(world->FindNearestPoint(Vec3(6, 0, 6)));
+}
+
 TEST(NavMeshBadInputTest, HugeBoxesGiveACutOffNotAnOverflow)
 {
     const TileGrid grid(0, 0, 12.8f, 0, 10);
