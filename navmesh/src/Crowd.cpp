@@ -226,9 +226,17 @@ Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const 
     return crowd;
 }
 
+namespace
+{
+constexpr uint32_t cAgentSlotMask = (1u << Crowd::cAgentSlotBits) - 1;
+constexpr uint32_t cAgentGenerationMask = (1u << (32 - Crowd::cAgentSlotBits)) - 1;
+} // namespace
+
 Crowd::Agent* Crowd::Find(AgentID inAgent) const
 {
-    return inAgent < mAgents.size() ? mAgents[inAgent].get() : nullptr;
+    const uint32_t slot = inAgent & cAgentSlotMask;
+    return slot < mAgents.size() && mGenerations[slot] == inAgent >> cAgentSlotBits ? mAgents[slot].get()
+                                                                                    : nullptr;
 }
 
 Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams& inParams)
@@ -241,7 +249,7 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
         return MakeError(
             ErrorCode::InvalidArgument,
             "agent: radius in (0, the crowd's max], speed in (0, 100], acceleration in (0, 1000]");
-    if (mAgents.size() - mFreeIDs.size() >= size_t(mSettings.mMaxAgents))
+    if (mAgents.size() - mFreeSlots.size() >= size_t(mSettings.mMaxAgents))
         return MakeError(ErrorCode::OutOfCapacity, "agent: the crowd is full");
     auto agent = std::make_unique<Agent>();
     agent->mParams = inParams;
@@ -264,17 +272,21 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
     if (!queryReady) return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not make its query");
     // No navmesh there yet (its tiles not built): it waits in place until there is
     if (!onNavMesh) agent->mState = AgentState::OffNavMesh;
-    // The lowest free id: ids are reused, and the order of updates is the order of ids
-    AgentID id = AgentID(mAgents.size());
-    if (!mFreeIDs.empty())
+    // The lowest free slot: slots are reused (under a new generation), and the order of updates is the
+    // order of slots
+    uint32_t slot = uint32_t(mAgents.size());
+    if (!mFreeSlots.empty())
     {
-        id = *mFreeIDs.begin();
-        mFreeIDs.erase(mFreeIDs.begin());
+        slot = *mFreeSlots.begin();
+        mFreeSlots.erase(mFreeSlots.begin());
     }
     else
+    {
         mAgents.emplace_back();
-    mAgents[id] = std::move(agent);
-    return id;
+        mGenerations.push_back(0);
+    }
+    mAgents[slot] = std::move(agent);
+    return slot | AgentID(mGenerations[slot]) << cAgentSlotBits;
 }
 
 Status Crowd::RemoveAgent(AgentID inAgent)
@@ -282,8 +294,10 @@ Status Crowd::RemoveAgent(AgentID inAgent)
     Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
     if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
-    mAgents[inAgent].reset();
-    mFreeIDs.insert(inAgent);
+    const uint32_t slot = inAgent & cAgentSlotMask;
+    mAgents[slot].reset();
+    mGenerations[slot] = uint16_t((mGenerations[slot] + 1) & cAgentGenerationMask);
+    mFreeSlots.insert(slot);
     return Status::Ok();
 }
 
@@ -315,7 +329,9 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
     { return std::chrono::duration<double, std::milli>(Clock::now() - inStart).count(); };
     const Clock::time_point start = Clock::now();
     ++mUpdates;
-    mOrder = GetAgents();
+    mOrder.clear();
+    for (uint32_t slot = 0; slot < mAgents.size(); ++slot)
+        if (mAgents[slot] != nullptr) mOrder.push_back(slot);
     const uint32_t count = uint32_t(mOrder.size());
     const uint32_t chunks = (count + cAgentsPerChunk - 1) / cAgentsPerChunk;
     // Runs inTask beside inLoop(begin, end) over the agents, on the job threads when there are any
@@ -351,7 +367,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             // every neighbour in range, and few more. The physics bodies are looked for round the agents
             float largestRadius = 0.0f;
             AABB around;
-            for (AgentID id : mOrder)
+            for (const uint32_t id : mOrder)
             {
                 largestRadius = std::max(largestRadius, mAgents[id]->mParams.mRadius);
                 const Vec3 position = mAgents[id]->Position();
@@ -374,7 +390,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             mSnapshotVelocities.clear();
             mSnapshotRadii.clear();
             mCellAgents.clear();
-            for (AgentID id : mOrder)
+            for (const uint32_t id : mOrder)
             {
                 const Agent& agent = *mAgents[id];
                 AddToSnapshot(agent.Position(), agent.mVelocity, agent.mParams.mRadius);
@@ -638,7 +654,7 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
 void Crowd::RequestPaths()
 {
     // In id order, so the queue gets the same requests in the same order for any number of threads
-    for (AgentID id : mOrder)
+    for (const uint32_t id : mOrder)
     {
         Agent& agent = *mAgents[id];
         mStatistics.mReplans += agent.mReplanned ? 1 : 0;
@@ -663,7 +679,7 @@ void Crowd::RequestPaths()
 
 void Crowd::ApplyPathResults()
 {
-    for (AgentID id : mOrder)
+    for (const uint32_t id : mOrder)
     {
         Agent& agent = *mAgents[id];
         if (agent.mTicket.mValue == 0) continue;
@@ -930,8 +946,8 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
 std::vector<Crowd::AgentID> Crowd::GetAgents() const
 {
     std::vector<AgentID> ids;
-    for (AgentID id = 0; id < mAgents.size(); ++id)
-        if (mAgents[id] != nullptr) ids.push_back(id);
+    for (uint32_t slot = 0; slot < mAgents.size(); ++slot)
+        if (mAgents[slot] != nullptr) ids.push_back(slot | AgentID(mGenerations[slot]) << cAgentSlotBits);
     return ids;
 }
 

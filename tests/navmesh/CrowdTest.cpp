@@ -420,6 +420,14 @@ TEST_F(CrowdTest, BadInputGetsClearErrors)
     EXPECT_EQ(crowd->Update(0.0f).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_TRUE(crowd->RemoveAgent(a).IsOk());
     EXPECT_FALSE(crowd->RemoveAgent(a).IsOk()) << "removed twice";
+    // The freed slot is reused at once (the lowest free): a's id, kept by mistake, must not name the newcomer
+    const Crowd::AgentID newcomer = crowd->AddAgent(Vec3(20, 0, 20)).Value();
+    EXPECT_NE(newcomer, a);
+    EXPECT_EQ(crowd->SetTarget(a, Vec3(2, 0, 2)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_FALSE(crowd->GetPosition(a));
+    EXPECT_EQ(crowd->RemoveAgent(a).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_TRUE(crowd->GetPosition(newcomer)) << "the stale id's calls left the newcomer in place";
+    EXPECT_TRUE(crowd->RemoveAgent(newcomer).IsOk());
     // A target off the navmesh: the agent's request fails and it says so
     const Crowd::AgentID b = crowd->AddAgent(Vec3(-20, 0, -20)).Value();
     ASSERT_TRUE(crowd->SetTarget(b, Vec3(500, 0, 500)).IsOk());

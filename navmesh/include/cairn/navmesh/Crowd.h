@@ -83,7 +83,11 @@ public:
         /// the calling thread: four times the queue's own default, enough for 10,000 agents' requests
         PathRequestQueue::Settings mPaths{.mIterationsPerUpdate = 8192};
     };
+    /// An agent's id: its slot in the low cAgentSlotBits bits, and above them the slot's generation, which
+    /// RemoveAgent moves on. An id kept past RemoveAgent names no later agent of the slot (until the slot's
+    /// 4,096th reuse), so every call with it is refused (InvalidArgument) instead of acting on a stranger.
     using AgentID = uint32_t;
+    static constexpr uint32_t cAgentSlotBits = 20; ///< Settings::mMaxAgents is at most 2^20
 
     static Result<std::unique_ptr<Crowd>> Create(const NavMeshWorld& inWorld, const Settings& inSettings);
     static Result<std::unique_ptr<Crowd>> Create(const NavMeshWorld& inWorld)
@@ -131,7 +135,7 @@ public:
     Result<float> GetRadius(AgentID inAgent) const;
     /// The agent's corridor, Detour polygon references (to draw it, or to check it against the navmesh).
     Result<std::vector<uint64_t>> GetCorridor(AgentID inAgent) const;
-    /// Agents in the crowd, and the ids in use in increasing order.
+    /// The ids of the agents in the crowd, in slot order (the order of their updates).
     std::vector<AgentID> GetAgents() const;
 
     struct Statistics
@@ -173,9 +177,9 @@ private:
     /// Before the moves, agents [inBegin, inEnd) of mOrder (a ParallelFor chunk): corridors checked against
     /// the navmesh, cut short where a polygon went away, agents re-snapped or set waiting.
     void CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQuery);
-    /// After the checks, agents in id order: the requests for paths, and the checks' statistics.
+    /// After the checks, agents in slot order: the requests for paths, and the checks' statistics.
     void RequestPaths();
-    /// After the moves and the search, agents in id order: the paths found handed to their agents.
+    /// After the moves and the search, agents in slot order: the paths found handed to their agents.
     void ApplyPathResults();
     /// Appends the other crowds' agents to the snapshot and grid.
     void AddOtherCrowds();
@@ -189,9 +193,10 @@ private:
     std::unique_ptr<dtQueryFilter> mFilter;
     std::vector<dtNavMeshQuery*> mQueries; ///< One per ParallelFor chunk, made as needed (scratch only)
     std::vector<std::unique_ptr<dtObstacleAvoidanceQuery>> mAvoidance; ///< Likewise, for the avoidance
-    std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By id; null where removed
-    std::set<AgentID> mFreeIDs;  ///< The ids below mAgents.size() whose slot is null, for the lowest free id
-    std::vector<AgentID> mOrder; ///< The agents in id order, for this Update
+    std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By slot; null where removed
+    std::vector<uint16_t> mGenerations; ///< By slot: the generation of its agent's id (12 bits), see AgentID
+    std::set<uint32_t> mFreeSlots;      ///< The slots below mAgents.size() that are null, for the lowest free
+    std::vector<uint32_t> mOrder;       ///< The agents' slots in order, for this Update
     std::vector<uint32_t> mChunkSampled; ///< Per ParallelFor chunk: its agents that sampled (a chunk's own)
     std::vector<uint32_t> mChunkWalls;   ///< Per ParallelFor chunk: its agents that gathered walls again
     // The snapshot every agent steers from: positions and velocities at the Update's start, by mOrder index
