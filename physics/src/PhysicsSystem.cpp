@@ -90,6 +90,33 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobI
     return UpdateImpl(inDeltaTime, inCollisionSteps, &ioJobs);
 }
 
+Status PhysicsSystem::OptimizeBroadPhase()
+{
+    if (BodyManager::IsInsideStep())
+        return MakeError(ErrorCode::WrongThread, "OptimizeBroadPhase called from inside the physics step");
+    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        return MakeError(ErrorCode::WrongThread,
+                         "OptimizeBroadPhase called while this thread holds a body lock (it would deadlock)");
+    // Acquire and release as Update's: the broad phase's update state passes between the two
+    if (mUpdating.exchange(true, std::memory_order_acquire))
+        return MakeError(ErrorCode::WrongThread,
+                         "OptimizeBroadPhase called while Update runs on another thread");
+    bool locked = false;
+    const ScopeExit release(
+        [&]
+        {
+            if (locked) mBodies->UnlockAllBodies();
+            mUpdating.store(false, std::memory_order_release);
+        });
+    mBodies->LockAllBodies();
+    locked = true;
+    // A rebuild retires the nodes it replaces, and the next update frees them once no query can still be
+    // walking them: the second frees what the first retired (and what removed bodies held)
+    mBroadPhase->Update();
+    mBroadPhase->Update();
+    return Status::Ok();
+}
+
 Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::JobInterface* ioJobs)
 {
     if (!std::isfinite(inDeltaTime) || inDeltaTime <= 0.0f || inDeltaTime > 1.0f)

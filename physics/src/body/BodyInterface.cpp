@@ -44,6 +44,10 @@ const char* MotionTypeName(MotionType inType)
     }
     return "unknown";
 }
+/// What an OutOfCapacity from the broad phase adds: a pool the world's capacity sizes fills with the nodes
+/// of removed bodies too, which only a broad-phase update frees
+constexpr const char* cBroadPhaseFullHint =
+    " (removed bodies hold broad-phase nodes until the next Update or PhysicsSystem::OptimizeBroadPhase)";
 bool IsMotionType(MotionType inType)
 {
     return inType == MotionType::Static || inType == MotionType::Kinematic || inType == MotionType::Dynamic;
@@ -81,7 +85,8 @@ Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
     const BroadPhaseBody entry = ToBroadPhase(*body);
     BroadPhase::AddState state = mBroadPhase.AddBodiesPrepare({&entry, 1});
     if (state == nullptr)
-        return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this body");
+        return MakeError(ErrorCode::OutOfCapacity,
+                         std::string("the broad phase has no room for this body") + cBroadPhaseFullHint);
     mBroadPhase.AddBodiesFinalize(state);
     body->mInWorld = true;
     mBodies.PublishPose(*body); // After the broad phase has its bounds: see PublishedPose.h
@@ -187,7 +192,8 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
     if (batch.mState == nullptr)
     {
         undo();
-        return MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room for this batch");
+        return MakeError(ErrorCode::OutOfCapacity,
+                         std::string("the broad phase has no room for this batch") + cBroadPhaseFullHint);
     }
     return batch;
 }
@@ -533,7 +539,7 @@ Status BodyInterface::SetObjectLayer(const BodyID& inID, ObjectLayer inLayer)
                 return Status(
                     MakeError(ErrorCode::OutOfCapacity, "the broad phase has no room to move the body to "
                                                         "object layer " +
-                                                            std::to_string(inLayer)));
+                                                            std::to_string(inLayer) + cBroadPhaseFullHint));
             mBodies.NotifyChange(BodyChangeKind::Moved, ioBody, bounds);
             return Status::Ok();
         });

@@ -244,6 +244,42 @@ TEST_F(HostileInputTest, AFullWorldSaysSo)
     Step(5);
 }
 
+// A body removed keeps its broad-phase nodes until an update frees them: a world that adds and removes bodies
+// without stepping found its node pool full with no body in it. The error says what frees them, and
+// OptimizeBroadPhase does, between Updates
+TEST_F(HostileInputTest, AddsAndRemovesWithoutStepsFillTheBroadPhaseUntilItIsOptimized)
+{
+    PhysicsSettings settings;
+    settings.mMaxBodies = 16;
+    ResetWorld(settings);
+    BodyCreationSettings box = DynamicSettings(Sphere(1), Vec3(0, 5, 0));
+    box.mMotionType = MotionType::Static;
+    box.mObjectLayer = Layers::cStatic;
+    auto cycle = [&]() -> Status
+    {
+        const Result<BodyID> added = Bodies().CreateAndAddBody(box, Activation::DontActivate);
+        if (!added) return added.GetError();
+        EXPECT_TRUE(Bodies().RemoveBody(added.Value()));
+        EXPECT_TRUE(Bodies().DestroyBody(added.Value()));
+        return Status::Ok();
+    };
+    int cycles = 0;
+    Status last = Status::Ok();
+    while (cycles < 1'000'000 && (last = cycle()))
+        ++cycles;
+    ASSERT_FALSE(last) << "a million adds and removes and the pool never filled: the test tests nothing";
+    EXPECT_EQ(last.GetError().mCode, ErrorCode::OutOfCapacity);
+    EXPECT_NE(last.GetError().mMessage.find("OptimizeBroadPhase"), std::string::npos)
+        << last.GetError().mMessage;
+    EXPECT_EQ(System().GetBroadPhase().GetBodyCount(), 0u);
+
+    ASSERT_TRUE(System().OptimizeBroadPhase());
+    for (int i = 0; i < cycles; ++i)
+        ASSERT_TRUE(cycle()) << "cycle " << i << " of the " << cycles << " that fitted before";
+    ASSERT_TRUE(System().OptimizeBroadPhase());
+    Step(1);
+}
+
 // --- Values the validation lets through --------------------------------------------------------------------
 
 TEST_F(HostileInputTest, PushesAndMovesWithNaNInfOrHugeValuesAreRefusedWhole)

@@ -53,6 +53,13 @@ public:
     /// bit-identical to the single-threaded Update, whatever the number of threads. While it runs, this
     /// thread may run other queued jobs; those must not call BodyInterface (they get WrongThread).
     Status Update(float inDeltaTime, int inCollisionSteps, jobs::JobInterface& ioJobs);
+    /// The broad-phase update of a step, alone: the trees rebuilt and the nodes of removed bodies freed. For
+    /// a world that adds and removes many bodies without stepping (a paused game, a loading screen): a body
+    /// removed keeps its tree nodes until an update, so adds find the node pool full (OutOfCapacity) after
+    /// about one and a half times the capacity in adds. Like Jolt's OptimizeBroadPhase. The thread that
+    /// calls Update, between Updates: it takes every body lock, as a step does. Errors: as Update's
+    /// (WrongThread inside the step, while holding a body lock, or while an Update runs).
+    Status OptimizeBroadPhase();
 
     BodyInterface& GetBodyInterface() { return *mBodyInterface; }
     /// Joints (ConstraintInterface.h): from any thread, outside step callbacks.
