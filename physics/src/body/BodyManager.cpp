@@ -3,6 +3,7 @@
 #include "PublishedPoseStore.h"
 #include "body/StepCallbackScope.h"
 #include "cairn/physics/LockWaits.h"
+#include "cairn/physics/PhysicsSettings.h"
 
 #include <algorithm>
 #include <bit>
@@ -89,14 +90,15 @@ template <class T> T* AllocateSlots(uint32_t inCount)
 } // namespace
 
 BodyManager::BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes)
-    : mMaxBodies(inMaxBodies), mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
-      mBodies(AllocateSlots<Body>(inMaxBodies)), mSlotInUse(new bool[inMaxBodies]()),
-      mGroupFilters(AllocateSlots<std::shared_ptr<const GroupFilterTable>>(inMaxBodies)),
-      mPoses(std::make_unique<PublishedPoseStore>(inMaxBodies))
+    : mMaxBodies(std::clamp(inMaxBodies, 1u, PhysicsSettings::cMaxBodiesLimit)),
+      mMutexMask(std::bit_floor(std::clamp(inNumMutexes, 1u, cNumBodyMutexes)) - 1),
+      mBodies(AllocateSlots<Body>(mMaxBodies)), mSlotInUse(new bool[mMaxBodies]()),
+      mGroupFilters(AllocateSlots<std::shared_ptr<const GroupFilterTable>>(mMaxBodies)),
+      mPoses(std::make_unique<PublishedPoseStore>(mMaxBodies))
 {
     // Reserved whole, so that DestroyBody's push never allocates
-    mFreeList.reserve(inMaxBodies);
-    mActiveBodies.reserve(inMaxBodies);
+    mFreeList.reserve(mMaxBodies);
+    mActiveBodies.reserve(mMaxBodies);
 }
 
 BodyManager::~BodyManager()

@@ -433,8 +433,10 @@ Result<std::shared_ptr<const ConvexHullShape>> ConvexHullShape::Create(std::span
     if (inPoints.size() < 4)
         return MakeError(ErrorCode::DegenerateShape,
                          "ConvexHullShape: needs at least 4 points, got " + std::to_string(inPoints.size()));
-    if (inPoints.size() > size_t(std::numeric_limits<uint32_t>::max()))
-        return MakeError(ErrorCode::InvalidArgument, "ConvexHullShape: too many points");
+    if (inPoints.size() > cMaxInputPoints)
+        return MakeError(ErrorCode::InvalidArgument,
+                         "ConvexHullShape: " + std::to_string(inPoints.size()) + " points, over the " +
+                             std::to_string(cMaxInputPoints) + " a hull is built from");
 
     std::vector<Vec3> vertices;
     std::vector<Face> faces;

@@ -51,6 +51,14 @@ TEST(BodySlotsTest, SlotsGoOutInIndexOrderAFreedOneFirstWithTheNextSequence)
     EXPECT_EQ(fresh.DestroyBody(BodyID(5, 0)).GetError().mCode, ErrorCode::InvalidBodyID);
 }
 
+// The capacity is clamped into [1, PhysicsSettings::cMaxBodiesLimit], as the shard count is into its range:
+// 2^32 slots threw bad_alloc (the top end is not made here: its storage is a quarter gigabyte)
+TEST(BodySlotsTest, TheCapacityIsClampedIntoRange)
+{
+    EXPECT_EQ(BodyManager(0).GetMaxBodies(), 1u);
+    EXPECT_EQ(BodyManager(5).GetMaxBodies(), 5u);
+}
+
 TEST(BodySlotsTest, TheBodiesMadeAreDestroyedWithTheManager)
 {
     const ShapeRef sphere = SphereShape::Create(0.5f).Value();

@@ -101,6 +101,22 @@ TEST(ConvexHullShapeTest, RejectsBadInput)
     EXPECT_NE(p.GetError().mMessage.find("coplanar"), std::string::npos);
 }
 
+// The build grows faster than the point count (100,000 points on a sphere took 38 s): a cloud over the limit
+// is refused at once, one at the limit is built
+TEST(ConvexHullShapeTest, MorePointsThanTheLimitAreRefused)
+{
+    std::vector<Vec3> points;
+    for (size_t i = 0; i <= ConvexHullShape::cMaxInputPoints; ++i)
+        points.push_back(Vec3(float(i % 7), float(i % 11), float(i % 13))); // Inside a 6 x 10 x 12 box
+    const auto tooMany = ConvexHullShape::Create(points);
+    ASSERT_FALSE(tooMany);
+    EXPECT_EQ(tooMany.GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_NE(tooMany.GetError().mMessage.find("16385 points"), std::string::npos)
+        << tooMany.GetError().mMessage;
+    points.pop_back();
+    EXPECT_TRUE(ConvexHullShape::Create(points));
+}
+
 TEST(ConvexHullShapeTest, BoxCornersMatchBox)
 {
     const Vec3 half(0.5f, 1.0f, 2.0f);

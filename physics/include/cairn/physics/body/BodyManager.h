@@ -45,6 +45,8 @@ class BodyManager
 public:
     static constexpr uint32_t cNumBodyMutexes = 32; ///< Shards at most (and by default)
 
+    /// inMaxBodies is clamped to [1, PhysicsSettings::cMaxBodiesLimit] (every slot's storage is set aside at
+    /// once: 2^32 of them threw bad_alloc); PhysicsSystem::Create refuses a count out of range instead.
     /// inNumMutexes: shards, a power of two from 1 to cNumBodyMutexes (others are rounded down into range).
     explicit BodyManager(uint32_t inMaxBodies, uint32_t inNumMutexes = cNumBodyMutexes);
     ~BodyManager();

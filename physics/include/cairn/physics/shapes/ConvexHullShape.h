@@ -21,9 +21,13 @@ public:
         std::vector<uint32_t> mIndices; ///< Into GetVertices(); coplanar triangles are merged into one face
     };
 
+    /// The most points Create takes. The build grows faster than the point count (some 6 s for 40,000
+    /// points on a sphere), and a game's hulls have tens to hundreds: reduce a larger cloud first.
+    static constexpr size_t cMaxInputPoints = 16384;
+
     /// Builds the hull of inPoints. Fails with DegenerateShape for fewer than 4 points, coincident,
-    /// collinear or coplanar input (no volume), and with InvalidArgument for NaN/infinite points.
-    /// Points inside the hull are dropped.
+    /// collinear or coplanar input (no volume), and with InvalidArgument for NaN/infinite points or more
+    /// than cMaxInputPoints. Points inside the hull are dropped.
     static Result<std::shared_ptr<const ConvexHullShape>> Create(std::span<const Vec3> inPoints);
 
     const std::vector<Vec3>& GetVertices() const { return mVertices; }
