@@ -6,6 +6,7 @@
 #include "broadphase/BroadPhaseQuadTree.h"
 #include "cairn/physics/LockWaits.h"
 
+#include <string>
 #include <utility>
 
 namespace cairn::physics
@@ -31,6 +32,20 @@ std::unique_ptr<BroadPhase> CreateBroadPhase(const PhysicsSettings& inSettings, 
         return std::make_unique<BroadPhaseGlobalMutex>(quadTree());
     }
     return nullptr;
+}
+
+/// WrongThread for a call that would take every body lock (inCall: Update, OptimizeBroadPhase) from inside
+/// the step or while this thread holds a body lock, where it would deadlock; else Ok.
+Status CheckMayLockAllBodies(const char* inCall)
+{
+    if (BodyManager::IsInsideStep())
+        return MakeError(ErrorCode::WrongThread,
+                         std::string(inCall) + " called from inside the physics step");
+    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        return MakeError(ErrorCode::WrongThread, std::string(inCall) +
+                                                     " called while this thread holds a body lock (it would "
+                                                     "deadlock)");
+    return Status::Ok();
 }
 
 /// Runs a function when it goes out of scope, whichever way: a return or an exception.
@@ -92,11 +107,7 @@ Status PhysicsSystem::Update(float inDeltaTime, int inCollisionSteps, jobs::JobI
 
 Status PhysicsSystem::OptimizeBroadPhase()
 {
-    if (BodyManager::IsInsideStep())
-        return MakeError(ErrorCode::WrongThread, "OptimizeBroadPhase called from inside the physics step");
-    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
-        return MakeError(ErrorCode::WrongThread,
-                         "OptimizeBroadPhase called while this thread holds a body lock (it would deadlock)");
+    if (Status may = CheckMayLockAllBodies("OptimizeBroadPhase"); !may) return may;
     // Acquire and release as Update's: the broad phase's update state passes between the two
     if (mUpdating.exchange(true, std::memory_order_acquire))
         return MakeError(ErrorCode::WrongThread,
@@ -123,11 +134,7 @@ Status PhysicsSystem::UpdateImpl(float inDeltaTime, int inCollisionSteps, jobs::
         return MakeError(ErrorCode::InvalidArgument, "time step must be in (0, 1] s");
     if (inCollisionSteps < 1 || inCollisionSteps > 16)
         return MakeError(ErrorCode::InvalidArgument, "collision steps must be in 1..16");
-    if (BodyManager::IsInsideStep())
-        return MakeError(ErrorCode::WrongThread, "Update called from inside the physics step");
-    if (BodyManager::GetBodyLocksHeldByThisThread() > 0)
-        return MakeError(ErrorCode::WrongThread,
-                         "Update called while this thread holds a body lock (it would deadlock)");
+    if (Status may = CheckMayLockAllBodies("Update"); !may) return may;
     // Acquire pairs with the release below, so a step sees everything the previous updating thread wrote
     if (mUpdating.exchange(true, std::memory_order_acquire))
         return MakeError(ErrorCode::WrongThread, "Update is already running on another thread");
