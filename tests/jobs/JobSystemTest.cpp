@@ -574,7 +574,7 @@ TEST_P(JobSystemThreads, WaitIdleInsideAJobIsRefused)
 TEST_P(JobSystemThreads, AJobsWaitForItselfIsRefused)
 {
     JobSystem jobs(MakeSettings());
-    std::atomic<JobHandle> self{JobHandle{}};
+    JobHandle self; // Plain: written before the release below, read after the acquire that pairs with it
     std::atomic<bool> published{false};
     bool selfWait = true, childWait = false, childRan = false;
     const JobHandle job = jobs.Schedule("waits for itself",
@@ -583,12 +583,12 @@ TEST_P(JobSystemThreads, AJobsWaitForItselfIsRefused)
                                             // Acquire: pairs with the release that publishes the handle
                                             while (!published.load(std::memory_order_acquire))
                                                 std::this_thread::yield();
-                                            selfWait = jobs.Wait(self.load(std::memory_order_relaxed));
+                                            selfWait = jobs.Wait(self);
                                             childWait =
                                                 jobs.Wait(jobs.Schedule("child", [&] { childRan = true; }));
                                         });
-    self.store(job, std::memory_order_relaxed);
-    published.store(true, std::memory_order_release); // Release: the handle is stored before
+    self = job;
+    published.store(true, std::memory_order_release); // Release: the handle is written before
     EXPECT_TRUE(jobs.Wait(job));
     EXPECT_FALSE(selfWait);
     EXPECT_TRUE(childWait);
