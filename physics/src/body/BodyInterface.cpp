@@ -48,10 +48,6 @@ const char* MotionTypeName(MotionType inType)
 /// of removed bodies too, which only a broad-phase update frees
 constexpr const char* cBroadPhaseFullHint =
     " (removed bodies hold broad-phase nodes until the next Update or PhysicsSystem::OptimizeBroadPhase)";
-bool IsMotionType(MotionType inType)
-{
-    return inType == MotionType::Static || inType == MotionType::Kinematic || inType == MotionType::Dynamic;
-}
 } // namespace
 
 BodyInterface::BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, const LayerSetup& inLayers)
@@ -448,7 +444,7 @@ Status BodyInterface::DeactivateBody(const BodyID& inID)
 
 Status BodyInterface::SetMotionType(const BodyID& inID, MotionType inMotionType, Activation inActivation)
 {
-    if (!IsMotionType(inMotionType))
+    if (!IsValidMotionType(inMotionType))
         return MakeError(ErrorCode::InvalidArgument, "motion type " + std::to_string(int(inMotionType)) +
                                                          " is not static, kinematic or dynamic");
     return ModifyBody(

@@ -49,9 +49,7 @@ Status ValidateSettings(const BodyCreationSettings& inSettings)
         return invalid("velocity limits must be in (0, 1e5] m/s and rad/s");
     // A value outside the enum would be a body that is none of the three (never integrated, yet active) and
     // would spill out of its two bits into the layer of its published pose
-    if (inSettings.mMotionType != MotionType::Static && inSettings.mMotionType != MotionType::Kinematic &&
-        inSettings.mMotionType != MotionType::Dynamic)
-        return invalid("motion type is not a MotionType");
+    if (!IsValidMotionType(inSettings.mMotionType)) return invalid("motion type is not a MotionType");
     if (inSettings.mMotionQuality != MotionQuality::Discrete &&
         inSettings.mMotionQuality != MotionQuality::LinearCast)
         return invalid("motion quality is not a MotionQuality");

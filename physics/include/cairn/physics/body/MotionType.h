@@ -12,6 +12,12 @@ enum class MotionType : uint8_t
     Dynamic,   ///< Moved by forces and contacts
 };
 
+/// Whether inType is one of the three: a value cast from a number (a file, a script) may be none of them.
+constexpr bool IsValidMotionType(MotionType inType)
+{
+    return inType == MotionType::Static || inType == MotionType::Kinematic || inType == MotionType::Dynamic;
+}
+
 /// How a dynamic body's motion is checked against what it could pass through in one step.
 enum class MotionQuality : uint8_t
 {
