@@ -91,12 +91,21 @@ void JobSystem::ExtendSpin(uint64_t inNanoseconds)
     }
 }
 
+namespace
+{
+/// Settings::mMaxJobs in its range (see there).
+uint32_t ClampedMaxJobs(const JobSystem::Settings& inSettings)
+{
+    return std::clamp<uint32_t>(inSettings.mMaxJobs, 1, JobSystem::cMaxJobsLimit);
+}
+} // namespace
+
 JobSystem::JobSystem() : JobSystem(Settings{}) {}
 
 JobSystem::JobSystem(const Settings& inSettings)
-    : mSlots(std::make_unique<JobSlot[]>(std::clamp<uint32_t>(inSettings.mMaxJobs, 1, cMaxJobsLimit))),
-      mMaxJobs(std::clamp<uint32_t>(inSettings.mMaxJobs, 1, cMaxJobsLimit)), mReady(mMaxJobs),
-      mUseLoopBoard(inSettings.mUseLoopBoard), mSearchMarks(mMaxJobs, 0u), mSearchStack(mMaxJobs)
+    : mSlots(std::make_unique<JobSlot[]>(ClampedMaxJobs(inSettings))), mMaxJobs(ClampedMaxJobs(inSettings)),
+      mReady(mMaxJobs), mUseLoopBoard(inSettings.mUseLoopBoard), mSearchMarks(mMaxJobs, 0u),
+      mSearchStack(mMaxJobs)
 {
     mFree.reserve(mMaxJobs);
     for (uint32_t i = mMaxJobs; i-- > 0;)

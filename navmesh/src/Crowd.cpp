@@ -228,15 +228,27 @@ Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const 
 
 namespace
 {
-constexpr uint32_t cAgentSlotMask = (1u << Crowd::cAgentSlotBits) - 1;
 constexpr uint32_t cAgentGenerationMask = (1u << (32 - Crowd::cAgentSlotBits)) - 1;
+
+uint32_t SlotOf(Crowd::AgentID inAgent)
+{
+    return inAgent & ((1u << Crowd::cAgentSlotBits) - 1);
+}
+uint32_t GenerationOf(Crowd::AgentID inAgent)
+{
+    return inAgent >> Crowd::cAgentSlotBits;
+}
+Crowd::AgentID MakeAgentID(uint32_t inSlot, uint16_t inGeneration)
+{
+    return inSlot | Crowd::AgentID(inGeneration) << Crowd::cAgentSlotBits;
+}
 } // namespace
 
 Crowd::Agent* Crowd::Find(AgentID inAgent) const
 {
-    const uint32_t slot = inAgent & cAgentSlotMask;
-    return slot < mAgents.size() && mGenerations[slot] == inAgent >> cAgentSlotBits ? mAgents[slot].get()
-                                                                                    : nullptr;
+    const uint32_t slot = SlotOf(inAgent);
+    return slot < mAgents.size() && mGenerations[slot] == GenerationOf(inAgent) ? mAgents[slot].get()
+                                                                                : nullptr;
 }
 
 Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams& inParams)
@@ -286,7 +298,7 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
         mGenerations.push_back(0);
     }
     mAgents[slot] = std::move(agent);
-    return slot | AgentID(mGenerations[slot]) << cAgentSlotBits;
+    return MakeAgentID(slot, mGenerations[slot]);
 }
 
 Status Crowd::RemoveAgent(AgentID inAgent)
@@ -294,7 +306,7 @@ Status Crowd::RemoveAgent(AgentID inAgent)
     Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
     if (agent->mTicket.mValue != 0) mPaths->Cancel(agent->mTicket);
-    const uint32_t slot = inAgent & cAgentSlotMask;
+    const uint32_t slot = SlotOf(inAgent);
     mAgents[slot].reset();
     mGenerations[slot] = uint16_t((mGenerations[slot] + 1) & cAgentGenerationMask);
     mFreeSlots.insert(slot);
@@ -653,7 +665,7 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
 
 void Crowd::RequestPaths()
 {
-    // In id order, so the queue gets the same requests in the same order for any number of threads
+    // In slot order, so the queue gets the same requests in the same order for any number of threads
     for (const uint32_t id : mOrder)
     {
         Agent& agent = *mAgents[id];
@@ -947,7 +959,7 @@ std::vector<Crowd::AgentID> Crowd::GetAgents() const
 {
     std::vector<AgentID> ids;
     for (uint32_t slot = 0; slot < mAgents.size(); ++slot)
-        if (mAgents[slot] != nullptr) ids.push_back(slot | AgentID(mGenerations[slot]) << cAgentSlotBits);
+        if (mAgents[slot] != nullptr) ids.push_back(MakeAgentID(slot, mGenerations[slot]));
     return ids;
 }
 

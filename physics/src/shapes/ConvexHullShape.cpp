@@ -425,6 +425,10 @@ private:
 
 Result<std::shared_ptr<const ConvexHullShape>> ConvexHullShape::Create(std::span<const Vec3> inPoints)
 {
+    if (inPoints.size() > cMaxInputPoints)
+        return MakeError(ErrorCode::InvalidArgument,
+                         "ConvexHullShape: " + std::to_string(inPoints.size()) + " points, over the " +
+                             std::to_string(cMaxInputPoints) + " a hull is built from");
     for (size_t i = 0; i < inPoints.size(); ++i)
         if (!IsValidWorldPosition(inPoints[i]))
             return MakeError(ErrorCode::InvalidArgument,
@@ -433,10 +437,6 @@ Result<std::shared_ptr<const ConvexHullShape>> ConvexHullShape::Create(std::span
     if (inPoints.size() < 4)
         return MakeError(ErrorCode::DegenerateShape,
                          "ConvexHullShape: needs at least 4 points, got " + std::to_string(inPoints.size()));
-    if (inPoints.size() > cMaxInputPoints)
-        return MakeError(ErrorCode::InvalidArgument,
-                         "ConvexHullShape: " + std::to_string(inPoints.size()) + " points, over the " +
-                             std::to_string(cMaxInputPoints) + " a hull is built from");
 
     std::vector<Vec3> vertices;
     std::vector<Face> faces;
