@@ -1,9 +1,11 @@
 #include "cairn/physics/body/BodyInterface.h"
 
+#include "body/AddBatchRegistry.h"
 #include "cairn/physics/body/BodyLock.h"
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace cairn::physics
 {
@@ -51,8 +53,16 @@ constexpr const char* cBroadPhaseFullHint =
 } // namespace
 
 BodyInterface::BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, const LayerSetup& inLayers)
-    : mBodies(ioBodies), mBroadPhase(ioBroadPhase), mLayers(inLayers)
+    : mBodies(ioBodies), mBroadPhase(ioBroadPhase), mLayers(inLayers),
+      mBatches(std::make_shared<AddBatchRegistry>(*this))
 {
+}
+
+BodyInterface::~BodyInterface()
+{
+    // The bodies go with the world, so only the broad phase's prepared states need freeing
+    for (BroadPhase::AddState state : mBatches->Close())
+        mBroadPhase.AddBodiesAbort(state);
 }
 
 Result<BodyID> BodyInterface::CreateBody(const BodyCreationSettings& inSettings)
@@ -66,11 +76,13 @@ Result<BodyID> BodyInterface::CreateBody(const BodyCreationSettings& inSettings)
 
 Status BodyInterface::DestroyBody(const BodyID& inID)
 {
+    AbortDeferredBatches(); // A body of a batch let go inside the step is pending until then
     return mBodies.DestroyBody(inID);
 }
 
 Status BodyInterface::AddBody(const BodyID& inID, Activation inActivation)
 {
+    AbortDeferredBatches();
     BodyLockWrite lock(mBodies, inID);
     if (lock.WasWrongThread()) return WrongThread();
     Body* body = lock.GetBody();
@@ -154,8 +166,8 @@ void BodyInterface::WakeBodiesIn(const AABB& inBounds, ObjectLayerMask inLayers)
 Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const BodyID> inIDs)
 {
     if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
+    AbortDeferredBatches();
     AddBatch batch;
-    batch.mOwner = this;
     batch.mBodies.reserve(inIDs.size());
     auto undo = [&]
     {
@@ -191,6 +203,8 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
         return MakeError(ErrorCode::OutOfCapacity,
                          std::string("the broad phase has no room for this batch") + cBroadPhaseFullHint);
     }
+    mBatches->Register(batch.mState);
+    batch.mRegistry = mBatches;
     return batch;
 }
 
@@ -199,7 +213,9 @@ Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivati
     if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
     if (ioBatch.mState == nullptr)
         return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
-    if (ioBatch.mOwner != this) return OtherWorldsBatch();
+    if (ioBatch.mRegistry != mBatches) return OtherWorldsBatch();
+    AbortDeferredBatches();
+    mBatches->Unregister(ioBatch.mState);
     mBroadPhase.AddBodiesFinalize(ioBatch.mState);
     ioBatch.mState = nullptr;
     for (const BroadPhaseBody& entry : ioBatch.mBodies)
@@ -231,16 +247,79 @@ Status BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
         return Status::Ok(); // Finished: nothing to free
     // Refused whole: a body lock this thread could not take would leave its body pending for good
     if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
-    if (ioBatch.mOwner != this) return OtherWorldsBatch();
-    if (ioBatch.mState != nullptr) mBroadPhase.AddBodiesAbort(ioBatch.mState);
-    ioBatch.mState = nullptr;
-    for (const BroadPhaseBody& entry : ioBatch.mBodies)
+    if (ioBatch.mRegistry != mBatches) return OtherWorldsBatch();
+    AbortDeferredBatches();
+    AbortBatchParts(std::exchange(ioBatch.mState, nullptr), ioBatch.mBodies);
+    ioBatch.mBodies.clear();
+    return Status::Ok();
+}
+
+void BodyInterface::AbortBatchParts(BroadPhase::AddState inState, const std::vector<BroadPhaseBody>& inBodies)
+{
+    if (inState != nullptr)
+    {
+        mBatches->Unregister(inState);
+        mBroadPhase.AddBodiesAbort(inState);
+    }
+    for (const BroadPhaseBody& entry : inBodies)
     {
         BodyLockWrite lock(mBodies, entry.mID);
         if (Body* body = lock.GetBody(); body != nullptr) body->mAddPending = false;
     }
-    ioBatch.mBodies.clear();
-    return Status::Ok();
+}
+
+void BodyInterface::AbortLetGo(AddBatch& ioBatch)
+{
+    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        mBatches->Defer({std::exchange(ioBatch.mState, nullptr), std::move(ioBatch.mBodies)});
+    else
+        AbortBatchParts(std::exchange(ioBatch.mState, nullptr), ioBatch.mBodies);
+}
+
+void BodyInterface::AbortDeferredBatches()
+{
+    if (!mBatches->HasDeferred() || BodyManager::IsInsideStep() ||
+        BodyManager::GetBodyLocksHeldByThisThread() > 0)
+        return;
+    for (const AddBatchRegistry::Deferred& batch : mBatches->TakeDeferred())
+        AbortBatchParts(batch.mState, batch.mBodies);
+}
+
+BodyInterface::AddBatch::AddBatch(AddBatch&& ioOther) noexcept
+    : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr)),
+      mRegistry(std::move(ioOther.mRegistry))
+{
+    ioOther.mBodies.clear();
+}
+
+BodyInterface::AddBatch& BodyInterface::AddBatch::operator=(AddBatch&& ioOther) noexcept
+{
+    if (this == &ioOther) return *this;
+    LetGo();
+    mBodies = std::move(ioOther.mBodies);
+    ioOther.mBodies.clear();
+    mState = std::exchange(ioOther.mState, nullptr);
+    mRegistry = std::move(ioOther.mRegistry);
+    return *this;
+}
+
+BodyInterface::AddBatch::~AddBatch()
+{
+    LetGo();
+}
+
+void BodyInterface::AddBatch::LetGo() noexcept
+{
+    if (mState != nullptr && mRegistry != nullptr)
+        // The registry keeps the world alive until LeaveDrop, or says that it is gone with the batch's state
+        if (BodyInterface* world = mRegistry->EnterDrop(); world != nullptr)
+        {
+            world->AbortLetGo(*this);
+            mRegistry->LeaveDrop();
+        }
+    mState = nullptr;
+    mBodies.clear();
+    mRegistry.reset();
 }
 
 template <class F> Status BodyInterface::ModifyBody(const BodyID& inID, bool inMustBeDynamic, F&& inChange)
@@ -508,6 +587,7 @@ Status BodyInterface::SetObjectLayer(const BodyID& inID, ObjectLayer inLayer)
     if (!mLayers.IsValid(inLayer))
         return MakeError(ErrorCode::InvalidArgument,
                          "object layer " + std::to_string(inLayer) + " is not in the layer setup");
+    AbortDeferredBatches(); // A batch let go inside the step no longer holds the body's old layer
     return ModifyBody(
         inID, false,
         [&](Body& ioBody)

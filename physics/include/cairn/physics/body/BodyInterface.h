@@ -17,17 +17,24 @@
 #include "cairn/physics/body/BodyManager.h"
 #include "cairn/physics/broadphase/BroadPhase.h"
 
+#include <memory>
 #include <span>
-#include <utility>
 #include <vector>
 
 namespace cairn::physics
 {
 
+class AddBatchRegistry;
+
 class BodyInterface
 {
 public:
     BodyInterface(BodyManager& ioBodies, BroadPhase& ioBroadPhase, const LayerSetup& inLayers);
+    /// Aborts the add batches still prepared (they may outlive the world, and then do nothing when let go).
+    /// Waits for a batch being let go on another thread meanwhile.
+    ~BodyInterface();
+    BodyInterface(const BodyInterface&) = delete;
+    BodyInterface& operator=(const BodyInterface&) = delete;
 
     /// Creates a body (not yet in the world).
     Result<BodyID> CreateBody(const BodyCreationSettings& inSettings);
@@ -42,26 +49,34 @@ public:
 
     /// A batch of bodies being added: the slow part (broad-phase preparation) runs on the caller's thread
     /// without touching the live world; AddBodiesFinalize then links it quickly.
-    /// Move-only: it owns the broad phase's prepared state, which must be finalized or aborted exactly once
-    /// (a copy finalized and then the original aborted would free it twice).
+    /// Move-only: it owns the broad phase's prepared state, which is finalized or aborted exactly once (a
+    /// copy finalized and then the original aborted would free it twice). A batch destroyed or overwritten
+    /// before either is aborted: at once on a thread that may call AddBodiesAbort; inside a step or under a
+    /// body lock, by the world's next call that takes its bodies (AddBody, DestroyBody, SetObjectLayer, the
+    /// batch calls); after its world is gone, not at all (the world aborted it as it went). A loader that
+    /// bails out on an error leaks nothing and leaves no body pending.
     struct AddBatch
     {
-        std::vector<BroadPhaseBody> mBodies;
-        BroadPhase::AddState mState = nullptr;
-        /// The interface that prepared it: its ids and broad-phase state mean nothing to another world's
-        const BodyInterface* mOwner = nullptr;
         bool IsEmpty() const { return mBodies.empty(); }
+        size_t GetNumBodies() const { return mBodies.size(); }
 
         AddBatch() = default;
-        AddBatch(AddBatch&& ioOther) noexcept
-            : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr)),
-              mOwner(std::exchange(ioOther.mOwner, nullptr))
-        {
-            ioOther.mBodies.clear();
-        }
+        AddBatch(AddBatch&& ioOther) noexcept;
+        AddBatch& operator=(AddBatch&& ioOther) noexcept;
         AddBatch(const AddBatch&) = delete;
         AddBatch& operator=(const AddBatch&) = delete;
-        AddBatch& operator=(AddBatch&&) = delete; ///< Overwriting a prepared batch would leak it
+        ~AddBatch();
+
+    private:
+        friend class BodyInterface;
+        /// Aborts a batch that is neither finalized nor aborted, as the struct's comment says
+        void LetGo() noexcept;
+
+        std::vector<BroadPhaseBody> mBodies;
+        BroadPhase::AddState mState = nullptr;
+        /// The registry of the world that prepared it: its ids and broad-phase state mean nothing to another
+        /// world's, and it outlives the world, which tells a batch let go after the world that it is gone
+        std::shared_ptr<AddBatchRegistry> mRegistry;
     };
     /// Fails (and marks nothing) if any id is stale, already in the world, or already in another batch.
     Result<AddBatch> AddBodiesPrepare(std::span<const BodyID> inIDs);
@@ -156,10 +171,18 @@ private:
     void OnBodyMoved(Body& ioBody, Activation inActivation);
     /// Activates every sleeping dynamic body of inLayers whose bounds overlap inBounds (after a removal).
     void WakeBodiesIn(const AABB& inBounds, ObjectLayerMask inLayers);
+    /// A batch let go (AddBatch::LetGo): aborted now, or deferred where this thread may not lock its bodies
+    void AbortLetGo(AddBatch& ioBatch);
+    /// Aborts the batches let go inside a step or under a body lock; on a thread that may lock bodies only
+    void AbortDeferredBatches();
+    /// Frees a batch's broad-phase state (if any) and its bodies' pending marks
+    void AbortBatchParts(BroadPhase::AddState inState, const std::vector<BroadPhaseBody>& inBodies);
 
     BodyManager& mBodies;
     BroadPhase& mBroadPhase;
     const LayerSetup& mLayers;
+    /// The batches this world prepared and has not finished (AddBatchRegistry.h says which threads)
+    std::shared_ptr<AddBatchRegistry> mBatches;
 };
 
 } // namespace cairn::physics
