@@ -59,7 +59,7 @@ MassProperties BoxShape::GetMassProperties(float inDensity) const
     return props;
 }
 
-bool BoxShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool BoxShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     const Vec3& o = inLocalRay.mOrigin;
     const Vec3& d = inLocalRay.mDirection;

@@ -140,7 +140,7 @@ MassProperties CapsuleShape::GetMassProperties(float inDensity) const
     return props;
 }
 
-bool CapsuleShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool CapsuleShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     const Vec3& o = inLocalRay.mOrigin;
     const Vec3& d = inLocalRay.mDirection;

@@ -115,7 +115,7 @@ uint32_t CompoundShape::GetManifoldChild(SubShapeID inID, size_t inNumChildren)
     return bits == 0 ? 0u : inID & ((1u << bits) - 1u);
 }
 
-bool CompoundShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool CompoundShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     bool hit = false;
     for (size_t i = 0; i < mSubShapes.size(); ++i)

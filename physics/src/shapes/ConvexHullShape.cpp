@@ -496,7 +496,7 @@ MassProperties ConvexHullShape::GetMassProperties(float inDensity) const
     return props;
 }
 
-bool ConvexHullShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool ConvexHullShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     // Clip the segment against every face plane; the last plane entered is the hit face
     float tEnter = 0.0f;

@@ -278,7 +278,7 @@ void HeightFieldShape::VisitTriangles(const AABB& inLocalBox, TriangleVisitor in
             VisitCell(*this, x, z, &inLocalBox, true, inVisitor);
 }
 
-bool HeightFieldShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool HeightFieldShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     if (!IsFinite(inLocalRay.mOrigin) || !IsFinite(inLocalRay.mDirection) || !(ioHit.mFraction >= 0.0f))
         return false;

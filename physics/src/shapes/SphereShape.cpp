@@ -40,7 +40,7 @@ MassProperties SphereShape::GetMassProperties(float inDensity) const
     return props;
 }
 
-bool SphereShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool SphereShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     const Vec3& o = inLocalRay.mOrigin;
     const Vec3& d = inLocalRay.mDirection;

@@ -251,7 +251,7 @@ MassProperties TriangleMeshShape::GetMassProperties(float /*inDensity*/) const
     return {};
 }
 
-bool TriangleMeshShape::CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+bool TriangleMeshShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
 {
     const Vec3 invDirection = SafeReciprocal(inLocalRay.mDirection);
     float closest = std::min(ioHit.mFraction, 1.0f);

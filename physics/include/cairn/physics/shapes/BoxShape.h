@@ -18,7 +18,6 @@ public:
 
     AABB GetLocalBounds() const override;
     MassProperties GetMassProperties(float inDensity) const override;
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
     Vec3 GetSupport(const Vec3& inDirection) const override;
     void GetSupportingFace(const Vec3& inDirection, SupportingFace& outFace) const override;
@@ -26,6 +25,8 @@ public:
     explicit BoxShape(const Vec3& inHalfExtent); ///< Use Create(), which validates
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
+
     Vec3 mHalfExtent; ///< Metres, each > 0
 };
 

@@ -22,7 +22,6 @@ public:
     /// The box of the inner segment's two ends grown by the radius: tight at every rotation.
     AABB GetWorldBounds(const Transform& inTransform) const override;
     MassProperties GetMassProperties(float inDensity) const override;
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
     Vec3 GetSupport(const Vec3& inDirection) const override;
     /// Two points (the segment pushed out by the radius) when inDirection is nearly perpendicular to the
@@ -32,6 +31,8 @@ public:
     CapsuleShape(float inHalfHeight, float inRadius); ///< Use Create(), which validates
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
+
     float mHalfHeight; ///< Half the inner segment length, >= 0
     float mRadius;     ///< > 0
 };

@@ -47,12 +47,13 @@ public:
     AABB GetLocalBounds() const override;
     AABB GetWorldBounds(const Transform& inTransform) const override;
     MassProperties GetMassProperties(float inDensity) const override; ///< Sum of children (parallel axis)
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
 
     explicit CompoundShape(std::vector<SubShape> inSubShapes); ///< Use Create()
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
+
     std::vector<SubShape> mSubShapes;
     AABB mBounds;
     uint32_t mDepth = 1;

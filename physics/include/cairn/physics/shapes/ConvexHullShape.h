@@ -35,7 +35,6 @@ public:
 
     AABB GetLocalBounds() const override;
     MassProperties GetMassProperties(float inDensity) const override;
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
     Vec3 GetSupport(const Vec3& inDirection) const override;
     void GetSupportingFace(const Vec3& inDirection, SupportingFace& outFace) const override;
@@ -43,6 +42,8 @@ public:
     ConvexHullShape(std::vector<Vec3> inVertices, std::vector<Face> inFaces); ///< Use Create()
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
+
     std::vector<Vec3> mVertices; ///< Hull vertices only
     std::vector<Face> mFaces;    ///< Planar faces, merged
     AABB mBounds;                ///< Local bounds of mVertices

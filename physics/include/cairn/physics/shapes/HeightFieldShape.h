@@ -48,14 +48,15 @@ public:
     }
 
     AABB GetLocalBounds() const override;
-    MassProperties GetMassProperties(float inDensity) const override;      ///< Zero mass: no volume
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
+    MassProperties GetMassProperties(float inDensity) const override; ///< Zero mass: no volume
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
 
     HeightFieldShape(uint32_t inSampleCountX, uint32_t inSampleCountZ, float inCellSize,
                      std::vector<float> inHeights); ///< Use Create()
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
+
     uint32_t mSampleCountX;
     uint32_t mSampleCountZ;
     float mCellSize;

@@ -46,6 +46,20 @@ struct RayCast
     Vec3 mDirection = Vec3::Zero(); ///< Full displacement, not unit length; at most cMaxRayLength for queries
 };
 
+/// The largest coordinate of a ray that a shape casts in its local space. A world query's ray, taken into a
+/// body's space and a compound child's, stays within it (origins within the world, shapes' offsets within
+/// it, lengths at most cMaxRayLength); the shapes' squares stay far from a float's overflow.
+inline constexpr float cMaxLocalRayCoordinate = 2.0f * cMaxRayLength;
+
+/// Whether Shape::CastRay takes the ray: every coordinate of its origin and direction finite and within
+/// cMaxLocalRayCoordinate.
+inline bool IsCastableRay(const RayCast& inRay)
+{
+    // One comparison a coordinate: false for NaN as well as for an infinity or a huge value
+    return (inRay.mOrigin.cwiseAbs().array() <= cMaxLocalRayCoordinate).all() &&
+           (inRay.mDirection.cwiseAbs().array() <= cMaxLocalRayCoordinate).all();
+}
+
 /// Identifies a part of a shape: a triangle of a mesh, a cell half of a height field, a compound child...
 /// Shapes with one part use 0.
 using SubShapeID = uint32_t;
@@ -109,8 +123,13 @@ public:
     virtual MassProperties GetMassProperties(float inDensity) const = 0;
 
     /// Closest hit of a local-space ray with fraction < ioHit.mFraction; updates ioHit and returns true on a
-    /// hit. A ray starting inside a solid shape hits at fraction 0 (normal = -ray direction).
-    virtual bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const = 0;
+    /// hit. A ray starting inside a solid shape hits at fraction 0 (normal = -ray direction). A ray that
+    /// IsCastableRay refuses has no hit (WorldQuery's rays all pass: it refuses the others with an error):
+    /// the ray tests' maths on a NaN, an infinity or an overflowing square reported hits anywhere.
+    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const
+    {
+        return IsCastableRay(inLocalRay) && CastCheckedRay(inLocalRay, ioHit);
+    }
 
     /// Visits every triangle of the surface that may overlap inLocalBox (local space). Convex primitives
     /// visit a tessellation (spheres and capsules with a fixed resolution). Visiting extra triangles is
@@ -121,6 +140,10 @@ public:
     /// overlap inWorldBox: the navmesh collects geometry with this.
     void CollectTriangles(const AABB& inWorldBox, const Transform& inTransform,
                           std::vector<Vec3>& outVertices) const;
+
+protected:
+    /// CastRay for a ray that IsCastableRay accepts.
+    virtual bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const = 0;
 
 private:
     ShapeType mType;

@@ -20,13 +20,14 @@ public:
     /// The centre grown by the radius: a sphere's box does not turn with it.
     AABB GetWorldBounds(const Transform& inTransform) const override;
     MassProperties GetMassProperties(float inDensity) const override;
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
     Vec3 GetSupport(const Vec3& inDirection) const override;
 
     explicit SphereShape(float inRadius); ///< Use Create(), which validates
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override;
+
     float mRadius; ///< Metres, > 0
 };
 

@@ -31,8 +31,7 @@ public:
     size_t GetTriangleCount() const;
 
     AABB GetLocalBounds() const override;
-    MassProperties GetMassProperties(float inDensity) const override;      ///< Zero mass: no volume
-    bool CastRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
+    MassProperties GetMassProperties(float inDensity) const override; ///< Zero mass: no volume
     void VisitTriangles(const AABB& inLocalBox, TriangleVisitor inVisitor) const override;
 
     struct Impl;
@@ -40,6 +39,8 @@ public:
     ~TriangleMeshShape() override;
 
 private:
+    bool CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const override; ///< Two-sided
+
     std::unique_ptr<Impl> mImpl; ///< Vertices, triangles with edge flags, BVH nodes
 };
 
