@@ -625,13 +625,15 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
                 ++probeCount;
             }
 
-            // The running count, now and then, so the main thread can stop at the target
+            // The running counts, now and then, so the main thread can stop at the targets
             if (count >= 1024)
             {
                 checks.fetch_add(count, std::memory_order_relaxed);
                 checksDuringStep.fetch_add(duringStep, std::memory_order_relaxed);
+                churnedReported.fetch_add(churnSeen, std::memory_order_relaxed);
                 count = 0;
                 duringStep = 0;
+                churnSeen = 0;
             }
         }
         checks.fetch_add(count, std::memory_order_relaxed);
@@ -661,9 +663,12 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
         const auto elapsed = std::chrono::steady_clock::now() - start;
         if (elapsed >= inConfig.mMaxDuration) break;
+        // The churn's check too: on a loaded machine the churn thread, which sleeps between its steps, got
+        // one batch in before the other targets were met, and no query had seen a churned body yet
         if (elapsed >= inConfig.mMinDuration &&
             checks.load(std::memory_order_relaxed) >= inConfig.mTargetChecks &&
-            updates.load(std::memory_order_relaxed) >= inConfig.mMinUpdates)
+            updates.load(std::memory_order_relaxed) >= inConfig.mMinUpdates &&
+            churnedReported.load(std::memory_order_relaxed) > 0)
             break;
     }
     stop.store(true, std::memory_order_relaxed);
