@@ -1,9 +1,12 @@
 // Add batches let go on several threads at the moment their world is destroyed: each is aborted by the world
 // (which waits for it) or finds the world gone and does nothing, and nothing is freed twice, leaked or used
 // after it is freed. Under ThreadSanitizer (this suite's label) a race between the two shows; under the
-// address sanitizer, a leak or a use after free.
+// address sanitizer, a leak or a use after free. And a batch whose abort was deferred (let go under a body
+// lock): a call that needs its bodies, made while another thread is aborting it, waits for that abort.
 
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/body/BodyLock.h"
+#include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "common/MakePhysicsSystem.h"
 
@@ -66,6 +69,56 @@ TEST(AddBatchLetGoConcurrencyTest, BatchesLetGoOnManyThreadsAsTheWorldIsDestroye
         for (std::thread& thread : threads)
             thread.join();
         ASSERT_EQ(preparedOk.load(std::memory_order_relaxed), cThreads) << "round " << round;
+    }
+}
+
+TEST(AddBatchLetGoConcurrencyTest, ACallMadeWhileAnotherThreadAbortsADeferredBatchWaitsForIt)
+{
+    // Large enough that its abort (a body lock each) is still running when the second call starts
+    constexpr int cBodies = 2048;
+    constexpr int cRounds = 20;
+    const ShapeRef sphere = SphereShape::Create(0.4f).Value();
+    for (int round = 0; round < cRounds; ++round)
+    {
+        std::unique_ptr<PhysicsSystem> world = test::MakePhysicsSystem();
+        BodyInterface& bodies = world->GetBodyInterface();
+        BodyCreationSettings settings;
+        settings.mShape = sphere;
+        settings.mObjectLayer = Layers::cMoving;
+        std::vector<BodyID> ids;
+        for (int i = 0; i < cBodies; ++i)
+        {
+            settings.mPosition = Vec3(float(i % 64), 5.0f, float(i / 64));
+            ids.push_back(bodies.CreateBody(settings).Value());
+        }
+        const BodyID other = bodies.CreateBody(settings).Value();
+        settings.mShape = BoxShape::Create(Vec3(40, 1, 40)).Value();
+        settings.mMotionType = MotionType::Static;
+        settings.mObjectLayer = Layers::cStatic;
+        const BodyID floor = bodies.CreateAndAddBody(settings, Activation::DontActivate).Value();
+        {
+            Result<BodyInterface::AddBatch> batch = bodies.AddBodiesPrepare(ids);
+            ASSERT_TRUE(batch.IsOk());
+            BodyLockRead lock(world->GetBodyManager(), floor);
+            batch.Value() = BodyInterface::AddBatch(); // Deferred: this thread holds a body lock
+        }
+        std::atomic<bool> started{false};
+        // Its AddBody aborts the deferred batch first
+        std::thread aborter(
+            [&]
+            {
+                started.store(true, std::memory_order_relaxed); // Relaxed: only a moment, nothing handed over
+                EXPECT_TRUE(bodies.AddBody(other, Activation::Activate).IsOk());
+            });
+        while (!started.load(std::memory_order_relaxed))
+            std::this_thread::yield();
+        Result<BodyInterface::AddBatch> again = bodies.AddBodiesPrepare(ids);
+        EXPECT_TRUE(again.IsOk()) << "round " << round << ": " << again.GetError().mMessage;
+        aborter.join();
+        if (again.IsOk())
+        {
+            EXPECT_TRUE(bodies.AddBodiesFinalize(again.Value(), Activation::Activate).IsOk());
+        }
     }
 }
 

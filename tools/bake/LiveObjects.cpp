@@ -52,6 +52,8 @@ Result<std::vector<TileObject>> LiveObjects::Acquire(std::vector<SourceObject>& 
         }
         if (Status added = bodies.AddBodiesFinalize(batch.Value(), Activation::DontActivate); !added)
         {
+            // The batch first: its bodies cannot be destroyed while it holds them
+            (void)bodies.AddBodiesAbort(batch.Value());
             undo();
             return added.GetError();
         }

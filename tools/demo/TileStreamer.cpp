@@ -146,18 +146,27 @@ bool TileStreamer::AddBatch(const std::vector<BodyCreationSettings>& inSettings,
         outIDs.push_back(id.Value());
     }
     const std::span<const BodyID> created(outIDs.data() + first, outIDs.size() - first);
-    Result<BodyInterface::AddBatch> batch = bodies.AddBodiesPrepare(created);
-    if (!batch)
+    // A batch that fails takes its bodies with it: none is left created but not in the world
+    auto dropCreated = [&]
     {
-        NoteError("prepare batch: " + batch.GetError().mMessage);
         for (const BodyID& id : created)
             (void)bodies.DestroyBody(id);
         outIDs.resize(first);
         return false;
+    };
+    Result<BodyInterface::AddBatch> batch = bodies.AddBodiesPrepare(created);
+    if (!batch)
+    {
+        NoteError("prepare batch: " + batch.GetError().mMessage);
+        return dropCreated();
     }
     const Clock::time_point link = Clock::now();
     if (Status finalized = bodies.AddBodiesFinalize(batch.Value(), inActivation); !finalized)
+    {
         NoteError("finalize batch: " + finalized.GetError().mMessage);
+        (void)bodies.AddBodiesAbort(batch.Value()); // Its bodies cannot be destroyed while it holds them
+        return dropCreated();
+    }
     const double linkMs = tools::MillisecondsSince(link);
     std::lock_guard lock(mMutex);
     mStats.mStreamLinkMs.push_back(linkMs);

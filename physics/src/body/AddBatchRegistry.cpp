@@ -40,15 +40,22 @@ void AddBatchRegistry::Defer(Deferred&& inBatch)
 std::vector<AddBatchRegistry::Deferred> AddBatchRegistry::TakeDeferred()
 {
     const std::lock_guard lock(mMutex);
-    mHasDeferred.store(false, std::memory_order_relaxed); // Relaxed: a hint, see HasDeferred
     return std::exchange(mDeferred, {});
+}
+
+void AddBatchRegistry::EndDrain()
+{
+    const std::lock_guard lock(mMutex);
+    // Relaxed: a hint, see HasDeferred. Cleared only now, so that a call starting during the aborts saw it
+    // set and waited for them on the drain mutex
+    if (mDeferred.empty()) mHasDeferred.store(false, std::memory_order_relaxed);
 }
 
 std::vector<BroadPhase::AddState> AddBatchRegistry::Close()
 {
     std::unique_lock lock(mMutex);
+    mOwner = nullptr; // Before the wait: drops that keep coming cannot hold it off
     mNoDropsInFlight.wait(lock, [&] { return mDropsInFlight == 0; });
-    mOwner = nullptr;
     mDeferred.clear();
     std::vector<BroadPhase::AddState> live(mLive.begin(), mLive.end());
     mLive.clear();

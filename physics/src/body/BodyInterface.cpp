@@ -203,8 +203,8 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
         return MakeError(ErrorCode::OutOfCapacity,
                          std::string("the broad phase has no room for this batch") + cBroadPhaseFullHint);
     }
+    batch.mRegistry = mBatches; // First: should Register throw, the batch aborts itself as it goes
     mBatches->Register(batch.mState);
-    batch.mRegistry = mBatches;
     return batch;
 }
 
@@ -281,8 +281,10 @@ void BodyInterface::AbortDeferredBatches()
     if (!mBatches->HasDeferred() || BodyManager::IsInsideStep() ||
         BodyManager::GetBodyLocksHeldByThisThread() > 0)
         return;
+    const std::lock_guard drain(mBatches->DrainMutex());
     for (const AddBatchRegistry::Deferred& batch : mBatches->TakeDeferred())
         AbortBatchParts(batch.mState, batch.mBodies);
+    mBatches->EndDrain();
 }
 
 BodyInterface::AddBatch::AddBatch(AddBatch&& ioOther) noexcept

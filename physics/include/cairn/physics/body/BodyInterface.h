@@ -51,10 +51,15 @@ public:
     /// without touching the live world; AddBodiesFinalize then links it quickly.
     /// Move-only: it owns the broad phase's prepared state, which is finalized or aborted exactly once (a
     /// copy finalized and then the original aborted would free it twice). A batch destroyed or overwritten
-    /// before either is aborted: at once on a thread that may call AddBodiesAbort; inside a step or under a
-    /// body lock, by the world's next call that takes its bodies (AddBody, DestroyBody, SetObjectLayer, the
-    /// batch calls); after its world is gone, not at all (the world aborted it as it went). A loader that
-    /// bails out on an error leaks nothing and leaves no body pending.
+    /// before either is aborted, so a loader that bails out on an error leaks nothing and leaves no body
+    /// pending:
+    /// - on a thread that may call AddBodiesAbort, at once, as that call does (waiting for a running step);
+    /// - inside a step or under a body lock, where locking its bodies could deadlock, by the world's next
+    /// call
+    ///   that takes them (AddBody, DestroyBody, SetObjectLayer, the batch calls) and starts after the step
+    ///   returned or the lock was released;
+    /// - after its world is gone, not at all: the world aborted it as it went.
+    /// Like any call that locks bodies, not inside a broad-phase query's visitor (BroadPhase.h).
     struct AddBatch
     {
         bool IsEmpty() const { return mBodies.empty(); }

@@ -83,8 +83,8 @@ public:
     virtual ~BroadPhase() = default;
 
     /// Builds whatever a batch needs without touching the live structure: safe on a loading thread while
-    /// physics runs. inBodies must stay valid until AddBodiesFinalize/Abort. Returns nullptr when the broad
-    /// phase has no room for the batch (a fixed-capacity pool is full): nothing was added.
+    /// physics runs. inBodies is read during the call only. Returns nullptr when the broad phase has no room
+    /// for the batch (a fixed-capacity pool is full): nothing was added.
     virtual AddState AddBodiesPrepare(std::span<const BroadPhaseBody> inBodies) = 0;
     /// Makes a prepared batch visible to queries.
     virtual void AddBodiesFinalize(AddState inState) = 0;
