@@ -1,5 +1,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 
+#include "shapes/RayQuadratic.h"
+
 #include <array>
 #include <string>
 
@@ -59,9 +61,9 @@ float RaySphereEntry(const Vec3& inOrigin, const Vec3& inDirection, const Vec3& 
     const float b = o.dot(inDirection);
     const float c = o.squaredNorm() - inRadius * inRadius;
     if (!(a > 0.0f) || b >= 0.0f) return cLargeFloat;
-    const float disc = b * b - a * c;
+    const float disc = RayQuadratic::Discriminant(o, inDirection, a, b, inRadius);
     if (disc < 0.0f) return cLargeFloat;
-    return std::max(0.0f, (-b - std::sqrt(disc)) / a);
+    return std::max(0.0f, RayQuadratic::Entry(b, c, disc));
 }
 
 /// Entry fraction of a ray (origin outside) into the side of the infinite cylinder around Y, restricted to
@@ -72,9 +74,12 @@ float RayCylinderSideEntry(const Vec3& inOrigin, const Vec3& inDirection, float 
     const float b = inOrigin.x() * inDirection.x() + inOrigin.z() * inDirection.z();
     const float c = inOrigin.x() * inOrigin.x() + inOrigin.z() * inOrigin.z() - inRadius * inRadius;
     if (!(a > 0.0f) || b >= 0.0f || c < 0.0f) return cLargeFloat;
-    const float disc = b * b - a * c;
+    // The quadratic in the XZ plane: the direction's and origin's Y play no part
+    const Vec3 flatOrigin(inOrigin.x(), 0.0f, inOrigin.z());
+    const Vec3 flatDirection(inDirection.x(), 0.0f, inDirection.z());
+    const float disc = RayQuadratic::Discriminant(flatOrigin, flatDirection, a, b, inRadius);
     if (disc < 0.0f) return cLargeFloat;
-    const float t = (-b - std::sqrt(disc)) / a;
+    const float t = RayQuadratic::Entry(b, c, disc);
     const float y = inOrigin.y() + t * inDirection.y();
     return std::abs(y) <= inHalfHeight ? t : cLargeFloat;
 }

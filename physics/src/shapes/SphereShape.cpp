@@ -1,6 +1,7 @@
 #include "cairn/physics/shapes/SphereShape.h"
 
 #include "cairn/physics/shapes/CapsuleShape.h"
+#include "shapes/RayQuadratic.h"
 
 #include <string>
 
@@ -51,9 +52,9 @@ bool SphereShape::CastCheckedRay(const RayCast& inLocalRay, RayHit& ioHit) const
     const float a = d.squaredNorm();
     const float b = o.dot(d);
     if (!(a > 0.0f) || b >= 0.0f) return false; // Not moving, or moving away from the centre while outside
-    const float disc = b * b - a * c;
+    const float disc = RayQuadratic::Discriminant(o, d, a, b, mRadius);
     if (disc < 0.0f) return false;
-    const float t = (-b - std::sqrt(disc)) / a;
+    const float t = RayQuadratic::Entry(b, c, disc);
     if (!(t >= 0.0f && t <= 1.0f && t < ioHit.mFraction)) return false;
     ioHit.mFraction = t;
     ioHit.mNormal = ShapeHelpers::SafeNormalized(o + t * d, -d.normalized());
