@@ -36,8 +36,8 @@ struct MassProperties
 };
 
 /// A ray as a segment: points mOrigin + t * mDirection for t in [0, 1].
-/// The longest ray a world query takes, m: corner to corner of the world (about 3.5e6 m) and a margin. Longer
-/// ones overflow the squares in the shapes' ray tests (a sphere's b^2 - ac) and pass through what they hit.
+/// The longest ray a world query takes, m: corner to corner of the world (about 3.5e6 m) and a margin; it
+/// refuses longer ones. The shapes' ray tests stay exact to a few float steps of the ray's length up to it.
 inline constexpr float cMaxRayLength = 4.0f * cMaxWorldCoordinate;
 
 struct RayCast
