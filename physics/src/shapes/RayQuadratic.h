@@ -1,13 +1,13 @@
 #pragma once
 
 // The ray-sphere quadratic |o + t d|^2 = r^2, i.e. a t^2 + 2 b t + c = 0 with a = d.d, b = o.d and
-// c = o.o - r^2, solved so that long rays stay exact: the sphere's and the capsule's ray tests (the
-// cylinder's too, in its plane).
+// c = o.o - r^2, solved so that long rays keep the precision their inputs have (a few float steps of the
+// origin's distance): the sphere's and the capsule's ray tests (the cylinder's too, in its plane).
 //
 // The textbook discriminant b^2 - a c subtracts two numbers of the size of (|o| |d|)^2. For a ray of a few
 // km those are about 1e13, whose float steps are larger than the a r^2 they differ by, so a ray passing
 // metres beside a half-metre sphere "hit" it. The same value, written a (r^2 - |o - (b / a) d|^2), takes the
-// square of the ray's distance to the centre, a small number, and keeps its precision at any length (after
+// square of the ray line's distance to the centre, which is small, and keeps its precision (after
 // "Precision Improvements for Ray/Sphere Intersection", Haines et al., Ray Tracing Gems, 2019).
 
 #include "cairn/physics/math/Math.h"

@@ -89,5 +89,26 @@ TEST(ShapeRayInputTest, TheLongestRaysOfTheRangeStillHit)
     }
 }
 
+TEST(ShapeRayInputTest, ARayThroughADeepCompoundFarFromItsLevelsOriginsStillHits)
+{
+    // Nine levels each 950 km further out, then nine back: the ray meets the middle levels almost 9,000 km
+    // from their origins, beyond twice the longest world ray, though the sphere it hits is at the compound's
+    // origin. A world query sends such a ray, and a bound of the local ray at the world's scale missed the
+    // sphere. The offsets and the ray are exact in float, so every level sees the ray exactly.
+    constexpr float cStep = 950000.0f;
+    constexpr int cLevels = 9;
+    ShapeRef shape = SphereShape::Create(0.5f).Value();
+    for (int level = 0; level < 2 * cLevels; ++level)
+    {
+        Transform inward;
+        inward.mPosition = Vec3(level < cLevels ? -cStep : cStep, 0.0f, 0.0f);
+        shape = CompoundShape::Create({{shape, inward}}).Value();
+    }
+    ASSERT_EQ(std::static_pointer_cast<const CompoundShape>(shape)->GetDepth(), uint32_t(2 * cLevels));
+    RayHit hit;
+    ASSERT_TRUE(shape->CastRay({Vec3(0, 5, 0), Vec3(0, -10, 0)}, hit));
+    EXPECT_NEAR(hit.mFraction, 0.45f, 1e-6f);
+}
+
 } // namespace
 } // namespace cairn::test

@@ -53,6 +53,36 @@ void ExpectRaysMeetTheCircle(const Shape& inShape, const char* inWhat, float inY
     }
 }
 
+TEST(ShapeRayPrecisionTest, SlantedRaysHitASphereWhereTheyMeetItAndMissItBeside)
+{
+    // Off every axis, so b / a and the closest point are rounded too. The origin's own rounding (a float step
+    // of its distance) moves the ray by up to a few mm at 50 km: the offsets keep clear of the surface by
+    // more
+    const ShapeRef sphere = SphereShape::Create(cRadius).Value();
+    const Vec3 along = Vec3(1.0f, 2.0f, 3.0f).normalized();
+    const Vec3 across = along.cross(Vec3::UnitX()).normalized();
+    for (float length : {1e2f, 1e3f, 1e4f, 1e5f})
+    {
+        const float start = 0.5f * length;
+        const float tolerance = 8.0f * std::ldexp(1.0f, std::ilogb(start) - 23) + 1e-4f;
+        for (float offset : {0.0f, 0.3f, 0.45f})
+        {
+            RayHit hit;
+            ASSERT_TRUE(sphere->CastRay({-start * along + offset * across, length * along}, hit))
+                << length << " m, " << offset << " m off";
+            EXPECT_NEAR(hit.mFraction * length, start - std::sqrt(cRadius * cRadius - offset * offset),
+                        tolerance)
+                << length << " m, " << offset << " m off";
+        }
+        for (float offset : {0.55f, 0.6f, 2.0f})
+        {
+            RayHit hit;
+            EXPECT_FALSE(sphere->CastRay({-start * along + offset * across, length * along}, hit))
+                << length << " m, " << offset << " m off";
+        }
+    }
+}
+
 TEST(ShapeRayPrecisionTest, LongRaysHitASphereWhereTheyMeetItAndMissItBeside)
 {
     const ShapeRef sphere = SphereShape::Create(cRadius).Value();

@@ -37,7 +37,8 @@ struct MassProperties
 
 /// A ray as a segment: points mOrigin + t * mDirection for t in [0, 1].
 /// The longest ray a world query takes, m: corner to corner of the world (about 3.5e6 m) and a margin; it
-/// refuses longer ones. The shapes' ray tests stay exact to a few float steps of the ray's length up to it.
+/// refuses longer ones. Up to it, the shapes' ray tests are exact to a few float steps of the distances
+/// involved.
 inline constexpr float cMaxRayLength = 4.0f * cMaxWorldCoordinate;
 
 struct RayCast
@@ -46,10 +47,12 @@ struct RayCast
     Vec3 mDirection = Vec3::Zero(); ///< Full displacement, not unit length; at most cMaxRayLength for queries
 };
 
-/// The largest coordinate of a ray that a shape casts in its local space. A world query's ray, taken into a
-/// body's space and a compound child's, stays within it (origins within the world, shapes' offsets within
-/// it, lengths at most cMaxRayLength); the shapes' squares stay far from a float's overflow.
-inline constexpr float cMaxLocalRayCoordinate = 2.0f * cMaxRayLength;
+/// The largest coordinate of a ray that a shape casts in its local space. Far beyond any ray a world query
+/// sends, taken into a body's space and through every level of a compound (CompoundShape::cMaxDepth, each
+/// child offset within the world's size), also into a body that has fallen out of the world; and small
+/// enough that the ray tests' products of up to three coordinates (1e36) stay below a float's overflow,
+/// which is what made up hits.
+inline constexpr float cMaxLocalRayCoordinate = 1.0e12f;
 
 /// Whether Shape::CastRay takes the ray: every coordinate of its origin and direction finite and within
 /// cMaxLocalRayCoordinate.
