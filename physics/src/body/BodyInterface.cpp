@@ -165,7 +165,7 @@ void BodyInterface::WakeBodiesIn(const AABB& inBounds, ObjectLayerMask inLayers)
 
 Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const BodyID> inIDs)
 {
-    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     AbortDeferredBatches();
     AddBatch batch;
     batch.mBodies.reserve(inIDs.size());
@@ -210,7 +210,7 @@ Result<BodyInterface::AddBatch> BodyInterface::AddBodiesPrepare(std::span<const 
 
 Status BodyInterface::AddBodiesFinalize(AddBatch& ioBatch, Activation inActivation)
 {
-    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     if (ioBatch.mState == nullptr)
         return MakeError(ErrorCode::InvalidArgument, "batch was not prepared or was already finalized");
     if (ioBatch.mRegistry != mBatches) return OtherWorldsBatch();
@@ -246,7 +246,7 @@ Status BodyInterface::AddBodiesAbort(AddBatch& ioBatch)
     if (ioBatch.mState == nullptr && ioBatch.mBodies.empty())
         return Status::Ok(); // Finished: nothing to free
     // Refused whole: a body lock this thread could not take would leave its body pending for good
-    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     if (ioBatch.mRegistry != mBatches) return OtherWorldsBatch();
     AbortDeferredBatches();
     AbortBatchParts(std::exchange(ioBatch.mState, nullptr), ioBatch.mBodies);
@@ -270,7 +270,7 @@ void BodyInterface::AbortBatchParts(BroadPhase::AddState inState, const std::vec
 
 void BodyInterface::AbortLetGo(AddBatch& ioBatch)
 {
-    if (BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0)
+    if (!BodyManager::MayTakeBodyLocks())
         mBatches->Defer({std::exchange(ioBatch.mState, nullptr), std::move(ioBatch.mBodies)});
     else
         AbortBatchParts(std::exchange(ioBatch.mState, nullptr), ioBatch.mBodies);
@@ -278,9 +278,7 @@ void BodyInterface::AbortLetGo(AddBatch& ioBatch)
 
 void BodyInterface::AbortDeferredBatches()
 {
-    if (!mBatches->HasDeferred() || BodyManager::IsInsideStep() ||
-        BodyManager::GetBodyLocksHeldByThisThread() > 0)
-        return;
+    if (!mBatches->HasDeferred() || !BodyManager::MayTakeBodyLocks()) return;
     const std::lock_guard drain(mBatches->DrainMutex());
     for (const AddBatchRegistry::Deferred& batch : mBatches->TakeDeferred())
         AbortBatchParts(batch.mState, batch.mBodies);
@@ -288,10 +286,8 @@ void BodyInterface::AbortDeferredBatches()
 }
 
 BodyInterface::AddBatch::AddBatch(AddBatch&& ioOther) noexcept
-    : mBodies(std::move(ioOther.mBodies)), mState(std::exchange(ioOther.mState, nullptr)),
-      mRegistry(std::move(ioOther.mRegistry))
 {
-    ioOther.mBodies.clear();
+    *this = std::move(ioOther); // Letting go of this empty batch does nothing
 }
 
 BodyInterface::AddBatch& BodyInterface::AddBatch::operator=(AddBatch&& ioOther) noexcept

@@ -114,7 +114,7 @@ uint32_t BodyManager::GetNumBodies() const
 Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 {
     if (Status status = ValidateSettings(inSettings); !status) return status.GetError();
-    if (IsInsideStep() || tBodyLocksHeld > 0)
+    if (!MayTakeBodyLocks())
         return MakeError(ErrorCode::WrongThread,
                          "CreateBody called inside the physics step or while holding a body lock");
 
@@ -157,7 +157,7 @@ Result<BodyID> BodyManager::CreateBody(const BodyCreationSettings& inSettings)
 
 Status BodyManager::DestroyBody(const BodyID& inID)
 {
-    if (IsInsideStep() || tBodyLocksHeld > 0)
+    if (!MayTakeBodyLocks())
         return MakeError(ErrorCode::WrongThread,
                          "DestroyBody called inside the physics step or while holding a body lock");
     if (inID.IsInvalid() || inID.GetIndex() >= mMaxBodies)

@@ -20,10 +20,6 @@ Error WrongThread()
             "constraint calls are refused inside the physics step and while this thread "
             "holds a body lock"};
 }
-bool IsWrongThread()
-{
-    return BodyManager::IsInsideStep() || BodyManager::GetBodyLocksHeldByThisThread() > 0;
-}
 /// A joint of inType between the settings' two bodies, the rest of it as Joint starts it.
 template <class Settings> Joint JointOf(JointType inType, const Settings& inSettings)
 {
@@ -86,7 +82,7 @@ void ConstraintInterface::WakeBody(const BodyID& inID)
 
 Result<ConstraintID> ConstraintInterface::Add(Joint& ioJoint, const Vec3& inPointA, const Vec3& inPointB)
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     if (!IsValidWorldPosition(inPointA) || !IsValidWorldPosition(inPointB))
         return MakeError(ErrorCode::InvalidArgument, "joint point is NaN, infinite or beyond the world");
     if (ioJoint.mBodyA.IsInvalid() && ioJoint.mBodyB.IsInvalid())
@@ -254,7 +250,7 @@ Result<ConstraintID> ConstraintInterface::AddDistance(const DistanceConstraintSe
 
 Status ConstraintInterface::SetMotor(ConstraintID inID, const MotorSettings& inMotor)
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     BodyID a, b;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -275,7 +271,7 @@ Status ConstraintInterface::SetMotor(ConstraintID inID, const MotorSettings& inM
 
 Result<float> ConstraintInterface::GetPosition(ConstraintID inID) const
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     Joint joint;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -309,7 +305,7 @@ Result<float> ConstraintInterface::GetPosition(ConstraintID inID) const
 
 Status ConstraintInterface::SetBreakThresholds(ConstraintID inID, float inForce, float inTorque)
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     if (!(inForce >= 0.0f) || !(inTorque >= 0.0f))
         return MakeError(ErrorCode::InvalidArgument,
                          "break thresholds must be at least 0 (cLargeFloat: never)");
@@ -323,7 +319,7 @@ Status ConstraintInterface::SetBreakThresholds(ConstraintID inID, float inForce,
 
 Result<std::vector<BrokenConstraint>> ConstraintInterface::TakeBrokenConstraints()
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     std::lock_guard lock(mManager.GetMutex());
     std::vector<BrokenConstraint> broken;
     broken.swap(mManager.GetBroken());
@@ -332,7 +328,7 @@ Result<std::vector<BrokenConstraint>> ConstraintInterface::TakeBrokenConstraints
 
 Status ConstraintInterface::Remove(ConstraintID inID)
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     BodyID a, b;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -349,7 +345,7 @@ Status ConstraintInterface::Remove(ConstraintID inID)
 
 Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     BodyID a, b;
     {
         std::lock_guard lock(mManager.GetMutex());
@@ -379,7 +375,7 @@ Status ConstraintInterface::SetEnabled(ConstraintID inID, bool inEnabled)
 
 Result<bool> ConstraintInterface::IsEnabled(ConstraintID inID) const
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     std::lock_guard lock(mManager.GetMutex());
     const Joint* joint = mManager.Find(inID);
     if (joint == nullptr) return StaleID();
@@ -388,7 +384,7 @@ Result<bool> ConstraintInterface::IsEnabled(ConstraintID inID) const
 
 Result<uint32_t> ConstraintInterface::GetNumConstraints() const
 {
-    if (IsWrongThread()) return WrongThread();
+    if (!BodyManager::MayTakeBodyLocks()) return WrongThread();
     std::lock_guard lock(mManager.GetMutex());
     return mManager.GetNumInUse();
 }

@@ -54,10 +54,9 @@ public:
     /// before either is aborted, so a loader that bails out on an error leaks nothing and leaves no body
     /// pending:
     /// - on a thread that may call AddBodiesAbort, at once, as that call does (waiting for a running step);
-    /// - inside a step or under a body lock, where locking its bodies could deadlock, by the world's next
-    /// call
-    ///   that takes them (AddBody, DestroyBody, SetObjectLayer, the batch calls) and starts after the step
-    ///   returned or the lock was released;
+    /// - inside a step or under a body lock, where locking its bodies could deadlock, by the world's
+    ///   next call that takes them (AddBody, DestroyBody, SetObjectLayer, the batch calls) and starts
+    ///   after the step returned or the lock was released;
     /// - after its world is gone, not at all: the world aborted it as it went.
     /// Like any call that locks bodies, not inside a broad-phase query's visitor (BroadPhase.h).
     struct AddBatch

@@ -126,6 +126,9 @@ public:
     /// Body locks (BodyLockRead/Write) the calling thread holds now. A thread may hold one at a time: a
     /// second, or a step started while holding one, could deadlock against the step, which takes them all.
     static uint32_t GetBodyLocksHeldByThisThread();
+    /// Whether a call that takes body locks (one at a time) may run on this thread: not inside the step and
+    /// not while it holds a body lock, where it would deadlock.
+    static bool MayTakeBodyLocks() { return !IsInsideStep() && GetBodyLocksHeldByThisThread() == 0; }
     /// Bookkeeping for BodyLock: +1 when it locks, -1 when it unlocks.
     static void NoteBodyLockHeld(int inDelta);
 
