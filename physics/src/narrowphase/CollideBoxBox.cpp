@@ -260,7 +260,14 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
         BoxSupportingFace(inTransformA.mPosition, rotA, eA, n, incident);
     }
     outManifold.mNormal = n;
-    if (ClipIncidentAgainstReference(ref, incident, refIsA, maxSep, outManifold) > 0) return true;
+    if (ClipIncidentAgainstReference(ref, incident, refIsA, maxSep, outManifold) > 0)
+    {
+        // The two boxes' support points along the normal are the axis's own gap apart along it
+        const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
+        const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
+        KeepTheContactGap({pA, pB, (pA - pB).dot(n)}, outManifold);
+        return true;
+    }
 
     // Clipping lost everything (only possible through float noise at a corner): use the two support points
     const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);

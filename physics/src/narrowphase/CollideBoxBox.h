@@ -4,7 +4,8 @@
 // the 9 cross products of their edges). The axis of least penetration wins, with a bias towards face axes
 // (A's faces first, then B's, then edges) so that a resting box does not flicker between equivalent axes.
 // A face axis gives up to 4 points by clipping the incident face against the reference face; an edge axis
-// gives the single pair of closest points of the two edges.
+// gives the single pair of closest points of the two edges. A face manifold never claims more clearance than
+// its axis has (KeepTheContactGap).
 
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/BoxShape.h"

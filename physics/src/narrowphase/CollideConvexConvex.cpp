@@ -32,7 +32,10 @@ void ManifoldFromContact(const ConvexShape& inA, const Transform& inTransformA, 
     {
         if (ManifoldFromFaces(faceA.mVertices, faceA.mCount, faceB.mVertices, faceB.mCount, inContact.mNormal,
                               inMaxSeparation, outManifold) > 0)
+        {
+            KeepTheContactGap({inContact.mPointA, inContact.mPointB, inContact.mPenetration}, outManifold);
             return;
+        }
     }
     outManifold.mNumPoints = 1;
     outManifold.mPoints[0] = {inContact.mPointA, inContact.mPointB, inContact.mPenetration};

@@ -129,7 +129,10 @@ bool CollideConvexTriangle(const ConvexShape& inA, const Transform& inTransformA
         if (countB == 0) faceB[countB++] = contact.mPointB;
         if (ManifoldFromFaces(faceA.mVertices, faceA.mCount, faceB, countB, contact.mNormal, maxSep,
                               outManifold) > 0)
+        {
+            KeepTheContactGap({contact.mPointA, contact.mPointB, contact.mPenetration}, outManifold);
             return true;
+        }
     }
     outManifold.mNumPoints = 1;
     outManifold.mPoints[0] = {contact.mPointA, contact.mPointB, contact.mPenetration};

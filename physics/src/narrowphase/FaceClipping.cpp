@@ -113,6 +113,20 @@ int ClipAgainstReference(const Vec3* inRef, int inRefCount, const Vec3& inRefNor
 
 } // namespace
 
+void KeepTheContactGap(const ContactPoint& inContact, ContactManifold& ioManifold)
+{
+    if (ioManifold.mNumPoints == 0) return;
+    int farthest = 0;
+    for (int i = 1; i < ioManifold.mNumPoints; ++i)
+        if (ioManifold.mPoints[i].mPenetration < ioManifold.mPoints[farthest].mPenetration) farthest = i;
+    float leastGap = cLargeFloat;
+    for (int i = 0; i < ioManifold.mNumPoints; ++i)
+        leastGap = std::min(leastGap, -ioManifold.mPoints[i].mPenetration);
+    if (!(leastGap > 0.0f && leastGap > -inContact.mPenetration + cClippedGapSlack)) return;
+    const int slot = ioManifold.mNumPoints < ContactManifold::cMaxPoints ? ioManifold.mNumPoints++ : farthest;
+    ioManifold.mPoints[slot] = inContact;
+}
+
 int ReduceContactPoints(const ContactPoint* inPoints, int inCount, const Vec3& inNormal,
                         ContactManifold& outManifold)
 {

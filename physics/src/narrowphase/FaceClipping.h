@@ -21,6 +21,19 @@ inline constexpr int cMaxClipPoints = 2 * SupportingFace::cMaxVertices + 2;
 int ManifoldFromFaces(const Vec3* inFaceA, int inCountA, const Vec3* inFaceB, int inCountB,
                       const Vec3& inNormal, float inMaxSeparation, ContactManifold& outManifold);
 
+/// A manifold that claims more clearance than its contact by more than this (metres) takes the contact in:
+/// well below the shape casts' tolerance, well above the float noise between the two figures where the
+/// contact's point was kept.
+inline constexpr float cClippedGapSlack = 1.0e-5f;
+
+/// Clipping keeps the part of the incident face over the reference face, and can lose the point where the
+/// contact was found (it lay beside the other face); the manifold then claims more clearance than the shapes
+/// have: a speculative contact that lets the solver close them further than they are apart in one step, and a
+/// shape cast advance past the touch. Where ioManifold claims clearance (its least gap > 0) wider than
+/// inContact's (its point pair along ioManifold's normal) by more than cClippedGapSlack, inContact takes the
+/// place of the farthest point, or joins them when there is room. Penetrating manifolds are left as they are.
+void KeepTheContactGap(const ContactPoint& inContact, ContactManifold& ioManifold);
+
 /// Copies at most ContactManifold::cMaxPoints of inPoints into outManifold: the deepest, the one furthest
 /// from it, then the two that add the most area on either side. Returns the number copied.
 int ReduceContactPoints(const ContactPoint* inPoints, int inCount, const Vec3& inNormal,
