@@ -5,6 +5,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/CompoundShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
+#include "narrowphase/ShapeCast.h"
 
 #include <algorithm>
 #include <string>
@@ -28,6 +29,35 @@ thread_local std::vector<BodyID> tBodies;
 BroadPhaseQueryFilter ToBroadPhase(const QueryFilter& inFilter)
 {
     return {inFilter.mObjectLayers};
+}
+
+/// The bodies a cast enters (inCast runs the broad-phase cast with the visitor it is given), the filter's
+/// ignored body left out, nearest entry first: a closest search stops once entries pass its best hit.
+const std::vector<Candidate>& CastCandidates(const QueryFilter& inFilter,
+                                             FunctionRef<void(RayBodyVisitor)> inCast)
+{
+    std::vector<Candidate>& candidates = tCandidates;
+    candidates.clear();
+    inCast(
+        [&](BodyID inBody, float inFraction)
+        {
+            if (inBody != inFilter.mIgnoreBody) candidates.push_back({inBody, inFraction});
+            return 1.0f;
+        });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const Candidate& inA, const Candidate& inB)
+              { return inA.mEntry < inB.mEntry || (inA.mEntry == inB.mEntry && inA.mBody < inB.mBody); });
+    return candidates;
+}
+
+/// Cast results by fraction, then by body: the same order whatever order the broad phase found them in.
+template <class CastResult> void SortByFraction(std::vector<CastResult>& ioHits)
+{
+    std::sort(ioHits.begin(), ioHits.end(),
+              [](const CastResult& inA, const CastResult& inB) {
+                  return inA.mFraction < inB.mFraction ||
+                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
+              });
 }
 
 /// WrongThread when this thread may not read bodies under their locks now, else Ok. Published poses need no
@@ -59,6 +89,33 @@ bool CanBeQueryShape(const Shape& inShape)
     for (const CompoundShape::SubShape& child : static_cast<const CompoundShape&>(inShape).GetSubShapes())
         if (!CanBeQueryShape(*child.mShape)) return false;
     return true;
+}
+
+/// InvalidArgument unless the shape and its transform make a query shape; else Ok, with its world bounds.
+Status CheckQueryShape(const Shape& inShape, const Transform& inTransform, AABB& outBounds)
+{
+    if (!IsValidWorldPosition(inTransform.mPosition))
+        return InvalidQuery("shape position is NaN, infinite or beyond the world");
+    if (!IsValidRotation(inTransform.mRotation))
+        return InvalidQuery("shape rotation is not a finite unit quaternion");
+    if (!CanBeQueryShape(inShape))
+        return InvalidQuery(
+            "a query shape must be convex or a compound of convex shapes, not a triangle mesh or "
+            "height field");
+    // A shape built around its checked Create (a NaN radius, an inverted box) has bounds the broad phase
+    // drops: the query would answer "nothing there"
+    outBounds = inShape.GetWorldBounds(inTransform);
+    if (!outBounds.IsFinite() || outBounds.IsEmpty())
+        return InvalidQuery("query shape's bounds are NaN, infinite or empty");
+    return Status::Ok();
+}
+
+/// How close to a body a shape cast stops, metres: a tenth of a millimetre, and more far from the origin,
+/// where a float step of the coordinates is larger than that and the contact depths are only as exact
+/// as the coordinates
+float ShapeCastTolerance(const Transform& inStart)
+{
+    return 1.0e-4f + 1.0e-6f * inStart.mPosition.cwiseAbs().maxCoeff();
 }
 
 /// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
@@ -103,18 +160,9 @@ Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bo
         return InvalidQuery("ray direction is NaN, infinite or longer than cMaxRayLength (4e6 m)");
     // One read section for the whole query: the shapes it reads stay alive until it returns
     const PoseReader poses(mBodies);
-    std::vector<Candidate>& candidates = tCandidates;
-    candidates.clear();
-    mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter),
-                        [&](BodyID inBody, float inFraction)
-                        {
-                            if (inBody != inFilter.mIgnoreBody) candidates.push_back({inBody, inFraction});
-                            return 1.0f;
-                        });
-    // Nearest boxes first, so the closest search can stop once boxes start beyond the best hit
-    std::sort(candidates.begin(), candidates.end(),
-              [](const Candidate& inA, const Candidate& inB)
-              { return inA.mEntry < inB.mEntry || (inA.mEntry == inB.mEntry && inA.mBody < inB.mBody); });
+    const std::vector<Candidate>& candidates =
+        CastCandidates(inFilter, [&](RayBodyVisitor inVisitor)
+                       { mBroadPhase.CastRay(inRay, ToBroadPhase(inFilter), inVisitor); });
     float best = 1.0f;
     for (const Candidate& candidate : candidates)
     {
@@ -137,11 +185,7 @@ Status WorldQuery::CastRay(const RayCast& inRay, const QueryFilter& inFilter, bo
             outHits.push_back(result);
         if (inAny) return Status::Ok();
     }
-    std::sort(outHits.begin(), outHits.end(),
-              [](const RayCastResult& inA, const RayCastResult& inB) {
-                  return inA.mFraction < inB.mFraction ||
-                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
-              });
+    SortByFraction(outHits);
     return Status::Ok();
 }
 
@@ -167,26 +211,77 @@ Status WorldQuery::CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& 
     return CastRay(inRay, inFilter, false, outHits, false);
 }
 
+Status WorldQuery::CastShape(const Shape& inShape, const Transform& inStart, const Vec3& inDisplacement,
+                             const QueryFilter& inFilter, std::vector<ShapeCastResult>& outHits,
+                             bool inClosestOnly) const
+{
+    outHits.clear();
+    if (Status thread = CheckThread(mReads == QueryReads::BodyLocks); !thread) return thread;
+    AABB shapeBounds;
+    if (Status shape = CheckQueryShape(inShape, inStart, shapeBounds); !shape) return shape;
+    if (!(inDisplacement.norm() <= cMaxRayLength))
+        return InvalidQuery("cast displacement is NaN, infinite or longer than cMaxRayLength (4e6 m)");
+    ShapeCastSettings settings;
+    settings.mTolerance = ShapeCastTolerance(inStart);
+    const PoseReader poses(mBodies); // See CastRay
+    // Grown by the tolerance: a body the shape stops short of by less is still a touch
+    const AABB swept = shapeBounds.Expanded(settings.mTolerance);
+    const std::vector<Candidate>& candidates =
+        CastCandidates(inFilter, [&](RayBodyVisitor inVisitor)
+                       { mBroadPhase.CastAABox(swept, inDisplacement, ToBroadPhase(inFilter), inVisitor); });
+    for (const Candidate& candidate : candidates)
+    {
+        if (inClosestOnly && !outHits.empty())
+        {
+            if (candidate.mEntry > outHits.front().mFraction) break;
+            // A later body wins only by touching first; a best hit at 0 cannot be beaten
+            if (outHits.front().mFraction == 0.0f) break;
+            settings.mMaxFraction = outHits.front().mFraction;
+        }
+        BodyView body;
+        if (!ReadBody(poses, candidate.mBody, body)) continue;
+        const std::optional<ShapeCastHit> hit =
+            CastShapeAgainst(inShape, inStart, inDisplacement, *body.mShape, body.mTransform, settings);
+        if (!hit.has_value()) continue;
+        const ContactPoint& point = hit->mManifold.mPoints[hit->mDeepestPoint];
+        const ShapeCastResult result{candidate.mBody,         hit->mFraction,     point.mPositionOnB,
+                                     -hit->mManifold.mNormal, point.mPenetration, hit->mManifold.mSubShapeB};
+        if (inClosestOnly)
+            outHits.assign(1, result);
+        else
+            outHits.push_back(result);
+    }
+    SortByFraction(outHits);
+    return Status::Ok();
+}
+
+Result<std::optional<ShapeCastResult>> WorldQuery::CastShapeClosest(const Shape& inShape,
+                                                                    const Transform& inStart,
+                                                                    const Vec3& inDisplacement,
+                                                                    const QueryFilter& inFilter) const
+{
+    thread_local std::vector<ShapeCastResult> hits;
+    if (Status status = CastShape(inShape, inStart, inDisplacement, inFilter, hits, true); !status)
+        return status.GetError();
+    if (hits.empty()) return std::optional<ShapeCastResult>();
+    return std::optional<ShapeCastResult>(hits.front());
+}
+
+Status WorldQuery::CastShapeAll(const Shape& inShape, const Transform& inStart, const Vec3& inDisplacement,
+                                std::vector<ShapeCastResult>& outHits, const QueryFilter& inFilter) const
+{
+    return CastShape(inShape, inStart, inDisplacement, inFilter, outHits, false);
+}
+
 Status WorldQuery::CollideShape(const Shape& inShape, const Transform& inTransform,
                                 std::vector<ShapeQueryHit>& outHits, const QueryFilter& inFilter,
                                 float inMaxSeparation) const
 {
     outHits.clear();
     if (Status thread = CheckThread(mReads == QueryReads::BodyLocks); !thread) return thread;
-    if (!IsValidWorldPosition(inTransform.mPosition))
-        return InvalidQuery("shape position is NaN, infinite or beyond the world");
-    if (!IsValidRotation(inTransform.mRotation))
-        return InvalidQuery("shape rotation is not a finite unit quaternion");
+    AABB shapeBounds;
+    if (Status shape = CheckQueryShape(inShape, inTransform, shapeBounds); !shape) return shape;
     if (!std::isfinite(inMaxSeparation)) return InvalidQuery("maximum separation is NaN or infinite");
-    if (!CanBeQueryShape(inShape))
-        return InvalidQuery(
-            "a query shape must be convex or a compound of convex shapes, not a triangle mesh or "
-            "height field");
-    // A shape built around its checked Create (a NaN radius, an inverted box) has bounds the broad phase
-    // drops: the query would answer "nothing there"
-    const AABB shapeBounds = inShape.GetWorldBounds(inTransform);
-    if (!shapeBounds.IsFinite() || shapeBounds.IsEmpty())
-        return InvalidQuery("query shape's bounds are NaN, infinite or empty");
     const PoseReader poses(mBodies); // See CastRay
     std::vector<BodyID>& bodies = tBodies;
     bodies.clear();

@@ -1,12 +1,10 @@
 #include "step/ContinuousCollision.h"
 
 #include "body/Integration.h"
-#include "cairn/physics/narrowphase/CollideShapes.h"
+#include "narrowphase/ShapeCast.h"
 #include "step/StepContext.h"
 
 #include <algorithm>
-#include <limits>
-#include <optional>
 
 namespace cairn::physics
 {
@@ -22,48 +20,6 @@ constexpr float cCastThreshold = 0.5f;
 constexpr float cAllowedPenetration = 0.25f;
 /// Conservative advancement stops this many iterations in, where it is (short of the surface, never past it).
 constexpr int cMaxIterations = 32;
-
-/// The fraction of inDisplacement at which shape A, translated from inStart, first sinks into body inOther
-/// (at its pose) by inAllowed, to within inTolerance, approaching it; none if it does not within the
-/// displacement.
-std::optional<float> TimeOfImpact(const Shape& inShape, const Transform& inStart, const Vec3& inDisplacement,
-                                  const Body& inOther, float inAllowed, float inTolerance)
-{
-    const float length = inDisplacement.norm();
-    const Transform otherTransform = inOther.GetTransform();
-    float t = 0.0f;
-    for (int iteration = 0; iteration < cMaxIterations; ++iteration)
-    {
-        Transform at = inStart;
-        at.mPosition += t * inDisplacement;
-        CollideSettings settings;
-        settings.mMaxSeparation = std::max((1.0f - t) * length + inTolerance - inAllowed, 0.0f);
-        // Each manifold is a separating plane (its normal, from A to B) with the points' gaps along it: the
-        // body can advance by gap / (displacement . normal) before that plane stops separating. The smallest
-        // advance over the approaching manifolds is safe against all of them
-        std::optional<float> advance;
-        bool touching = false;
-        CollideShapes(inShape, at, *inOther.GetShape(), otherTransform, settings,
-                      [&](const ContactManifold& inManifold)
-                      {
-                          const float approach = inDisplacement.dot(inManifold.mNormal);
-                          if (!(approach > 1.0e-6f * length)) return; // Parallel or moving away
-                          // The gap to the allowed depth
-                          float gap = std::numeric_limits<float>::max();
-                          for (int i = 0; i < inManifold.mNumPoints; ++i)
-                              gap = std::min(gap, inAllowed - inManifold.mPoints[i].mPenetration);
-                          touching |= gap <= inTolerance;
-                          // Aim for half the tolerance: the next gap is then within it, never below zero
-                          const float step = (gap - 0.5f * inTolerance) / approach;
-                          advance = advance.has_value() ? std::min(*advance, step) : step;
-                      });
-        if (touching) return t;
-        if (!advance.has_value()) return std::nullopt; // Nothing it approaches within reach
-        t += std::max(*advance, 0.0f);
-        if (t >= 1.0f) return std::nullopt;
-    }
-    return t;
-}
 } // namespace
 
 void ContinuousCollision::Count(const StepContext& inContext, std::span<const uint32_t> inBodies)
@@ -96,25 +52,28 @@ bool ContinuousCollision::Cast(const StepContext& inContext, Body& ioBody) const
     if (!(displacement.squaredNorm() > threshold * threshold)) return false;
     Transform start = ioBody.GetTransform();
     start.mPosition -= displacement;
-    const float tolerance = 0.25f * inContext.mSettings.mSpeculativeDistance;
-    const float allowed = cAllowedPenetration * smallestHalfExtent;
+    ShapeCastSettings cast;
+    cast.mTolerance = 0.25f * inContext.mSettings.mSpeculativeDistance;
+    cast.mAllowedPenetration = cAllowedPenetration * smallestHalfExtent;
+    cast.mMaxIterations = cMaxIterations;
     float earliest = 1.0f;
     BroadPhaseQueryFilter filter;
     filter.mObjectLayers = inContext.mLayers.GetCollisionMask(ioBody.GetObjectLayer());
     // Candidates in no particular order: the earliest time of impact is their minimum whatever the order
-    inContext.mBroadPhase.CastAABox(shape.GetWorldBounds(start), displacement, filter,
-                                    [&](BodyID inID, float inEntry) -> float
-                                    {
-                                        if (inID == ioBody.GetID() || inEntry >= earliest) return earliest;
-                                        const Body* other = inContext.mBodies.TryGetBody(inID);
-                                        if (other == nullptr || !other->IsInWorld() || other->IsSensor() ||
-                                            !inContext.mBodies.BodiesCollide(ioBody, *other))
-                                            return earliest;
-                                        if (const std::optional<float> impact = TimeOfImpact(
-                                                shape, start, displacement, *other, allowed, tolerance))
-                                            earliest = std::min(earliest, *impact);
-                                        return earliest;
-                                    });
+    inContext.mBroadPhase.CastAABox(
+        shape.GetWorldBounds(start), displacement, filter,
+        [&](BodyID inID, float inEntry) -> float
+        {
+            if (inID == ioBody.GetID() || inEntry >= earliest) return earliest;
+            const Body* other = inContext.mBodies.TryGetBody(inID);
+            if (other == nullptr || !other->IsInWorld() || other->IsSensor() ||
+                !inContext.mBodies.BodiesCollide(ioBody, *other))
+                return earliest;
+            if (const std::optional<ShapeCastHit> impact = CastShapeAgainst(
+                    shape, start, displacement, *other->GetShape(), other->GetTransform(), cast))
+                earliest = std::min(earliest, impact->mFraction);
+            return earliest;
+        });
     if (earliest >= 1.0f) return false;
     Integration::CorrectPose(ioBody, -(1.0f - earliest) * displacement, Vec3::Zero());
     return true;

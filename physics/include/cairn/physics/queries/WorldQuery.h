@@ -1,6 +1,7 @@
 #pragma once
 
-// WorldQuery: ray casts and shape / box / sphere / point overlap queries against the world, from any thread.
+// WorldQuery: ray casts, shape casts and shape / box / sphere / point overlap queries against the world, from
+// any thread.
 // Each query first asks the broad phase (lock-free) for candidates, collected in a thread-local buffer, then
 // tests each candidate's shape at its published pose (PublishedPose.h), read with no lock: a query never
 // waits for the physics step, also while the step runs. It sees every body as the last collision step (or
@@ -13,6 +14,12 @@
 // Errors: a query refuses bad input (a NaN or out-of-world origin or centre, a direction or radius that is
 // not finite, a rotation that is not a unit quaternion) with InvalidArgument, instead of returning "nothing
 // there": a caller must be able to tell a clear line of sight from a failed query.
+// Shape casts sweep a shape without turning it (as a character or a thrown object probes its way). They
+// report where it first touches each body: never past the touch, and short of it by at most the cast's
+// tolerance (about 0.1 mm near the origin) along the surface normal. A body the shape already overlaps at the
+// start is a hit at fraction 0 when the sweep moves deeper into it, and no hit when the sweep leaves it or
+// slides along it, so a character standing on the floor can probe sideways. A zero displacement reports what
+// the shape touches, at fraction 0.
 
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
@@ -41,6 +48,19 @@ struct RayCastResult
     SubShapeID mSubShape = 0;
 };
 
+/// Where a swept shape first touches a body.
+struct ShapeCastResult
+{
+    BodyID mBody;
+    float mFraction = 1.0f;            ///< Along the displacement, in [0, 1)
+    Vec3 mContactPoint = Vec3::Zero(); ///< World space, on the body's surface, where the shape touches it
+    Vec3 mNormal = Vec3::Zero(); ///< World space unit surface normal of the body there, towards the shape
+    /// How deep the shape is in the body at that fraction: about 0 at a touch (within the tolerance), more
+    /// where it started overlapping the body
+    float mPenetration = 0.0f;
+    SubShapeID mSubShape = 0; ///< The body's part that it touches
+};
+
 /// A body that a shape query touches, with the contact (normal from the query shape towards the body).
 struct ShapeQueryHit
 {
@@ -62,6 +82,15 @@ public:
     /// Every body hit (its closest hit each), sorted by fraction; outHits is cleared first.
     Status CastRayAll(const RayCast& inRay, std::vector<RayCastResult>& outHits,
                       const QueryFilter& inFilter = {}) const;
+
+    /// The first body that inShape (convex, or a compound of convex shapes) touches when swept from inStart
+    /// along inDisplacement (at most cMaxRayLength), or nullopt when there is none.
+    Result<std::optional<ShapeCastResult>> CastShapeClosest(const Shape& inShape, const Transform& inStart,
+                                                            const Vec3& inDisplacement,
+                                                            const QueryFilter& inFilter = {}) const;
+    /// Every body it touches (where it first touches each), sorted by fraction; outHits is cleared first.
+    Status CastShapeAll(const Shape& inShape, const Transform& inStart, const Vec3& inDisplacement,
+                        std::vector<ShapeCastResult>& outHits, const QueryFilter& inFilter = {}) const;
 
     /// Bodies whose shape overlaps inShape at inTransform (penetration >= -inMaxSeparation, which must be
     /// finite; negative counts as 0); outHits is cleared.
@@ -92,6 +121,10 @@ private:
     /// Runs the ray against candidate bodies; inAny stops at the first hit.
     Status CastRay(const RayCast& inRay, const QueryFilter& inFilter, bool inAny,
                    std::vector<RayCastResult>& outHits, bool inClosestOnly) const;
+    /// Sweeps the shape against candidate bodies; inClosestOnly keeps the first hit only.
+    Status CastShape(const Shape& inShape, const Transform& inStart, const Vec3& inDisplacement,
+                     const QueryFilter& inFilter, std::vector<ShapeCastResult>& outHits,
+                     bool inClosestOnly) const;
 
     const BodyManager& mBodies;
     const BroadPhase& mBroadPhase;
