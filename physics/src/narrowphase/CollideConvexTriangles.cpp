@@ -99,7 +99,8 @@ bool CollideConvexTriangle(const ConvexShape& inA, const Transform& inTransformA
 
     // The triangle pushes A along -normal; it must push A out of its front
     float cosFace = -contact.mNormal.dot(faceNormal);
-    if (cosFace < cFaceNormalCos && IsInactiveFeature(feature, inTriangle.mActiveEdges))
+    if (inSettings.mFaceNormalsAtInternalEdges && cosFace < cFaceNormalCos &&
+        IsInactiveFeature(feature, inTriangle.mActiveEdges))
     {
         // Internal edge or vertex: use the face normal, and the deepest point of A below the plane
         const Vec3 n = -faceNormal;

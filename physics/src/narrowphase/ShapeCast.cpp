@@ -67,6 +67,7 @@ private:
         Transform at = mStartA;
         at.mPosition += inT * mDisplacement;
         CollideSettings collide;
+        collide.mFaceNormalsAtInternalEdges = false; // See there: the plane's depth beside a triangle is none
         const float allowed = mSettings.mAllowedPenetration;
         const float tolerance = mSettings.mTolerance;
         collide.mMaxSeparation =

@@ -11,9 +11,11 @@
 // that starts clear of B), the cast bisects back to the touch between the last fraction clear of B and that
 // one; an advance that overstated gap carries right through B is not caught. A manifold A does not approach
 // (parallel or moving away) cannot stop it: a shape already overlapping B and leaving it, or sliding along
-// it, is not stopped. Used by the step's continuous collision (which lets a body sink a little before
-// stopping it) and by the world's shape-cast queries (which stop at the touch). Pure function over immutable
-// shapes: any thread.
+// it, is not stopped. Against a mesh or height field each triangle counts by its true nearest feature: no
+// face normal at an internal edge (CollideSettings::mFaceNormalsAtInternalEdges), whose plane depth would
+// stop a shape beside the triangle, not in it; the normal reported at a seam is the edge's.
+// Used by the step's continuous collision (which lets a body sink a little before stopping it) and by the
+// world's shape-cast queries (which stop at the touch). Pure function over immutable shapes: any thread.
 
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
@@ -42,6 +44,14 @@ struct ShapeCastHit
     ContactManifold mManifold; ///< The manifold that stopped A, at that fraction (normal from A towards B)
     int mDeepestPoint = 0;     ///< The index of its point nearest the allowed depth
 };
+
+/// The tolerance of the world's shape-cast queries from inStart (metres): a tenth of a millimetre, and more
+/// far from the origin, where a float step of the coordinates is larger than that and the contact depths are
+/// only as exact as the coordinates.
+inline float QueryCastTolerance(const Vec3& inStart)
+{
+    return 1.0e-4f + 1.0e-6f * inStart.cwiseAbs().maxCoeff();
+}
 
 /// The first fraction of inDisplacement at which inShapeA, translated from inStartA, sinks into inShapeB at
 /// inTransformB by inSettings.mAllowedPenetration (to within the tolerance) while approaching it; nullopt

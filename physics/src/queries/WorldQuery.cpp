@@ -110,14 +110,6 @@ Status CheckQueryShape(const Shape& inShape, const Transform& inTransform, AABB&
     return Status::Ok();
 }
 
-/// How close to a body a shape cast stops, metres: a tenth of a millimetre, and more far from the origin,
-/// where a float step of the coordinates is larger than that and the contact depths are only as exact
-/// as the coordinates
-float ShapeCastTolerance(const Transform& inStart)
-{
-    return 1.0e-4f + 1.0e-6f * inStart.mPosition.cwiseAbs().maxCoeff();
-}
-
 /// Keeps query boxes usable as shapes: a flat or inverted box becomes a very thin one.
 Vec3 QueryHalfExtent(const AABB& inBox)
 {
@@ -222,7 +214,7 @@ Status WorldQuery::CastShape(const Shape& inShape, const Transform& inStart, con
     if (!(inDisplacement.norm() <= cMaxRayLength))
         return InvalidQuery("cast displacement is NaN, infinite or longer than cMaxRayLength (4e6 m)");
     ShapeCastSettings settings;
-    settings.mTolerance = ShapeCastTolerance(inStart);
+    settings.mTolerance = QueryCastTolerance(inStart.mPosition);
     const PoseReader poses(mBodies); // See CastRay
     // Grown by the tolerance: a body the shape stops short of by less is still a touch
     const AABB swept = shapeBounds.Expanded(settings.mTolerance);

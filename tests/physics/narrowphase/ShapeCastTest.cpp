@@ -122,6 +122,31 @@ TEST(ShapeCastTest, LeavingOrSlidingAlongAnOverlappedShapeIsNotStopped)
     EXPECT_NEAR(atWall->mFraction, 0.5f, cTolerance);
 }
 
+// A flat quad rising along x (y = x / 2, x and z in [0, 2]) of two triangles whose shared diagonal, from
+// (2, 1, 0) to (0, 0, 2), is an internal edge. The sphere is off the quad's far corner, a little above its
+// plane extended: of the first triangle its nearest feature is that diagonal, and the face-normal rule there
+// would take the depth below the plane, 0.32 m, as a contact the sphere is not in
+TEST(ShapeCastTest, AShapeBesideAMeshIsNotStoppedByATrianglesPlane)
+{
+    const std::vector<Vec3> vertices = {Vec3(0, 0, 0), Vec3(0, 0, 2), Vec3(2, 1, 0), Vec3(2, 1, 2)};
+    const std::vector<std::array<uint32_t, 3>> triangles = {{0, 1, 2}, {2, 1, 3}};
+    const std::shared_ptr<const TriangleMeshShape> quad =
+        TriangleMeshShape::Create(vertices, triangles).Value();
+    const SphereShape sphere(0.5f);
+    for (const Vec3& beside : {Vec3(2.5f, 1.45f, 2.5f), Vec3(4.0f, 2.2f, 4.0f)})
+    {
+        EXPECT_FALSE(Cast(sphere, beside, Vec3(3, 0, 3), *quad).has_value())
+            << "moving away, from x " << beside.x();
+        EXPECT_FALSE(Cast(sphere, beside, Vec3(3, 1.5f, 0), *quad).has_value())
+            << "along the plane, from x " << beside.x();
+    }
+    // Dropped onto the quad: the centre stops the radius over the plane
+    const std::optional<ShapeCastHit> dropped = Cast(sphere, Vec3(1, 4, 1), Vec3(0, -8, 0), *quad);
+    ASSERT_TRUE(dropped.has_value());
+    const float touchY = 0.5f + 0.5f / std::cos(std::atan(0.5f));
+    EXPECT_NEAR(4.0f - 8.0f * dropped->mFraction, touchY, 1.0e-3f);
+}
+
 TEST(ShapeCastTest, AZeroDisplacementReportsATouchAtTheStart)
 {
     const SphereShape sphere(0.5f);

@@ -22,6 +22,12 @@ struct CollideSettings
     /// Points separated by less than this still produce (speculative) contacts with negative penetration,
     /// which lets the solver stop fast bodies before they tunnel. Metres.
     float mMaxSeparation = 0.02f;
+    /// A contact at a mesh's internal edge or vertex takes the triangle's face normal, with the depth below
+    /// its plane (CollideConvexTriangles.h), so that bodies slide across seams. That depth is the plane's,
+    /// which reaches beyond the triangle: a shape beside the triangle and below its plane gets a contact it
+    /// is not in. Harmless within a speculative distance; a shape cast, which looks metres ahead, turns it
+    /// off and takes each triangle's true nearest feature.
+    bool mFaceNormalsAtInternalEdges = true;
 };
 
 /// Collides shape A at inTransformA with shape B at inTransformB and reports every manifold with at least one
