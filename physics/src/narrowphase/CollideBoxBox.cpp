@@ -262,10 +262,13 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
     outManifold.mNormal = n;
     if (ClipIncidentAgainstReference(ref, incident, refIsA, maxSep, outManifold) > 0)
     {
-        // The two boxes' support points along the normal are the axis's own gap apart along it
-        const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
-        const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
-        KeepTheContactGap({pA, pB, (pA - pB).dot(n)}, outManifold);
+        // KeepTheContactGap: the two boxes' support points along the normal are the axis's own gap apart
+        if (ClaimsMoreClearance(outManifold, -best))
+        {
+            const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
+            const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
+            PutContactIn({pA, pB, (pA - pB).dot(n)}, outManifold);
+        }
         return true;
     }
 

@@ -113,16 +113,20 @@ int ClipAgainstReference(const Vec3* inRef, int inRefCount, const Vec3& inRefNor
 
 } // namespace
 
-void KeepTheContactGap(const ContactPoint& inContact, ContactManifold& ioManifold)
+bool ClaimsMoreClearance(const ContactManifold& inManifold, float inContactPenetration)
 {
-    if (ioManifold.mNumPoints == 0) return;
+    float leastGap = cLargeFloat;
+    for (int i = 0; i < inManifold.mNumPoints; ++i)
+        leastGap = std::min(leastGap, -inManifold.mPoints[i].mPenetration);
+    return inManifold.mNumPoints > 0 && leastGap > 0.0f &&
+           leastGap > -inContactPenetration + cClippedGapSlack;
+}
+
+void PutContactIn(const ContactPoint& inContact, ContactManifold& ioManifold)
+{
     int farthest = 0;
     for (int i = 1; i < ioManifold.mNumPoints; ++i)
         if (ioManifold.mPoints[i].mPenetration < ioManifold.mPoints[farthest].mPenetration) farthest = i;
-    float leastGap = cLargeFloat;
-    for (int i = 0; i < ioManifold.mNumPoints; ++i)
-        leastGap = std::min(leastGap, -ioManifold.mPoints[i].mPenetration);
-    if (!(leastGap > 0.0f && leastGap > -inContact.mPenetration + cClippedGapSlack)) return;
     const int slot = ioManifold.mNumPoints < ContactManifold::cMaxPoints ? ioManifold.mNumPoints++ : farthest;
     ioManifold.mPoints[slot] = inContact;
 }

@@ -32,7 +32,14 @@ inline constexpr float cClippedGapSlack = 1.0e-5f;
 /// shape cast advance past the touch. Where ioManifold claims clearance (its least gap > 0) wider than
 /// inContact's (its point pair along ioManifold's normal) by more than cClippedGapSlack, inContact takes the
 /// place of the farthest point, or joins them when there is room. Penetrating manifolds are left as they are.
-void KeepTheContactGap(const ContactPoint& inContact, ContactManifold& ioManifold);
+/// The two halves apart, for a caller whose contact point costs something to make (box-box: the boxes'
+/// support points, whose depth is the axis's).
+bool ClaimsMoreClearance(const ContactManifold& inManifold, float inContactPenetration);
+void PutContactIn(const ContactPoint& inContact, ContactManifold& ioManifold);
+inline void KeepTheContactGap(const ContactPoint& inContact, ContactManifold& ioManifold)
+{
+    if (ClaimsMoreClearance(ioManifold, inContact.mPenetration)) PutContactIn(inContact, ioManifold);
+}
 
 /// Copies at most ContactManifold::cMaxPoints of inPoints into outManifold: the deepest, the one furthest
 /// from it, then the two that add the most area on either side. Returns the number copied.
