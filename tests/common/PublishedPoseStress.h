@@ -15,10 +15,11 @@
 //  - a churn thread creates batches of 16 bodies (dynamic spheres dropped over the pile, static plates above
 //    it), adds them (AddBodiesPrepare / AddBodiesFinalize), lets the world step, removes and destroys them;
 //  - query threads each pick a random moving body (dynamic or kinematic), read its published pose (version
-//    v1), pick a point well inside its shape at that pose, run CollidePoint there and CollideAABox on a 2 cm
-//    box around it, and read the pose again (v2).
+//    v1), pick a point well inside its shape at that pose, run CollidePoint there, CollideAABox on a 2 cm
+//    box around it and CastShapeAll of a 1 cm sphere swept to it from outside the shape (from a random
+//    side), and read the pose again (v2).
 // With v1 == v2 nothing was published for that body between the two reads, so during both queries the world
-// published exactly the pose the point was chosen in: both queries must report the body. Each such query is
+// published exactly the pose the point was chosen in: all three queries must report the body. Each such query is
 // a "check", and a check that does not report the body is a "miss". With v1 != v2 a query may rightly have
 // seen another pose: it is counted as inconclusive, never as a check.
 // Every id any query reports (also those of a box query among the churned bodies, made to see many of them)
@@ -467,7 +468,9 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
         std::uniform_int_distribution<size_t> pick(0, targets.size() - 1);
         std::uniform_real_distribution<float> symmetric(-1.0f, 1.0f), probeXZ(-10.0f, 10.0f),
             probeY(4.0f, 7.5f);
-        std::vector<BodyID> pointHits, boxHits, probeHits;
+        std::vector<BodyID> pointHits, boxHits, castHits, probeHits;
+        std::vector<ShapeCastResult> castResults;
+        const SphereShape castProbe(0.01f);
         uint64_t rounds = 0, count = 0, duringStep = 0, missed = 0, notChecked = 0, movedAway = 0, stale = 0,
                  twice = 0, torn = 0, notRead = 0, probeCount = 0, churnSeen = 0, churnGone = 0, failed = 0;
 
@@ -558,6 +561,21 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
             failed += query.CollidePoint(point, pointHits) ? 0 : 1;
             failed +=
                 query.CollideAABox(AABB::FromCenterExtent(point, Vec3::Constant(0.01f)), boxHits) ? 0 : 1;
+            // From beyond the shape's bounding sphere (the point is within it) plus the probe's radius, so
+            // the probe starts outside the body and must touch it on its way to the point
+            Vec3 side;
+            do
+                side = Vec3(symmetric(random), symmetric(random), symmetric(random));
+            while (side.squaredNorm() > 1.0f || side.squaredNorm() < 0.01f);
+            const float reach = 2.0f * (target.mSphere ? target.mRadius : target.mHalfExtent.norm()) + 0.05f;
+            const Vec3 castFrom = point + reach * side.normalized();
+            failed += query.CastShapeAll(castProbe, {castFrom, Quat::Identity()}, point - castFrom, castResults)
+                          ? 0
+                          : 1;
+            castHits.clear();
+            for (const ShapeCastResult& result : castResults)
+                castHits.push_back(result.mBody);
+            std::sort(castHits.begin(), castHits.end());
 
             PublishedPose after;
             bool readAfter;
@@ -576,17 +594,17 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
             if (after.mVersion != before.mVersion)
             {
                 // Not checked: the body may have left the point. How often it did shows what a check catches
-                notChecked += 2;
-                for (const std::vector<BodyID>* hits : {&pointHits, &boxHits})
+                notChecked += 3;
+                for (const std::vector<BodyID>* hits : {&pointHits, &boxHits, &castHits})
                     movedAway += std::find(hits->begin(), hits->end(), target.mID) == hits->end() ? 1 : 0;
             }
             else
             {
-                count += 2;
-                if (steppingBefore || steppingAfter) duringStep += 2;
-                const std::vector<BodyID>* hitLists[2] = {&pointHits, &boxHits};
-                const char* names[2] = {"CollidePoint", "CollideAABox"};
-                for (int k = 0; k < 2; ++k)
+                count += 3;
+                if (steppingBefore || steppingAfter) duringStep += 3;
+                const std::vector<BodyID>* hitLists[3] = {&pointHits, &boxHits, &castHits};
+                const char* names[3] = {"CollidePoint", "CollideAABox", "CastShapeAll"};
+                for (int k = 0; k < 3; ++k)
                 {
                     const std::vector<BodyID>& hits = *hitLists[k];
                     if (std::find(hits.begin(), hits.end(), target.mID) != hits.end()) continue;
@@ -610,6 +628,7 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
             }
             checkReported(pointHits, clockBefore, "CollidePoint");
             checkReported(boxHits, clockBefore, "CollideAABox");
+            checkReported(castHits, clockBefore, "CastShapeAll");
 
             // Every 8th round, a box among the churned bodies (the spheres falling, the plates above), so
             // that many of the ids checked are of bodies being added and removed

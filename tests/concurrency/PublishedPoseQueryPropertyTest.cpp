@@ -9,15 +9,17 @@
 //    the next Update) it captures a snapshot: every body's published pose, read with a PoseReader, with a
 //    generation number;
 //  - two query threads each take the latest snapshot, run one random query (CastRayClosest, CastRayAll,
-//    CollideSphere, CollideAABox or CollidePoint, half of them aimed at a body, half anywhere in the box),
+//    CollideSphere, CollideAABox, CollidePoint or CastShapeAll of a capsule, half of them aimed at a body,
+//    half anywhere in the box),
 //    then read every body's published version again. When every version still equals the snapshot's, nothing
 //    was published between the capture and the end of the query, so the world the query saw is the snapshot:
 //    its result must equal the brute-force answer over the snapshot, where each body is tested by the same
 //    exact test WorldQuery makes (the shape's CastRay with the ray in local space; CollideShapes of the query
-//    shape against the body's shape, deepest penetration >= 0; a zero-length CastRay from the point).
-//    Overlap results are compared as sorted sets of ids; CastRayAll as lists of (body, fraction, normal,
-//    sub-shape), exactly; CastRayClosest by its fraction, exactly, and its body, which must be one of the
-//    bodies the brute force hits at that fraction (WorldQuery breaks ties by its own order).
+//    shape against the body's shape, deepest penetration >= 0; a zero-length CastRay from the point;
+//    CastShapeAgainst with the queries' tolerance).
+//    Overlap results are compared as sorted sets of ids; CastRayAll and CastShapeAll as lists of (body,
+//    fraction, normal, sub-shape), exactly; CastRayClosest by its fraction, exactly, and its body, which must
+//    be one of the bodies the brute force hits at that fraction (WorldQuery breaks ties by its own order).
 // A comparison is "during a step" when the flag was set when the query started or when it ended: the step's
 // broad-phase rebuild, pair search and solver ran beside the query. Queries whose snapshot went stale
 // meanwhile are counted apart; the brute force is run on them too, and how often they differ shows that the
@@ -36,6 +38,7 @@
 #include "common/MakePhysicsSystem.h"
 #include "common/PublishedPoseStress.h"
 #include "common/StaticFloor.h"
+#include "narrowphase/ShapeCast.h"
 
 #include <algorithm>
 #include <array>
@@ -75,13 +78,14 @@ enum class QueryKind : int
     Sphere,
     Box,
     Point,
+    ShapeAll,
     Count
 };
 
 const char* KindName(QueryKind inKind)
 {
-    static const char* const names[] = {"CastRayClosest", "CastRayAll", "CollideSphere", "CollideAABox",
-                                        "CollidePoint"};
+    static const char* const names[] = {"CastRayClosest", "CastRayAll",   "CollideSphere",
+                                        "CollideAABox",   "CollidePoint", "CastShapeAll"};
     return names[int(inKind)];
 }
 
@@ -89,8 +93,9 @@ const char* KindName(QueryKind inKind)
 struct Query
 {
     QueryKind mKind = QueryKind::Point;
-    RayCast mRay;
-    Vec3 mCenter = Vec3::Zero(); ///< Sphere centre or point
+    RayCast mRay;                      ///< Also the shape cast's start and displacement
+    Quat mRotation = Quat::Identity(); ///< The cast capsule's
+    Vec3 mCenter = Vec3::Zero();       ///< Sphere centre or point
     float mRadius = 0.0f;
     AABB mBox;
 };
@@ -98,8 +103,10 @@ struct Query
 /// What a query returned, in a form both sides of the comparison share.
 struct Answer
 {
-    std::vector<BodyID> mBodies;      ///< Overlap queries: sorted
-    std::vector<RayCastResult> mHits; ///< CastRayAll: sorted by fraction then body; CastRayClosest: 0 or 1
+    std::vector<BodyID> mBodies; ///< Overlap queries: sorted
+    /// CastRayAll and CastShapeAll (its contact point and depth left out): sorted by fraction then body;
+    /// CastRayClosest: 0 or 1
+    std::vector<RayCastResult> mHits;
 };
 
 /// Bit for bit: both sides compute a hit with the same operations on the same pose
@@ -131,6 +138,10 @@ std::string Describe(const Query& inQuery)
     case QueryKind::RayAll:
         return text + " origin " + Describe(inQuery.mRay.mOrigin) + " direction " +
                Describe(inQuery.mRay.mDirection);
+    case QueryKind::ShapeAll:
+        return text + " start " + Describe(inQuery.mRay.mOrigin) + " rotation (" +
+               std::to_string(inQuery.mRotation.w()) + ", " + Describe(inQuery.mRotation.vec()) +
+               ") displacement " + Describe(inQuery.mRay.mDirection);
     case QueryKind::Sphere:
         return text + " centre " + Describe(inQuery.mCenter) + " radius " + std::to_string(inQuery.mRadius);
     case QueryKind::Box:
@@ -152,6 +163,13 @@ std::string Describe(const Answer& inAnswer)
     return text.str();
 }
 
+/// The shape CastShapeAll sweeps: a capsule, turned by each query's rotation.
+const Shape* CastShape()
+{
+    static const ShapeRef capsule = CapsuleShape::Create(0.3f, 0.25f).Value();
+    return capsule.get();
+}
+
 /// The query against the world; false when it returned an error.
 bool RunWorldQuery(const WorldQuery& inWorld, const Query& inQuery, Answer& outAnswer)
 {
@@ -167,6 +185,16 @@ bool RunWorldQuery(const WorldQuery& inWorld, const Query& inQuery, Answer& outA
     }
     case QueryKind::RayAll:
         return bool(inWorld.CastRayAll(inQuery.mRay, outAnswer.mHits));
+    case QueryKind::ShapeAll:
+    {
+        thread_local std::vector<ShapeCastResult> hits;
+        if (!inWorld.CastShapeAll(*CastShape(), {inQuery.mRay.mOrigin, inQuery.mRotation},
+                                  inQuery.mRay.mDirection, hits))
+            return false;
+        for (const ShapeCastResult& hit : hits)
+            outAnswer.mHits.push_back({hit.mBody, hit.mFraction, hit.mNormal, hit.mSubShape});
+        return true;
+    }
     case QueryKind::Sphere:
         return bool(inWorld.CollideSphere(inQuery.mCenter, inQuery.mRadius, outAnswer.mBodies));
     case QueryKind::Box:
@@ -221,6 +249,26 @@ std::vector<BodyID> BruteForceShape(const Snapshot& inSnapshot, const Shape& inS
     return bodies;
 }
 
+/// Every body of the snapshot the cast capsule touches, where it first touches each, as WorldQuery sweeps it
+/// (the same routine and tolerance), sorted by fraction then body.
+std::vector<RayCastResult> BruteForceShapeCast(const Snapshot& inSnapshot, const Query& inQuery)
+{
+    std::vector<RayCastResult> hits;
+    ShapeCastSettings settings;
+    settings.mTolerance = QueryCastTolerance(inQuery.mRay.mOrigin);
+    for (const PublishedPose& pose : inSnapshot.mPoses)
+        if (const std::optional<ShapeCastHit> hit =
+                CastShapeAgainst(*CastShape(), {inQuery.mRay.mOrigin, inQuery.mRotation},
+                                 inQuery.mRay.mDirection, *pose.mShape, pose.mTransform, settings))
+            hits.push_back({pose.mID, hit->mFraction, -hit->mManifold.mNormal, hit->mManifold.mSubShapeB});
+    std::sort(hits.begin(), hits.end(),
+              [](const RayCastResult& inA, const RayCastResult& inB) {
+                  return inA.mFraction < inB.mFraction ||
+                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
+              });
+    return hits;
+}
+
 /// The answer the world must give if it published exactly the snapshot.
 Answer BruteForce(const Snapshot& inSnapshot, const Query& inQuery)
 {
@@ -230,6 +278,9 @@ Answer BruteForce(const Snapshot& inSnapshot, const Query& inQuery)
     case QueryKind::RayClosest:
     case QueryKind::RayAll:
         answer.mHits = BruteForceRay(inSnapshot, inQuery.mRay);
+        break;
+    case QueryKind::ShapeAll:
+        answer.mHits = BruteForceShapeCast(inSnapshot, inQuery);
         break;
     case QueryKind::Sphere:
         answer.mBodies =
@@ -492,7 +543,9 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
             {
             case QueryKind::RayClosest:
             case QueryKind::RayAll:
+            case QueryKind::ShapeAll:
             {
+                query.mRotation = test::published_pose_stress::RandomRotation(random);
                 Vec3 away(symmetric(random), symmetric(random), symmetric(random));
                 if (away.squaredNorm() < 1.0e-4f) away = Vec3::UnitY();
                 query.mRay.mOrigin = focus + (1.0f + 7.0f * unit(random)) * away.normalized();
@@ -608,13 +661,15 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
     const uint64_t conclusive = duringStep + total.mBetweenSteps;
     std::printf(
         "[ figure   ] %llu comparisons during a step (ray closest %llu, ray all %llu, sphere %llu, box %llu, "
-        "point %llu), %llu between steps, %llu mismatches; %llu of %llu answers not empty; %llu queries on a "
+        "point %llu, shape cast all %llu), %llu between steps, %llu mismatches; %llu of %llu answers not "
+        "empty; %llu queries on a "
         "snapshot gone stale, %llu of them differing from it; %llu updates in %.1f s\n",
         (unsigned long long)duringStep, (unsigned long long)total.mDuringStep[0],
         (unsigned long long)total.mDuringStep[1], (unsigned long long)total.mDuringStep[2],
         (unsigned long long)total.mDuringStep[3], (unsigned long long)total.mDuringStep[4],
-        (unsigned long long)total.mBetweenSteps, (unsigned long long)total.mMismatches,
-        (unsigned long long)total.mNonEmpty, (unsigned long long)conclusive, (unsigned long long)total.mStale,
+        (unsigned long long)total.mDuringStep[5], (unsigned long long)total.mBetweenSteps,
+        (unsigned long long)total.mMismatches, (unsigned long long)total.mNonEmpty,
+        (unsigned long long)conclusive, (unsigned long long)total.mStale,
         (unsigned long long)total.mStaleDiffering, (unsigned long long)updates.load(), seconds);
     for (const std::string& failure : failures)
         ADD_FAILURE() << failure;
