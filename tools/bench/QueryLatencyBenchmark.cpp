@@ -9,6 +9,8 @@
 //  sphere_overlap      CollideSphere, radius 1.5 m, inside the pyramid
 //  box_overlap         CollideAABox, a 4 m cube, inside the pyramid
 //  ray_static          CastRayClosest straight down onto the floor beside the pyramid: only a static body
+//  capsule_cast        CastShapeClosest of a standing capsule (radius 0.4 m, 1.8 m tall) along ray_pyramid's
+//                      path, 1 m higher: a character's probe, a ray's candidates and more, each one swept
 //  tile_collect        GeometryCollector::FindBodies + CollectTriangles over the 12.8 m navmesh tile
 //                      x, z in [-12.8, 0] (a quarter of the pyramid), full height, awake boxes included
 // and a write, from a third thread that sleeps 0 to --write-interval-us between writes:
@@ -55,6 +57,7 @@
 #include "cairn/navmesh/GeometryCollector.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
 #include "common/BenchOptions.h"
 #include "common/BenchScenes.h"
 #include "common/FrameTimes.h"
@@ -90,14 +93,16 @@ enum class Kind : uint8_t
     SphereOverlap,
     BoxOverlap,
     RayStatic,
+    CapsuleCast,
     TileCollect,
     WriteSetPosition,
 };
-constexpr size_t cNumKinds = 6;
+constexpr size_t cNumKinds = 7;
 constexpr std::array<const char*, cNumKinds> cKindNames = {
-    "ray_pyramid", "sphere_overlap", "box_overlap", "ray_static", "tile_collect", "write_set_position"};
+    "ray_pyramid",  "sphere_overlap", "box_overlap",       "ray_static",
+    "capsule_cast", "tile_collect",   "write_set_position"};
 /// What the checksum counts of each kind
-constexpr std::array<const char*, cNumKinds> cKindCounts = {"hits", "bodies", "bodies",
+constexpr std::array<const char*, cNumKinds> cKindCounts = {"hits", "bodies", "bodies", "hits",
                                                             "hits", "bodies", "ok"};
 
 /// The targets are on queries; a write may wait for the step
@@ -266,10 +271,13 @@ QueryInput DrawInput(Kind inKind, Random& ioRandom)
     switch (inKind)
     {
     case Kind::RayPyramid:
+    case Kind::CapsuleCast:
         // From 24 m off the pyramid's -x face, level with its lower half, 60 m across it
         input.mRay.mOrigin = Vec3(tools::cPyramidFootprintMin - 24.0f, ioRandom.Next(0.5f, 12.0f),
                                   ioRandom.Next(cInsideMin, cInsideMax));
         input.mRay.mDirection = Vec3(60.0f, ioRandom.Next(-2.0f, 2.0f), ioRandom.Next(-2.0f, 2.0f));
+        // The capsule starts clear of the floor (its foot 0.1 m up at the least), as a character stands
+        if (inKind == Kind::CapsuleCast) input.mRay.mOrigin.y() += 1.0f;
         break;
     case Kind::SphereOverlap:
     case Kind::BoxOverlap:
@@ -296,6 +304,7 @@ struct QueryContext
 {
     const WorldQuery& mQuery;
     const navmesh::GeometryCollector mCollector;
+    const ShapeRef mCapsule = CapsuleShape::Create(0.5f, 0.4f).Value();
     std::vector<BodyID> mBodies;
     navmesh::TileGeometry mGeometry;
     navmesh::NavMeshInclusion mInclusion;
@@ -320,6 +329,14 @@ bool RunQuery(Kind inKind, const QueryInput& inInput, QueryContext& ioContext, u
     case Kind::RayStatic:
     {
         const Result<std::optional<RayCastResult>> hit = ioContext.mQuery.CastRayClosest(inInput.mRay);
+        if (!hit) return false;
+        outCount = hit.Value().has_value() ? 1 : 0;
+        return true;
+    }
+    case Kind::CapsuleCast:
+    {
+        const Result<std::optional<ShapeCastResult>> hit = ioContext.mQuery.CastShapeClosest(
+            *ioContext.mCapsule, {inInput.mRay.mOrigin, Quat::Identity()}, inInput.mRay.mDirection);
         if (!hit) return false;
         outCount = hit.Value().has_value() ? 1 : 0;
         return true;
