@@ -18,7 +18,7 @@
 #include <rapidcheck/gtest.h>
 #include <vector>
 
-namespace cairn
+namespace cairn::shape_cast_test // Named: a unity build puts this beside other tests' anonymous helpers
 {
 using namespace cairn::physics;
 namespace
@@ -380,4 +380,4 @@ RC_GTEST_PROP(ShapeCastProperty, AnyConvexPairNeverEndsInsideNorPassesThrough, (
 }
 
 } // namespace
-} // namespace cairn
+} // namespace cairn::shape_cast_test
