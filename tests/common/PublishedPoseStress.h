@@ -18,10 +18,10 @@
 //    v1), pick a point well inside its shape at that pose, run CollidePoint there, CollideAABox on a 2 cm
 //    box around it and CastShapeAll of a 1 cm sphere swept to it from outside the shape (from a random
 //    side), and read the pose again (v2).
-// With v1 == v2 nothing was published for that body between the two reads, so during both queries the world
-// published exactly the pose the point was chosen in: all three queries must report the body. Each such query is
-// a "check", and a check that does not report the body is a "miss". With v1 != v2 a query may rightly have
-// seen another pose: it is counted as inconclusive, never as a check.
+// With v1 == v2 nothing was published for that body between the two reads, so during the queries the world
+// published exactly the pose the point was chosen in: all three queries must report the body. Each such query
+// is a "check", and a check that does not report the body is a "miss". With v1 != v2 a query may rightly
+// have seen another pose: it is counted as inconclusive, never as a check.
 // Every id any query reports (also those of a box query among the churned bodies, made to see many of them)
 // must be a body in the world during the query: a body the test never created, a churned body never added, or
 // one whose RemoveBody had returned before the query started is a "stale id". The same id twice in one
@@ -569,9 +569,10 @@ inline PublishedPoseStressResult RunPublishedPoseStress(const PublishedPoseStres
             while (side.squaredNorm() > 1.0f || side.squaredNorm() < 0.01f);
             const float reach = 2.0f * (target.mSphere ? target.mRadius : target.mHalfExtent.norm()) + 0.05f;
             const Vec3 castFrom = point + reach * side.normalized();
-            failed += query.CastShapeAll(castProbe, {castFrom, Quat::Identity()}, point - castFrom, castResults)
-                          ? 0
-                          : 1;
+            failed +=
+                query.CastShapeAll(castProbe, {castFrom, Quat::Identity()}, point - castFrom, castResults)
+                    ? 0
+                    : 1;
             castHits.clear();
             for (const ShapeCastResult& result : castResults)
                 castHits.push_back(result.mBody);
