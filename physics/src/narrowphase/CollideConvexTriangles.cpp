@@ -146,7 +146,17 @@ int CollideConvexTriangles(const ConvexShape& inA, const Transform& inTransformA
 {
     // Work in B's local space: the convex shape is moved once instead of every triangle
     const Transform relative = inTransformB.Inverse() * inTransformA;
-    const AABB localBox = inA.GetWorldBounds(relative).Expanded(inSettings.mMaxSeparation);
+    AABB localBox = inA.GetWorldBounds(relative);
+    if (inSettings.mSweep == Vec3::Zero())
+        localBox = localBox.Expanded(inSettings.mMaxSeparation);
+    else
+    {
+        // A cast: the triangles its remaining path can reach
+        const Vec3 sweep = inTransformB.InverseRotateVector(inSettings.mSweep);
+        localBox =
+            AABB(localBox.mMin.cwiseMin(localBox.mMin + sweep), localBox.mMax.cwiseMax(localBox.mMax + sweep))
+                .Expanded(cSweptTriangleMargin);
+    }
     const Mat3 rotB = inTransformB.mRotation.toRotationMatrix();
     int count = 0;
     inB.VisitTriangles(localBox,

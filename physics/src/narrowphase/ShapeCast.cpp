@@ -68,6 +68,7 @@ private:
         at.mPosition += inT * mDisplacement;
         CollideSettings collide;
         collide.mFaceNormalsAtInternalEdges = false; // See there: the plane's depth beside a triangle is none
+        collide.mSweep = (mSettings.mMaxFraction - inT) * mDisplacement;
         const float allowed = mSettings.mAllowedPenetration;
         const float tolerance = mSettings.mTolerance;
         collide.mMaxSeparation =

@@ -28,7 +28,14 @@ struct CollideSettings
     /// is not in. Harmless within a speculative distance; a shape cast, which looks metres ahead, turns it
     /// off and takes each triangle's true nearest feature.
     bool mFaceNormalsAtInternalEdges = true;
+    /// A shape cast's remaining displacement of A (world space), or zero. When set, a mesh's or height
+    /// field's triangles are taken from A's bounds swept along it (grown by cSweptTriangleMargin) instead of
+    /// A's bounds grown by mMaxSeparation all round: a cast looks that far ahead, not that far around.
+    Vec3 mSweep = Vec3::Zero();
 };
+
+/// How far round A's swept bounds a shape cast takes triangles (metres): beyond any cast tolerance.
+inline constexpr float cSweptTriangleMargin = 0.01f;
 
 /// Collides shape A at inTransformA with shape B at inTransformB and reports every manifold with at least one
 /// point whose penetration >= -inSettings.mMaxSeparation. Mesh/height-field pairs with each other produce
