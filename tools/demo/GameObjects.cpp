@@ -3,6 +3,7 @@
 #include "WorldGenerator.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
 
 #include <algorithm>
 #include <chrono>
@@ -15,6 +16,14 @@ using namespace cairn::physics;
 namespace
 {
 using Clock = std::chrono::steady_clock;
+/// The walk probe: a capsule as wide as the object, its foot this far above the object's, so that the
+/// terrain's rise over one frame's move does not stop it (a step-up, as a character controller has)
+constexpr float cWalkProbeRadius = 0.3f, cWalkProbeHalfHeight = 0.35f, cWalkProbeLift = 0.3f;
+/// An object stops this short of what its probe met (metres), so that the next frame's probe starts clear
+constexpr float cWalkSkin = 0.02f;
+/// An object left farther than this behind its spot (held at a wall while the player walked on) is put back
+/// at its spot without a sweep, as a game brings back a companion that fell behind
+constexpr float cMaxSweptMove = 3.0f;
 std::atomic<uint32_t> sNextThreadSlot{0}; // Relaxed: only uniqueness matters
 } // namespace
 
@@ -26,7 +35,8 @@ uint32_t GameObjects::ThreadSlotIndex()
 
 GameObjects::GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
                          uint64_t inSeed)
-    : mPhysics(ioPhysics), mGenerator(inGenerator)
+    : mPhysics(ioPhysics), mGenerator(inGenerator),
+      mWalkProbe(CapsuleShape::Create(cWalkProbeHalfHeight, cWalkProbeRadius).Value())
 {
     std::mt19937_64 random(inSeed);
     std::uniform_real_distribution<float> offset(-40.0f, 40.0f), phase(0.0f, 6.28f);
@@ -85,11 +95,32 @@ void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, uint64_t& 
     // What is around it
     thread_local std::vector<BodyID> around;
     const Status aroundStatus = query.CollideSphere(eye, 2.0f, around, filter);
-    const int errors = int(!ground.IsOk()) + int(!blocked.IsOk()) + int(!aroundStatus.IsOk());
+    int errors = int(!ground.IsOk()) + int(!blocked.IsOk()) + int(!aroundStatus.IsOk());
+    ioQueries += 3;
+    // Its move to the spot, swept (see cWalkProbeLift): a body on the way stops it short
+    const Vec3 target(spot.x(), ioObject.mGroundY + 0.9f, spot.z());
+    const Vec3 move = target - ioObject.mTarget;
+    Vec3 goTo = target;
+    if (ioObject.mPlaced && move.squaredNorm() < cMaxSweptMove * cMaxSweptMove)
+    {
+        const Vec3 probeCentre =
+            ioObject.mTarget +
+            Vec3(0.0f, cWalkProbeLift - 0.9f + cWalkProbeHalfHeight + cWalkProbeRadius, 0.0f);
+        const Result<std::optional<ShapeCastResult>> walk =
+            query.CastShapeClosest(*mWalkProbe, {probeCentre, Quat::Identity()}, move, filter);
+        errors += int(!walk.IsOk());
+        ++ioQueries;
+        if (walk.IsOk() && walk.Value().has_value())
+        {
+            const float length = move.norm();
+            const float reach = std::max(walk.Value()->mFraction * length - cWalkSkin, 0.0f);
+            goTo = ioObject.mTarget + (length > 0.0f ? reach / length : 0.0f) * move;
+        }
+    }
     if (errors > 0) mQueryErrors.fetch_add(uint64_t(errors), std::memory_order_relaxed); // A count only
     ioNanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
-    ioQueries += 3;
-    ioObject.mTarget = Vec3(spot.x(), ioObject.mGroundY + 0.9f, spot.z());
+    ioObject.mTarget = goTo;
+    ioObject.mPlaced = true;
 }
 
 void GameObjects::UpdateQueries(jobs::JobSystem& ioJobs, uint32_t inJobs, const Vec3& inPlayer,

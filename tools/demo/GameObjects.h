@@ -4,7 +4,8 @@
 // around the player) are updated each frame by K jobs on the job system's threads, as a game with a frame
 // pipeline does: while the physics step runs on another thread, each object probes the ground (a ray cast
 // down), checks its line of sight to the player (a ray cast), looks for bodies around it (a sphere query) and
-// decides where to go (UpdateQueries); after the step, K jobs move the bodies (ApplyMoves: broad-phase
+// sweeps its move there (a capsule cast at knee height, as a character controller probes its way: a prop or
+// a wall stops it) (UpdateQueries); after the step, K jobs move the bodies (ApplyMoves: broad-phase
 // writes). The queries during the step are the load under which the two modes are compared: lock-free
 // (queries read published poses and never wait) and global mutex (queries read each body under the one body
 // mutex, which the step holds: the reference engine's "before"). The time each thread's jobs spend in
@@ -69,6 +70,7 @@ private:
         bool mCanSeePlayer = false;
         float mGroundY = 0.0f;
         Vec3 mTarget = Vec3::Zero(); ///< Where its queries sent it this frame (the body's origin)
+        bool mPlaced = false;        ///< mTarget holds where it stands (from its first frame on)
     };
     struct alignas(64) ThreadSlot
     {
@@ -85,6 +87,7 @@ private:
     PhysicsSystem& mPhysics;
     const WorldGenerator& mGenerator;
     std::vector<Object> mObjects;
+    const ShapeRef mWalkProbe; ///< The capsule its move is swept with (see QueryObject)
     float mTime = 0.0f;
     uint64_t mFrames = 0; ///< Updates with objects (main thread)
     std::array<ThreadSlot, cMaxThreadSlots> mSlots;
