@@ -19,7 +19,8 @@
 // tolerance (about 0.1 mm near the origin) along the surface normal. A body the shape already overlaps at the
 // start is a hit at fraction 0 when the sweep moves deeper into it, and no hit when the sweep leaves it or
 // slides along it, so a character standing on the floor can probe sideways. A zero displacement reports what
-// the shape touches, at fraction 0.
+// the shape touches, at fraction 0. Against a mesh or height field the normal at a seam between two triangles
+// is the seam's; the step's contacts take the face's there (CollideSettings::mFaceNormalsAtInternalEdges).
 
 #include "cairn/physics/PhysicsSettings.h"
 #include "cairn/physics/body/BodyManager.h"
