@@ -204,6 +204,16 @@ bool RunWorldQuery(const WorldQuery& inWorld, const Query& inQuery, Answer& outA
     }
 }
 
+/// Hits in WorldQuery's order of cast results: by fraction, then by body.
+void SortByFractionThenBody(std::vector<RayCastResult>& ioHits)
+{
+    std::sort(ioHits.begin(), ioHits.end(),
+              [](const RayCastResult& inA, const RayCastResult& inB) {
+                  return inA.mFraction < inB.mFraction ||
+                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
+              });
+}
+
 /// Every body of the snapshot the ray hits, each with its closest hit, sorted by fraction then body: the ray
 /// in the body's local space, as WorldQuery casts it.
 std::vector<RayCastResult> BruteForceRay(const Snapshot& inSnapshot, const RayCast& inRay)
@@ -219,11 +229,7 @@ std::vector<RayCastResult> BruteForceRay(const Snapshot& inSnapshot, const RayCa
         hits.push_back({pose.mID, std::min(hit.mFraction, 1.0f), pose.mTransform.RotateVector(hit.mNormal),
                         hit.mSubShape});
     }
-    std::sort(hits.begin(), hits.end(),
-              [](const RayCastResult& inA, const RayCastResult& inB) {
-                  return inA.mFraction < inB.mFraction ||
-                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
-              });
+    SortByFractionThenBody(hits);
     return hits;
 }
 
@@ -261,11 +267,7 @@ std::vector<RayCastResult> BruteForceShapeCast(const Snapshot& inSnapshot, const
                 CastShapeAgainst(*CastShape(), {inQuery.mRay.mOrigin, inQuery.mRotation},
                                  inQuery.mRay.mDirection, *pose.mShape, pose.mTransform, settings))
             hits.push_back({pose.mID, hit->mFraction, -hit->mManifold.mNormal, hit->mManifold.mSubShapeB});
-    std::sort(hits.begin(), hits.end(),
-              [](const RayCastResult& inA, const RayCastResult& inB) {
-                  return inA.mFraction < inB.mFraction ||
-                         (inA.mFraction == inB.mFraction && inA.mBody < inB.mBody);
-              });
+    SortByFractionThenBody(hits);
     return hits;
 }
 

@@ -260,25 +260,25 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
         BoxSupportingFace(inTransformA.mPosition, rotA, eA, n, incident);
     }
     outManifold.mNormal = n;
+    // The two boxes' support points along the normal: the axis's own gap apart along it
+    const auto supportPair = [&]() -> ContactPoint
+    {
+        const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
+        const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
+        return {pA, pB, (pA - pB).dot(n)};
+    };
     if (ClipIncidentAgainstReference(ref, incident, refIsA, maxSep, outManifold) > 0)
     {
-        // KeepTheContactGap: the two boxes' support points along the normal are the axis's own gap apart
-        if (ClaimsMoreClearance(outManifold, -best))
-        {
-            const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
-            const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
-            PutContactIn({pA, pB, (pA - pB).dot(n)}, outManifold);
-        }
+        // KeepTheContactGap, the support pair made only when it goes in
+        if (ClaimsMoreClearance(outManifold, -best)) PutContactIn(supportPair(), outManifold);
         return true;
     }
 
     // Clipping lost everything (only possible through float noise at a corner): use the two support points
-    const Vec3 pA = inTransformA * BoxCorner(rotA.transpose() * n, eA);
-    const Vec3 pB = inTransformB * BoxCorner(rotB.transpose() * -n, eB);
-    const float pen = (pA - pB).dot(n);
-    if (pen < -maxSep) return false;
+    const ContactPoint support = supportPair();
+    if (support.mPenetration < -maxSep) return false;
     outManifold.mNumPoints = 1;
-    outManifold.mPoints[0] = {pA, pB, pen};
+    outManifold.mPoints[0] = support;
     return true;
 }
 

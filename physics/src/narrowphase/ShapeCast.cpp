@@ -79,9 +79,10 @@ private:
                       {
                           Nearest nearest;
                           for (int i = 0; i < inManifold.mNumPoints; ++i)
-                              if (allowed - inManifold.mPoints[i].mPenetration < nearest.mGap)
+                              if (const float gap = allowed - inManifold.mPoints[i].mPenetration;
+                                  gap < nearest.mGap)
                               {
-                                  nearest.mGap = allowed - inManifold.mPoints[i].mPenetration;
+                                  nearest.mGap = gap;
                                   nearest.mHit = {inT, inManifold, i};
                               }
                           if (nearest.mGap < probe.mLeast.mGap) probe.mLeast = nearest;
