@@ -20,6 +20,7 @@
 #include "common/FrameTimes.h"
 #include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
+#include "common/WorkloadBodies.h"
 
 #include <algorithm>
 #include <chrono>
@@ -40,28 +41,9 @@ using tools::MillisecondsSince;
 namespace
 {
 
-BodyCreationSettings BoxSettings(const BenchBox& inBox, MotionType inMotion)
-{
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(inBox.mHalfExtent).Value();
-    settings.mPosition = inBox.mCenter;
-    settings.mRotation = Quat(Eigen::AngleAxisf(inBox.mYaw, Vec3::UnitY()));
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    settings.mFriction = 0.5f;
-    settings.mDensity = 1000.0f;
-    return settings;
-}
-
 void AddBatch(PhysicsSystem& ioPhysics, const std::vector<BenchBox>& inBoxes, MotionType inMotion)
 {
-    BodyInterface& bodies = ioPhysics.GetBodyInterface();
-    std::vector<BodyID> ids;
-    for (const BenchBox& box : inBoxes)
-        ids.push_back(bodies.CreateBody(BoxSettings(box, inMotion)).Value());
-    BodyInterface::AddBatch batch = bodies.AddBodiesPrepare(ids).Value();
-    (void)bodies.AddBodiesFinalize(batch, inMotion == MotionType::Static ? Activation::DontActivate
-                                                                         : Activation::Activate);
+    (void)AddWorkloadBoxes(ioPhysics.GetBodyInterface(), inBoxes, inMotion);
 }
 
 PhysicsSettings PileSettings()

@@ -3,6 +3,8 @@
 #include "narrowphase/ClosestPoints.h"
 #include "narrowphase/FaceClipping.h"
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 namespace cairn::physics
@@ -212,6 +214,8 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
         kind = BoxBoxAxis::FaceB;
         best = bestFaceB;
     }
+    // The best face axis, in A's frame: an edge axis close to it is read through the faces (below)
+    const Vec3 faceAxis = kind == BoxBoxAxis::FaceA ? Vec3(Vec3::Unit(faceA)) : Vec3(c.col(faceB));
     if (bestEdge > best + cBoxEdgeBias) kind = BoxBoxAxis::Edge;
     if (outAxis != nullptr) *outAxis = kind;
 
@@ -236,9 +240,29 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
         Vec3 pB;
         ClosestPointsSegmentSegment(inTransformA * cornerA, inTransformA * endA, inTransformB * cornerB,
                                     inTransformB * endB, s, u, pA, pB);
+        const ContactPoint edges{pA, pB, (pA - pB).dot(n)};
         outManifold.mNormal = n;
+        // Near a face axis the edges cross where a face lies nearly flat on the other box (a landing box
+        // tilted by a fraction of a degree gets here by more than the bias). Their single point would carry
+        // that face on one corner, and the box would spin deep into the other: the faces' clipped points
+        // hold it, with the edges' pair among them so that the manifold is as deep as the axis
+        if (std::abs(edgeAxis.dot(faceAxis)) >= cBoxEdgeAxisNearFaceCos)
+        {
+            Vec3 faceOfA[4];
+            Vec3 faceOfB[4];
+            BoxSupportingFace(inTransformA.mPosition, rotA, eA, n, faceOfA);
+            BoxSupportingFace(inTransformB.mPosition, rotB, eB, -n, faceOfB);
+            if (ManifoldFromFaces(faceOfA, 4, faceOfB, 4, n, maxSep, outManifold) > 0)
+            {
+                float deepest = -cLargeFloat;
+                for (int i = 0; i < outManifold.mNumPoints; ++i)
+                    deepest = std::max(deepest, outManifold.mPoints[i].mPenetration);
+                if (deepest < edges.mPenetration - cClippedGapSlack) PutContactIn(edges, outManifold);
+                return true;
+            }
+        }
         outManifold.mNumPoints = 1;
-        outManifold.mPoints[0] = {pA, pB, (pA - pB).dot(n)};
+        outManifold.mPoints[0] = edges;
         return true;
     }
 

@@ -1,5 +1,6 @@
 // Hand-made box-box cases with analytic answers: face-face manifolds, edge-edge, rotations, touching and
-// separated boxes, and the reduction of a clipped octagon to 4 points.
+// separated boxes, a nearly flat landing box over an edge, and the reduction of a clipped octagon to 4
+// points.
 
 #include "common/ShapeExpect.h"
 #include "narrowphase/CollideBoxBox.h"
@@ -133,6 +134,37 @@ TEST(BoxBoxTest, EdgeEdgeCrossing)
     EXPECT_NEAR(m.mPoints[0].mPenetration, 0.05f, cEps);
     ExpectVec(m.mPoints[0].mPositionOnA, Vec3(0, h, 0));
     ExpectVec(m.mPoints[0].mPositionOnB, Vec3(0, h - 0.05f, 0));
+}
+
+TEST(BoxBoxTest, ANearlyFlatLandingBoxIsHeldByItsFaceNotByOneCorner)
+{
+    // step_pile2k's case, in the static box's frame: a falling cube, turned about the vertical against the
+    // box under it and tilted by a tenth of a degree, over that box's edge, its lowest corner a millimetre
+    // into it. The edges crossing under it make an axis a shade shallower than the face axis by more than the
+    // bias, whose single point once carried the cube on one corner: it spun 21 cm into the box
+    const auto slab = BoxShape::Create(Vec3(0.914f, 0.53f, 0.737f)).Value();
+    const auto cube = BoxShape::Create(Vec3(0.5f, 0.5f, 0.5f)).Value();
+    const Transform tb{Vec3(-0.342219591f, 1.029356f, -0.786708057f),
+                       Quat(0.139192805f, 0.000346043205f, 0.990265012f, -0.000745627272f).normalized()};
+    CollideSettings settings;
+    settings.mMaxSeparation = 0.02f; // The step's speculative distance
+    ContactManifold m;
+    BoxBoxAxis axis;
+    ASSERT_TRUE(CollideBoxBox(*slab, {}, *cube, tb, settings, m, &axis));
+    ASSERT_EQ(axis, BoxBoxAxis::Edge) << "the case must reach the edge axis it is about";
+    EXPECT_GT(m.mNormal.y(), 0.9999f);
+    // The cube's face over the slab holds it: points spread over that face, not a corner alone
+    ASSERT_GE(m.mNumPoints, 3);
+    float spread = 0.0f;
+    for (int i = 0; i < m.mNumPoints; ++i)
+        for (int j = 0; j < i; ++j)
+            spread = std::max(spread, (m.mPoints[i].mPositionOnB - m.mPoints[j].mPositionOnB).norm());
+    EXPECT_GT(spread, 0.5f);
+    // As deep as the edge axis (the lowest corner's millimetre), every point within the speculative distance
+    EXPECT_NEAR(MaxPenetration(m), 0.0009f, 0.0003f);
+    for (int i = 0; i < m.mNumPoints; ++i)
+        EXPECT_GE(m.mPoints[i].mPenetration, -settings.mMaxSeparation);
+    ExpectConsistentPoints(m);
 }
 
 TEST(BoxBoxTest, TouchingSpeculativeAndBeyond)
