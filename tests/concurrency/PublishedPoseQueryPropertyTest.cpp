@@ -9,8 +9,8 @@
 //    the next Update) it captures a snapshot: every body's published pose, read with a PoseReader, with a
 //    generation number;
 //  - two query threads each take the latest snapshot, run one random query (CastRayClosest, CastRayAll,
-//    CollideSphere, CollideAABox, CollidePoint or CastShapeAll of a capsule, half of them aimed at a body,
-//    half anywhere in the box),
+//    CollideSphere, CollideAABox, CollidePoint, or CastShapeAll or CastShapeClosest of a capsule, half of
+//    them aimed at a body, half anywhere in the box),
 //    then read every body's published version again. When every version still equals the snapshot's, nothing
 //    was published between the capture and the end of the query, so the world the query saw is the snapshot:
 //    its result must equal the brute-force answer over the snapshot, where each body is tested by the same
@@ -19,7 +19,10 @@
 //    CastShapeAgainst with the queries' tolerance).
 //    Overlap results are compared as sorted sets of ids; CastRayAll and CastShapeAll as lists of (body,
 //    fraction, normal, sub-shape), exactly; CastRayClosest by its fraction, exactly, and its body, which must
-//    be one of the bodies the brute force hits at that fraction (WorldQuery breaks ties by its own order).
+//    be one of the bodies the brute force hits at that fraction (WorldQuery breaks ties by its own order);
+//    CastShapeClosest by its body, which must be one the brute force hits, within the cast's tolerance of
+//    the brute force's first touch and of its own fraction there (the search for the closest sweeps each
+//    later body only up to the best fraction so far, which changes the manifolds it advances by).
 // A comparison is "during a step" when the flag was set when the query started or when it ended: the step's
 // broad-phase rebuild, pair search and solver ran beside the query. Queries whose snapshot went stale
 // meanwhile are counted apart; the brute force is run on them too, and how often they differ shows that the
@@ -44,6 +47,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <gtest/gtest.h>
 #include <memory>
@@ -79,13 +83,14 @@ enum class QueryKind : int
     Box,
     Point,
     ShapeAll,
+    ShapeClosest,
     Count
 };
 
 const char* KindName(QueryKind inKind)
 {
-    static const char* const names[] = {"CastRayClosest", "CastRayAll",   "CollideSphere",
-                                        "CollideAABox",   "CollidePoint", "CastShapeAll"};
+    static const char* const names[] = {"CastRayClosest", "CastRayAll",   "CollideSphere",   "CollideAABox",
+                                        "CollidePoint",   "CastShapeAll", "CastShapeClosest"};
     return names[int(inKind)];
 }
 
@@ -105,7 +110,7 @@ struct Answer
 {
     std::vector<BodyID> mBodies; ///< Overlap queries: sorted
     /// CastRayAll and CastShapeAll (its contact point and depth left out): sorted by fraction then body;
-    /// CastRayClosest: 0 or 1
+    /// CastRayClosest and CastShapeClosest: 0 or 1
     std::vector<RayCastResult> mHits;
 };
 
@@ -139,6 +144,7 @@ std::string Describe(const Query& inQuery)
         return text + " origin " + Describe(inQuery.mRay.mOrigin) + " direction " +
                Describe(inQuery.mRay.mDirection);
     case QueryKind::ShapeAll:
+    case QueryKind::ShapeClosest:
         return text + " start " + Describe(inQuery.mRay.mOrigin) + " rotation (" +
                std::to_string(inQuery.mRotation.w()) + ", " + Describe(inQuery.mRotation.vec()) +
                ") displacement " + Describe(inQuery.mRay.mDirection);
@@ -163,7 +169,7 @@ std::string Describe(const Answer& inAnswer)
     return text.str();
 }
 
-/// The shape CastShapeAll sweeps: a capsule, turned by each query's rotation.
+/// The shape CastShapeAll and CastShapeClosest sweep: a capsule, turned by each query's rotation.
 const Shape* CastShape()
 {
     static const ShapeRef capsule = CapsuleShape::Create(0.3f, 0.25f).Value();
@@ -193,6 +199,15 @@ bool RunWorldQuery(const WorldQuery& inWorld, const Query& inQuery, Answer& outA
             return false;
         for (const ShapeCastResult& hit : hits)
             outAnswer.mHits.push_back({hit.mBody, hit.mFraction, hit.mNormal, hit.mSubShape});
+        return true;
+    }
+    case QueryKind::ShapeClosest:
+    {
+        const Result<std::optional<ShapeCastResult>> hit = inWorld.CastShapeClosest(
+            *CastShape(), {inQuery.mRay.mOrigin, inQuery.mRotation}, inQuery.mRay.mDirection);
+        if (!hit) return false;
+        if (const std::optional<ShapeCastResult>& first = hit.Value())
+            outAnswer.mHits.push_back({first->mBody, first->mFraction, first->mNormal, first->mSubShape});
         return true;
     }
     case QueryKind::Sphere:
@@ -282,6 +297,7 @@ Answer BruteForce(const Snapshot& inSnapshot, const Query& inQuery)
         answer.mHits = BruteForceRay(inSnapshot, inQuery.mRay);
         break;
     case QueryKind::ShapeAll:
+    case QueryKind::ShapeClosest:
         answer.mHits = BruteForceShapeCast(inSnapshot, inQuery);
         break;
     case QueryKind::Sphere:
@@ -312,11 +328,25 @@ Answer BruteForce(const Snapshot& inSnapshot, const Query& inQuery)
 
 /// Whether the world's answer is the brute force's. CastRayClosest: the same fraction, and the hit of one of
 /// the bodies the brute force hits at that fraction (several at once is a tie WorldQuery breaks its own way).
+/// CastShapeClosest: see the file's comment.
 bool Matches(const Query& inQuery, const Answer& inWorld, const Answer& inBruteForce)
 {
-    if (inQuery.mKind != QueryKind::RayClosest) return SameAnswer(inWorld, inBruteForce);
+    if (inQuery.mKind != QueryKind::RayClosest && inQuery.mKind != QueryKind::ShapeClosest)
+        return SameAnswer(inWorld, inBruteForce);
     if (inBruteForce.mHits.empty()) return inWorld.mHits.empty();
     if (inWorld.mHits.size() != 1) return false;
+    if (inQuery.mKind == QueryKind::ShapeClosest)
+    {
+        // The tolerance as a fraction of the displacement, twice: each side stops within it of the touch
+        const float slack = 2.0f * QueryCastTolerance(inQuery.mRay.mOrigin) / inQuery.mRay.mDirection.norm();
+        const RayCastResult& world = inWorld.mHits.front();
+        if (world.mFraction > inBruteForce.mHits.front().mFraction + slack) return false;
+        return std::any_of(inBruteForce.mHits.begin(), inBruteForce.mHits.end(),
+                           [&](const RayCastResult& inHit) {
+                               return inHit.mBody == world.mBody &&
+                                      std::abs(inHit.mFraction - world.mFraction) <= slack;
+                           });
+    }
     for (const RayCastResult& hit : inBruteForce.mHits)
         if (hit.mFraction == inBruteForce.mHits.front().mFraction && SameHit(hit, inWorld.mHits.front()))
             return true;
@@ -546,6 +576,7 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
             case QueryKind::RayClosest:
             case QueryKind::RayAll:
             case QueryKind::ShapeAll:
+            case QueryKind::ShapeClosest:
             {
                 query.mRotation = test::published_pose_stress::RandomRotation(random);
                 Vec3 away(symmetric(random), symmetric(random), symmetric(random));
@@ -663,15 +694,16 @@ TEST_P(PublishedPoseQueryPropertyTest, QueryDuringStepEqualsBruteForceOverLastPu
     const uint64_t conclusive = duringStep + total.mBetweenSteps;
     std::printf(
         "[ figure   ] %llu comparisons during a step (ray closest %llu, ray all %llu, sphere %llu, box %llu, "
-        "point %llu, shape cast all %llu), %llu between steps, %llu mismatches; %llu of %llu answers not "
+        "point %llu, shape cast all %llu, shape cast closest %llu), %llu between steps, %llu mismatches; "
+        "%llu of %llu answers not "
         "empty; %llu queries on a "
         "snapshot gone stale, %llu of them differing from it; %llu updates in %.1f s\n",
         (unsigned long long)duringStep, (unsigned long long)total.mDuringStep[0],
         (unsigned long long)total.mDuringStep[1], (unsigned long long)total.mDuringStep[2],
         (unsigned long long)total.mDuringStep[3], (unsigned long long)total.mDuringStep[4],
-        (unsigned long long)total.mDuringStep[5], (unsigned long long)total.mBetweenSteps,
-        (unsigned long long)total.mMismatches, (unsigned long long)total.mNonEmpty,
-        (unsigned long long)conclusive, (unsigned long long)total.mStale,
+        (unsigned long long)total.mDuringStep[5], (unsigned long long)total.mDuringStep[6],
+        (unsigned long long)total.mBetweenSteps, (unsigned long long)total.mMismatches,
+        (unsigned long long)total.mNonEmpty, (unsigned long long)conclusive, (unsigned long long)total.mStale,
         (unsigned long long)total.mStaleDiffering, (unsigned long long)updates.load(), seconds);
     for (const std::string& failure : failures)
         ADD_FAILURE() << failure;
