@@ -165,6 +165,15 @@ TEST(BoxBoxTest, ANearlyFlatLandingBoxIsHeldByItsFaceNotByOneCorner)
     for (int i = 0; i < m.mNumPoints; ++i)
         EXPECT_GE(m.mPoints[i].mPenetration, -settings.mMaxSeparation);
     ExpectConsistentPoints(m);
+
+    // The other way round: the same points, the normal turned
+    ContactManifold swapped;
+    ASSERT_TRUE(CollideBoxBox(*cube, tb, *slab, {}, settings, swapped, &axis));
+    EXPECT_EQ(axis, BoxBoxAxis::Edge);
+    EXPECT_LT(swapped.mNormal.y(), -0.9999f);
+    EXPECT_EQ(swapped.mNumPoints, m.mNumPoints);
+    EXPECT_NEAR(MaxPenetration(swapped), MaxPenetration(m), 1.0e-5f);
+    ExpectConsistentPoints(swapped);
 }
 
 TEST(BoxBoxTest, TouchingSpeculativeAndBeyond)
