@@ -35,6 +35,7 @@
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "common/MakePhysicsSystem.h"
+#include "common/SlowBuild.h"
 #include "common/StaticFloor.h"
 
 #include <algorithm>
@@ -56,15 +57,6 @@
 namespace cairn::test
 {
 using namespace cairn::physics;
-
-/// A build whose checks run many times slower than an optimised one (sanitizers, no optimisation): the runs
-/// keep their time caps there and require a lower floor of checks instead of the full target.
-inline constexpr bool cSlowBuild =
-#if defined(__SANITIZE_THREAD__) || defined(__SANITIZE_ADDRESS__) || !defined(__OPTIMIZE__)
-    true;
-#else
-    false;
-#endif
 
 struct PublishedPoseStressConfig
 {
