@@ -21,7 +21,7 @@ BodyCreationSettings WorkloadBoxSettings(const BenchBox& inBox, MotionType inMot
 }
 
 std::vector<BodyID> AddWorkloadBoxes(BodyInterface& ioBodies, const std::vector<BenchBox>& inBoxes,
-                                     MotionType inMotion)
+                                     MotionType inMotion, bool inActivateDynamic)
 {
     std::vector<BodyID> ids;
     ids.reserve(inBoxes.size());
@@ -40,7 +40,7 @@ std::vector<BodyID> AddWorkloadBoxes(BodyInterface& ioBodies, const std::vector<
     Result<BodyInterface::AddBatch> batch = ioBodies.AddBodiesPrepare(ids);
     if (!batch) return refused();
     const Activation activation =
-        inMotion == MotionType::Static ? Activation::DontActivate : Activation::Activate;
+        inMotion != MotionType::Static && inActivateDynamic ? Activation::Activate : Activation::DontActivate;
     if (!ioBodies.AddBodiesFinalize(batch.Value(), activation)) return refused();
     return ids;
 }

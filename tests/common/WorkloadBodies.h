@@ -15,10 +15,11 @@ namespace cairn
 /// boxes in the static layer, the others in the moving one.
 physics::BodyCreationSettings WorkloadBoxSettings(const BenchBox& inBox, physics::MotionType inMotion);
 
-/// Adds inBoxes in one batch, as a streaming loader would: static ones asleep, the others active. Returns
-/// their ids in order (empty, with nothing added, when the world refuses them).
+/// Adds inBoxes in one batch, as a streaming loader would: static ones asleep, the others active unless
+/// inActivateDynamic is false. Returns their ids in order (empty, with nothing added, when the world refuses
+/// them).
 std::vector<physics::BodyID> AddWorkloadBoxes(physics::BodyInterface& ioBodies,
                                               const std::vector<BenchBox>& inBoxes,
-                                              physics::MotionType inMotion);
+                                              physics::MotionType inMotion, bool inActivateDynamic = true);
 
 } // namespace cairn

@@ -23,6 +23,7 @@
 #include "common/FrameTimes.h"
 #include "common/PhysicsSystemOrExit.h"
 #include "common/SharedBenchData.h"
+#include "common/WorkloadBodies.h"
 
 #include <algorithm>
 #include <atomic>
@@ -364,25 +365,9 @@ struct ContendedWorld
             inKind == cQuadTree ? BroadPhaseType::QuadTree : BroadPhaseType::QuadTreeGlobalMutex;
         mSystem = tools::CreatePhysicsSystemOrExit("cairn-bench-broadphase", settings);
         BodyInterface& bodies = mSystem->GetBodyInterface();
-        auto addAll =
-            [&](const std::vector<BenchBox>& inBoxes, MotionType inMotion, std::vector<BodyID>& outIDs)
-        {
-            for (const BenchBox& box : inBoxes)
-            {
-                BodyCreationSettings body;
-                body.mShape = BoxShape::Create(box.mHalfExtent).Value();
-                body.mPosition = box.mCenter;
-                body.mRotation = Quat(Eigen::AngleAxisf(box.mYaw, Vec3::UnitY()));
-                body.mMotionType = inMotion;
-                body.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-                outIDs.push_back(bodies.CreateBody(body).Value());
-            }
-            BodyInterface::AddBatch batch = bodies.AddBodiesPrepare(outIDs).Value();
-            (void)bodies.AddBodiesFinalize(batch, Activation::DontActivate);
-        };
-        std::vector<BodyID> statics;
-        addAll(Data().mStatic, MotionType::Static, statics);
-        addAll(Data().mDynamic, MotionType::Dynamic, mDynamic);
+        // Not simulated: the dynamic boxes stay asleep where the workload puts them
+        (void)AddWorkloadBoxes(bodies, Data().mStatic, MotionType::Static);
+        mDynamic = AddWorkloadBoxes(bodies, Data().mDynamic, MotionType::Dynamic, false);
         (void)mSystem->Update(1.0f / 60.0f,
                               1); // Optimises the broad phase (the dynamic boxes are not active)
         for (const BodyID& id : mDynamic)
