@@ -7,6 +7,7 @@
 #include "cairn/physics/math/Transform.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/narrowphase/ContactManifold.h"
+#include "narrowphase/FaceClipping.h"
 
 #include <algorithm>
 #include <gtest/gtest.h>
@@ -44,13 +45,6 @@ Collide(const physics::Shape& inA, const physics::Transform& inTA, const physics
     return result;
 }
 
-/// The deepest of the manifold's points; -cLargeFloat for none
-inline float MaxPenetration(const physics::ContactManifold& inManifold)
-{
-    float best = -physics::cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        best = std::max(best, inManifold.mPoints[i].mPenetration);
-    return best;
-}
+using physics::MaxPenetration; // The tests read manifolds' depths as the narrow phase does
 
 } // namespace cairn::test

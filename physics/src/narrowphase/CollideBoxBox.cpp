@@ -254,10 +254,8 @@ bool CollideBoxBox(const BoxShape& inA, const Transform& inTransformA, const Box
             BoxSupportingFace(inTransformB.mPosition, rotB, eB, -n, faceOfB);
             if (ManifoldFromFaces(faceOfA, 4, faceOfB, 4, n, maxSep, outManifold) > 0)
             {
-                float deepest = -cLargeFloat;
-                for (int i = 0; i < outManifold.mNumPoints; ++i)
-                    deepest = std::max(deepest, outManifold.mPoints[i].mPenetration);
-                if (deepest < edges.mPenetration - cClippedGapSlack) PutContactIn(edges, outManifold);
+                if (MaxPenetration(outManifold) < edges.mPenetration - cClippedGapSlack)
+                    PutContactIn(edges, outManifold);
                 return true;
             }
         }

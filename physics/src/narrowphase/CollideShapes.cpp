@@ -8,6 +8,7 @@
 #include "narrowphase/CollideSphereBox.h"
 #include "narrowphase/CollideSphereCapsule.h"
 #include "narrowphase/CollideSphereSphere.h"
+#include "narrowphase/FaceClipping.h"
 
 #include <utility>
 
@@ -76,15 +77,6 @@ bool CollideConvexPair(const ConvexShape& inA, const Transform& inTransformA, co
         return CollideBoxBox(static_cast<const BoxShape&>(inA), inTransformA,
                              static_cast<const BoxShape&>(inB), inTransformB, inSettings, outManifold);
     return CollideConvexConvex(inA, inTransformA, inB, inTransformB, inSettings, outManifold);
-}
-
-// Deepest point of a manifold, to apply the reporting rule in one place
-float MaxPenetration(const ContactManifold& inManifold)
-{
-    float best = -cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        best = std::max(best, inManifold.mPoints[i].mPenetration);
-    return best;
 }
 
 } // namespace

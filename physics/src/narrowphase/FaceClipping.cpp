@@ -115,9 +115,7 @@ int ClipAgainstReference(const Vec3* inRef, int inRefCount, const Vec3& inRefNor
 
 bool ClaimsMoreClearance(const ContactManifold& inManifold, float inContactPenetration)
 {
-    float leastGap = cLargeFloat;
-    for (int i = 0; i < inManifold.mNumPoints; ++i)
-        leastGap = std::min(leastGap, -inManifold.mPoints[i].mPenetration);
+    const float leastGap = -MaxPenetration(inManifold);
     return inManifold.mNumPoints > 0 && leastGap > 0.0f &&
            leastGap > -inContactPenetration + cClippedGapSlack;
 }

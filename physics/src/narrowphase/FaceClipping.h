@@ -8,6 +8,8 @@
 
 #include "cairn/physics/narrowphase/ContactManifold.h"
 
+#include <algorithm>
+
 namespace cairn::physics
 {
 
@@ -20,6 +22,15 @@ inline constexpr int cMaxClipPoints = 2 * SupportingFace::cMaxVertices + 2;
 /// (the caller then uses its single deepest point).
 int ManifoldFromFaces(const Vec3* inFaceA, int inCountA, const Vec3* inFaceB, int inCountB,
                       const Vec3& inNormal, float inMaxSeparation, ContactManifold& outManifold);
+
+/// The penetration of a manifold's deepest point (-cLargeFloat when it has none).
+inline float MaxPenetration(const ContactManifold& inManifold)
+{
+    float deepest = -cLargeFloat;
+    for (int i = 0; i < inManifold.mNumPoints; ++i)
+        deepest = std::max(deepest, inManifold.mPoints[i].mPenetration);
+    return deepest;
+}
 
 /// A manifold that claims more clearance than its contact by more than this (metres) takes the contact in:
 /// well below the shape casts' tolerance, well above the float noise between the two figures where the
