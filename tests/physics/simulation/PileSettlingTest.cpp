@@ -5,6 +5,7 @@
 // a landing box spin 21 cm into the box under it and stay there, awake.
 
 #include "SimulationFixture.h"
+#include "common/ShapeExpect.h"
 #include "common/SharedBenchData.h"
 #include "common/WorkloadBodies.h"
 
@@ -62,8 +63,7 @@ TEST_F(PileSettlingTest, TheSharedPileComesToRestWithNoBoxSunkIntoAnother)
         ASSERT_TRUE(System().GetWorldQuery().CollideShape(shape, pose, hits, filter, 0.0f));
         float depth = 0.0f;
         for (const ShapeQueryHit& hit : hits)
-            for (int point = 0; point < hit.mManifold.mNumPoints; ++point)
-                depth = std::max(depth, hit.mManifold.mPoints[point].mPenetration);
+            depth = std::max(depth, MaxPenetration(hit.mManifold));
         deepest = std::max(deepest, depth);
         sum += depth;
         overSlop += depth > slop + 0.001f ? 1 : 0;
