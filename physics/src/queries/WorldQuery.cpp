@@ -3,9 +3,9 @@
 #include "cairn/physics/body/BodyLock.h"
 #include "cairn/physics/narrowphase/CollideShapes.h"
 #include "cairn/physics/shapes/BoxShape.h"
-#include "cairn/physics/shapes/CompoundShape.h"
 #include "cairn/physics/shapes/SphereShape.h"
 #include "narrowphase/ShapeCast.h"
+#include "queries/QueryShape.h"
 
 #include <algorithm>
 #include <string>
@@ -77,18 +77,6 @@ Status CheckThread(bool inReadsBodyLocks)
 Status InvalidQuery(const char* inWhat)
 {
     return MakeError(ErrorCode::InvalidArgument, std::string("world query: ") + inWhat);
-}
-
-/// Whether the narrow phase can collide inShape with any body: convex shapes and compounds of them. A
-/// triangle mesh or height field collides only with convex shapes, so against a mesh body it would answer
-/// "clear".
-bool CanBeQueryShape(const Shape& inShape)
-{
-    if (inShape.IsConvex()) return true;
-    if (inShape.GetType() != ShapeType::Compound) return false;
-    for (const CompoundShape::SubShape& child : static_cast<const CompoundShape&>(inShape).GetSubShapes())
-        if (!CanBeQueryShape(*child.mShape)) return false;
-    return true;
 }
 
 /// InvalidArgument unless the shape and its transform make a query shape; else Ok, with its world bounds.
