@@ -1,0 +1,122 @@
+#pragma once
+
+// CharacterController: a character that is not a body (a convex shape, usually an upright capsule) walked
+// through the world by collide-and-slide over WorldQuery's shape casts. It stands on slopes up to a maximum
+// angle and slides down steeper ones, slides along walls and into creases, steps up stairs, follows the floor
+// walking down, rides moving platforms and is pushed out of bodies that moved into it. What Jolt's
+// CharacterVirtual, PhysX's character controllers and Unreal's character movement give a game.
+//
+// Threads: a controller belongs to one thread at a time (it has no lock of its own); many controllers update
+// at once on any threads, also while the physics step runs. It reads the world only through WorldQuery and
+// PoseReader, so an Update never waits for the step and never makes it wait. It sees the bodies as last
+// published (the last collision step, or the last move by hand). It moves no body: the bodies it touched are
+// in GetContacts, for a game that pushes them.
+// The world (PhysicsSystem) must outlive the controller.
+// Errors: bad input (a NaN or out-of-world position, a velocity or gravity that is not finite, a time step
+// that is not positive and finite, a move past the queries' reach, settings out of range, a shape that is
+// neither convex nor a compound of convex shapes) is InvalidArgument and leaves the controller as it was.
+
+#include "cairn/physics/math/Result.h"
+#include "cairn/physics/queries/WorldQuery.h"
+#include "cairn/physics/shapes/Shape.h"
+
+#include <span>
+#include <vector>
+
+namespace cairn::physics
+{
+
+class PhysicsSystem;
+
+struct CharacterSettings
+{
+    /// Convex, or a compound of convex shapes. It does not turn; its local y axis points along mUp (a
+    /// CapsuleShape stands upright)
+    ShapeRef mShape;
+    Vec3 mUp = Vec3::UnitY(); ///< Unit vector; gravity is the caller's and may point anywhere
+    /// Ground steeper than this (radians, in (0, pi/2)) is not walkable: the character slides down it and can
+    /// not walk up it
+    float mMaxSlopeAngle = 50.0f * cPi / 180.0f;
+    /// Steps (a stair, a kerb) up to this high are walked up; 0 walks up none
+    float mStepHeight = 0.3f;
+    /// Walking on, ground up to this far below is followed down (stairs and slopes down); 0 leaves the
+    /// character to fall each time
+    float mStickToFloorDistance = 0.4f;
+    /// The gap kept from every surface, so that sliding along one is not a touch; in (0, 0.1] metres
+    float mPadding = 0.02f;
+    QueryFilter mFilter; ///< What blocks the character (its own body, if it has one, goes in mIgnoreBody)
+};
+
+enum class GroundState : uint8_t
+{
+    OnGround,      ///< On walkable ground: no gravity, follows the floor down
+    OnSteepGround, ///< Touching ground too steep to stand on: slides down it
+    InAir,
+};
+
+/// A body the character touched in the last Update.
+struct CharacterContact
+{
+    BodyID mBody;
+    Vec3 mPoint = Vec3::Zero();  ///< World space, on the body's surface
+    Vec3 mNormal = Vec3::Zero(); ///< The body's surface normal there, towards the character
+};
+
+class CharacterController
+{
+public:
+    /// A character standing (or hanging) at inPosition (where the shape's origin is). It does not look at
+    /// the world until the first Update.
+    static Result<CharacterController> Create(const PhysicsSystem& inWorld,
+                                              const CharacterSettings& inSettings, const Vec3& inPosition);
+
+    /// Moves the character by its velocity over inDeltaTime seconds. Off walkable ground the velocity first
+    /// gains inGravity * inDeltaTime; on it, the velocity's part into the ground is dropped, unless the
+    /// velocity leaves the ground upwards (a jump: the character is InAir after it). Then the character is
+    /// carried by a moving ground body, pushed out of bodies that moved into it, slid, stepped up, stuck to
+    /// the floor, and its ground found. The velocity loses what the surfaces it slid along took; on the
+    /// ground it loses its part along up too (the ground takes the character up and down its slopes), and a
+    /// character leaving a moving ground body gains that body's velocity.
+    Status Update(float inDeltaTime, const Vec3& inGravity);
+
+    Vec3 GetPosition() const { return mPosition; }
+    /// Teleports the character (no sweep); it forgets its ground until the next Update.
+    Status SetPosition(const Vec3& inPosition);
+    Vec3 GetLinearVelocity() const { return mVelocity; }
+    Status SetLinearVelocity(const Vec3& inVelocity);
+
+    GroundState GetGroundState() const { return mGroundState; }
+    /// The body under the character, invalid InAir
+    BodyID GetGroundBody() const { return mGroundBody; }
+    /// The ground's surface normal under the character (towards it); mUp InAir
+    Vec3 GetGroundNormal() const { return mGroundNormal; }
+    /// The bodies the last Update touched (the ground among them), each once.
+    std::span<const CharacterContact> GetContacts() const { return mContacts; }
+    const CharacterSettings& GetSettings() const { return mSettings; }
+
+private:
+    CharacterController(const PhysicsSystem& inWorld, const CharacterSettings& inSettings,
+                        const Vec3& inPosition);
+
+    const PhysicsSystem* mWorld;
+    CharacterSettings mSettings;
+    float mCosMaxSlope;
+    Vec3 mPosition;
+    Vec3 mVelocity = Vec3::Zero();
+    GroundState mGroundState = GroundState::InAir;
+    BodyID mGroundBody;
+    Vec3 mGroundNormal;
+    /// Where the character stood in its ground body's frame, and the version of that body's pose then: a
+    /// ground body that moved since carries the character along
+    Vec3 mPositionOnGround = Vec3::Zero();
+    uint32_t mGroundPoseVersion = 0;
+    bool mGroundMoves = false;
+    /// Seconds since the ground body's pose last changed, and its velocity as its carries measured it: what a
+    /// character leaving a moving platform keeps
+    float mTimeSinceGroundMoved = 0.0f;
+    Vec3 mGroundVelocity = Vec3::Zero();
+    std::vector<CharacterContact> mContacts;
+    std::vector<CharacterContact> mNextContacts; ///< An Update's, kept only if it succeeds
+};
+
+} // namespace cairn::physics

@@ -1,0 +1,317 @@
+#include "cairn/physics/character/CharacterController.h"
+
+#include "cairn/physics/PhysicsSystem.h"
+#include "character/CharacterMoves.h"
+#include "queries/QueryShape.h"
+
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace cairn::physics
+{
+
+namespace
+{
+/// A character on the ground whose velocity leaves it faster than this (m/s), up and off the ground's plane,
+/// jumps: no floor holds it, gravity pulls it
+constexpr float cLeaveSpeed = 1.0e-2f;
+/// Surfaces met in one Update's slide; more is a corner it can not get out of this frame
+constexpr int cMaxSlidePlanes = 6;
+constexpr int cMaxSlideIterations = 8;
+/// Ground is what the character touches within this many paddings: the moves stop it one padding short
+constexpr float cGroundGapPaddings = 2.0f;
+/// A ground body whose pose has not changed for this long (seconds) is at rest (asleep, or stopped): a
+/// character leaving it keeps no velocity of its
+constexpr float cGroundAtRestAfter = 0.1f;
+/// Lengths past this (metres) are refused, as a world query refuses them
+constexpr float cMaxCharacterLength = 100.0f;
+
+Error InvalidCharacter(const std::string& inWhat)
+{
+    return MakeError(ErrorCode::InvalidArgument, "character: " + inWhat);
+}
+
+bool IsLength(float inValue, float inMin)
+{
+    return std::isfinite(inValue) && inValue >= inMin && inValue <= cMaxCharacterLength;
+}
+
+Status CheckSettings(const CharacterSettings& inSettings)
+{
+    if (inSettings.mShape == nullptr) return InvalidCharacter("no shape");
+    if (!CanBeQueryShape(*inSettings.mShape))
+        return InvalidCharacter("the shape must be convex or a compound of convex shapes");
+    if (!IsFinite(inSettings.mUp) || std::abs(inSettings.mUp.norm() - 1.0f) > 1.0e-3f)
+        return InvalidCharacter("up must be a unit vector");
+    if (!(inSettings.mMaxSlopeAngle > 0.0f && inSettings.mMaxSlopeAngle < 0.5f * cPi))
+        return InvalidCharacter("the maximum slope angle must be in (0, pi/2) radians");
+    if (!IsLength(inSettings.mStepHeight, 0.0f)) return InvalidCharacter("step height must be in [0, 100] m");
+    if (!IsLength(inSettings.mStickToFloorDistance, 0.0f))
+        return InvalidCharacter("stick-to-floor distance must be in [0, 100] m");
+    if (!(inSettings.mPadding > 0.0f && inSettings.mPadding <= 0.1f))
+        return InvalidCharacter("padding must be in (0, 0.1] m");
+    return Status::Ok();
+}
+
+/// The walk inVelocity along walkable ground whose normal is inNormal: its part across up kept, and as much
+/// along up as follows the ground's slope (as Unreal's characters keep their horizontal speed on ramps).
+Vec3 AlongGround(const Vec3& inVelocity, const Vec3& inNormal, const Vec3& inUp)
+{
+    const Vec3 across = inVelocity - inVelocity.dot(inUp) * inUp;
+    return across - inUp * (across.dot(inNormal) / inNormal.dot(inUp));
+}
+
+/// How the slide ended.
+struct Slide
+{
+    Vec3 mEnd;
+    Vec3 mVelocity;
+    bool mStepped = false;
+};
+
+/// Collide-and-slide: along the velocity's displacement, each surface met taking the part of the move (and
+/// of the velocity) that goes into it. A character on its feet takes ground too steep to stand on as a wall
+/// (it can not climb it), and tries to step up onto what it walked into.
+Result<Slide> SlideAlong(const CharacterMoveContext& inContext, const Vec3& inStart, const Vec3& inVelocity,
+                         float inDeltaTime, bool inOnFeet, float inStepHeight)
+{
+    Slide slide{inStart, inVelocity};
+    const Vec3 wanted = inVelocity * inDeltaTime;
+    Vec3 remaining = wanted;
+    std::array<Vec3, cMaxSlidePlanes> planes;
+    size_t numPlanes = 0;
+    bool onFeet = inOnFeet;
+    for (int iteration = 0; iteration < cMaxSlideIterations; ++iteration)
+    {
+        if (remaining.norm() < cMinCharacterMove) break;
+        Result<CharacterSweep> sweep = SweepCharacter(inContext, slide.mEnd, remaining);
+        if (!sweep) return sweep.GetError();
+        const Vec3 rest = remaining - (sweep.Value().mEnd - slide.mEnd);
+        slide.mEnd = sweep.Value().mEnd;
+        if (!sweep.Value().mHit) break;
+
+        Vec3 normal = sweep.Value().mHit->mNormal;
+        Vec3 next = rest;
+        if (inContext.IsWalkable(normal))
+        {
+            // Onto a ramp or over an edge it can walk: on its feet, it keeps its pace across up
+            if (onFeet)
+            {
+                next = AlongGround(rest, normal, inContext.mUp);
+                slide.mVelocity = AlongGround(slide.mVelocity, normal, inContext.mUp);
+            }
+            onFeet = true;
+        }
+        else if (onFeet && normal.dot(inContext.mUp) > 0.0f)
+        {
+            const Vec3 across = normal - normal.dot(inContext.mUp) * inContext.mUp;
+            if (across.norm() > 1.0e-3f) normal = across.normalized();
+            const Vec3 horizontal = rest - rest.dot(inContext.mUp) * inContext.mUp;
+            if (!slide.mStepped && inStepHeight > 0.0f && horizontal.dot(normal) < 0.0f)
+            {
+                Result<std::optional<Vec3>> step = StepUp(inContext, slide.mEnd, horizontal, inStepHeight);
+                if (!step) return step.GetError();
+                if (step.Value())
+                {
+                    // The step took the rest of this frame's walk
+                    slide.mEnd = *step.Value();
+                    slide.mStepped = true;
+                    break;
+                }
+            }
+        }
+        if (numPlanes == planes.size()) break;
+        planes[numPlanes++] = normal;
+        const std::span<const Vec3> met(planes.data(), numPlanes);
+        remaining = ClipToPlanes(next, met);
+        slide.mVelocity = ClipToPlanes(slide.mVelocity, met);
+        // Turned back against the walk (an acute corner): stopping here is still, bouncing between is jitter
+        if (remaining.dot(wanted) <= 0.0f) break;
+    }
+    return slide;
+}
+
+} // namespace
+
+Result<CharacterController> CharacterController::Create(const PhysicsSystem& inWorld,
+                                                        const CharacterSettings& inSettings,
+                                                        const Vec3& inPosition)
+{
+    if (Status settings = CheckSettings(inSettings); !settings) return settings.GetError();
+    if (!IsValidWorldPosition(inPosition))
+        return InvalidCharacter("position is NaN, infinite or beyond the world");
+    return CharacterController(inWorld, inSettings, inPosition);
+}
+
+CharacterController::CharacterController(const PhysicsSystem& inWorld, const CharacterSettings& inSettings,
+                                         const Vec3& inPosition)
+    : mWorld(&inWorld), mSettings(inSettings), mCosMaxSlope(std::cos(inSettings.mMaxSlopeAngle)),
+      mPosition(inPosition), mGroundNormal(inSettings.mUp)
+{
+    mSettings.mUp.normalize();
+}
+
+Status CharacterController::SetPosition(const Vec3& inPosition)
+{
+    if (!IsValidWorldPosition(inPosition))
+        return InvalidCharacter("position is NaN, infinite or beyond the world");
+    mPosition = inPosition;
+    mGroundState = GroundState::InAir;
+    mGroundBody = BodyID();
+    mGroundNormal = mSettings.mUp;
+    mGroundMoves = false;
+    mGroundVelocity = Vec3::Zero();
+    return Status::Ok();
+}
+
+Status CharacterController::SetLinearVelocity(const Vec3& inVelocity)
+{
+    if (!IsFinite(inVelocity)) return InvalidCharacter("velocity is NaN or infinite");
+    mVelocity = inVelocity;
+    return Status::Ok();
+}
+
+Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
+{
+    if (!(std::isfinite(inDeltaTime) && inDeltaTime > 0.0f))
+        return InvalidCharacter("time step must be positive and finite");
+    if (!IsFinite(inGravity)) return InvalidCharacter("gravity is NaN or infinite");
+
+    const Vec3& up = mSettings.mUp;
+    mNextContacts.clear();
+    const CharacterMoveContext context{mWorld->GetWorldQuery(),
+                                       *mSettings.mShape,
+                                       Quat::FromTwoVectors(Vec3::UnitY(), up),
+                                       mSettings.mFilter,
+                                       up,
+                                       mCosMaxSlope,
+                                       mSettings.mPadding,
+                                       -mSettings.mShape->GetLocalBounds().mMin.y(),
+                                       mNextContacts};
+
+    // On its feet unless it jumps: then the floor holds it (no gravity, nothing of the velocity into it)
+    Vec3 velocity = mVelocity;
+    const bool wasOnGround = mGroundState == GroundState::OnGround;
+    const bool jumps = velocity.dot(up) > cLeaveSpeed && velocity.dot(mGroundNormal) > cLeaveSpeed;
+    const bool onFeet = wasOnGround && !jumps;
+    if (onFeet)
+        velocity = AlongGround(velocity, mGroundNormal, up);
+    else
+        velocity += inGravity * inDeltaTime;
+
+    // Carried by its ground, where that moved since the last Update
+    Vec3 position = mPosition;
+    Vec3 groundVelocity = mGroundVelocity;
+    const float sinceGroundMoved = mTimeSinceGroundMoved + inDeltaTime;
+    bool groundMovedNow = false;
+    if (mGroundState != GroundState::InAir && mGroundMoves)
+    {
+        PoseReader poses(mWorld->GetBodyManager());
+        PublishedPose pose;
+        if (poses.Read(mGroundBody, pose) && pose.mVersion != mGroundPoseVersion)
+        {
+            Result<CharacterSweep> carry =
+                SweepCharacter(context, position, pose.mTransform * mPositionOnGround - position);
+            if (!carry) return carry.GetError();
+            groundVelocity = (carry.Value().mEnd - position) / sinceGroundMoved;
+            position = carry.Value().mEnd;
+            groundMovedNow = true;
+        }
+    }
+
+    Result<Vec3> pushedOut = PushOutOfBodies(context, position);
+    if (!pushedOut) return pushedOut.GetError();
+    position = pushedOut.Value();
+
+    const float groundGap = cGroundGapPaddings * mSettings.mPadding;
+    Result<Slide> slide = SlideAlong(context, position, velocity, inDeltaTime, onFeet, mSettings.mStepHeight);
+    if (!slide) return slide.GetError();
+    position = slide.Value().mEnd;
+    velocity = slide.Value().mVelocity;
+
+    // Walking on, down a slope or a stair: the floor a little below is followed, not fallen to. Landing (or
+    // walking) within the ground's gap, it is put down to its padding
+    const float stickDistance =
+        std::max(onFeet && !slide.Value().mStepped ? mSettings.mStickToFloorDistance : 0.0f, groundGap);
+    if (!jumps)
+    {
+        Result<CharacterSweep> stick = SweepCharacter(context, position, -up * stickDistance);
+        if (!stick) return stick.GetError();
+        if (stick.Value().mHit)
+        {
+            const ShapeCastResult& hit = *stick.Value().mHit;
+            Result<std::optional<CharacterSupport>> support = FindSupport(
+                context, stick.Value().mEnd, {hit.mBody, hit.mContactPoint, hit.mNormal}, stickDistance);
+            if (!support) return support.GetError();
+            if (support.Value()) position = stick.Value().mEnd;
+        }
+    }
+
+    Result<std::optional<CharacterContact>> ground = FindGround(context, position, groundGap);
+    if (!ground) return ground.GetError();
+    std::optional<CharacterSupport> support;
+    if (ground.Value())
+    {
+        Result<std::optional<CharacterSupport>> found = FindSupport(
+            context, position, *ground.Value(), std::max(mSettings.mStickToFloorDistance, groundGap));
+        if (!found) return found.GetError();
+        support = found.Value();
+    }
+
+    // Every query has answered: what follows can not fail, so the controller changes all at once or not at
+    // all
+    GroundState state = GroundState::InAir;
+    BodyID groundBody;
+    Vec3 groundNormal = up;
+    if (support && !jumps)
+    {
+        state = GroundState::OnGround;
+        groundBody = support->mBody;
+        groundNormal = support->mNormal;
+    }
+    else if (ground.Value() && !jumps)
+    {
+        state = GroundState::OnSteepGround;
+        groundBody = ground.Value()->mBody;
+        groundNormal = ground.Value()->mNormal;
+    }
+    if (ground.Value())
+    {
+        const CharacterContact& touched = *ground.Value();
+        bool recorded = false;
+        for (const CharacterContact& contact : mNextContacts)
+            recorded = recorded || contact.mBody == touched.mBody;
+        if (!recorded) mNextContacts.push_back(touched);
+    }
+    // On the ground the velocity is the walk: the ground takes it up and down its slopes, so no speed along
+    // up is left to read as a jump (or a fall) in the next Update
+    if (state == GroundState::OnGround) velocity -= velocity.dot(up) * up;
+    if (!groundMovedNow && sinceGroundMoved > cGroundAtRestAfter) groundVelocity = Vec3::Zero();
+    if (wasOnGround && state == GroundState::InAir) velocity += groundVelocity; // Off a moving platform
+
+    const BodyID previousGround = mGroundBody;
+    mGroundMoves = false;
+    if (state != GroundState::InAir)
+    {
+        PoseReader poses(mWorld->GetBodyManager());
+        PublishedPose pose;
+        if (poses.Read(groundBody, pose) && pose.mMotionType != MotionType::Static)
+        {
+            mGroundMoves = true;
+            mPositionOnGround = pose.mTransform.InverseTransformPoint(position);
+            mGroundPoseVersion = pose.mVersion;
+        }
+    }
+    mTimeSinceGroundMoved = groundMovedNow || groundBody != previousGround ? 0.0f : sinceGroundMoved;
+    mGroundVelocity = mGroundMoves ? groundVelocity : Vec3::Zero();
+    mPosition = position;
+    mVelocity = velocity;
+    mGroundState = state;
+    mGroundBody = groundBody;
+    mGroundNormal = groundNormal;
+    mContacts.swap(mNextContacts);
+    return Status::Ok();
+}
+
+} // namespace cairn::physics

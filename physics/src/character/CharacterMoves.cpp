@@ -1,0 +1,222 @@
+#include "character/CharacterMoves.h"
+
+#include "narrowphase/FaceClipping.h"
+
+#include <algorithm>
+
+namespace cairn::physics
+{
+
+namespace
+{
+/// A move that meets a surface at a slant backs off along its direction by padding / cos(angle to the normal)
+/// to keep the gap along the normal; at a grazing angle that would be metres, so the cosine counts as at
+/// least this (the gap kept is then smaller, and the slide that follows keeps off the surface anyway).
+constexpr float cMinApproachCos = 0.25f;
+
+/// Overlaps shallower than this (metres) are left: the moves keep mPadding clear of every surface, so only a
+/// body that moved into the character or appeared on it is this deep, and a cast slides along a touch.
+constexpr float cPushOutSlack = 1.0e-3f;
+/// Rounds of pushing out: each takes the deepest body; a character wedged between bodies stops after these.
+constexpr int cPushOutRounds = 4;
+
+/// A surface is ground when its normal points up at least this much (the cosine with up): a wall the
+/// character brushes against is not.
+constexpr float cMinGroundUp = 1.0e-2f;
+
+/// A step up moves at least this far forward (metres), so that a slow walk still gets onto the stair.
+constexpr float cMinStepForward = 0.02f;
+/// A step up that gets no farther forward than this at the raised height is a wall, not a stair.
+constexpr float cMinStepAdvance = 1.0e-3f;
+/// Where the stair's edge is too steep to stand on, the ground this far farther on must be walkable.
+constexpr float cStepForwardTest = 0.15f;
+
+void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,
+                   const Vec3& inNormal)
+{
+    for (const CharacterContact& contact : inContext.mContacts)
+        if (contact.mBody == inBody) return;
+    inContext.mContacts.push_back({inBody, inPoint, inNormal});
+}
+} // namespace
+
+Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, const Vec3& inStart,
+                                      const Vec3& inDisplacement, bool inRecordContact)
+{
+    CharacterSweep sweep{inStart, std::nullopt};
+    const float length = inDisplacement.norm();
+    if (length < cMinCharacterMove) return sweep;
+    Result<std::optional<ShapeCastResult>> cast = inContext.mQuery.CastShapeClosest(
+        inContext.mShape, inContext.At(inStart), inDisplacement, inContext.mFilter);
+    if (!cast) return cast.GetError();
+    if (!cast.Value())
+    {
+        sweep.mEnd = inStart + inDisplacement;
+        return sweep;
+    }
+    const ShapeCastResult& hit = *cast.Value();
+    const Vec3 direction = inDisplacement / length;
+    const float approach = std::max(-direction.dot(hit.mNormal), cMinApproachCos);
+    const float travel = std::max(hit.mFraction * length - inContext.mPadding / approach, 0.0f);
+    sweep.mEnd = inStart + direction * travel;
+    sweep.mHit = hit;
+    if (inRecordContact) RecordContact(inContext, hit.mBody, hit.mContactPoint, hit.mNormal);
+    return sweep;
+}
+
+Result<std::optional<CharacterContact>> FindGround(const CharacterMoveContext& inContext,
+                                                   const Vec3& inPosition, float inGap)
+{
+    thread_local std::vector<ShapeQueryHit> tHits; // As PushOutOfBodies's
+    const Status collided = inContext.mQuery.CollideShape(inContext.mShape, inContext.At(inPosition), tHits,
+                                                          inContext.mFilter, inGap);
+    if (!collided) return collided.GetError();
+    std::optional<CharacterContact> ground;
+    float bestUp = cMinGroundUp;
+    for (const ShapeQueryHit& hit : tHits)
+    {
+        // The manifold's normal points from the character towards the body: the body's surface faces back
+        const Vec3 surface = -hit.mManifold.mNormal;
+        const float up = surface.dot(inContext.mUp);
+        if (up <= bestUp || hit.mManifold.mNumPoints == 0) continue;
+        bestUp = up;
+        ground = CharacterContact{hit.mBody, hit.mManifold.mPoints[0].mPositionOnB, surface};
+    }
+    return ground;
+}
+
+Result<std::optional<CharacterSupport>> FindSupport(const CharacterMoveContext& inContext,
+                                                    const Vec3& inPosition, const CharacterContact& inGround,
+                                                    float inReach)
+{
+    if (inContext.IsWalkable(inGround.mNormal))
+        return std::optional<CharacterSupport>({inGround.mBody, inGround.mNormal});
+    const RayCast underfoot{inPosition, -inContext.mUp * (inContext.mBottom + inReach)};
+    Result<std::optional<RayCastResult>> ray = inContext.mQuery.CastRayClosest(underfoot, inContext.mFilter);
+    if (!ray) return ray.GetError();
+    if (!ray.Value() || !inContext.IsWalkable(ray.Value()->mNormal)) return std::optional<CharacterSupport>();
+    return std::optional<CharacterSupport>({ray.Value()->mBody, ray.Value()->mNormal});
+}
+
+Vec3 ClipToPlanes(const Vec3& inVector, std::span<const Vec3> inNormals)
+{
+    // A projection's rounding leaves it a hair into its own plane: that is not pointing into it
+    const float slack = 1.0e-5f * inVector.norm();
+    const auto pointsIntoNone = [&](const Vec3& inCandidate)
+    {
+        return std::all_of(inNormals.begin(), inNormals.end(),
+                           [&](const Vec3& inNormal) { return inCandidate.dot(inNormal) >= -slack; });
+    };
+    if (pointsIntoNone(inVector)) return inVector;
+    // Each candidate is inVector's projection on a subspace, so the longest allowed one is the nearest
+    Vec3 best = Vec3::Zero();
+    float bestLengthSq = 0.0f;
+    const auto consider = [&](const Vec3& inCandidate)
+    {
+        const float lengthSq = inCandidate.squaredNorm();
+        if (lengthSq > bestLengthSq && pointsIntoNone(inCandidate))
+        {
+            best = inCandidate;
+            bestLengthSq = lengthSq;
+        }
+    };
+    for (size_t i = 0; i < inNormals.size(); ++i)
+    {
+        const float into = inVector.dot(inNormals[i]);
+        if (into < 0.0f) consider(inVector - into * inNormals[i]);
+    }
+    for (size_t i = 0; i < inNormals.size(); ++i)
+        for (size_t j = i + 1; j < inNormals.size(); ++j)
+        {
+            const Vec3 crease = inNormals[i].cross(inNormals[j]);
+            const float creaseLength = crease.norm();
+            if (creaseLength < 1.0e-4f) continue; // Parallel planes: the one-plane projections cover them
+            const Vec3 along = crease / creaseLength;
+            consider(along * inVector.dot(along));
+        }
+    return best;
+}
+
+Result<Vec3> PushOutOfBodies(const CharacterMoveContext& inContext, const Vec3& inStart)
+{
+    // Per-thread scratch, as the queries' own: a controller's Update never re-enters itself on one thread
+    thread_local std::vector<ShapeQueryHit> tHits;
+    Vec3 position = inStart;
+    for (int round = 0; round < cPushOutRounds; ++round)
+    {
+        const Status collided =
+            inContext.mQuery.CollideShape(inContext.mShape, inContext.At(position), tHits, inContext.mFilter);
+        if (!collided) return collided.GetError();
+        const ShapeQueryHit* deepest = nullptr;
+        float deepestPenetration = cPushOutSlack;
+        for (const ShapeQueryHit& hit : tHits)
+        {
+            const float penetration = MaxPenetration(hit.mManifold);
+            if (penetration > deepestPenetration)
+            {
+                deepest = &hit;
+                deepestPenetration = penetration;
+            }
+        }
+        if (deepest == nullptr) break;
+        // The manifold's normal points from the character towards the body
+        const ContactManifold& manifold = deepest->mManifold;
+        position -= manifold.mNormal * (deepestPenetration + inContext.mPadding);
+        RecordContact(inContext, deepest->mBody, manifold.mPoints[0].mPositionOnB, -manifold.mNormal);
+    }
+    return position;
+}
+
+namespace
+{
+Result<std::optional<Vec3>> TryStepUp(const CharacterMoveContext& inContext, const Vec3& inStart,
+                                      const Vec3& inHorizontal, float inStepHeight)
+{
+    const float length = inHorizontal.norm();
+    if (length < cMinCharacterMove) return std::optional<Vec3>();
+    const Vec3 forward = inHorizontal / length;
+
+    Result<CharacterSweep> up = SweepCharacter(inContext, inStart, inContext.mUp * inStepHeight);
+    if (!up) return up.GetError();
+    const Vec3 raised = up.Value().mEnd;
+    const float rise = (raised - inStart).dot(inContext.mUp);
+    if (rise <= inContext.mPadding) return std::optional<Vec3>(); // No headroom to step up into
+
+    Result<CharacterSweep> along =
+        SweepCharacter(inContext, raised, forward * std::max(length, cMinStepForward));
+    if (!along) return along.GetError();
+    const Vec3 ahead = along.Value().mEnd;
+    if ((ahead - raised).dot(forward) < cMinStepAdvance) return std::optional<Vec3>();
+
+    // Down no lower than the start: ground at the start's height or below is no stair (a ledge, or a fence
+    // to climb over)
+    Result<CharacterSweep> down = SweepCharacter(inContext, ahead, -inContext.mUp * rise);
+    if (!down) return down.GetError();
+    if (!down.Value().mHit) return std::optional<Vec3>();
+    if (!inContext.IsWalkable(down.Value().mHit->mNormal))
+    {
+        // On the stair's edge a round bottom meets it at a slant: look at the tread a little farther on
+        // (a look, not a move: what it meets is no contact)
+        Result<CharacterSweep> further = SweepCharacter(inContext, ahead, forward * cStepForwardTest, false);
+        if (!further) return further.GetError();
+        Result<CharacterSweep> tread =
+            SweepCharacter(inContext, further.Value().mEnd, -inContext.mUp * rise, false);
+        if (!tread) return tread.GetError();
+        if (!tread.Value().mHit || !inContext.IsWalkable(tread.Value().mHit->mNormal))
+            return std::optional<Vec3>();
+    }
+    return std::optional<Vec3>(down.Value().mEnd);
+}
+} // namespace
+
+Result<std::optional<Vec3>> StepUp(const CharacterMoveContext& inContext, const Vec3& inStart,
+                                   const Vec3& inHorizontal, float inStepHeight)
+{
+    // A step not taken touched nothing: its casts' contacts go
+    const size_t contactsBefore = inContext.mContacts.size();
+    Result<std::optional<Vec3>> step = TryStepUp(inContext, inStart, inHorizontal, inStepHeight);
+    if (!step || !step.Value()) inContext.mContacts.resize(contactsBefore);
+    return step;
+}
+
+} // namespace cairn::physics

@@ -1,0 +1,443 @@
+// CharacterController: standing and landing, walls and creases, slopes it may and may not walk, stairs up and
+// down, moving platforms, bodies that move into it, its contacts, and bad input.
+
+#include "cairn/physics/character/CharacterController.h"
+
+#include "SimulationFixture.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
+#include "cairn/physics/shapes/TriangleMeshShape.h"
+#include "character/CharacterMoves.h"
+#include "narrowphase/FaceClipping.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace cairn::test
+{
+using namespace cairn::physics;
+
+namespace
+{
+constexpr float cCharacterHalfHeight = 0.6f;
+constexpr float cCharacterRadius = 0.3f;
+/// The capsule's centre above the ground it stands on
+constexpr float cCharacterStandHeight = cCharacterHalfHeight + cCharacterRadius;
+const Vec3 cCharacterGravity(0.0f, -9.81f, 0.0f);
+} // namespace
+
+class CharacterControllerTest : public SimulationFixture
+{
+protected:
+    static CharacterSettings Settings()
+    {
+        CharacterSettings settings;
+        settings.mShape = CapsuleShape::Create(cCharacterHalfHeight, cCharacterRadius).Value();
+        return settings;
+    }
+    CharacterController MakeCharacter(const Vec3& inPosition,
+                                      const CharacterSettings& inSettings = Settings())
+    {
+        return CharacterController::Create(System(), inSettings, inPosition).Value();
+    }
+
+    /// Walks the character at inVelocity (kept each frame, the fall added) for inFrames frames at 60 Hz.
+    static void Walk(CharacterController& ioCharacter, const Vec3& inVelocity, int inFrames)
+    {
+        for (int frame = 0; frame < inFrames; ++frame)
+        {
+            Vec3 velocity = inVelocity;
+            velocity.y() = ioCharacter.GetLinearVelocity().y();
+            ASSERT_TRUE(ioCharacter.SetLinearVelocity(velocity).IsOk());
+            ASSERT_TRUE(ioCharacter.Update(cDeltaTime, cCharacterGravity).IsOk());
+        }
+    }
+
+    /// On the floor (top at y = 0), clear of it by no more than its padding and a millimetre: a fall shorter
+    /// than the padding in its last frame ends that little higher.
+    static void ExpectStandingOnFloor(const CharacterController& inCharacter)
+    {
+        EXPECT_GE(inCharacter.GetPosition().y(), cCharacterStandHeight);
+        EXPECT_LE(inCharacter.GetPosition().y(),
+                  cCharacterStandHeight + inCharacter.GetSettings().mPadding + 1.0e-3f);
+        EXPECT_EQ(inCharacter.GetGroundState(), GroundState::OnGround);
+    }
+
+    /// How deep the character's shape is in any body where it stands (0 when clear).
+    float DeepestOverlap(const CharacterController& inCharacter)
+    {
+        std::vector<ShapeQueryHit> hits;
+        EXPECT_TRUE(System()
+                        .GetWorldQuery()
+                        .CollideShape(*inCharacter.GetSettings().mShape,
+                                      {inCharacter.GetPosition(), Quat::Identity()}, hits)
+                        .IsOk());
+        float deepest = 0.0f;
+        for (const ShapeQueryHit& hit : hits)
+            deepest = std::max(deepest, MaxPenetration(hit.mManifold));
+        return deepest;
+    }
+
+    /// A static ramp rising along +x at inAngle, its top surface through the origin's ground line at x = 0.
+    BodyID AddRamp(float inAngle)
+    {
+        const Quat tilt(Eigen::AngleAxisf(inAngle, Vec3::UnitZ()));
+        // A slab 20 m long and 1 m thick, its top face's centre line through (0, 0, 0) at its low end's side
+        const Vec3 halfExtent(10.0f, 0.5f, 5.0f);
+        const Vec3 center = tilt * Vec3(10.0f, -0.5f, 0.0f);
+        return AddStatic(Box(halfExtent), center, tilt);
+    }
+
+    /// Stairs along +x from x = inStartX: inSteps steps of inRise each, inRun deep, the top one 3 m deep.
+    void AddStairs(float inStartX, int inSteps, float inRise, float inRun)
+    {
+        for (int step = 0; step < inSteps; ++step)
+        {
+            const float height = inRise * float(step + 1);
+            const float run = step + 1 == inSteps ? 3.0f : inRun;
+            AddStatic(Box(Vec3(run / 2.0f, height / 2.0f, 3.0f)),
+                      Vec3(inStartX + inRun * float(step) + run / 2.0f, height / 2.0f, 0.0f));
+        }
+    }
+};
+
+TEST_F(CharacterControllerTest, FallsLandsAndStandsStillOnTheFloor)
+{
+    const BodyID floor = AddFloor();
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 3.0f, 0));
+    EXPECT_EQ(character.GetGroundState(), GroundState::InAir);
+    float lowest = std::numeric_limits<float>::max();
+    for (int frame = 0; frame < 120; ++frame)
+    {
+        ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+        lowest = std::min(lowest, character.GetPosition().y());
+    }
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+    EXPECT_EQ(character.GetGroundBody(), floor);
+    EXPECT_NEAR(character.GetGroundNormal().y(), 1.0f, 1.0e-4f);
+    EXPECT_GE(lowest, cCharacterStandHeight) << "it never sinks into the floor, landing at about 6 m/s";
+    ExpectStandingOnFloor(character);
+    EXPECT_NEAR(character.GetLinearVelocity().norm(), 0.0f, 1.0e-5f) << "the fall ended on landing";
+
+    const Vec3 rested = character.GetPosition();
+    for (int frame = 0; frame < 300; ++frame)
+        ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_LT((character.GetPosition() - rested).norm(), 1.0e-5f) << "standing still, it stays put";
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+}
+
+TEST_F(CharacterControllerTest, AJumpLeavesTheGroundAndComesBackDown)
+{
+    AddFloor();
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3::Zero(), 5);
+    ASSERT_EQ(character.GetGroundState(), GroundState::OnGround);
+    ASSERT_TRUE(character.SetLinearVelocity(Vec3(0, 5, 0)).IsOk());
+    float highest = 0.0f;
+    int framesInAir = 0;
+    for (int frame = 0; frame < 90; ++frame)
+    {
+        ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+        highest = std::max(highest, character.GetPosition().y());
+        framesInAir += character.GetGroundState() == GroundState::InAir ? 1 : 0;
+    }
+    // 5 m/s up rises 5^2 / (2 g) = 1.27 m, and is up about 2 * 5 / g = 1.02 s
+    EXPECT_NEAR(highest - (cCharacterStandHeight + 0.02f), 25.0f / (2.0f * 9.81f), 0.05f);
+    EXPECT_NEAR(framesInAir, 61, 2);
+    ExpectStandingOnFloor(character);
+
+    // A hop at 1 m/s, whose first frame stays within the ground's gap, still leaves it: 1 / (2 g) = 5.1 cm
+    ASSERT_TRUE(character.SetLinearVelocity(Vec3(0, 1, 0)).IsOk());
+    highest = 0.0f;
+    for (int frame = 0; frame < 30; ++frame)
+    {
+        ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+        highest = std::max(highest, character.GetPosition().y());
+    }
+    EXPECT_GT(highest - (cCharacterStandHeight + 0.02f), 0.04f);
+}
+
+TEST_F(CharacterControllerTest, AWallStopsItAndItSlidesAlongTheWall)
+{
+    AddFloor();
+    const BodyID wall = AddStatic(Box(Vec3(0.5f, 2, 10)), Vec3(3.5f, 2, 0)); // Its -x face at x = 3
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3(4, 0, 0), 90);
+    EXPECT_LE(character.GetPosition().x(), 3.0f - cCharacterRadius) << "never into the wall";
+    EXPECT_GT(character.GetPosition().x(), 3.0f - cCharacterRadius - 0.05f)
+        << "stopped at it, a padding short";
+    EXPECT_NEAR(character.GetLinearVelocity().x(), 0.0f, 1.0e-4f) << "the wall took the velocity into it";
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+
+    // Along the wall at 45 degrees: the part along it goes on, at full speed
+    const float zBefore = character.GetPosition().z();
+    Walk(character, Vec3(2, 0, 2), 60);
+    EXPECT_NEAR(character.GetPosition().z() - zBefore, 2.0f, 0.02f);
+    EXPECT_LE(character.GetPosition().x(), 3.0f - cCharacterRadius);
+    bool touchesWall = false;
+    for (const CharacterContact& contact : character.GetContacts())
+        touchesWall = touchesWall || (contact.mBody == wall && contact.mNormal.x() < -0.99f);
+    EXPECT_TRUE(touchesWall) << "the wall is among the contacts, its normal towards the character";
+    EXPECT_LT(DeepestOverlap(character), 1.0e-3f);
+}
+
+TEST_F(CharacterControllerTest, AnAcuteCornerHoldsItStillWithoutJitter)
+{
+    AddFloor();
+    // Two walls meeting at x = 4 in a V 60 degrees wide, open towards -x
+    for (const float side : {-1.0f, 1.0f})
+    {
+        const Quat turn(Eigen::AngleAxisf(side * cPi / 6.0f, Vec3::UnitY()));
+        AddStatic(Box(Vec3(3, 2, 0.25f)), Vec3(4, 2, 0) + turn * Vec3(-3, 0, side * 0.25f), turn);
+    }
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0.1f));
+    Walk(character, Vec3(3, 0, 0), 120);
+    const Vec3 settled = character.GetPosition();
+    float wander = 0.0f;
+    for (int frame = 0; frame < 60; ++frame)
+    {
+        Walk(character, Vec3(3, 0, 0), 1);
+        wander = std::max(wander, (character.GetPosition() - settled).norm());
+        EXPECT_LT(DeepestOverlap(character), 1.0e-3f) << "frame " << frame;
+    }
+    EXPECT_LT(wander, 2.0e-3f) << "pushed into the corner, it stays in it";
+    EXPECT_GT(settled.x(), 1.5f) << "it went into the corner";
+}
+
+TEST_F(CharacterControllerTest, ItWalksUpAWalkableSlopeAndNotUpASteepOne)
+{
+    AddFloor();
+    AddRamp(30.0f * cPi / 180.0f);
+    CharacterController walker = MakeCharacter(Vec3(-2, cCharacterStandHeight + 0.02f, 0));
+    Walk(walker, Vec3(3, 0, 0), 120);
+    EXPECT_GT(walker.GetPosition().y(), cCharacterStandHeight + 2.0f) << "up the 30 degree ramp";
+    EXPECT_EQ(walker.GetGroundState(), GroundState::OnGround);
+    EXPECT_LT(DeepestOverlap(walker), 1.0e-3f);
+}
+
+TEST_F(CharacterControllerTest, ItCanNotClimbASteepSlopeAndSlidesDownIt)
+{
+    AddFloor();
+    AddRamp(60.0f * cPi / 180.0f);
+    CharacterController walker = MakeCharacter(Vec3(-2, cCharacterStandHeight + 0.02f, 0));
+    float highest = 0.0f;
+    for (int frame = 0; frame < 180; ++frame)
+    {
+        Walk(walker, Vec3(3, 0, 0), 1);
+        highest = std::max(highest, walker.GetPosition().y());
+    }
+    // The capsule's round bottom rests against the slope's foot a little up it, no higher
+    EXPECT_LT(highest, cCharacterStandHeight + 0.2f) << "the 60 degree ramp is a wall to it";
+    EXPECT_EQ(walker.GetGroundState(), GroundState::OnGround) << "on the floor at the ramp's foot";
+
+    // Put on the steep ramp, it slides down to its foot
+    const Vec3 onRamp =
+        Quat(Eigen::AngleAxisf(cPi / 3.0f, Vec3::UnitZ())) * Vec3(2, cCharacterRadius + 0.05f, 0) +
+        Vec3(0, cCharacterHalfHeight, 0);
+    CharacterController slider = MakeCharacter(onRamp);
+    ASSERT_TRUE(slider.Update(cDeltaTime, cCharacterGravity).IsOk());
+    ASSERT_TRUE(slider.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_NE(slider.GetGroundState(), GroundState::OnGround);
+    for (int frame = 0; frame < 120; ++frame)
+        ASSERT_TRUE(slider.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_LT(slider.GetPosition().y(), onRamp.y() - 1.0f);
+    EXPECT_LT(DeepestOverlap(slider), 1.0e-3f);
+}
+
+TEST_F(CharacterControllerTest, ItStepsUpStairsNoHigherThanItsStepHeight)
+{
+    AddFloor();
+    AddStairs(1.0f, 5, 0.2f, 0.4f); // Top at 1 m, from x = 2.6 to 5.6
+    CharacterController climber = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    int offGround = 0;
+    for (int frame = 0; frame < 100; ++frame)
+    {
+        Walk(climber, Vec3(2, 0, 0), 1);
+        offGround += climber.GetGroundState() != GroundState::OnGround ? 1 : 0;
+    }
+    EXPECT_EQ(offGround, 0) << "on its feet all the way up";
+    EXPECT_NEAR(climber.GetPosition().y(), cCharacterStandHeight + 1.0f, 0.05f) << "on the top step";
+    EXPECT_GT(climber.GetPosition().x(), 3.0f) << "and on along it";
+    EXPECT_EQ(climber.GetGroundState(), GroundState::OnGround);
+
+    CharacterSettings noSteps = Settings();
+    noSteps.mStepHeight = 0.0f;
+    CharacterController blocked = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 1), noSteps);
+    Walk(blocked, Vec3(2, 0, 0), 150);
+    EXPECT_LT(blocked.GetPosition().y(), cCharacterStandHeight + 0.1f)
+        << "with no step height the first step stops it";
+    EXPECT_LT(blocked.GetPosition().x(), 1.0f);
+}
+
+TEST_F(CharacterControllerTest, AStepHigherThanItsStepHeightStopsIt)
+{
+    AddFloor();
+    AddStatic(Box(Vec3(1, 0.25f, 3)), Vec3(3, 0.25f, 0)); // 0.5 m high, from x = 2
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3(2, 0, 0), 120);
+    EXPECT_LT(character.GetPosition().y(), cCharacterStandHeight + 0.1f);
+    EXPECT_LT(character.GetPosition().x(), 2.0f);
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+}
+
+TEST_F(CharacterControllerTest, WalkingDownStairsItKeepsToTheFloor)
+{
+    AddFloor();
+    AddStairs(1.0f, 5, 0.2f, 0.4f);
+    const Vec3 top(3.4f, cCharacterStandHeight + 1.0f + 0.02f, 0);
+    const auto framesOffGround = [&](const CharacterSettings& inSettings)
+    {
+        CharacterController character = MakeCharacter(top, inSettings);
+        Walk(character, Vec3(0, 0, 0), 10);
+        EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+        int offGround = 0;
+        for (int frame = 0; frame < 90; ++frame)
+        {
+            Walk(character, Vec3(-2, 0, 0), 1);
+            offGround += character.GetGroundState() != GroundState::OnGround ? 1 : 0;
+        }
+        EXPECT_LT(character.GetPosition().x(), 0.5f) << "it walked down to the floor";
+        ExpectStandingOnFloor(character);
+        return offGround;
+    };
+    EXPECT_EQ(framesOffGround(Settings()), 0) << "it follows each step down";
+    CharacterSettings loose = Settings();
+    loose.mStickToFloorDistance = 0.0f;
+    EXPECT_GE(framesOffGround(loose), 5) << "without it, it drops off each step";
+}
+
+TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
+{
+    AddFloor();
+    BodyCreationSettings platform;
+    platform.mShape = Box(Vec3(2, 0.25f, 2));
+    platform.mPosition = Vec3(0, 1, 0);
+    platform.mMotionType = MotionType::Kinematic;
+    platform.mObjectLayer = Layers::cMoving;
+    const BodyID id = Bodies().CreateAndAddBody(platform, Activation::Activate).Value();
+    CharacterController rider = MakeCharacter(Vec3(0, 1.25f + cCharacterStandHeight + 0.02f, 0));
+    Walk(rider, Vec3::Zero(), 10);
+    ASSERT_EQ(rider.GetGroundBody(), id);
+
+    // Sideways at 1 m/s, then up at 1 m/s, a second each
+    for (int frame = 0; frame < 120; ++frame)
+    {
+        const Vec3 velocity = frame < 60 ? Vec3(1, 0, 0) : Vec3(0, 1, 0);
+        const Vec3 target = Position(id) + velocity * cDeltaTime;
+        ASSERT_TRUE(Bodies().MoveKinematic(id, target, Quat::Identity(), cDeltaTime).IsOk());
+        ASSERT_TRUE(UpdateWorld(cDeltaTime).IsOk());
+        Walk(rider, Vec3::Zero(), 1);
+        EXPECT_EQ(rider.GetGroundState(), GroundState::OnGround) << "frame " << frame;
+        EXPECT_GE(rider.GetPosition().y() - Position(id).y(), 0.25f + cCharacterStandHeight - 1.0e-3f)
+            << "never sunk into the platform, frame " << frame;
+    }
+    EXPECT_NEAR(rider.GetPosition().x(), 1.0f, 0.03f);
+    EXPECT_NEAR(rider.GetPosition().y() - Position(id).y(), 0.25f + cCharacterStandHeight + 0.02f, 0.03f);
+
+    // Stepping off while the platform rises, it keeps the platform's velocity
+    ASSERT_TRUE(rider.SetLinearVelocity(Vec3(0, 3, 0)).IsOk());
+    ASSERT_TRUE(rider.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_EQ(rider.GetGroundState(), GroundState::InAir);
+    EXPECT_NEAR(rider.GetLinearVelocity().y(), 3.0f + 1.0f - 9.81f * cDeltaTime, 0.05f);
+}
+
+TEST_F(CharacterControllerTest, ABodyMovedIntoItPushesItOut)
+{
+    AddFloor();
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3::Zero(), 5);
+    // A crate dropped half into it from the side
+    const BodyID crate = AddStatic(Box(Vec3(0.5f, 0.5f, 0.5f)), Vec3(0.6f, 0.5f, 0));
+    ASSERT_GT(DeepestOverlap(character), 0.1f);
+    ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_LT(DeepestOverlap(character), 1.0e-3f);
+    EXPECT_LT(character.GetPosition().x(), 0.1f - cCharacterRadius + 1.0e-3f);
+    EXPECT_NEAR(character.GetPosition().y(), cCharacterStandHeight + 0.02f, 0.01f)
+        << "pushed sideways, not up or down";
+    bool touched = false;
+    for (const CharacterContact& contact : character.GetContacts())
+        touched = touched || contact.mBody == crate;
+    EXPECT_TRUE(touched);
+}
+
+TEST_F(CharacterControllerTest, BadInputIsRefusedAndChangesNothing)
+{
+    AddFloor();
+    const auto refused = [&](const CharacterSettings& inSettings, const Vec3& inPosition)
+    {
+        Result<CharacterController> created = CharacterController::Create(System(), inSettings, inPosition);
+        return !created && created.GetError().mCode == ErrorCode::InvalidArgument;
+    };
+    const Vec3 start(0, cCharacterStandHeight + 0.02f, 0);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    CharacterSettings settings = Settings();
+    EXPECT_TRUE(refused(settings, Vec3(nan, 0, 0)));
+    EXPECT_TRUE(refused(settings, Vec3(0, 2.0e6f, 0)));
+    settings.mShape = nullptr;
+    EXPECT_TRUE(refused(settings, start));
+    const std::array<Vec3, 3> vertices{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};
+    const std::array<std::array<uint32_t, 3>, 1> triangle{{{0, 1, 2}}};
+    settings.mShape = TriangleMeshShape::Create(vertices, triangle).Value();
+    EXPECT_TRUE(refused(settings, start)) << "a mesh can not be swept";
+    for (const float angle : {0.0f, cPi / 2.0f, nan})
+    {
+        settings = Settings();
+        settings.mMaxSlopeAngle = angle;
+        EXPECT_TRUE(refused(settings, start)) << angle;
+    }
+    for (const float length : {-1.0f, nan, 1.0e9f})
+    {
+        settings = Settings();
+        settings.mStepHeight = length;
+        EXPECT_TRUE(refused(settings, start)) << length;
+        settings = Settings();
+        settings.mStickToFloorDistance = length;
+        EXPECT_TRUE(refused(settings, start)) << length;
+    }
+    for (const float padding : {0.0f, 0.5f, nan})
+    {
+        settings = Settings();
+        settings.mPadding = padding;
+        EXPECT_TRUE(refused(settings, start)) << padding;
+    }
+    settings = Settings();
+    settings.mUp = Vec3(0, 2, 0);
+    EXPECT_TRUE(refused(settings, start));
+
+    CharacterController character = MakeCharacter(start);
+    Walk(character, Vec3(1, 0, 0), 5);
+    const Vec3 position = character.GetPosition();
+    const Vec3 velocity = character.GetLinearVelocity();
+    for (const float deltaTime : {0.0f, -1.0f, nan, std::numeric_limits<float>::infinity()})
+        EXPECT_EQ(character.Update(deltaTime, cCharacterGravity).GetError().mCode,
+                  ErrorCode::InvalidArgument);
+    EXPECT_EQ(character.Update(cDeltaTime, Vec3(0, nan, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(character.SetLinearVelocity(Vec3(nan, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(character.SetPosition(Vec3(0, 0, 1.0e7f)).GetError().mCode, ErrorCode::InvalidArgument);
+    // A move past the queries' reach: refused as a whole, not half made
+    ASSERT_TRUE(character.SetLinearVelocity(Vec3(1.0e12f, 0, 0)).IsOk());
+    EXPECT_EQ(character.Update(cDeltaTime, cCharacterGravity).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(character.GetPosition(), position);
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+    ASSERT_TRUE(character.SetLinearVelocity(velocity).IsOk());
+    EXPECT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+}
+
+TEST(CharacterClipToPlanesTest, ItKeepsWhatPointsIntoNoPlaneAlongOnePlaneACreaseOrNothing)
+{
+    const Vec3 floor = Vec3::UnitY();
+    const Vec3 wall = -Vec3::UnitX();
+    const std::array<Vec3, 1> justFloor{floor};
+    EXPECT_EQ(ClipToPlanes(Vec3(1, 2, 0), justFloor), Vec3(1, 2, 0)) << "away from the plane: kept";
+    EXPECT_TRUE(ClipToPlanes(Vec3(1, -2, 3), justFloor).isApprox(Vec3(1, 0, 3)));
+    const std::array<Vec3, 2> floorAndWall{floor, wall};
+    EXPECT_TRUE(ClipToPlanes(Vec3(1, -1, 2), floorAndWall).isApprox(Vec3(0, 0, 2))) << "along the crease";
+    // Two walls in a V: into it the nearest allowed is nothing; along one, the other does not matter
+    const Vec3 left = Vec3(-1, 0, 1).normalized(), right = Vec3(-1, 0, -1).normalized();
+    const std::array<Vec3, 3> corner{floor, left, right};
+    EXPECT_LT(ClipToPlanes(Vec3(1, -1, 0), corner).norm(), 1.0e-6f);
+    // Into the left wall and away from the right one: along the left wall
+    EXPECT_TRUE(ClipToPlanes(Vec3(1, 0, -2), corner).isApprox(Vec3(-0.5f, 0, -0.5f)));
+}
+
+} // namespace cairn::test
