@@ -1,0 +1,199 @@
+// Characters walking on their own threads while the world steps on a job system, crates are added and
+// removed, and an elevator rises and sinks under some of them: every Update answers, none waits for the step,
+// and no character sinks through the floor or the elevator. Part of the test command and run under
+// ThreadSanitizer in CI (the concurrency label). The single-threaded behaviour is
+// tests/physics/simulation/CharacterControllerTest.cpp.
+
+#include "cairn/jobs/JobSystem.h"
+#include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/character/CharacterController.h"
+#include "cairn/physics/shapes/BoxShape.h"
+#include "cairn/physics/shapes/CapsuleShape.h"
+#include "common/MakePhysicsSystem.h"
+#include "common/SlowBuild.h"
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <gtest/gtest.h>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace cairn
+{
+using namespace cairn::physics;
+namespace
+{
+
+using Clock = std::chrono::steady_clock;
+constexpr float cDeltaTime = 1.0f / 60.0f;
+constexpr float cHalfHeight = 0.6f, cRadius = 0.3f;
+const Vec3 cGravity(0.0f, -9.81f, 0.0f);
+/// The elevator: a kinematic slab at x, z in [6, 10], its top rising from 0.5 m to 2.5 m and back
+constexpr float cElevatorLow = 0.25f, cElevatorRise = 2.0f;
+
+BodyCreationSettings BoxSettings(const Vec3& inHalfExtent, const Vec3& inPosition, MotionType inMotion)
+{
+    BodyCreationSettings settings;
+    settings.mShape = BoxShape::Create(inHalfExtent).Value();
+    settings.mPosition = inPosition;
+    settings.mMotionType = inMotion;
+    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
+    return settings;
+}
+
+TEST(CharacterConcurrencyTest, CharactersWalkOnTheirThreadsWhileTheWorldStepsAndChanges)
+{
+    const std::unique_ptr<PhysicsSystem> world = test::MakePhysicsSystem();
+    BodyInterface& bodies = world->GetBodyInterface();
+    ASSERT_TRUE(bodies.CreateAndAddBody(BoxSettings(Vec3(30, 1, 30), Vec3(0, -1, 0), MotionType::Static),
+                                        Activation::DontActivate));
+    const BodyID elevator =
+        bodies
+            .CreateAndAddBody(BoxSettings(Vec3(2, 0.25f, 2), Vec3(8, cElevatorLow, 8), MotionType::Kinematic),
+                              Activation::Activate)
+            .Value();
+
+    constexpr int cThreads = 2, cPerThread = 4;
+    CharacterSettings settings;
+    settings.mShape = CapsuleShape::Create(cHalfHeight, cRadius).Value();
+    std::vector<CharacterController> characters;
+    for (int i = 0; i < cThreads * cPerThread; ++i)
+    {
+        // The last of each thread's characters stands on the elevator and walks a small circle there
+        const bool onElevator = i % cPerThread == cPerThread - 1;
+        const Vec3 centre = onElevator ? Vec3(8.0f + float(i / cPerThread) * 0.4f - 0.2f, 0, 8)
+                                       : Vec3(-12.0f + 6.0f * float(i % 5), 0, -8.0f + 8.0f * float(i / 5));
+        const float floorTop = onElevator ? cElevatorLow + 0.25f : 0.0f;
+        characters.push_back(
+            CharacterController::Create(*world, settings,
+                                        centre + Vec3(0, floorTop + cHalfHeight + cRadius + 0.02f, 0))
+                .Value());
+    }
+
+    const Clock::duration minTime = std::chrono::milliseconds(1000);
+    const Clock::duration maxTime = std::chrono::milliseconds(test::cSlowBuild ? 8000 : 20000);
+    const uint64_t targetSteps = test::cSlowBuild ? 60 : 300;
+    std::atomic<bool> stop{false};
+    // A game's pace: a walker's frame f runs once the world has made step f - 1, beside step f, and step f
+    // waits for every walker's frame f - 1 (a character that missed a hundred steps would find its elevator
+    // metres away). Relaxed throughout: a pace only; what a character reads of the world is ordered by the
+    // world's own publication
+    std::atomic<uint64_t> steps{0};
+    std::array<std::atomic<uint64_t>, cThreads> walkerFrames{};
+    std::mutex failureMutex; // Guards firstFailure and failures: written by the character threads
+    std::string firstFailure;
+    uint64_t failures = 0;
+    auto fail = [&](const std::string& inWhat)
+    {
+        const std::lock_guard lock(failureMutex);
+        if (failures++ == 0) firstFailure = inWhat;
+    };
+
+    std::vector<std::thread> walkers;
+    for (int t = 0; t < cThreads; ++t)
+        walkers.emplace_back(
+            [&, t]
+            {
+                float time = 0.0f;
+                // Relaxed: a stop flag only
+                for (uint64_t frame = 0; !stop.load(std::memory_order_relaxed); ++frame)
+                {
+                    while (steps.load(std::memory_order_relaxed) + 1 < frame &&
+                           !stop.load(std::memory_order_relaxed))
+                        std::this_thread::yield();
+                    time += cDeltaTime;
+                    for (int i = t * cPerThread; i < (t + 1) * cPerThread; ++i)
+                    {
+                        CharacterController& character = characters[size_t(i)];
+                        const bool onElevator = i % cPerThread == cPerThread - 1;
+                        const float radius = onElevator ? 0.6f : 3.0f, speed = onElevator ? 0.8f : 3.0f;
+                        const float angle = time * speed / radius + float(i);
+                        Vec3 velocity(-std::sin(angle) * speed, character.GetLinearVelocity().y(),
+                                      std::cos(angle) * speed);
+                        const Status set = character.SetLinearVelocity(velocity);
+                        const Status updated = character.Update(cDeltaTime, cGravity);
+                        if (!set || !updated)
+                        {
+                            fail("character " + std::to_string(i) + ": " +
+                                 (set ? updated : set).GetError().mMessage);
+                            continue;
+                        }
+                        // Its centre stays more than its radius above the floor: it never sinks through it
+                        // (the elevator's riders stand higher still)
+                        const float floorTop = onElevator ? cElevatorLow + 0.25f : 0.0f;
+                        if (character.GetPosition().y() < floorTop + cHalfHeight)
+                            fail("character " + std::to_string(i) +
+                                 " sank to y = " + std::to_string(character.GetPosition().y()));
+                    }
+                    walkerFrames[size_t(t)].store(frame + 1, std::memory_order_relaxed);
+                }
+            });
+
+    // This thread steps the world on a job system, moves the elevator and adds and removes crates
+    jobs::JobSystem::Settings jobSettings;
+    jobSettings.mNumThreads = 2;
+    jobs::JobSystem jobSystem(jobSettings);
+    std::mt19937 random(11);
+    // Crates fall on the floor's walkers, not on the elevator (x, z in [6, 10]), whose riders they would push
+    // off: a rider is checked against the elevator's top
+    std::uniform_real_distribution<float> across(-14.0f, 4.0f);
+    std::deque<BodyID> crates;
+    const Clock::time_point start = Clock::now();
+    for (uint64_t step = 0;; ++step)
+    {
+        const Clock::duration elapsed = Clock::now() - start;
+        if ((elapsed >= minTime && step >= targetSteps) || elapsed >= maxTime) break;
+        const auto walkersBehind = [&]
+        {
+            for (const std::atomic<uint64_t>& frames : walkerFrames)
+                if (frames.load(std::memory_order_relaxed) < step) return true;
+            return false;
+        };
+        while (walkersBehind() && Clock::now() - start < maxTime)
+            std::this_thread::yield();
+        {
+            const std::lock_guard lock(failureMutex);
+            if (failures > 0) break;
+        }
+        const float phase = float(step % 240) / 240.0f; // Up and down every 4 s
+        const float height = cElevatorLow + cElevatorRise * (1.0f - std::cos(2.0f * cPi * phase)) * 0.5f;
+        ASSERT_TRUE(bodies.MoveKinematic(elevator, Vec3(8, height, 8), Quat::Identity(), cDeltaTime));
+        crates.push_back(
+            bodies
+                .CreateAndAddBody(BoxSettings(Vec3::Constant(0.2f), Vec3(across(random), 6, across(random)),
+                                              MotionType::Dynamic),
+                                  Activation::Activate)
+                .Value());
+        if (crates.size() > 40)
+        {
+            ASSERT_TRUE(bodies.RemoveBody(crates.front()));
+            ASSERT_TRUE(bodies.DestroyBody(crates.front()));
+            crates.pop_front();
+        }
+        ASSERT_TRUE(world->Update(cDeltaTime, 1, jobSystem));
+        steps.store(step + 1, std::memory_order_relaxed);
+    }
+    stop.store(true, std::memory_order_relaxed); // Relaxed: a stop flag; the joins order the rest
+    for (std::thread& walker : walkers)
+        walker.join();
+
+    EXPECT_EQ(failures, 0u) << failures << " failures, the first: " << firstFailure;
+    EXPECT_GE(steps.load(std::memory_order_relaxed), test::cSlowBuild ? 10u : targetSteps);
+    // The elevator's riders went up and down with it: each is still on it, within its 4 m square
+    for (int i = cPerThread - 1; i < cThreads * cPerThread; i += cPerThread)
+    {
+        const Vec3 position = characters[size_t(i)].GetPosition();
+        EXPECT_LT((Vec3(position.x(), 0, position.z()) - Vec3(8, 0, 8)).cwiseAbs().maxCoeff(), 2.0f)
+            << "character " << i;
+        EXPECT_GE(position.y(), bodies.GetPosition(elevator).Value().y() + 0.25f + cHalfHeight) << i;
+    }
+}
+
+} // namespace
+} // namespace cairn
