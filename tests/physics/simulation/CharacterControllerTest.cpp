@@ -181,6 +181,21 @@ TEST_F(CharacterControllerTest, AWallStopsItAndItSlidesAlongTheWall)
     EXPECT_LT(DeepestOverlap(character), 1.0e-3f);
 }
 
+TEST_F(CharacterControllerTest, ASensorInItsWayDoesNotStopIt)
+{
+    AddFloor();
+    BodyCreationSettings trigger;
+    trigger.mShape = Box(Vec3(0.5f, 2, 5));
+    trigger.mPosition = Vec3(3.5f, 2, 0);
+    trigger.mMotionType = MotionType::Static;
+    trigger.mObjectLayer = Layers::cTrigger;
+    trigger.mIsSensor = true;
+    ASSERT_TRUE(Bodies().CreateAndAddBody(trigger, Activation::DontActivate));
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3(4, 0, 0), 90);
+    EXPECT_GT(character.GetPosition().x(), 5.0f) << "through the trigger volume";
+}
+
 TEST_F(CharacterControllerTest, AnAcuteCornerHoldsItStillWithoutJitter)
 {
     AddFloor();

@@ -16,6 +16,7 @@
 // that is not positive and finite, a move past the queries' reach, settings out of range, a shape that is
 // neither convex nor a compound of convex shapes) is InvalidArgument and leaves the controller as it was.
 
+#include "cairn/physics/body/Layers.h"
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/queries/WorldQuery.h"
 #include "cairn/physics/shapes/Shape.h"
@@ -44,7 +45,9 @@ struct CharacterSettings
     float mStickToFloorDistance = 0.4f;
     /// The gap kept from every surface, so that sliding along one is not a touch; in (0, 0.1] metres
     float mPadding = 0.02f;
-    QueryFilter mFilter; ///< What blocks the character (its own body, if it has one, goes in mIgnoreBody)
+    /// What blocks the character: by default every layer but Layers::cTrigger (sensors, which queries find
+    /// and nothing collides with). Its own body, if it has one, goes in mIgnoreBody
+    QueryFilter mFilter{cAllObjectLayers & ~(ObjectLayerMask(1) << Layers::cTrigger), BodyID()};
 };
 
 enum class GroundState : uint8_t
