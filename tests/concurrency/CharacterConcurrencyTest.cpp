@@ -11,6 +11,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "common/MakePhysicsSystem.h"
 #include "common/SlowBuild.h"
+#include "common/StaticFloor.h"
 
 #include <array>
 #include <atomic>
@@ -37,26 +38,16 @@ const Vec3 cGravity(0.0f, -9.81f, 0.0f);
 /// The elevator: a kinematic slab at x, z in [6, 10], its top rising from 0.5 m to 2.5 m and back
 constexpr float cElevatorLow = 0.25f, cElevatorRise = 2.0f;
 
-BodyCreationSettings BoxSettings(const Vec3& inHalfExtent, const Vec3& inPosition, MotionType inMotion)
-{
-    BodyCreationSettings settings;
-    settings.mShape = BoxShape::Create(inHalfExtent).Value();
-    settings.mPosition = inPosition;
-    settings.mMotionType = inMotion;
-    settings.mObjectLayer = inMotion == MotionType::Static ? Layers::cStatic : Layers::cMoving;
-    return settings;
-}
-
 TEST(CharacterConcurrencyTest, CharactersWalkOnTheirThreadsWhileTheWorldStepsAndChanges)
 {
     const std::unique_ptr<PhysicsSystem> world = test::MakePhysicsSystem();
     BodyInterface& bodies = world->GetBodyInterface();
-    ASSERT_TRUE(bodies.CreateAndAddBody(BoxSettings(Vec3(30, 1, 30), Vec3(0, -1, 0), MotionType::Static),
-                                        Activation::DontActivate));
+    ASSERT_TRUE(bodies.CreateAndAddBody(test::StaticFloorSettings(30.0f), Activation::DontActivate));
     const BodyID elevator =
         bodies
-            .CreateAndAddBody(BoxSettings(Vec3(2, 0.25f, 2), Vec3(8, cElevatorLow, 8), MotionType::Kinematic),
-                              Activation::Activate)
+            .CreateAndAddBody(
+                test::BoxBodySettings(Vec3(8, cElevatorLow, 8), Vec3(2, 0.25f, 2), MotionType::Kinematic),
+                Activation::Activate)
             .Value();
 
     constexpr int cThreads = 2, cPerThread = 4;
@@ -166,8 +157,8 @@ TEST(CharacterConcurrencyTest, CharactersWalkOnTheirThreadsWhileTheWorldStepsAnd
         ASSERT_TRUE(bodies.MoveKinematic(elevator, Vec3(8, height, 8), Quat::Identity(), cDeltaTime));
         crates.push_back(
             bodies
-                .CreateAndAddBody(BoxSettings(Vec3::Constant(0.2f), Vec3(across(random), 6, across(random)),
-                                              MotionType::Dynamic),
+                .CreateAndAddBody(test::BoxBodySettings(Vec3(across(random), 6, across(random)),
+                                                        Vec3::Constant(0.2f), MotionType::Dynamic),
                                   Activation::Activate)
                 .Value());
         if (crates.size() > 40)
