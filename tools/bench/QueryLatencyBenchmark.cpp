@@ -11,6 +11,10 @@
 //  ray_static          CastRayClosest straight down onto the floor beside the pyramid: only a static body
 //  capsule_cast        CastShapeClosest of a standing capsule (radius 0.4 m, 1.8 m tall) along ray_pyramid's
 //                      path, 1 m higher: a character's probe, a ray's candidates and more, each one swept
+//  character_walk      CharacterController::Update of a standing capsule (the same), one 1/60 s frame of a
+//                      walk at 3 m/s from 2-6 m off the pyramid's -x face into it: it meets the boxes and
+//                      slides along them (a character's frame: a few sweeps and overlaps); every 90 frames it
+//                      is put back at a new start
 //  tile_collect        GeometryCollector::FindBodies + CollectTriangles over the 12.8 m navmesh tile
 //                      x, z in [-12.8, 0] (a quarter of the pyramid), full height, awake boxes included
 // and a write, from a third thread that sleeps 0 to --write-interval-us between writes:
@@ -57,6 +61,7 @@
 #include "cairn/navmesh/GeometryCollector.h"
 #include "cairn/physics/LockWaits.h"
 #include "cairn/physics/PhysicsSystem.h"
+#include "cairn/physics/character/CharacterController.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "common/BenchOptions.h"
 #include "common/BenchScenes.h"
@@ -94,16 +99,19 @@ enum class Kind : uint8_t
     BoxOverlap,
     RayStatic,
     CapsuleCast,
+    CharacterWalk,
     TileCollect,
     WriteSetPosition,
 };
-constexpr size_t cNumKinds = 7;
+constexpr size_t cNumKinds = 8;
 constexpr std::array<const char*, cNumKinds> cKindNames = {
-    "ray_pyramid",  "sphere_overlap", "box_overlap",       "ray_static",
-    "capsule_cast", "tile_collect",   "write_set_position"};
+    "ray_pyramid",  "sphere_overlap", "box_overlap",  "ray_static",
+    "capsule_cast", "character_walk", "tile_collect", "write_set_position"};
 /// What the checksum counts of each kind
-constexpr std::array<const char*, cNumKinds> cKindCounts = {"hits", "bodies", "bodies", "hits",
-                                                            "hits", "bodies", "ok"};
+constexpr std::array<const char*, cNumKinds> cKindCounts = {"hits", "bodies",   "bodies", "hits",
+                                                            "hits", "contacts", "bodies", "ok"};
+/// character_walk: frames of a walk before the character is put back at a new start
+constexpr uint64_t cCharacterWalkFrames = 90;
 
 /// The targets are on queries; a write may wait for the step
 bool IsQuery(Kind inKind)
@@ -279,6 +287,12 @@ QueryInput DrawInput(Kind inKind, Random& ioRandom)
         // The capsule starts clear of the floor (its foot 0.1 m up at the least), as a character stands
         if (inKind == Kind::CapsuleCast) input.mRay.mOrigin.y() += 1.0f;
         break;
+    case Kind::CharacterWalk:
+        // On the floor (the capsule's foot 2 cm up), 2-6 m off the pyramid's -x face
+        input.mPoint = Vec3(tools::cPyramidFootprintMin - ioRandom.Next(2.0f, 6.0f), 0.92f,
+                            ioRandom.Next(cInsideMin, cInsideMax));
+        input.mRay.mDirection = Vec3(3.0f, 0.0f, ioRandom.Next(-1.0f, 1.0f));
+        break;
     case Kind::SphereOverlap:
     case Kind::BoxOverlap:
         input.mPoint = Vec3(ioRandom.Next(cInsideMin, cInsideMax), ioRandom.Next(0.5f, 14.0f),
@@ -299,18 +313,32 @@ QueryInput DrawInput(Kind inKind, Random& ioRandom)
     return input;
 }
 
+CharacterController MakeCharacter(const PhysicsSystem& inPhysics, const ShapeRef& inCapsule)
+{
+    CharacterSettings settings;
+    settings.mShape = inCapsule;
+    // Valid settings and a valid place: Create can not refuse them
+    return CharacterController::Create(inPhysics, settings,
+                                       Vec3(tools::cPyramidFootprintMin - 4.0f, 0.92f, 0.0f))
+        .Value();
+}
+
 /// What the query thread works with; its buffers are reused, so a query's time is not an allocation's.
 struct QueryContext
 {
     const WorldQuery& mQuery;
     const navmesh::GeometryCollector mCollector;
     const ShapeRef mCapsule = CapsuleShape::Create(0.5f, 0.4f).Value();
+    CharacterController mCharacter;
+    uint64_t mCharacterFrames = 0;
     std::vector<BodyID> mBodies;
     navmesh::TileGeometry mGeometry;
     navmesh::NavMeshInclusion mInclusion;
 
     explicit QueryContext(const PhysicsSystem& inPhysics)
-        : mQuery(inPhysics.GetWorldQuery()), mCollector(inPhysics.GetBodyManager(), inPhysics.GetBroadPhase())
+        : mQuery(inPhysics.GetWorldQuery()),
+          mCollector(inPhysics.GetBodyManager(), inPhysics.GetBroadPhase()),
+          mCharacter(MakeCharacter(inPhysics, mCapsule))
     {
         mInclusion.mAwakeDynamic = true; // The pyramid's boxes are all awake: collect them
     }
@@ -339,6 +367,20 @@ bool RunQuery(Kind inKind, const QueryInput& inInput, QueryContext& ioContext, u
             *ioContext.mCapsule, {inInput.mRay.mOrigin, Quat::Identity()}, inInput.mRay.mDirection);
         if (!hit) return false;
         outCount = hit.Value().has_value() ? 1 : 0;
+        return true;
+    }
+    case Kind::CharacterWalk:
+    {
+        CharacterController& character = ioContext.mCharacter;
+        if (ioContext.mCharacterFrames++ % cCharacterWalkFrames == 0 &&
+            !character.SetPosition(inInput.mPoint))
+            return false;
+        Vec3 velocity = inInput.mRay.mDirection;
+        velocity.y() = character.GetLinearVelocity().y();
+        if (!character.SetLinearVelocity(velocity) ||
+            !character.Update(1.0f / 60.0f, Vec3(0.0f, -9.81f, 0.0f)))
+            return false;
+        outCount = character.GetContacts().size();
         return true;
     }
     case Kind::SphereOverlap:
