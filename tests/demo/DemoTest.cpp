@@ -111,6 +111,9 @@ void ExpectInvariants(const DemoRunResult& inRun)
     }
     EXPECT_FALSE(LockWaitMicrosPerThreadFrame(inRun).empty());
     EXPECT_GT(inRun.mQueries, 0u);
+    // The game objects walk as characters: one is put back at its spot (3 m behind it) far less often
+    EXPECT_GT(inRun.mCharacterWalks, 0u);
+    EXPECT_LT(inRun.mCharacterPutBack * 20, inRun.mCharacterWalks) << inRun.mModeName;
     EXPECT_GT(inRun.mNavTilesBuilt, 0u);
     const std::string paths =
         inRun.mModeName + ": paths requested " + std::to_string(agents.mPathsRequested) + ", served " +

@@ -401,6 +401,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
     sections.push_back(
         {"game-object queries",
          {{"queries (beside the step)", Count(inRun.mQueries)},
+          {"character walks", Count(inRun.mCharacterWalks)},
+          {"put back 3 m behind", Count(inRun.mCharacterPutBack)},
           {"mean µs/query", Micros(inRun.mQueryMicrosMean)},
           {"µs/query per thread", MicrosList(inRun.mQueryMicrosPerThread)},
           {"lock waits µs/query", Micros(QueryLockWaitMicrosPerQuery(inRun))},

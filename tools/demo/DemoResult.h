@@ -145,8 +145,10 @@ struct DemoRunResult
     std::vector<StepStatistics> mSteps;
     /// Game-object query jobs: mean microseconds per query, per job-system thread (index = thread slot)
     std::vector<double> mQueryMicrosPerThread;
-    uint64_t mQueries = 0;         ///< Ray casts and shape queries made by game-object jobs
-    double mQueryMicrosMean = 0.0; ///< Over all queries
+    uint64_t mQueries = 0;          ///< Ray casts and shape queries made by game-object jobs
+    uint64_t mCharacterWalks = 0;   ///< Frames a game object walked as a character (one query each)
+    uint64_t mCharacterPutBack = 0; ///< Times a game object fell 3 m behind its spot and was put back there
+    double mQueryMicrosMean = 0.0;  ///< Over all queries
     /// Game-object query jobs (during the step): microseconds per frame each thread spent waiting for the
     /// broad phase's locks (LockWaits), in the order of mQueryMicrosPerThread
     std::vector<double> mBroadPhaseLockWaitMicrosPerThreadFrame;

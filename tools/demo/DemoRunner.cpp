@@ -343,6 +343,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mCorridorsThroughGone) +
                                  " corridors went through a polygon that was gone");
     result.mQueries = gameObjects->GetNumQueries();
+    result.mCharacterWalks = gameObjects->GetNumWalks();
+    result.mCharacterPutBack = gameObjects->GetNumPutBack();
     if (const uint64_t queryErrors = gameObjects->GetNumQueryErrors(); queryErrors > 0)
         result.mErrors.push_back("game objects: " + std::to_string(queryErrors) + " world queries failed");
     result.mQueryMicrosMean = gameObjects->GetQueryMicrosMean();

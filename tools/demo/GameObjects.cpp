@@ -16,14 +16,18 @@ using namespace cairn::physics;
 namespace
 {
 using Clock = std::chrono::steady_clock;
-/// The walk probe: a capsule as wide as the object, its foot this far above the object's, so that the
-/// terrain's rise over one frame's move does not stop it (a step-up, as a character controller has)
-constexpr float cWalkProbeRadius = 0.3f, cWalkProbeHalfHeight = 0.35f, cWalkProbeLift = 0.3f;
-/// An object stops this short of what its probe met (metres), so that the next frame's probe starts clear
-constexpr float cWalkSkin = 0.02f;
-/// An object left farther than this behind its spot (held at a wall while the player walked on) is put back
-/// at its spot without a sweep, as a game brings back a companion that fell behind
-constexpr float cMaxSweptMove = 3.0f;
+/// The character: a capsule as tall (1.8 m) and as wide as the object's box
+constexpr float cWalkerRadius = 0.3f, cWalkerHalfHeight = 0.6f;
+/// The object's box's centre above the ground: its character's capsule's, which keeps its padding clear of
+/// the ground, is 2 cm higher
+constexpr float cBodyCentreHeight = 0.9f, cWalkerPadding = 0.02f;
+/// The fastest an object walks after its spot (m/s): the spot circles at 1.5 m/s and follows the player
+constexpr float cMaxWalkSpeed = 10.0f;
+/// An object left farther than this behind its spot (held at a wall while the player walked on, or left
+/// without ground when a tile streamed out under it) is put back at its spot, as a game brings back a
+/// companion that fell behind
+constexpr float cMaxWalkBehind = 3.0f;
+const Vec3 cGravity(0.0f, -9.81f, 0.0f);
 std::atomic<uint32_t> sNextThreadSlot{0}; // Relaxed: only uniqueness matters
 } // namespace
 
@@ -36,7 +40,7 @@ uint32_t GameObjects::ThreadSlotIndex()
 GameObjects::GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
                          uint64_t inSeed)
     : mPhysics(ioPhysics), mGenerator(inGenerator),
-      mWalkProbe(CapsuleShape::Create(cWalkProbeHalfHeight, cWalkProbeRadius).Value())
+      mWalker(CapsuleShape::Create(cWalkerHalfHeight, cWalkerRadius).Value())
 {
     std::mt19937_64 random(inSeed);
     std::uniform_real_distribution<float> offset(-40.0f, 40.0f), phase(0.0f, 6.28f);
@@ -54,7 +58,13 @@ GameObjects::GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGener
         Result<BodyID> id = mPhysics.GetBodyInterface().CreateAndAddBody(settings, Activation::DontActivate);
         if (!id) continue;
         object.mBody = id.Value();
-        mObjects.push_back(object);
+        CharacterSettings walker;
+        walker.mShape = mWalker;
+        walker.mFilter.mIgnoreBody = object.mBody;
+        Result<CharacterController> character =
+            CharacterController::Create(mPhysics, walker, settings.mPosition);
+        if (character) object.mCharacter.emplace(std::move(character).Value());
+        mObjects.push_back(std::move(object));
     }
 }
 
@@ -67,7 +77,8 @@ GameObjects::~GameObjects()
     }
 }
 
-void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, uint64_t& ioNanos, uint64_t& ioQueries)
+void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, float inDeltaTime, uint64_t& ioNanos,
+                              uint64_t& ioQueries)
 {
     const WorldQuery& query = mPhysics.GetWorldQuery();
     // A patrol circle around its spot near the player
@@ -97,25 +108,32 @@ void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, uint64_t& 
     const Status aroundStatus = query.CollideSphere(eye, 2.0f, around, filter);
     int errors = int(!ground.IsOk()) + int(!blocked.IsOk()) + int(!aroundStatus.IsOk());
     ioQueries += 3;
-    // Its move to the spot, swept (see cWalkProbeLift): a body on the way stops it short
-    const Vec3 target(spot.x(), ioObject.mGroundY + 0.9f, spot.z());
-    const Vec3 move = target - ioObject.mTarget;
-    Vec3 goTo = target;
-    if (ioObject.mPlaced && move.squaredNorm() < cMaxSweptMove * cMaxSweptMove)
+    // It walks to its spot as a character: props and walls stop it, slopes and steps take it up and down
+    const Vec3 spotOnGround(spot.x(), ioObject.mGroundY + cBodyCentreHeight, spot.z());
+    Vec3 goTo = spotOnGround;
+    if (ioObject.mCharacter)
     {
-        const Vec3 probeCentre =
-            ioObject.mTarget +
-            Vec3(0.0f, cWalkProbeLift - 0.9f + cWalkProbeHalfHeight + cWalkProbeRadius, 0.0f);
-        const Result<std::optional<ShapeCastResult>> walk =
-            query.CastShapeClosest(*mWalkProbe, {probeCentre, Quat::Identity()}, move, filter);
-        errors += int(!walk.IsOk());
-        ++ioQueries;
-        if (walk.IsOk() && walk.Value().has_value())
+        CharacterController& character = *ioObject.mCharacter;
+        const Vec3 behind = spotOnGround - character.GetPosition();
+        if (!ioObject.mPlaced || behind.squaredNorm() > cMaxWalkBehind * cMaxWalkBehind)
         {
-            const float length = move.norm();
-            const float reach = std::max(walk.Value()->mFraction * length - cWalkSkin, 0.0f);
-            goTo = ioObject.mTarget + (length > 0.0f ? reach / length : 0.0f) * move;
+            errors += int(!character.SetPosition(spotOnGround + Vec3(0.0f, cWalkerPadding, 0.0f)));
+            // Relaxed: a count read after the frame's jobs
+            if (ioObject.mPlaced) mPutBack.fetch_add(1, std::memory_order_relaxed);
         }
+        else if (inDeltaTime > 0.0f)
+        {
+            mWalks.fetch_add(1, std::memory_order_relaxed); // Relaxed: as mPutBack
+            Vec3 walk(behind.x(), 0.0f, behind.z());
+            walk /= inDeltaTime;
+            if (walk.norm() > cMaxWalkSpeed) walk *= cMaxWalkSpeed / walk.norm();
+            walk.y() = character.GetLinearVelocity().y();
+            const Status set = character.SetLinearVelocity(walk);
+            const Status updated = set ? character.Update(inDeltaTime, cGravity) : set;
+            errors += int(!updated);
+            ++ioQueries;
+        }
+        goTo = character.GetPosition();
     }
     if (errors > 0) mQueryErrors.fetch_add(uint64_t(errors), std::memory_order_relaxed); // A count only
     ioNanos += uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start).count());
@@ -139,7 +157,7 @@ void GameObjects::UpdateQueries(jobs::JobSystem& ioJobs, uint32_t inJobs, const 
                            for (size_t kind = 0; kind < cNumLockKinds; ++kind)
                                waitedBefore[kind] = GetThisThreadLockWaitNanoseconds(LockKind(kind));
                            for (uint32_t i = inBegin; i < inEnd; ++i)
-                               QueryObject(mObjects[i], inPlayer, nanos, queries);
+                               QueryObject(mObjects[i], inPlayer, inDeltaTime, nanos, queries);
                            ThreadSlot& slot = mSlots[ThreadSlotIndex()];
                            // Relaxed: totals read after the jobs are waited for (the wait orders them)
                            slot.mNanos.fetch_add(nanos, std::memory_order_relaxed);
