@@ -193,8 +193,8 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     const float navMeshRadius = Agents::NavMeshRadius(inSettings.mAgents);
 
     // Game objects before the streamer: the streamer counts the bodies it finds as not its own
-    auto gameObjects =
-        std::make_unique<GameObjects>(physics, generator, inSettings.mGameObjects, inSettings.mSeed);
+    auto gameObjects = std::make_unique<GameObjects>(physics, generator, inSettings.mGameObjects,
+                                                     inSettings.mSeed, inSettings.mPlayerSpeed);
     auto streamer = std::make_unique<TileStreamer>(physics, generator, inSettings.mCollisionRadius);
 
     // The main thread on the first core, the job workers on the others (see PinnedThread); pinned after the

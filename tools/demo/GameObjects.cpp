@@ -21,8 +21,9 @@ constexpr float cWalkerRadius = 0.3f, cWalkerHalfHeight = 0.6f;
 /// The object's box's centre above the ground: its character's capsule's, which keeps its padding clear of
 /// the ground, is 2 cm higher
 constexpr float cBodyCentreHeight = 0.9f, cWalkerPadding = 0.02f;
-/// The fastest an object walks after its spot (m/s): the spot circles at 1.5 m/s and follows the player
-constexpr float cMaxWalkSpeed = 10.0f;
+/// How much faster than the player an object may walk after its spot (m/s): its spot circles at 1.5 m/s
+/// round a place that follows the player, and an object held at a wall catches up
+constexpr float cWalkSpeedOverPlayer = 10.0f;
 /// An object left farther than this behind its spot (held at a wall while the player walked on, or left
 /// without ground when a tile streamed out under it) is put back at its spot, as a game brings back a
 /// companion that fell behind
@@ -38,8 +39,8 @@ uint32_t GameObjects::ThreadSlotIndex()
 }
 
 GameObjects::GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
-                         uint64_t inSeed)
-    : mPhysics(ioPhysics), mGenerator(inGenerator),
+                         uint64_t inSeed, float inPlayerSpeed)
+    : mPhysics(ioPhysics), mGenerator(inGenerator), mMaxWalkSpeed(inPlayerSpeed + cWalkSpeedOverPlayer),
       mWalker(CapsuleShape::Create(cWalkerHalfHeight, cWalkerRadius).Value())
 {
     std::mt19937_64 random(inSeed);
@@ -126,7 +127,7 @@ void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, float inDe
             mWalks.fetch_add(1, std::memory_order_relaxed); // Relaxed: as mPutBack
             Vec3 walk(behind.x(), 0.0f, behind.z());
             walk /= inDeltaTime;
-            if (walk.norm() > cMaxWalkSpeed) walk *= cMaxWalkSpeed / walk.norm();
+            if (walk.norm() > mMaxWalkSpeed) walk *= mMaxWalkSpeed / walk.norm();
             walk.y() = character.GetLinearVelocity().y();
             const Status set = character.SetLinearVelocity(walk);
             const Status updated = set ? character.Update(inDeltaTime, cGravity) : set;

@@ -37,8 +37,10 @@ class GameObjects
 public:
     static constexpr uint32_t cMaxThreadSlots = 16;
 
+    /// inPlayerSpeed (m/s): how fast the place the objects patrol round moves, which they walk to keep up
+    /// with
     GameObjects(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, uint32_t inCount,
-                uint64_t inSeed);
+                uint64_t inSeed, float inPlayerSpeed);
     ~GameObjects();
 
     /// One frame's queries: inJobs jobs on ioJobs look around every object near inPlayer and choose where it
@@ -96,7 +98,8 @@ private:
     PhysicsSystem& mPhysics;
     const WorldGenerator& mGenerator;
     std::vector<Object> mObjects;
-    const ShapeRef mWalker; ///< Every object's character shape: a capsule as tall and wide as its body
+    const float mMaxWalkSpeed; ///< m/s
+    const ShapeRef mWalker;    ///< Every object's character shape: a capsule as tall and wide as its body
     float mTime = 0.0f;
     uint64_t mFrames = 0; ///< Updates with objects (main thread)
     std::array<ThreadSlot, cMaxThreadSlots> mSlots;
