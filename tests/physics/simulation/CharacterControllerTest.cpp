@@ -5,6 +5,7 @@
 
 #include "SimulationFixture.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
+#include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 #include "character/CharacterMoves.h"
 #include "narrowphase/FaceClipping.h"
@@ -12,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace cairn::test
 {
@@ -257,6 +259,65 @@ TEST_F(CharacterControllerTest, ItCanNotClimbASteepSlopeAndSlidesDownIt)
         ASSERT_TRUE(slider.Update(cDeltaTime, cCharacterGravity).IsOk());
     EXPECT_LT(slider.GetPosition().y(), onRamp.y() - 1.0f);
     EXPECT_LT(DeepestOverlap(slider), 1.0e-3f);
+}
+
+TEST_F(CharacterControllerTest, ItWalksOverRollingTerrainWithoutSnaggingOrSinking)
+{
+    // 40 m of height field, 1 m cells, hills 2.4 m from trough to top, nowhere steeper than 32 degrees
+    constexpr uint32_t cSamples = 41;
+    std::vector<float> heights(cSamples * cSamples);
+    for (uint32_t z = 0; z < cSamples; ++z)
+        for (uint32_t x = 0; x < cSamples; ++x)
+            heights[x + z * cSamples] = 1.2f * std::sin(0.4f * float(x)) * std::cos(0.3f * float(z));
+    AddStatic(HeightFieldShape::Create(cSamples, cSamples, 1.0f, heights).Value(), Vec3(-20, 0, -20));
+    CharacterController character = MakeCharacter(Vec3(-15, cCharacterStandHeight + 1.5f, 0.5f));
+    Walk(character, Vec3::Zero(), 60); // Lands
+    const float startX = character.GetPosition().x();
+    int offGround = 0;
+    float deepest = 0.0f;
+    for (int frame = 0; frame < 360; ++frame)
+    {
+        Walk(character, Vec3(4, 0, 0), 1);
+        offGround += character.GetGroundState() != GroundState::OnGround ? 1 : 0;
+        deepest = std::max(deepest, DeepestOverlap(character));
+    }
+    EXPECT_EQ(offGround, 0) << "over the hills and down them, on its feet";
+    EXPECT_LT(deepest, 1.0e-3f) << "never into the ground";
+    EXPECT_GT(character.GetPosition().x() - startX, 0.99f * 24.0f) << "at its pace across up, never caught";
+}
+
+TEST_F(CharacterControllerTest, ItWalksAcrossAFlatMeshAtFullPaceWithoutBumpingOnItsSeams)
+{
+    // 20 x 20 quads of 1 m, two triangles each, at y = 0
+    std::vector<Vec3> vertices;
+    std::vector<std::array<uint32_t, 3>> triangles;
+    constexpr uint32_t cQuads = 20;
+    for (uint32_t z = 0; z <= cQuads; ++z)
+        for (uint32_t x = 0; x <= cQuads; ++x)
+            vertices.emplace_back(float(x) - 10.0f, 0.0f, float(z) - 10.0f);
+    for (uint32_t z = 0; z < cQuads; ++z)
+        for (uint32_t x = 0; x < cQuads; ++x)
+        {
+            const uint32_t corner = x + z * (cQuads + 1);
+            triangles.push_back({corner, corner + cQuads + 1, corner + 1});
+            triangles.push_back({corner + 1, corner + cQuads + 1, corner + cQuads + 2});
+        }
+    AddStatic(TriangleMeshShape::Create(vertices, triangles).Value(), Vec3::Zero());
+    CharacterController character = MakeCharacter(Vec3(-7, cCharacterStandHeight + 0.02f, -7.3f));
+    Walk(character, Vec3::Zero(), 5);
+    const Vec3 start = character.GetPosition();
+    float lowest = start.y(), highest = start.y();
+    int offGround = 0;
+    for (int frame = 0; frame < 180; ++frame)
+    {
+        Walk(character, Vec3(3, 0, 3), 1);
+        lowest = std::min(lowest, character.GetPosition().y());
+        highest = std::max(highest, character.GetPosition().y());
+        offGround += character.GetGroundState() != GroundState::OnGround ? 1 : 0;
+    }
+    EXPECT_EQ(offGround, 0);
+    EXPECT_LT(highest - lowest, 1.0e-3f) << "no bump where triangles meet";
+    EXPECT_NEAR((character.GetPosition() - start).norm(), 9.0f * std::sqrt(2.0f), 0.01f);
 }
 
 TEST_F(CharacterControllerTest, ItStepsUpStairsNoHigherThanItsStepHeight)
