@@ -26,6 +26,8 @@ constexpr float cGroundGapPaddings = 2.0f;
 constexpr float cGroundAtRestAfter = 0.1f;
 /// Lengths past this (metres) are refused, as a world query refuses them
 constexpr float cMaxCharacterLength = 100.0f;
+/// A mass and a push past these are no character's: refused, so that an impulse stays far from overflowing
+constexpr float cMaxCharacterMass = 1.0e6f, cMaxCharacterPushForce = 1.0e9f;
 
 Error InvalidCharacter(const std::string& inWhat)
 {
@@ -51,6 +53,12 @@ Status CheckSettings(const CharacterSettings& inSettings)
         return InvalidCharacter("stick-to-floor distance must be in [0, 100] m");
     if (!(inSettings.mPadding > 0.0f && inSettings.mPadding <= 0.1f))
         return InvalidCharacter("padding must be in (0, 0.1] m");
+    if (!(std::isfinite(inSettings.mMass) && inSettings.mMass > 0.0f &&
+          inSettings.mMass <= cMaxCharacterMass))
+        return InvalidCharacter("mass must be in (0, 1e6] kg");
+    if (!(std::isfinite(inSettings.mMaxPushForce) && inSettings.mMaxPushForce >= 0.0f &&
+          inSettings.mMaxPushForce <= cMaxCharacterPushForce))
+        return InvalidCharacter("maximum push force must be in [0, 1e9] N");
     return Status::Ok();
 }
 
@@ -60,6 +68,13 @@ Vec3 AlongGround(const Vec3& inVelocity, const Vec3& inNormal, const Vec3& inUp)
 {
     const Vec3 across = inVelocity - inVelocity.dot(inUp) * inUp;
     return across - inUp * (across.dot(inNormal) / inNormal.dot(inUp));
+}
+
+/// Keeps on inBody's contact how fast the character walked into it, the fastest of this Update's meetings.
+void RecordApproach(const CharacterMoveContext& inContext, const BodyID& inBody, float inSpeed)
+{
+    for (CharacterContact& contact : inContext.mContacts)
+        if (contact.mBody == inBody) contact.mApproachSpeed = std::max(contact.mApproachSpeed, inSpeed);
 }
 
 /// How the slide ended.
@@ -92,6 +107,7 @@ Result<Slide> SlideAlong(const CharacterMoveContext& inContext, const Vec3& inSt
         if (!sweep.Value().mHit) break;
 
         Vec3 normal = sweep.Value().mHit->mNormal;
+        RecordApproach(inContext, sweep.Value().mHit->mBody, -slide.mVelocity.dot(normal));
         Vec3 next = rest;
         if (inContext.IsWalkable(normal))
         {
@@ -162,6 +178,7 @@ Status CharacterController::SetPosition(const Vec3& inPosition)
     mGroundNormal = mSettings.mUp;
     mGroundMoves = false;
     mGroundVelocity = Vec3::Zero();
+    mContacts.clear(); // Not where it is now: nothing for PushBodies
     return Status::Ok();
 }
 
@@ -310,7 +327,41 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     mGroundState = state;
     mGroundBody = groundBody;
     mGroundNormal = groundNormal;
+    mGroundPoint = ground.Value() ? ground.Value()->mPoint : position;
+    mLastDeltaTime = inDeltaTime;
+    mLastGravity = inGravity;
     mContacts.swap(mNextContacts);
+    return Status::Ok();
+}
+
+Status CharacterController::PushBodies(BodyInterface& ioBodies) const
+{
+    const float maxImpulse = mSettings.mMaxPushForce * mLastDeltaTime;
+    PoseReader poses(mWorld->GetBodyManager());
+    const auto isDynamic = [&](const BodyID& inBody)
+    {
+        PublishedPose pose;
+        return poses.Read(inBody, pose) && pose.mMotionType == MotionType::Dynamic;
+    };
+    // A body removed, destroyed or turned static since the Update is no longer there to push
+    const auto skipGone = [](const Status& inStatus)
+    {
+        return inStatus || inStatus.GetError().mCode == ErrorCode::InvalidBodyID ||
+               inStatus.GetError().mCode == ErrorCode::NotAdded;
+    };
+    for (const CharacterContact& contact : mContacts)
+    {
+        const float impulse = std::min(mSettings.mMass * contact.mApproachSpeed, maxImpulse);
+        if (impulse <= 0.0f || !isDynamic(contact.mBody)) continue;
+        const Status pushed = ioBodies.AddImpulse(contact.mBody, -contact.mNormal * impulse, contact.mPoint);
+        if (!skipGone(pushed)) return pushed;
+    }
+    if (mGroundState != GroundState::InAir && isDynamic(mGroundBody))
+    {
+        const Status pressed =
+            ioBodies.AddImpulse(mGroundBody, mLastGravity * (mSettings.mMass * mLastDeltaTime), mGroundPoint);
+        if (!skipGone(pressed)) return pressed;
+    }
     return Status::Ok();
 }
 

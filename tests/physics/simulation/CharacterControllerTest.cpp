@@ -417,6 +417,56 @@ TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
     EXPECT_NEAR(rider.GetLinearVelocity().y(), 3.0f + 1.0f - 9.81f * cDeltaTime, 0.05f);
 }
 
+TEST_F(CharacterControllerTest, ItPushesADynamicBoxItWalksIntoWhenAskedTo)
+{
+    AddFloor();
+    const auto walkIntoCrate = [&](bool inPush)
+    {
+        BodyCreationSettings crate =
+            DynamicSettings(Box(Vec3::Constant(0.3f)), Vec3(2.0f + (inPush ? 0 : 10), 0.3f, 0));
+        crate.mDensity =
+            100.0f; // 21.6 kg: its friction on the floor, about 106 N, is less than the push's 500 N
+        const BodyID id = AddDynamic(crate);
+        CharacterController character =
+            MakeCharacter(Vec3(inPush ? 0 : 10, cCharacterStandHeight + 0.02f, 0));
+        const float start = Position(id).x();
+        for (int frame = 0; frame < 120; ++frame)
+        {
+            Walk(character, Vec3(2, 0, 0), 1);
+            if (inPush)
+            {
+                EXPECT_TRUE(character.PushBodies(Bodies()).IsOk());
+            }
+            EXPECT_TRUE(UpdateWorld(cDeltaTime).IsOk());
+        }
+        return Position(id).x() - start;
+    };
+    EXPECT_GT(walkIntoCrate(true), 1.0f) << "pushed ahead of it";
+    EXPECT_LT(walkIntoCrate(false), 0.05f) << "Update alone moves no body";
+}
+
+TEST_F(CharacterControllerTest, ItPressesOnADynamicBodyItStandsOnAndLeavesStaticOnesBe)
+{
+    PhysicsSettings weightless;
+    weightless.mGravity = Vec3::Zero();
+    ResetWorld(weightless);
+    const BodyID wall = AddStatic(Box(Vec3(0.5f, 2, 5)), Vec3(1.5f, 2, 0)); // Its -x face at x = 1
+    BodyCreationSettings raft = DynamicSettings(Box(Vec3(2, 0.25f, 2)), Vec3(0, -0.25f, 0));
+    const BodyID id = AddDynamic(raft);
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(character, Vec3(3, 0, 0), 30); // On the raft and against the wall
+    ASSERT_EQ(character.GetGroundBody(), id);
+    bool touchesWall = false;
+    for (const CharacterContact& contact : character.GetContacts())
+        touchesWall = touchesWall || contact.mBody == wall;
+    ASSERT_TRUE(touchesWall);
+    ASSERT_TRUE(character.PushBodies(Bodies()).IsOk())
+        << "the static wall is not pushed, and that is no error";
+    // Its 70 kg's weight over one frame, on the raft's 2,000 kg (it has no gravity of its own here)
+    const float raftMass = 1000.0f * 4 * 0.5f * 4;
+    EXPECT_NEAR(Velocity(id).y(), -70.0f * 9.81f * cDeltaTime / raftMass, 1.0e-4f);
+}
+
 TEST_F(CharacterControllerTest, ABodyMovedIntoItPushesItOut)
 {
     AddFloor();
@@ -479,6 +529,18 @@ TEST_F(CharacterControllerTest, BadInputIsRefusedAndChangesNothing)
     settings = Settings();
     settings.mUp = Vec3(0, 2, 0);
     EXPECT_TRUE(refused(settings, start));
+    for (const float mass : {0.0f, -70.0f, nan, 1.0e7f})
+    {
+        settings = Settings();
+        settings.mMass = mass;
+        EXPECT_TRUE(refused(settings, start)) << mass;
+    }
+    for (const float force : {-1.0f, nan, 1.0e10f})
+    {
+        settings = Settings();
+        settings.mMaxPushForce = force;
+        EXPECT_TRUE(refused(settings, start)) << force;
+    }
 
     CharacterController character = MakeCharacter(start);
     Walk(character, Vec3(1, 0, 0), 5);

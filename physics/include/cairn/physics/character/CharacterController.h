@@ -16,6 +16,7 @@
 // that is not positive and finite, a move past the queries' reach, settings out of range, a shape that is
 // neither convex nor a compound of convex shapes) is InvalidArgument and leaves the controller as it was.
 
+#include "cairn/physics/body/BodyInterface.h"
 #include "cairn/physics/body/Layers.h"
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/queries/WorldQuery.h"
@@ -31,6 +32,10 @@ class PhysicsSystem;
 
 struct CharacterSettings
 {
+    /// What PushBodies pushes with: the character's mass (kg, > 0), and the most force it pushes a body
+    /// with (N, >= 0; 0 pushes nothing)
+    float mMass = 70.0f;
+    float mMaxPushForce = 500.0f;
     /// Convex, or a compound of convex shapes. It does not turn; its local y axis points along mUp (a
     /// CapsuleShape stands upright)
     ShapeRef mShape;
@@ -63,6 +68,8 @@ struct CharacterContact
     BodyID mBody;
     Vec3 mPoint = Vec3::Zero();  ///< World space, on the body's surface
     Vec3 mNormal = Vec3::Zero(); ///< The body's surface normal there, towards the character
+    /// How fast the character walked into it, along -mNormal (m/s): 0 for a body it only touched
+    float mApproachSpeed = 0.0f;
 };
 
 class CharacterController
@@ -83,7 +90,7 @@ public:
     Status Update(float inDeltaTime, const Vec3& inGravity);
 
     Vec3 GetPosition() const { return mPosition; }
-    /// Teleports the character (no sweep); it forgets its ground until the next Update.
+    /// Teleports the character (no sweep); it forgets its ground and contacts until the next Update.
     Status SetPosition(const Vec3& inPosition);
     Vec3 GetLinearVelocity() const { return mVelocity; }
     Status SetLinearVelocity(const Vec3& inVelocity);
@@ -95,6 +102,14 @@ public:
     Vec3 GetGroundNormal() const { return mGroundNormal; }
     /// The bodies the last Update touched (the ground among them), each once.
     std::span<const CharacterContact> GetContacts() const { return mContacts; }
+
+    /// Pushes the dynamic bodies the last Update walked into, each with an impulse at its contact, along
+    /// -mNormal: as much as would stop the character's walk into it (mMass times mApproachSpeed), at most
+    /// mMaxPushForce over the Update's time step; and presses on a dynamic ground body with the character's
+    /// weight over that time step. Update only reads the world: this is its one write, through ioBodies, so
+    /// it takes body locks and waits for a running step (BodyInterface's threads, not a step callback's). A
+    /// body gone since the Update is skipped; other errors are ioBodies's, returned at the first.
+    Status PushBodies(BodyInterface& ioBodies) const;
     const CharacterSettings& GetSettings() const { return mSettings; }
 
 private:
@@ -120,6 +135,10 @@ private:
     Vec3 mGroundVelocity = Vec3::Zero();
     std::vector<CharacterContact> mContacts;
     std::vector<CharacterContact> mNextContacts; ///< An Update's, kept only if it succeeds
+    /// The last Update's: where the character stood on its ground, its time step and gravity (PushBodies)
+    Vec3 mGroundPoint = Vec3::Zero();
+    float mLastDeltaTime = 0.0f;
+    Vec3 mLastGravity = Vec3::Zero();
 };
 
 } // namespace cairn::physics
