@@ -19,8 +19,12 @@ constexpr float cLeaveSpeed = 1.0e-2f;
 /// Surfaces met in one Update's slide; more is a corner it can not get out of this frame
 constexpr int cMaxSlidePlanes = 6;
 constexpr int cMaxSlideIterations = 8;
-/// Ground is what the character touches within this many paddings: the moves stop it one padding short
+/// Ground is what the character touches within this many paddings along its normal: the moves stop it one
+/// padding short
 constexpr float cGroundGapPaddings = 2.0f;
+/// The ground is looked for at least this many paddings down: a move that met a slant stopped up to
+/// 1 / cMinApproachCos (4) paddings short of it along the move (CharacterMoves.cpp)
+constexpr float cGroundProbePaddings = 5.0f;
 /// A ground body whose pose has not changed for this long (seconds) is at rest (asleep, or stopped): a
 /// character leaving it keeps no velocity of its
 constexpr float cGroundAtRestAfter = 0.1f;
@@ -248,32 +252,33 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     velocity = slide.Value().mVelocity;
 
     // Walking on, down a slope or a stair: the floor a little below is followed, not fallen to. Landing (or
-    // walking) within the ground's gap, it is put down to its padding
+    // walking) within the ground's gap, it is put down to its padding. The same sweep finds the ground: what
+    // holds the character up, it stands on; what it meets within the gap and can not stand on, it touches
     const float stickDistance =
-        std::max(onFeet && !slide.Value().mStepped ? mSettings.mStickToFloorDistance : 0.0f, groundGap);
+        std::max(onFeet && !slide.Value().mStepped ? mSettings.mStickToFloorDistance : 0.0f,
+                 cGroundProbePaddings * mSettings.mPadding);
+    std::optional<CharacterContact> ground;
+    std::optional<CharacterSupport> support;
     if (!jumps)
     {
-        Result<CharacterSweep> stick = SweepCharacter(context, position, -up * stickDistance);
+        Result<CharacterSweep> stick = SweepCharacter(context, position, -up * stickDistance, false);
         if (!stick) return stick.GetError();
         if (stick.Value().mHit)
         {
             const ShapeCastResult& hit = *stick.Value().mHit;
-            Result<std::optional<CharacterSupport>> support = FindSupport(
-                context, stick.Value().mEnd, {hit.mBody, hit.mContactPoint, hit.mNormal}, stickDistance);
-            if (!support) return support.GetError();
-            if (support.Value()) position = stick.Value().mEnd;
+            const CharacterContact met{hit.mBody, hit.mContactPoint, hit.mNormal};
+            Result<std::optional<CharacterSupport>> found = FindSupport(
+                context, stick.Value().mEnd, met, std::max(mSettings.mStickToFloorDistance, groundGap));
+            if (!found) return found.GetError();
+            if (found.Value())
+            {
+                position = stick.Value().mEnd;
+                support = found.Value();
+                ground = met;
+            }
+            else if (hit.mFraction * stickDistance * std::max(hit.mNormal.dot(up), 0.1f) <= groundGap)
+                ground = met; // Within the gap along the slope's normal
         }
-    }
-
-    Result<std::optional<CharacterContact>> ground = FindGround(context, position, groundGap);
-    if (!ground) return ground.GetError();
-    std::optional<CharacterSupport> support;
-    if (ground.Value())
-    {
-        Result<std::optional<CharacterSupport>> found = FindSupport(
-            context, position, *ground.Value(), std::max(mSettings.mStickToFloorDistance, groundGap));
-        if (!found) return found.GetError();
-        support = found.Value();
     }
 
     // Every query has answered: what follows can not fail, so the controller changes all at once or not at
@@ -281,25 +286,24 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     GroundState state = GroundState::InAir;
     BodyID groundBody;
     Vec3 groundNormal = up;
-    if (support && !jumps)
+    if (support)
     {
         state = GroundState::OnGround;
         groundBody = support->mBody;
         groundNormal = support->mNormal;
     }
-    else if (ground.Value() && !jumps)
+    else if (ground)
     {
         state = GroundState::OnSteepGround;
-        groundBody = ground.Value()->mBody;
-        groundNormal = ground.Value()->mNormal;
+        groundBody = ground->mBody;
+        groundNormal = ground->mNormal;
     }
-    if (ground.Value())
+    if (ground)
     {
-        const CharacterContact& touched = *ground.Value();
         bool recorded = false;
         for (const CharacterContact& contact : mNextContacts)
-            recorded = recorded || contact.mBody == touched.mBody;
-        if (!recorded) mNextContacts.push_back(touched);
+            recorded = recorded || contact.mBody == ground->mBody;
+        if (!recorded) mNextContacts.push_back(*ground);
     }
     // On the ground the velocity is the walk: the ground takes it up and down its slopes, so no speed along
     // up is left to read as a jump (or a fall) in the next Update
@@ -327,7 +331,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     mGroundState = state;
     mGroundBody = groundBody;
     mGroundNormal = groundNormal;
-    mGroundPoint = ground.Value() ? ground.Value()->mPoint : position;
+    mGroundPoint = ground ? ground->mPoint : position;
     mLastDeltaTime = inDeltaTime;
     mLastGravity = inGravity;
     mContacts.swap(mNextContacts);

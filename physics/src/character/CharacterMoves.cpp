@@ -20,10 +20,6 @@ constexpr float cPushOutSlack = 1.0e-3f;
 /// Rounds of pushing out: each takes the deepest body; a character wedged between bodies stops after these.
 constexpr int cPushOutRounds = 4;
 
-/// A surface is ground when its normal points up at least this much (the cosine with up): a wall the
-/// character brushes against is not.
-constexpr float cMinGroundUp = 1.0e-2f;
-
 /// A step up moves at least this far forward (metres), so that a slow walk still gets onto the stair.
 constexpr float cMinStepForward = 0.02f;
 /// A step up that gets no farther forward than this at the raised height is a wall, not a stair.
@@ -62,27 +58,6 @@ Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, con
     sweep.mHit = hit;
     if (inRecordContact) RecordContact(inContext, hit.mBody, hit.mContactPoint, hit.mNormal);
     return sweep;
-}
-
-Result<std::optional<CharacterContact>> FindGround(const CharacterMoveContext& inContext,
-                                                   const Vec3& inPosition, float inGap)
-{
-    thread_local std::vector<ShapeQueryHit> tHits; // As PushOutOfBodies's
-    const Status collided = inContext.mQuery.CollideShape(inContext.mShape, inContext.At(inPosition), tHits,
-                                                          inContext.mFilter, inGap);
-    if (!collided) return collided.GetError();
-    std::optional<CharacterContact> ground;
-    float bestUp = cMinGroundUp;
-    for (const ShapeQueryHit& hit : tHits)
-    {
-        // The manifold's normal points from the character towards the body: the body's surface faces back
-        const Vec3 surface = -hit.mManifold.mNormal;
-        const float up = surface.dot(inContext.mUp);
-        if (up <= bestUp || hit.mManifold.mNumPoints == 0) continue;
-        bestUp = up;
-        ground = CharacterContact{hit.mBody, hit.mManifold.mPoints[0].mPositionOnB, surface};
-    }
-    return ground;
 }
 
 Result<std::optional<CharacterSupport>> FindSupport(const CharacterMoveContext& inContext,

@@ -51,11 +51,6 @@ struct CharacterSupport
     Vec3 mNormal;
 };
 
-/// The ground the character at inPosition touches: of the bodies within inGap of its shape whose surface
-/// faces up at all, the one that faces up most (a wall beside it is no ground); nullopt for none.
-Result<std::optional<CharacterContact>> FindGround(const CharacterMoveContext& inContext,
-                                                   const Vec3& inPosition, float inGap);
-
 /// Whether inGround, under the character at inPosition, holds it up: where its normal is walkable, inGround;
 /// where it is not, walkable ground straight under the character no more than inReach below its bottom (a
 /// round bottom meets a stair's edge at a slant: the tread under it is the ground); else nullopt.
