@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <vector>
 
@@ -508,42 +509,25 @@ TEST_F(CharacterControllerTest, BadInputIsRefusedAndChangesNothing)
     const std::array<std::array<uint32_t, 3>, 1> triangle{{{0, 1, 2}}};
     settings.mShape = TriangleMeshShape::Create(vertices, triangle).Value();
     EXPECT_TRUE(refused(settings, start)) << "a mesh can not be swept";
-    for (const float angle : {0.0f, cPi / 2.0f, nan})
+    // Each out-of-range value of a setting, the others valid
+    const auto refusesEach = [&](float CharacterSettings::*inField, std::initializer_list<float> inValues)
     {
-        settings = Settings();
-        settings.mMaxSlopeAngle = angle;
-        EXPECT_TRUE(refused(settings, start)) << angle;
-    }
-    for (const float length : {-1.0f, nan, 1.0e9f})
-    {
-        settings = Settings();
-        settings.mStepHeight = length;
-        EXPECT_TRUE(refused(settings, start)) << length;
-        settings = Settings();
-        settings.mStickToFloorDistance = length;
-        EXPECT_TRUE(refused(settings, start)) << length;
-    }
-    for (const float padding : {0.0f, 0.5f, nan})
-    {
-        settings = Settings();
-        settings.mPadding = padding;
-        EXPECT_TRUE(refused(settings, start)) << padding;
-    }
+        for (const float value : inValues)
+        {
+            CharacterSettings bad = Settings();
+            bad.*inField = value;
+            EXPECT_TRUE(refused(bad, start)) << value;
+        }
+    };
+    refusesEach(&CharacterSettings::mMaxSlopeAngle, {0.0f, cPi / 2.0f, nan});
+    refusesEach(&CharacterSettings::mStepHeight, {-1.0f, nan, 1.0e9f});
+    refusesEach(&CharacterSettings::mStickToFloorDistance, {-1.0f, nan, 1.0e9f});
+    refusesEach(&CharacterSettings::mPadding, {0.0f, 0.5f, nan});
+    refusesEach(&CharacterSettings::mMass, {0.0f, -70.0f, nan, 1.0e7f});
+    refusesEach(&CharacterSettings::mMaxPushForce, {-1.0f, nan, 1.0e10f});
     settings = Settings();
     settings.mUp = Vec3(0, 2, 0);
     EXPECT_TRUE(refused(settings, start));
-    for (const float mass : {0.0f, -70.0f, nan, 1.0e7f})
-    {
-        settings = Settings();
-        settings.mMass = mass;
-        EXPECT_TRUE(refused(settings, start)) << mass;
-    }
-    for (const float force : {-1.0f, nan, 1.0e10f})
-    {
-        settings = Settings();
-        settings.mMaxPushForce = force;
-        EXPECT_TRUE(refused(settings, start)) << force;
-    }
 
     CharacterController character = MakeCharacter(start);
     Walk(character, Vec3(1, 0, 0), 5);
