@@ -9,8 +9,9 @@
 // Threads: a controller belongs to one thread at a time (it has no lock of its own); many controllers update
 // at once on any threads, also while the physics step runs. It reads the world only through WorldQuery and
 // PoseReader, so an Update never waits for the step and never makes it wait. It sees the bodies as last
-// published (the last collision step, or the last move by hand). It moves no body: the bodies it touched are
-// in GetContacts, for a game that pushes them.
+// published (the last collision step, or the last move by hand). Update moves no body: the bodies it touched
+// are in GetContacts, and PushBodies, called after it, pushes the dynamic ones through BodyInterface (its one
+// write, which takes body locks as BodyInterface does).
 // The world (PhysicsSystem) must outlive the controller.
 // Errors: bad input (a NaN or out-of-world position, a velocity or gravity that is not finite, a time step
 // that is not positive and finite, a move past the queries' reach, settings out of range, a shape that is
@@ -32,10 +33,6 @@ class PhysicsSystem;
 
 struct CharacterSettings
 {
-    /// What PushBodies pushes with: the character's mass (kg, > 0), and the most force it pushes a body
-    /// with (N, >= 0; 0 pushes nothing)
-    float mMass = 70.0f;
-    float mMaxPushForce = 500.0f;
     /// Convex, or a compound of convex shapes. It does not turn; its local y axis points along mUp (a
     /// CapsuleShape stands upright)
     ShapeRef mShape;
@@ -45,11 +42,15 @@ struct CharacterSettings
     float mMaxSlopeAngle = 50.0f * cPi / 180.0f;
     /// Steps (a stair, a kerb) up to this high are walked up; 0 walks up none
     float mStepHeight = 0.3f;
-    /// Walking on, ground up to this far below is followed down (stairs and slopes down); 0 leaves the
-    /// character to fall each time
+    /// Walking on, ground up to this far below is followed down (stairs and slopes down); with 0, only the
+    /// ground within five paddings is (as a character landing within them is put down on it)
     float mStickToFloorDistance = 0.4f;
     /// The gap kept from every surface, so that sliding along one is not a touch; in (0, 0.1] metres
     float mPadding = 0.02f;
+    /// What PushBodies pushes with: the character's mass (kg, > 0), and the most force it pushes a body
+    /// with (N, >= 0; 0 pushes nothing)
+    float mMass = 70.0f;
+    float mMaxPushForce = 500.0f;
     /// What blocks the character: by default every layer but Layers::cTrigger (sensors, which queries find
     /// and nothing collides with). Its own body, if it has one, goes in mIgnoreBody
     QueryFilter mFilter{cAllObjectLayers & ~(ObjectLayerMask(1) << Layers::cTrigger), BodyID()};
