@@ -184,6 +184,28 @@ TEST_F(CharacterControllerTest, AWallStopsItAndItSlidesAlongTheWall)
     EXPECT_LT(DeepestOverlap(character), 1.0e-3f);
 }
 
+TEST_F(CharacterControllerTest, NeitherAFastFallNorAFastRunPassesThroughAThinSlab)
+{
+    AddFloor();
+    const BodyID roof = AddStatic(Box(Vec3(3, 0.025f, 3)), Vec3(0, 5, 0)); // 5 cm thick, its top at 5.025
+    const BodyID wall =
+        AddStatic(Box(Vec3(0.025f, 3, 3)), Vec3(10, 3, 0)); // 5 cm thick, its -x face at 9.975
+    // Dropped from 200 m: over 60 m/s, a metre a frame, when it meets the slab
+    CharacterController faller = MakeCharacter(Vec3(0, 200, 0));
+    for (int frame = 0; frame < 400; ++frame)
+        ASSERT_TRUE(faller.Update(cDeltaTime, cCharacterGravity).IsOk());
+    EXPECT_EQ(faller.GetGroundBody(), roof);
+    EXPECT_GE(faller.GetPosition().y(), 5.025f + cCharacterStandHeight);
+    // Running at 60 m/s into the wall
+    CharacterController runner = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    Walk(runner, Vec3(60, 0, 0), 30);
+    EXPECT_LE(runner.GetPosition().x(), 9.975f - cCharacterRadius);
+    bool touchesWall = false;
+    for (const CharacterContact& contact : runner.GetContacts())
+        touchesWall = touchesWall || contact.mBody == wall;
+    EXPECT_TRUE(touchesWall);
+}
+
 TEST_F(CharacterControllerTest, ASensorInItsWayDoesNotStopIt)
 {
     AddFloor();
@@ -412,6 +434,7 @@ TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
             << "never sunk into the platform, frame " << frame;
     }
     EXPECT_NEAR(rider.GetPosition().x(), 1.0f, 0.03f);
+    EXPECT_LT((rider.GetGroundVelocity() - Vec3(0, 1, 0)).norm(), 0.05f) << "rising at 1 m/s";
     EXPECT_NEAR(rider.GetPosition().y() - Position(id).y(), 0.25f + cCharacterStandHeight + 0.02f, 0.03f);
 
     // Stepping off while the platform rises, it keeps the platform's velocity

@@ -101,6 +101,10 @@ public:
     BodyID GetGroundBody() const { return mGroundBody; }
     /// The ground's surface normal under the character (towards it); mUp InAir
     Vec3 GetGroundNormal() const { return mGroundNormal; }
+    /// The ground body's velocity where the character stands, as its moves since the last Updates measured
+    /// it (zero for static ground, a ground body at rest for 0.1 s, and InAir): what the character keeps when
+    /// it steps off.
+    Vec3 GetGroundVelocity() const { return mGroundVelocity; }
     /// The bodies the last Update touched (the ground among them), each once.
     std::span<const CharacterContact> GetContacts() const { return mContacts; }
 
