@@ -10,6 +10,7 @@
 #include "character/CharacterMoves.h"
 #include "narrowphase/FaceClipping.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <initializer_list>
@@ -64,6 +65,14 @@ protected:
         EXPECT_LE(inCharacter.GetPosition().y(),
                   cCharacterStandHeight + inCharacter.GetSettings().mPadding + 1.0e-3f);
         EXPECT_EQ(inCharacter.GetGroundState(), GroundState::OnGround);
+    }
+
+    /// Whether inBody is among the contacts of inCharacter's last Update.
+    static bool Touches(const CharacterController& inCharacter, const BodyID& inBody)
+    {
+        const std::span<const CharacterContact> contacts = inCharacter.GetContacts();
+        return std::any_of(contacts.begin(), contacts.end(),
+                           [&](const CharacterContact& inContact) { return inContact.mBody == inBody; });
     }
 
     /// How deep the character's shape is in any body where it stands (0 when clear).
@@ -200,10 +209,7 @@ TEST_F(CharacterControllerTest, NeitherAFastFallNorAFastRunPassesThroughAThinSla
     CharacterController runner = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
     Walk(runner, Vec3(60, 0, 0), 30);
     EXPECT_LE(runner.GetPosition().x(), 9.975f - cCharacterRadius);
-    bool touchesWall = false;
-    for (const CharacterContact& contact : runner.GetContacts())
-        touchesWall = touchesWall || contact.mBody == wall;
-    EXPECT_TRUE(touchesWall);
+    EXPECT_TRUE(Touches(runner, wall));
 }
 
 TEST_F(CharacterControllerTest, ASensorInItsWayDoesNotStopIt)
@@ -483,10 +489,7 @@ TEST_F(CharacterControllerTest, ItPressesOnADynamicBodyItStandsOnAndLeavesStatic
     CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
     Walk(character, Vec3(3, 0, 0), 30); // On the raft and against the wall
     ASSERT_EQ(character.GetGroundBody(), id);
-    bool touchesWall = false;
-    for (const CharacterContact& contact : character.GetContacts())
-        touchesWall = touchesWall || contact.mBody == wall;
-    ASSERT_TRUE(touchesWall);
+    ASSERT_TRUE(Touches(character, wall));
     ASSERT_TRUE(character.PushBodies(Bodies()).IsOk())
         << "the static wall is not pushed, and that is no error";
     // Its 70 kg's weight over one frame, on the raft's 2,000 kg (it has no gravity of its own here)
@@ -507,10 +510,7 @@ TEST_F(CharacterControllerTest, ABodyMovedIntoItPushesItOut)
     EXPECT_LT(character.GetPosition().x(), 0.1f - cCharacterRadius + 1.0e-3f);
     EXPECT_NEAR(character.GetPosition().y(), cCharacterStandHeight + 0.02f, 0.01f)
         << "pushed sideways, not up or down";
-    bool touched = false;
-    for (const CharacterContact& contact : character.GetContacts())
-        touched = touched || contact.mBody == crate;
-    EXPECT_TRUE(touched);
+    EXPECT_TRUE(Touches(character, crate));
 }
 
 TEST_F(CharacterControllerTest, BadInputIsRefusedAndChangesNothing)
