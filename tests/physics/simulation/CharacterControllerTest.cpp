@@ -8,6 +8,7 @@
 #include "cairn/physics/shapes/HeightFieldShape.h"
 #include "cairn/physics/shapes/TriangleMeshShape.h"
 #include "character/CharacterMoves.h"
+#include "common/StaticFloor.h"
 #include "narrowphase/FaceClipping.h"
 
 #include <algorithm>
@@ -215,10 +216,7 @@ TEST_F(CharacterControllerTest, NeitherAFastFallNorAFastRunPassesThroughAThinSla
 TEST_F(CharacterControllerTest, ASensorInItsWayDoesNotStopIt)
 {
     AddFloor();
-    BodyCreationSettings trigger;
-    trigger.mShape = Box(Vec3(0.5f, 2, 5));
-    trigger.mPosition = Vec3(3.5f, 2, 0);
-    trigger.mMotionType = MotionType::Static;
+    BodyCreationSettings trigger = BoxBodySettings(Vec3(3.5f, 2, 0), Vec3(0.5f, 2, 5), MotionType::Static);
     trigger.mObjectLayer = Layers::cTrigger;
     trigger.mIsSensor = true;
     ASSERT_TRUE(Bodies().CreateAndAddBody(trigger, Activation::DontActivate));
@@ -417,12 +415,11 @@ TEST_F(CharacterControllerTest, WalkingDownStairsItKeepsToTheFloor)
 TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
 {
     AddFloor();
-    BodyCreationSettings platform;
-    platform.mShape = Box(Vec3(2, 0.25f, 2));
-    platform.mPosition = Vec3(0, 1, 0);
-    platform.mMotionType = MotionType::Kinematic;
-    platform.mObjectLayer = Layers::cMoving;
-    const BodyID id = Bodies().CreateAndAddBody(platform, Activation::Activate).Value();
+    const BodyID id =
+        Bodies()
+            .CreateAndAddBody(BoxBodySettings(Vec3(0, 1, 0), Vec3(2, 0.25f, 2), MotionType::Kinematic),
+                              Activation::Activate)
+            .Value();
     CharacterController rider = MakeCharacter(Vec3(0, 1.25f + cCharacterStandHeight + 0.02f, 0));
     Walk(rider, Vec3::Zero(), 10);
     ASSERT_EQ(rider.GetGroundBody(), id);
