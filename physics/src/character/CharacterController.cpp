@@ -16,6 +16,12 @@ namespace
 /// A character on the ground whose velocity leaves it faster than this (m/s), up and off the ground's plane,
 /// jumps: no floor holds it, gravity pulls it
 constexpr float cLeaveSpeed = 1.0e-2f;
+/// A normal this close to level (the cosine with up) is a vertical face's (a stair's riser, a box's side),
+/// rounded: a wall to a character on its feet, and a step up to try
+constexpr float cLevelCos = 1.0e-3f;
+/// A ground body's velocity is measured over at least this long (seconds): its move over a shorter time,
+/// right after it changed, would read as a huge speed
+constexpr float cMinGroundMoveTime = 1.0e-3f;
 /// Surfaces met in one Update's slide; more is a corner it can not get out of this frame
 constexpr int cMaxSlidePlanes = 6;
 constexpr int cMaxSlideIterations = 8;
@@ -28,6 +34,9 @@ constexpr float cGroundProbePaddings = 5.0f;
 /// A ground body whose pose has not changed for this long (seconds) is at rest (asleep, or stopped): a
 /// character leaving it keeps no velocity of its
 constexpr float cGroundAtRestAfter = 0.1f;
+/// The steepest walkable ground a character may have: walking keeps its pace across up by dividing by the
+/// cosine of the ground's slope, which nearer 90 degrees would be a division by almost nothing
+constexpr float cMaxSlopeAngleLimit = 89.0f * cPi / 180.0f;
 /// Lengths past this (metres) are refused, as a world query refuses them
 constexpr float cMaxCharacterLength = 100.0f;
 /// A mass and a push past these are no character's: refused, so that an impulse stays far from overflowing
@@ -50,8 +59,8 @@ Status CheckSettings(const CharacterSettings& inSettings)
         return InvalidCharacter("the shape must be convex or a compound of convex shapes");
     if (!IsFinite(inSettings.mUp) || std::abs(inSettings.mUp.norm() - 1.0f) > 1.0e-3f)
         return InvalidCharacter("up must be a unit vector");
-    if (!(inSettings.mMaxSlopeAngle > 0.0f && inSettings.mMaxSlopeAngle < 0.5f * cPi))
-        return InvalidCharacter("the maximum slope angle must be in (0, pi/2) radians");
+    if (!(inSettings.mMaxSlopeAngle > 0.0f && inSettings.mMaxSlopeAngle <= cMaxSlopeAngleLimit))
+        return InvalidCharacter("the maximum slope angle must be in (0, 89] degrees");
     if (!IsLength(inSettings.mStepHeight, 0.0f)) return InvalidCharacter("step height must be in [0, 100] m");
     if (!IsLength(inSettings.mStickToFloorDistance, 0.0f))
         return InvalidCharacter("stick-to-floor distance must be in [0, 100] m");
@@ -123,7 +132,7 @@ Result<Slide> SlideAlong(const CharacterMoveContext& inContext, const Vec3& inSt
             }
             onFeet = true;
         }
-        else if (onFeet && normal.dot(inContext.mUp) > 0.0f)
+        else if (onFeet && normal.dot(inContext.mUp) > -cLevelCos)
         {
             const Vec3 across = normal - normal.dot(inContext.mUp) * inContext.mUp;
             if (across.norm() > 1.0e-3f) normal = across.normalized();
@@ -167,7 +176,7 @@ Result<CharacterController> CharacterController::Create(const PhysicsSystem& inW
 CharacterController::CharacterController(const PhysicsSystem& inWorld, const CharacterSettings& inSettings,
                                          const Vec3& inPosition)
     : mWorld(&inWorld), mSettings(inSettings), mCosMaxSlope(std::cos(inSettings.mMaxSlopeAngle)),
-      mPosition(inPosition), mGroundNormal(inSettings.mUp)
+      mPosition(inPosition), mGroundNormal(inSettings.mUp.normalized())
 {
     mSettings.mUp.normalize();
 }
@@ -226,16 +235,20 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     Vec3 groundVelocity = mGroundVelocity;
     const float sinceGroundMoved = mTimeSinceGroundMoved + inDeltaTime;
     bool groundMovedNow = false;
+    // The ground's pose the character is carried to: kept as its anchor when it still stands on that body,
+    // since a pose read after the moves could be a step newer than the one they were made against
+    std::optional<PublishedPose> carriedBy;
     if (mGroundState != GroundState::InAir && mGroundMoves)
     {
         PoseReader poses(mWorld->GetBodyManager());
         PublishedPose pose;
-        if (poses.Read(mGroundBody, pose) && pose.mVersion != mGroundPoseVersion)
+        if (poses.Read(mGroundBody, pose)) carriedBy = pose;
+        if (carriedBy && pose.mVersion != mGroundPoseVersion)
         {
             Result<CharacterSweep> carry =
                 SweepCharacter(context, position, pose.mTransform * mPositionOnGround - position);
             if (!carry) return carry.GetError();
-            groundVelocity = (carry.Value().mEnd - position) / sinceGroundMoved;
+            groundVelocity = (carry.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
             position = carry.Value().mEnd;
             groundMovedNow = true;
         }
@@ -298,18 +311,29 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         groundBody = ground->mBody;
         groundNormal = ground->mNormal;
     }
-    if (ground)
+    // What it touched below, and what holds it up where that is another body (a tread under a stair's edge)
+    const auto record = [&](const CharacterContact& inContact)
     {
-        bool recorded = false;
         for (const CharacterContact& contact : mNextContacts)
-            recorded = recorded || contact.mBody == ground->mBody;
-        if (!recorded) mNextContacts.push_back(*ground);
-    }
+            if (contact.mBody == inContact.mBody) return;
+        mNextContacts.push_back(inContact);
+    };
+    if (ground) record(*ground);
+    if (support) record({support->mBody, support->mPoint, support->mNormal});
     // On the ground the velocity is the walk: the ground takes it up and down its slopes, so no speed along
     // up is left to read as a jump (or a fall) in the next Update
     if (state == GroundState::OnGround) velocity -= velocity.dot(up) * up;
-    if (!groundMovedNow && sinceGroundMoved > cGroundAtRestAfter) groundVelocity = Vec3::Zero();
+    if ((!groundMovedNow && sinceGroundMoved > cGroundAtRestAfter) ||
+        (state != GroundState::InAir && groundBody != mGroundBody))
+        groundVelocity =
+            Vec3::Zero(); // At rest, or another body's: this one's is measured from its next move
     if (wasOnGround && state == GroundState::InAir) velocity += groundVelocity; // Off a moving platform
+
+    // A move the queries allowed can still end past the world's edge (they reach farther), and a step of a
+    // nanosecond can measure an enormous speed: such an Update is refused whole, as bad input is
+    if (!IsValidWorldPosition(position)) return InvalidCharacter("the move would end beyond the world");
+    if (!IsFiniteLength(velocity) || !IsFiniteLength(groundVelocity))
+        return InvalidCharacter("the velocity would overflow");
 
     const BodyID previousGround = mGroundBody;
     mGroundMoves = false;
@@ -317,7 +341,9 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     {
         PoseReader poses(mWorld->GetBodyManager());
         PublishedPose pose;
-        if (poses.Read(groundBody, pose) && pose.mMotionType != MotionType::Static)
+        const bool sameGround = carriedBy && groundBody == previousGround;
+        if (sameGround) pose = *carriedBy;
+        if ((sameGround || poses.Read(groundBody, pose)) && pose.mMotionType != MotionType::Static)
         {
             mGroundMoves = true;
             mPositionOnGround = pose.mTransform.InverseTransformPoint(position);
@@ -331,7 +357,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     mGroundState = state;
     mGroundBody = groundBody;
     mGroundNormal = groundNormal;
-    mGroundPoint = ground ? ground->mPoint : position;
+    mGroundPoint = support ? support->mPoint : ground ? ground->mPoint : position;
     mLastDeltaTime = inDeltaTime;
     mLastGravity = inGravity;
     mContacts.swap(mNextContacts);
@@ -358,13 +384,13 @@ Status CharacterController::PushBodies(BodyInterface& ioBodies) const
         const float impulse = std::min(mSettings.mMass * contact.mApproachSpeed, maxImpulse);
         if (impulse <= 0.0f || !isDynamic(contact.mBody)) continue;
         const Status pushed = ioBodies.AddImpulse(contact.mBody, -contact.mNormal * impulse, contact.mPoint);
-        if (!skipGone(pushed)) return pushed;
+        if (!skipGone(pushed) && isDynamic(contact.mBody)) return pushed; // Else it turned static meanwhile
     }
     if (mGroundState != GroundState::InAir && isDynamic(mGroundBody))
     {
         const Status pressed =
             ioBodies.AddImpulse(mGroundBody, mLastGravity * (mSettings.mMass * mLastDeltaTime), mGroundPoint);
-        if (!skipGone(pressed)) return pressed;
+        if (!skipGone(pressed) && isDynamic(mGroundBody)) return pressed;
     }
     return Status::Ok();
 }

@@ -65,12 +65,16 @@ Result<std::optional<CharacterSupport>> FindSupport(const CharacterMoveContext& 
                                                     float inReach)
 {
     if (inContext.IsWalkable(inGround.mNormal))
-        return std::optional<CharacterSupport>({inGround.mBody, inGround.mNormal});
-    const RayCast underfoot{inPosition, -inContext.mUp * (inContext.mBottom + inReach)};
+        return std::optional<CharacterSupport>({inGround.mBody, inGround.mPoint, inGround.mNormal});
+    // (at least a padding long: a shape whose origin lies below it has no length of its own to reach down)
+    const RayCast underfoot{inPosition,
+                            -inContext.mUp * std::max(inContext.mBottom + inReach, inContext.mPadding)};
     Result<std::optional<RayCastResult>> ray = inContext.mQuery.CastRayClosest(underfoot, inContext.mFilter);
     if (!ray) return ray.GetError();
     if (!ray.Value() || !inContext.IsWalkable(ray.Value()->mNormal)) return std::optional<CharacterSupport>();
-    return std::optional<CharacterSupport>({ray.Value()->mBody, ray.Value()->mNormal});
+    return std::optional<CharacterSupport>({ray.Value()->mBody,
+                                            underfoot.mOrigin + ray.Value()->mFraction * underfoot.mDirection,
+                                            ray.Value()->mNormal});
 }
 
 Vec3 ClipToPlanes(const Vec3& inVector, std::span<const Vec3> inNormals)
@@ -134,10 +138,21 @@ Result<Vec3> PushOutOfBodies(const CharacterMoveContext& inContext, const Vec3& 
             }
         }
         if (deepest == nullptr) break;
-        // The manifold's normal points from the character towards the body
+        // The manifold's normal points from the character towards the body. The push is swept: a body behind
+        // the character stops it, rather than taking it in (it leaves the body it is pushed out of, which
+        // so does not stop it)
         const ContactManifold& manifold = deepest->mManifold;
-        position -= manifold.mNormal * (deepestPenetration + inContext.mPadding);
-        RecordContact(inContext, deepest->mBody, manifold.mPoints[0].mPositionOnB, -manifold.mNormal);
+        int deepestPoint = 0;
+        for (int i = 1; i < manifold.mNumPoints; ++i)
+            if (manifold.mPoints[i].mPenetration > manifold.mPoints[deepestPoint].mPenetration)
+                deepestPoint = i;
+        RecordContact(inContext, deepest->mBody, manifold.mPoints[deepestPoint].mPositionOnB,
+                      -manifold.mNormal);
+        Result<CharacterSweep> push = SweepCharacter(
+            inContext, position, -manifold.mNormal * (deepestPenetration + inContext.mPadding), false);
+        if (!push) return push.GetError();
+        if ((push.Value().mEnd - position).norm() < cMinCharacterMove) break; // Wedged: it stays as it is
+        position = push.Value().mEnd;
     }
     return position;
 }

@@ -48,6 +48,7 @@ Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, con
 struct CharacterSupport
 {
     BodyID mBody;
+    Vec3 mPoint; ///< On its surface, world space
     Vec3 mNormal;
 };
 

@@ -560,12 +560,38 @@ TEST_F(CharacterControllerTest, BadInputIsRefusedAndChangesNothing)
     EXPECT_EQ(character.SetLinearVelocity(Vec3(nan, 0, 0)).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(character.SetPosition(Vec3(0, 0, 1.0e7f)).GetError().mCode, ErrorCode::InvalidArgument);
     // A move past the queries' reach: refused as a whole, not half made
+    const BodyID groundBody = character.GetGroundBody();
+    const size_t contacts = character.GetContacts().size();
     ASSERT_TRUE(character.SetLinearVelocity(Vec3(1.0e12f, 0, 0)).IsOk());
     EXPECT_EQ(character.Update(cDeltaTime, cCharacterGravity).GetError().mCode, ErrorCode::InvalidArgument);
     EXPECT_EQ(character.GetPosition(), position);
+    EXPECT_EQ(character.GetLinearVelocity(), Vec3(1.0e12f, 0, 0))
+        << "as set, not as a half-made Update left it";
     EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+    EXPECT_EQ(character.GetGroundBody(), groundBody);
+    EXPECT_EQ(character.GetContacts().size(), contacts);
     ASSERT_TRUE(character.SetLinearVelocity(velocity).IsOk());
     EXPECT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+
+    // A move the queries allow (17 m, rising: no sweep down follows it) that would end beyond the world's
+    // edge: refused, where it was
+    CharacterController atTheEdge = MakeCharacter(Vec3(cMaxWorldCoordinate - 10.0f, 10, 0));
+    ASSERT_TRUE(atTheEdge.SetLinearVelocity(Vec3(1000, 5, 0)).IsOk());
+    EXPECT_EQ(atTheEdge.Update(cDeltaTime, cCharacterGravity).GetError().mCode, ErrorCode::InvalidArgument);
+    EXPECT_EQ(atTheEdge.GetPosition(), Vec3(cMaxWorldCoordinate - 10.0f, 10, 0));
+}
+
+TEST_F(CharacterControllerTest, ABoxShapedCharacterStepsUpAStairsSheerRiser)
+{
+    AddFloor();
+    AddStairs(1.0f, 3, 0.2f, 0.5f);
+    CharacterSettings boxy = Settings();
+    boxy.mShape = Box(Vec3(0.3f, 0.9f, 0.3f)); // Its side meets a riser face to face: a level normal
+    CharacterController character = MakeCharacter(Vec3(0, 0.92f, 0), boxy);
+    Walk(character, Vec3(2, 0, 0), 120);
+    EXPECT_NEAR(character.GetPosition().y(), 0.9f + 0.6f, 0.05f) << "on the top step";
+    EXPECT_GT(character.GetPosition().x(), 2.0f);
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
 }
 
 TEST(CharacterClipToPlanesTest, ItKeepsWhatPointsIntoNoPlaneAlongOnePlaneACreaseOrNothing)

@@ -37,8 +37,8 @@ struct CharacterSettings
     /// CapsuleShape stands upright)
     ShapeRef mShape;
     Vec3 mUp = Vec3::UnitY(); ///< Unit vector; gravity is the caller's and may point anywhere
-    /// Ground steeper than this (radians, in (0, pi/2)) is not walkable: the character slides down it and can
-    /// not walk up it
+    /// Ground steeper than this (radians, in (0, 89 degrees]) is not walkable: the character slides down it
+    /// and can not walk up it
     float mMaxSlopeAngle = 50.0f * cPi / 180.0f;
     /// Steps (a stair, a kerb) up to this high are walked up; 0 walks up none
     float mStepHeight = 0.3f;
