@@ -119,6 +119,7 @@ void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, float inDe
         if (!ioObject.mPlaced || behind.squaredNorm() > cMaxWalkBehind * cMaxWalkBehind)
         {
             errors += int(!character.SetPosition(spotOnGround + Vec3(0.0f, cWalkerPadding, 0.0f)));
+            errors += int(!character.SetLinearVelocity(Vec3::Zero())); // Not still falling where it is put
             // Relaxed: a count read after the frame's jobs
             if (ioObject.mPlaced) mPutBack.fetch_add(1, std::memory_order_relaxed);
         }
