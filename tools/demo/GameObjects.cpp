@@ -19,8 +19,8 @@ using Clock = std::chrono::steady_clock;
 /// The character: a capsule as tall (1.8 m) and as wide as the object's box
 constexpr float cWalkerRadius = 0.3f, cWalkerHalfHeight = 0.6f;
 /// The object's box's centre above the ground: its character's capsule's, which keeps its padding clear of
-/// the ground, is 2 cm higher
-constexpr float cBodyCentreHeight = 0.9f, cWalkerPadding = 0.02f;
+/// the ground, is that padding higher
+constexpr float cBodyCentreHeight = 0.9f;
 /// How much faster than the player an object may walk after its spot (m/s): its spot circles at 1.5 m/s
 /// round a place that follows the player, and an object held at a wall catches up
 constexpr float cWalkSpeedOverPlayer = 10.0f;
@@ -118,7 +118,8 @@ void GameObjects::QueryObject(Object& ioObject, const Vec3& inPlayer, float inDe
         const Vec3 behind = spotOnGround - character.GetPosition();
         if (!ioObject.mPlaced || behind.squaredNorm() > cMaxWalkBehind * cMaxWalkBehind)
         {
-            errors += int(!character.SetPosition(spotOnGround + Vec3(0.0f, cWalkerPadding, 0.0f)));
+            errors += int(
+                !character.SetPosition(spotOnGround + Vec3(0.0f, character.GetSettings().mPadding, 0.0f)));
             errors += int(!character.SetLinearVelocity(Vec3::Zero())); // Not still falling where it is put
             // Relaxed: a count read after the frame's jobs
             if (ioObject.mPlaced) mPutBack.fetch_add(1, std::memory_order_relaxed);

@@ -47,9 +47,9 @@ Error InvalidCharacter(const std::string& inWhat)
     return MakeError(ErrorCode::InvalidArgument, "character: " + inWhat);
 }
 
-bool IsLength(float inValue, float inMin)
+bool IsLength(float inValue)
 {
-    return std::isfinite(inValue) && inValue >= inMin && inValue <= cMaxCharacterLength;
+    return std::isfinite(inValue) && inValue >= 0.0f && inValue <= cMaxCharacterLength;
 }
 
 Status CheckSettings(const CharacterSettings& inSettings)
@@ -61,8 +61,8 @@ Status CheckSettings(const CharacterSettings& inSettings)
         return InvalidCharacter("up must be a unit vector");
     if (!(inSettings.mMaxSlopeAngle > 0.0f && inSettings.mMaxSlopeAngle <= cMaxSlopeAngleLimit))
         return InvalidCharacter("the maximum slope angle must be in (0, 89] degrees");
-    if (!IsLength(inSettings.mStepHeight, 0.0f)) return InvalidCharacter("step height must be in [0, 100] m");
-    if (!IsLength(inSettings.mStickToFloorDistance, 0.0f))
+    if (!IsLength(inSettings.mStepHeight)) return InvalidCharacter("step height must be in [0, 100] m");
+    if (!IsLength(inSettings.mStickToFloorDistance))
         return InvalidCharacter("stick-to-floor distance must be in [0, 100] m");
     if (!(inSettings.mPadding > 0.0f && inSettings.mPadding <= 0.1f))
         return InvalidCharacter("padding must be in (0, 0.1] m");
@@ -79,7 +79,7 @@ Status CheckSettings(const CharacterSettings& inSettings)
 /// along up as follows the ground's slope (as Unreal's characters keep their horizontal speed on ramps).
 Vec3 AlongGround(const Vec3& inVelocity, const Vec3& inNormal, const Vec3& inUp)
 {
-    const Vec3 across = inVelocity - inVelocity.dot(inUp) * inUp;
+    const Vec3 across = AcrossAxis(inVelocity, inUp);
     return across - inUp * (across.dot(inNormal) / inNormal.dot(inUp));
 }
 
@@ -134,9 +134,9 @@ Result<Slide> SlideAlong(const CharacterMoveContext& inContext, const Vec3& inSt
         }
         else if (onFeet && normal.dot(inContext.mUp) > -cLevelCos)
         {
-            const Vec3 across = normal - normal.dot(inContext.mUp) * inContext.mUp;
+            const Vec3 across = AcrossAxis(normal, inContext.mUp);
             if (across.norm() > 1.0e-3f) normal = across.normalized();
-            const Vec3 horizontal = rest - rest.dot(inContext.mUp) * inContext.mUp;
+            const Vec3 horizontal = AcrossAxis(rest, inContext.mUp);
             if (!slide.mStepped && inStepHeight > 0.0f && horizontal.dot(normal) < 0.0f)
             {
                 Result<std::optional<Vec3>> step = StepUp(inContext, slide.mEnd, horizontal, inStepHeight);
@@ -176,7 +176,9 @@ Result<CharacterController> CharacterController::Create(const PhysicsSystem& inW
 CharacterController::CharacterController(const PhysicsSystem& inWorld, const CharacterSettings& inSettings,
                                          const Vec3& inPosition)
     : mWorld(&inWorld), mSettings(inSettings), mCosMaxSlope(std::cos(inSettings.mMaxSlopeAngle)),
-      mPosition(inPosition), mGroundNormal(inSettings.mUp.normalized())
+      mShapeRotation(Quat::FromTwoVectors(Vec3::UnitY(), inSettings.mUp.normalized())),
+      mShapeBottom(-inSettings.mShape->GetLocalBounds().mMin.y()), mPosition(inPosition),
+      mGroundNormal(inSettings.mUp.normalized())
 {
     mSettings.mUp.normalize();
 }
@@ -210,15 +212,9 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
 
     const Vec3& up = mSettings.mUp;
     mNextContacts.clear();
-    const CharacterMoveContext context{mWorld->GetWorldQuery(),
-                                       *mSettings.mShape,
-                                       Quat::FromTwoVectors(Vec3::UnitY(), up),
-                                       mSettings.mFilter,
-                                       up,
-                                       mCosMaxSlope,
-                                       mSettings.mPadding,
-                                       -mSettings.mShape->GetLocalBounds().mMin.y(),
-                                       mNextContacts};
+    const CharacterMoveContext context{
+        mWorld->GetWorldQuery(), *mSettings.mShape, mShapeRotation, mSettings.mFilter, up, mCosMaxSlope,
+        mSettings.mPadding,      mShapeBottom,      mNextContacts};
 
     // On its feet unless it jumps: then the floor holds it (no gravity, nothing of the velocity into it)
     Vec3 velocity = mVelocity;
@@ -312,21 +308,15 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         groundNormal = ground->mNormal;
     }
     // What it touched below, and what holds it up where that is another body (a tread under a stair's edge)
-    const auto record = [&](const CharacterContact& inContact)
-    {
-        for (const CharacterContact& contact : mNextContacts)
-            if (contact.mBody == inContact.mBody) return;
-        mNextContacts.push_back(inContact);
-    };
-    if (ground) record(*ground);
-    if (support) record({support->mBody, support->mPoint, support->mNormal});
+    if (ground) RecordContact(context, ground->mBody, ground->mPoint, ground->mNormal);
+    if (support) RecordContact(context, support->mBody, support->mPoint, support->mNormal);
     // On the ground the velocity is the walk: the ground takes it up and down its slopes, so no speed along
     // up is left to read as a jump (or a fall) in the next Update
-    if (state == GroundState::OnGround) velocity -= velocity.dot(up) * up;
+    if (state == GroundState::OnGround) velocity = AcrossAxis(velocity, up);
+    // At rest, or another body's: this one's is measured from its next move
     if ((!groundMovedNow && sinceGroundMoved > cGroundAtRestAfter) ||
         (state != GroundState::InAir && groundBody != mGroundBody))
-        groundVelocity =
-            Vec3::Zero(); // At rest, or another body's: this one's is measured from its next move
+        groundVelocity = Vec3::Zero();
     if (wasOnGround && state == GroundState::InAir) velocity += groundVelocity; // Off a moving platform
 
     // A move the queries allowed can still end past the world's edge (they reach farther), and a step of a

@@ -26,6 +26,7 @@ constexpr float cMinStepForward = 0.02f;
 constexpr float cMinStepAdvance = 1.0e-3f;
 /// Where the stair's edge is too steep to stand on, the ground this far farther on must be walkable.
 constexpr float cStepForwardTest = 0.15f;
+} // namespace
 
 void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,
                    const Vec3& inNormal)
@@ -34,7 +35,6 @@ void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, 
         if (contact.mBody == inBody) return;
     inContext.mContacts.push_back({inBody, inPoint, inNormal});
 }
-} // namespace
 
 Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, const Vec3& inStart,
                                       const Vec3& inDisplacement, bool inRecordContact)

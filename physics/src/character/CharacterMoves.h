@@ -30,6 +30,16 @@ struct CharacterMoveContext
     Transform At(const Vec3& inPosition) const { return {inPosition, mRotation}; }
 };
 
+/// inVector without its part along inAxis (a unit vector): what of it lies across the axis.
+inline Vec3 AcrossAxis(const Vec3& inVector, const Vec3& inAxis)
+{
+    return inVector - inVector.dot(inAxis) * inAxis;
+}
+
+/// Adds a contact with inBody to the context's, unless it holds one with that body already.
+void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,
+                   const Vec3& inNormal);
+
 /// Moves shorter than this (metres) are not cast: nothing can stop them that a query would see.
 inline constexpr float cMinCharacterMove = 1.0e-6f;
 

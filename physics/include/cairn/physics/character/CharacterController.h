@@ -124,6 +124,10 @@ private:
     const PhysicsSystem* mWorld;
     CharacterSettings mSettings;
     float mCosMaxSlope;
+    /// The shape's rotation (its local y axis to mUp) and the distance from its origin down to its lowest
+    /// point: the settings' own, worked out once
+    Quat mShapeRotation;
+    float mShapeBottom;
     Vec3 mPosition;
     Vec3 mVelocity = Vec3::Zero();
     GroundState mGroundState = GroundState::InAir;
