@@ -1,6 +1,7 @@
 #include "cairn/navmesh/NavMeshWorld.h"
 
 #include "DetourPaths.h"
+#include "DetourSurface.h"
 #include "cairn/navmesh/TileData.h"
 
 #include <DetourNavMesh.h>
@@ -53,6 +54,56 @@ float NextRandomFloat()
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     z ^= z >> 31;
     return float(z >> 40) * (1.0f / 16777216.0f); // 24 bits: in [0, 1)
+}
+/// The checks of a query from one point before the navmesh is locked: the point, the search extent and the
+/// filter, made Detour's. inRole names the point in the errors ("the centre").
+Result<dtQueryFilter> CheckPointQuery(const Vec3& inPoint, const Vec3& inSearchExtent,
+                                      const PathFilter& inFilter, float inTileSize, const std::string& inWhat,
+                                      const std::string& inRole)
+{
+    if (!IsValidWorldPosition(inPoint))
+        return MakeError(ErrorCode::InvalidArgument, inWhat + ": " + inRole + " must be finite");
+    if (Status extent = CheckSearchExtent(inSearchExtent, inTileSize, inWhat.c_str()); !extent)
+        return extent.GetError();
+    return MakeDetourFilter(inFilter, inWhat.c_str());
+}
+
+/// A search radius in (0, NavMeshWorld::cMaxSearchExtentTiles tiles]: the query's node pool bounds the search
+/// either way, the limit keeps the radius meaningful.
+Status CheckRadius(float inRadius, float inTileSize, const std::string& inWhat)
+{
+    const float maxRadius = NavMeshWorld::cMaxSearchExtentTiles * inTileSize;
+    if (!(inRadius > 0.0f && inRadius <= maxRadius))
+        return MakeError(ErrorCode::InvalidArgument,
+                         inWhat + ": the radius must be in (0, " + std::to_string(maxRadius) + "] m");
+    return {};
+}
+
+/// A query's point snapped onto the navmesh, the navmesh locked: its polygon, not in an excluded area, and
+/// this thread's query object.
+struct SnappedPoint
+{
+    dtNavMeshQuery* mQuery = nullptr;
+    dtPolyRef mPolygon = 0;
+    Vec3 mPoint = Vec3::Zero();
+};
+
+Result<SnappedPoint> SnapQueryPoint(uint64_t inSerial, const dtNavMesh& inNavMesh, const Vec3& inPoint,
+                                    const Vec3& inSearchExtent, const dtQueryFilter& inDetourFilter,
+                                    const PathFilter& inFilter, const std::string& inWhat,
+                                    const std::string& inRole)
+{
+    SnappedPoint snapped;
+    snapped.mQuery = QueryFor(inSerial, &inNavMesh);
+    if (snapped.mQuery == nullptr)
+        return MakeError(ErrorCode::OutOfCapacity, inWhat + ": Detour could not make a query object");
+    snapped.mQuery->findNearestPoly(inPoint.data(), inSearchExtent.data(), &inDetourFilter, &snapped.mPolygon,
+                                    snapped.mPoint.data());
+    if (snapped.mPolygon == 0)
+        return MakeError(ErrorCode::InvalidArgument, inWhat + ": " + inRole + " is not on the navmesh");
+    if (IsExcluded(inNavMesh, snapped.mPolygon, inFilter))
+        return MakeError(ErrorCode::InvalidArgument, inWhat + ": " + inRole + " is in an excluded area");
+    return snapped;
 }
 } // namespace
 
@@ -291,29 +342,19 @@ Result<Vec3> NavMeshWorld::FindNearestPoint(const Vec3& inPoint, const PathFilte
 Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
                                                  const PathFilter& inFilter, const Vec3& inSearchExtent) const
 {
-    if (!IsValidWorldPosition(inCenter))
-        return MakeError(ErrorCode::InvalidArgument, "random point: the centre must be finite");
-    // The search is bounded by the query's node pool either way; the limit keeps the radius meaningful
-    const float maxRadius = cMaxSearchExtentTiles * mGrid.GetTileSize();
-    if (!(inRadius > 0.0f && inRadius <= maxRadius))
-        return MakeError(ErrorCode::InvalidArgument,
-                         "random point: the radius must be in (0, " + std::to_string(maxRadius) + "] m");
-    if (Status extent = CheckSearchExtent(inSearchExtent, mGrid.GetTileSize(), "random point"); !extent)
-        return extent.GetError();
-    Result<dtQueryFilter> filter = MakeDetourFilter(inFilter, "random point");
+    Result<dtQueryFilter> filter = CheckPointQuery(inCenter, inSearchExtent, inFilter, mGrid.GetTileSize(),
+                                                   "random point", "the centre");
     if (!filter) return filter.GetError();
+    if (Status radius = CheckRadius(inRadius, mGrid.GetTileSize(), "random point"); !radius)
+        return radius.GetError();
 
     std::shared_lock lock(mNavMeshMutex);
-    dtNavMeshQuery* query = QueryFor(mSerial, mNavMesh);
-    if (query == nullptr)
-        return MakeError(ErrorCode::OutOfCapacity, "random point: Detour could not make a query object");
-    dtPolyRef start = 0;
-    float startPoint[3];
-    query->findNearestPoly(inCenter.data(), inSearchExtent.data(), &filter.Value(), &start, startPoint);
-    if (start == 0)
-        return MakeError(ErrorCode::InvalidArgument, "random point: the centre is not on the navmesh");
-    if (IsExcluded(*mNavMesh, start, inFilter))
-        return MakeError(ErrorCode::InvalidArgument, "random point: the centre is in an excluded area");
+    Result<SnappedPoint> centre = SnapQueryPoint(mSerial, *mNavMesh, inCenter, inSearchExtent, filter.Value(),
+                                                 inFilter, "random point", "the centre");
+    if (!centre) return centre.GetError();
+    dtNavMeshQuery* query = centre.Value().mQuery;
+    const dtPolyRef start = centre.Value().mPolygon;
+    const float* startPoint = centre.Value().mPoint.data();
     // Detour spreads through every polygon the circle touches, excluded areas included (its filter knows only
     // flags, and its spread no costs): a point in an excluded area, or one that can only be reached through
     // one, is drawn again
@@ -344,6 +385,47 @@ Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inR
     }
     return MakeError(ErrorCode::InvalidArgument,
                      "random point: every point drawn was in an excluded area or reachable only through one");
+}
+
+Result<NavRaycastHit> NavMeshWorld::Raycast(const Vec3& inStart, const Vec3& inEnd,
+                                            const PathFilter& inFilter, const Vec3& inSearchExtent) const
+{
+    Result<dtQueryFilter> filter =
+        CheckPointQuery(inStart, inSearchExtent, inFilter, mGrid.GetTileSize(), "raycast", "the start");
+    if (!filter) return filter.GetError();
+    if (!IsValidWorldPosition(inEnd))
+        return MakeError(ErrorCode::InvalidArgument, "raycast: the end must be finite");
+
+    std::shared_lock lock(mNavMeshMutex);
+    Result<SnappedPoint> start = SnapQueryPoint(mSerial, *mNavMesh, inStart, inSearchExtent, filter.Value(),
+                                                inFilter, "raycast", "the start");
+    if (!start) return start.GetError();
+    // The walk's length bounds how long the navmesh stays locked, as the search extent does
+    const float maxLength = cMaxSearchExtentTiles * mGrid.GetTileSize();
+    const Vec3& from = start.Value().mPoint;
+    if (Vec3(inEnd.x() - from.x(), 0.0f, inEnd.z() - from.z()).norm() > maxLength)
+        return MakeError(ErrorCode::InvalidArgument, "raycast: the line may be at most " +
+                                                         std::to_string(maxLength) +
+                                                         " m long across x and z");
+    return CastAcrossSurface(*start.Value().mQuery, *mNavMesh, start.Value().mPolygon, from, inEnd,
+                             filter.Value(), inFilter);
+}
+
+Result<NavWall> NavMeshWorld::FindNearestWall(const Vec3& inPoint, float inMaxRadius,
+                                              const PathFilter& inFilter, const Vec3& inSearchExtent) const
+{
+    Result<dtQueryFilter> filter =
+        CheckPointQuery(inPoint, inSearchExtent, inFilter, mGrid.GetTileSize(), "nearest wall", "the point");
+    if (!filter) return filter.GetError();
+    if (Status radius = CheckRadius(inMaxRadius, mGrid.GetTileSize(), "nearest wall"); !radius)
+        return radius.GetError();
+
+    std::shared_lock lock(mNavMeshMutex);
+    Result<SnappedPoint> point = SnapQueryPoint(mSerial, *mNavMesh, inPoint, inSearchExtent, filter.Value(),
+                                                inFilter, "nearest wall", "the point");
+    if (!point) return point.GetError();
+    return FindWallAround(*point.Value().mQuery, *mNavMesh, point.Value().mPolygon, point.Value().mPoint,
+                          inMaxRadius, filter.Value(), inFilter);
 }
 
 int NavMeshWorld::GetNumTiles() const

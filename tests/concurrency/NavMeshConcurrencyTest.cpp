@@ -1,7 +1,8 @@
 // The navmesh pipeline under concurrency (short enough for ThreadSanitizer): tile jobs run on two background
 // threads while the physics world steps, one thread adds and removes static and dynamic boxes, another moves
-// bodies by hand, and a third asks for paths. Afterwards, with every thread stopped and the dirty tiles
-// rebuilt, the navmesh must equal one built from scratch over the same world, tile for tile.
+// bodies by hand, and a third asks for paths, straight walks and walls. Afterwards, with every thread stopped
+// and the dirty tiles rebuilt, the navmesh must equal one built from scratch over the same world, tile for
+// tile.
 
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/navmesh/NavMeshWorld.h"
@@ -13,6 +14,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <gtest/gtest.h>
 #include <mutex>
 #include <random>
@@ -142,8 +144,9 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
                 std::this_thread::sleep_for(std::chrono::milliseconds(1));
             }
         });
-    // Asks for paths across the level while tiles are swapped in
-    std::atomic<int> pathsFound{0};
+    // Asks for paths, straight walks and walls across the level while tiles are swapped in. Each answer is
+    // whole: a walk stops between its ends with a level unit normal at a hit, a wall lies within its radius
+    std::atomic<int> pathsFound{0}, walksAnswered{0}, wallsFound{0}, wrongAnswers{0};
     std::thread walker(
         [&]
         {
@@ -151,10 +154,28 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
             std::uniform_real_distribution<float> position(-cHalfWorld + 0.5f, cHalfWorld - 0.5f);
             while (!stop.load(std::memory_order_relaxed))
             {
-                Result<PathResult> path = live.mWorld->FindPath(Vec3(position(random), 0, position(random)),
-                                                                Vec3(position(random), 0, position(random)));
+                const Vec3 from(position(random), 0, position(random)),
+                    to(position(random), 0, position(random));
+                Result<PathResult> path = live.mWorld->FindPath(from, to);
                 if (path && !path.Value().mStraightPath.empty())
                     pathsFound.fetch_add(1, std::memory_order_relaxed);
+                if (Result<NavRaycastHit> walk = live.mWorld->Raycast(from, to))
+                {
+                    const NavRaycastHit& hit = walk.Value();
+                    const bool whole = hit.mFraction >= 0.0f && hit.mFraction <= 1.0f &&
+                                       IsFinite(hit.mPosition) &&
+                                       (hit.mHit ? std::abs(hit.mWallNormal.norm() - 1.0f) < 1.0e-3f &&
+                                                       hit.mWallNormal.y() == 0.0f
+                                                 : hit.mFraction == 1.0f);
+                    (whole ? walksAnswered : wrongAnswers).fetch_add(1, std::memory_order_relaxed);
+                }
+                if (Result<NavWall> wall = live.mWorld->FindNearestWall(from, 3.0f);
+                    wall && wall.Value().mFound)
+                {
+                    const bool whole = wall.Value().mDistance >= 0.0f && wall.Value().mDistance <= 3.0f &&
+                                       IsFinite(wall.Value().mPosition);
+                    (whole ? wallsFound : wrongAnswers).fetch_add(1, std::memory_order_relaxed);
+                }
             }
         });
 
@@ -180,6 +201,9 @@ TEST(NavMeshConcurrencyTest, TilesBuiltWhileTheWorldChangesEqualTilesBuiltFromSc
     EXPECT_GT(stats.mRebuilds, 0u); // The world did change under the jobs
     EXPECT_EQ(stats.mJobsFailed, 0u) << stats.mLastError;
     EXPECT_GT(pathsFound.load(), 0);
+    EXPECT_GT(walksAnswered.load(), 0);
+    EXPECT_GT(wallsFound.load(), 0);
+    EXPECT_EQ(wrongAnswers.load(), 0);
     const auto liveTiles = live.mWorld->SnapshotTiles();
     EXPECT_EQ(liveTiles.size(), 4u);
     live.mScheduler.reset();

@@ -1,7 +1,7 @@
 // Path queries: area types from the bodies' navmesh area, priced and excluded by the path filter; errors for
 // points off the navmesh and for bad numbers.
 
-#include "NavMeshSceneFixture.h"
+#include "RiverSceneFixture.h"
 
 namespace cairn::navmesh::test
 {
@@ -9,23 +9,9 @@ using namespace cairn::physics;
 namespace
 {
 
-constexpr uint8_t cWater = 5;
-
-class PathQueryTest : public NavMeshSceneFixture
+class PathQueryTest : public RiverSceneFixture
 {
 protected:
-    /// Ground from z = -10 to 10, crossed at z in [-1, 1] by a band of water, except for a dry bridge at
-    /// x in [8, 10]. Start and end are on either side of the water at x = -8.
-    void BuildRiver()
-    {
-        AddStaticBox(Vec3(0, -0.5f, -5.5f), Vec3(10, 0.5f, 4.5f));  // South bank
-        AddStaticBox(Vec3(0, -0.5f, 5.5f), Vec3(10, 0.5f, 4.5f));   // North bank
-        AddStaticBox(Vec3(-1, -0.5f, 0), Vec3(9, 0.5f, 1), cWater); // Water, x in [-10, 8]
-        AddStaticBox(Vec3(9, -0.5f, 0), Vec3(1, 0.5f, 1));          // Bridge, x in [8, 10]
-        MakeNavMesh();
-        ASSERT_TRUE(RunUntilIdle());
-    }
-
     static float Length(const PathResult& inPath)
     {
         float length = 0.0f;
@@ -33,9 +19,6 @@ protected:
             length += (inPath.mStraightPath[i + 1] - inPath.mStraightPath[i]).norm();
         return length;
     }
-
-    const Vec3 mStart = Vec3(-8, 0, -6);
-    const Vec3 mEnd = Vec3(-8, 0, 6);
 };
 
 TEST_F(PathQueryTest, AreaCostsAndExclusionsChooseTheWay)

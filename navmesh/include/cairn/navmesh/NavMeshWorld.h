@@ -50,6 +50,31 @@ struct PathResult
     std::vector<uint64_t> mPolygons;
 };
 
+/// Where a NavMeshWorld::Raycast stopped.
+struct NavRaycastHit
+{
+    /// True when a wall stopped it short of the end: the navmesh's edge (a wall, a drop, the edge of the
+    /// loaded tiles) or the border of an area the filter excludes
+    bool mHit = false;
+    /// How far it went, as a fraction of the way from the (snapped) start to the end across x and z: 1
+    /// without a hit
+    float mFraction = 1.0f;
+    /// Where it stopped, on the navmesh (at its detail height): the wall's point, or the end's point on the
+    /// navmesh under the end
+    Vec3 mPosition = Vec3::Zero();
+    /// The wall's normal, level and towards the start's side (zero without a hit)
+    Vec3 mWallNormal = Vec3::Zero();
+};
+
+/// The wall nearest a point on the navmesh, found by NavMeshWorld::FindNearestWall.
+struct NavWall
+{
+    bool mFound = false;           ///< False: no wall within the radius (the rest is then zero)
+    float mDistance = 0.0f;        ///< Across x and z, from the (snapped) point
+    Vec3 mPosition = Vec3::Zero(); ///< The wall's nearest point, on the navmesh's polygon edge
+    Vec3 mNormal = Vec3::Zero();   ///< Level, from the wall towards the point
+};
+
 class NavMeshWorld
 {
 public:
@@ -102,6 +127,28 @@ public:
     Result<Vec3> FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
                                        const PathFilter& inFilter = {},
                                        const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+
+    /// Walks a straight line across the navmesh's surface from inStart (snapped within inSearchExtent)
+    /// towards inEnd, as an agent walking straight there would, and says where it stops: whether an agent can
+    /// walk straight from one to the other (line of sight across the surface, on Detour's raycast). The line
+    /// is cast across x and z and follows the surface over slopes and up steps; inEnd's height picks nothing.
+    /// It stops at the navmesh's edge and at the border of an area inFilter excludes, never takes an off-mesh
+    /// link, and goes on where Detour's own raycast stops for no wall (a line along a tile's border or
+    /// through its corner). It may be at most cMaxSearchExtentTiles tiles long across x and z. Error when
+    /// inStart is off the navmesh or in an excluded area, the line is too long or crosses more polygons than
+    /// a path holds, or a number is bad. Any thread.
+    Result<NavRaycastHit> Raycast(const Vec3& inStart, const Vec3& inEnd, const PathFilter& inFilter = {},
+                                  const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+    /// The wall nearest inPoint (snapped within inSearchExtent) across x and z, within inMaxRadius: the
+    /// navmesh's edge or the border of an area inFilter excludes. Only the navmesh an agent there could walk
+    /// to inside the circle counts (Detour's findPolysAroundCircle from the point's polygon), never what lies
+    /// past an excluded area or an off-mesh link: a roof above the point, reached by a jump, has no wall for
+    /// it. Where no area is excluded it answers as Detour's findDistanceToWall. Not found (mFound false) when
+    /// no wall is within inMaxRadius. Error when inPoint is off the navmesh or in an excluded area,
+    /// inMaxRadius is not in (0, cMaxSearchExtentTiles tiles], the circle holds more polygons than a query
+    /// can visit, or a number is bad. Any thread.
+    Result<NavWall> FindNearestWall(const Vec3& inPoint, float inMaxRadius, const PathFilter& inFilter = {},
+                                    const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
 
     /// Published tiles.
     int GetNumTiles() const;
