@@ -7,8 +7,11 @@
 //                         frame): ms per step and the ratio, the tile jobs' longest lock wait.
 //  nav_invoker_latency    at 60 Hz (real-time frames), an invoker appears at a new place every 20 frames:
 //                         frames from request to publication of its tile, median and p99.
+//  nav_queries_world_tile0 the published navmesh over world tile 0: FindPath, Raycast and FindNearestWall
+//                         (radius 2 m, 8 m, the largest) between seeded points, µs per query.
 // Own timers (Google Benchmark's loop does not fit multi-frame jobs); medians over --repetitions.
 
+#include "bench/NavQueryBenchmark.h"
 #include "cairn/jobs/BackgroundQueue.h"
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/navmesh/GeometryCollector.h"
@@ -251,9 +254,11 @@ void RunInvokerLatency(const SharedBenchData& inData)
 int main(int argc, char** argv)
 {
     tools::BenchOptions options;
-    if (auto stop = tools::ParseBenchOptions(
-            argc, argv, "cairn-bench-navmesh: navmesh tile and tile-job figures",
-            {"nav_tiles_world_tile0", "nav_step_pile2k_jobs", "nav_invoker_latency"}, options))
+    if (auto stop =
+            tools::ParseBenchOptions(argc, argv, "cairn-bench-navmesh: navmesh tile and tile-job figures",
+                                     {"nav_tiles_world_tile0", "nav_step_pile2k_jobs", "nav_invoker_latency",
+                                      "nav_queries_world_tile0"},
+                                     options))
         return *stop;
     const int repetitions = options.mRepetitions;
     const std::string& only = options.mOnly;
@@ -273,5 +278,6 @@ int main(int argc, char** argv)
     if (only.empty() || only == "nav_tiles_world_tile0") RunTiles(data.Value(), repetitions);
     if (only.empty() || only == "nav_step_pile2k_jobs") RunPileWithJobs(data.Value(), repetitions);
     if (only.empty() || only == "nav_invoker_latency") RunInvokerLatency(data.Value());
+    if (only.empty() || only == "nav_queries_world_tile0") tools::RunNavQueries(data.Value(), repetitions);
     return 0;
 }
