@@ -1,5 +1,6 @@
 // CharacterController: standing and landing, walls and creases, slopes it may and may not walk, stairs up and
-// down, moving platforms, bodies that move into it, its contacts, and bad input.
+// down (also with up along z), moving platforms, bodies that move into it, its contacts and pushes, and bad
+// input.
 
 #include "cairn/physics/character/CharacterController.h"
 
@@ -375,6 +376,50 @@ TEST_F(CharacterControllerTest, ItStepsUpStairsNoHigherThanItsStepHeight)
     EXPECT_LT(blocked.GetPosition().x(), 1.0f);
 }
 
+TEST_F(CharacterControllerTest, WithUpAlongZItLandsWalksAndClimbsAsWithUpAlongY)
+{
+    // The stairs scene turned so that y goes to z: the floor's top and the treads face +z, gravity pulls -z
+    const Quat turn(Eigen::AngleAxisf(cPi / 2.0f, Vec3::UnitX()));
+    const Vec3 up = turn * Vec3::UnitY();
+    ASSERT_TRUE(up.isApprox(Vec3::UnitZ()));
+    AddStatic(Box(Vec3(50, 1, 50)), turn * Vec3(0, -1, 0), turn);
+    for (int step = 0; step < 5; ++step)
+    {
+        const float height = 0.2f * float(step + 1), run = step == 4 ? 3.0f : 0.4f;
+        AddStatic(Box(Vec3(run / 2.0f, height / 2.0f, 3.0f)),
+                  turn * Vec3(1.0f + 0.4f * float(step) + run / 2.0f, height / 2.0f, 0.0f), turn);
+    }
+    CharacterSettings settings = Settings();
+    settings.mUp = up;
+    CharacterController character = MakeCharacter(turn * Vec3(0, cCharacterStandHeight + 0.5f, 0), settings);
+    const Vec3 gravity = turn * cCharacterGravity;
+    const auto walk = [&](const Vec3& inVelocity, int inFrames)
+    {
+        for (int frame = 0; frame < inFrames; ++frame)
+        {
+            const Vec3 fall = character.GetLinearVelocity().dot(up) * up;
+            ASSERT_TRUE(character.SetLinearVelocity(turn * inVelocity + fall).IsOk());
+            ASSERT_TRUE(character.Update(cDeltaTime, gravity).IsOk());
+        }
+    };
+    walk(Vec3::Zero(), 60); // Lands
+    EXPECT_EQ(character.GetGroundState(), GroundState::OnGround);
+    EXPECT_TRUE(character.GetGroundNormal().isApprox(up, 1.0e-4f));
+    EXPECT_NEAR(character.GetPosition().dot(up), cCharacterStandHeight,
+                character.GetSettings().mPadding + 1.0e-3f);
+    EXPECT_GE(character.GetPosition().dot(up), cCharacterStandHeight);
+    int offGround = 0;
+    for (int frame = 0; frame < 100; ++frame)
+    {
+        walk(Vec3(2, 0, 0), 1);
+        offGround += character.GetGroundState() != GroundState::OnGround ? 1 : 0;
+    }
+    EXPECT_EQ(offGround, 0) << "on its feet all the way up";
+    EXPECT_NEAR(character.GetPosition().dot(up), cCharacterStandHeight + 1.0f, 0.05f) << "on the top step";
+    EXPECT_GT(character.GetPosition().x(), 3.0f) << "and on along it";
+    EXPECT_NEAR(character.GetPosition().y(), 0.0f, 1.0e-3f) << "straight, not sideways";
+}
+
 TEST_F(CharacterControllerTest, AStepHigherThanItsStepHeightStopsIt)
 {
     AddFloor();
@@ -494,6 +539,33 @@ TEST_F(CharacterControllerTest, ItPressesOnADynamicBodyItStandsOnAndLeavesStatic
     EXPECT_NEAR(Velocity(id).y(), -70.0f * 9.81f * cDeltaTime / raftMass, 1.0e-4f);
 }
 
+TEST_F(CharacterControllerTest, AfterSetPositionPushBodiesPushesNothingUntilTheNextUpdate)
+{
+    PhysicsSettings weightless;
+    weightless.mGravity = Vec3::Zero();
+    ResetWorld(weightless);
+    const BodyID raft = AddDynamic(DynamicSettings(Box(Vec3(3, 0.25f, 3)), Vec3(0, -0.25f, 0)));
+    const BodyID crate = AddDynamic(DynamicSettings(Box(Vec3::Constant(0.3f)), Vec3(1.5f, 0.6f, 0)));
+    CharacterController character = MakeCharacter(Vec3(0, cCharacterStandHeight + 0.02f, 0));
+    for (int frame = 0; frame < 20; ++frame)
+    {
+        ASSERT_TRUE(character.SetLinearVelocity(Vec3(3, 0, 0)).IsOk());
+        ASSERT_TRUE(character.Update(cDeltaTime, cCharacterGravity).IsOk());
+    }
+    ASSERT_EQ(character.GetGroundBody(), raft);
+    ASSERT_TRUE(Touches(character, crate));
+    CharacterController control = character; // Where it stands, pushing and pressing
+
+    ASSERT_TRUE(character.SetPosition(Vec3(0, cCharacterStandHeight + 0.02f, -20)).IsOk());
+    ASSERT_TRUE(character.PushBodies(Bodies()).IsOk());
+    EXPECT_EQ(Velocity(raft), Vec3::Zero()) << "no weight on the raft it no longer stands on";
+    EXPECT_EQ(Velocity(crate), Vec3::Zero()) << "no push on the crate it is no longer at";
+
+    ASSERT_TRUE(control.PushBodies(Bodies()).IsOk());
+    EXPECT_LT(Velocity(raft).y(), 0.0f);
+    EXPECT_GT(Velocity(crate).x(), 0.0f);
+}
+
 TEST_F(CharacterControllerTest, ABodyMovedIntoItPushesItOut)
 {
     AddFloor();
@@ -603,6 +675,13 @@ TEST(CharacterClipToPlanesTest, ItKeepsWhatPointsIntoNoPlaneAlongOnePlaneACrease
     EXPECT_TRUE(ClipToPlanes(Vec3(1, -2, 3), justFloor).isApprox(Vec3(1, 0, 3)));
     const std::array<Vec3, 2> floorAndWall{floor, wall};
     EXPECT_TRUE(ClipToPlanes(Vec3(1, -1, 2), floorAndWall).isApprox(Vec3(0, 0, 2))) << "along the crease";
+    // Along the crease whichever way it points: the planes' cross product points +z, the vector -z
+    EXPECT_TRUE(floor.cross(wall).z() > 0.0f);
+    EXPECT_TRUE(ClipToPlanes(Vec3(1, -1, -2), floorAndWall).isApprox(Vec3(0, 0, -2)))
+        << "along the crease, back";
+    const std::array<Vec3, 2> wallAndFloor{wall, floor};
+    EXPECT_TRUE(ClipToPlanes(Vec3(1, -1, -2), wallAndFloor).isApprox(Vec3(0, 0, -2)))
+        << "the planes in any order";
     // Two walls in a V: into it the nearest allowed is nothing; along one, the other does not matter
     const Vec3 left = Vec3(-1, 0, 1).normalized(), right = Vec3(-1, 0, -1).normalized();
     const std::array<Vec3, 3> corner{floor, left, right};
