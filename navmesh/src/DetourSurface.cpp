@@ -85,7 +85,7 @@ constexpr float cOnPolygon = 1.0e-3f;
 
 /// The largest number of segments getPolyWallSegments gives for one polygon: each edge splits into portals
 /// to the polygons of a neighbouring tile, with walls between them.
-constexpr int cMaxWallSegments = DT_VERTS_PER_POLYGON * 32;
+constexpr int cMaxPolygonWallSegments = DT_VERTS_PER_POLYGON * 32;
 
 /// The first radius FindWallAround searches: most agents ask near a wall, and a small circle visits few
 /// polygons.
@@ -178,8 +178,8 @@ Result<NavWall> FindWallAround(dtNavMeshQuery& inQuery, const dtNavMesh& inNavMe
     // Kept per thread: a query's buffers are larger than its usual answer
     thread_local std::vector<dtPolyRef> polygons(cMaxQueryNodes), parents(cMaxQueryNodes);
     thread_local std::unordered_set<dtPolyRef> outOfReach;
-    float segments[cMaxWallSegments * 6];
-    dtPolyRef neighbours[cMaxWallSegments];
+    float segments[cMaxPolygonWallSegments * 6];
+    dtPolyRef neighbours[cMaxPolygonWallSegments];
     // A small circle first, then twice as wide up to the radius asked for: the wall nearest the point lies in
     // the first circle that holds a wall
     for (float radius = std::min(inMaxRadius, cFirstWallRadius);;
@@ -214,7 +214,8 @@ Result<NavWall> FindWallAround(dtNavMeshQuery& inQuery, const dtNavMesh& inNavMe
             }
             int numSegments = 0;
             if (dtStatusFailed(inQuery.getPolyWallSegments(polygons[size_t(i)], &inDetourFilter, segments,
-                                                           neighbours, &numSegments, cMaxWallSegments)))
+                                                           neighbours, &numSegments,
+                                                           cMaxPolygonWallSegments)))
                 return MakeError(ErrorCode::InvalidArgument,
                                  "nearest wall: Detour refused a polygon's edges");
             for (int s = 0; s < numSegments; ++s)
