@@ -1,12 +1,14 @@
 // Characters walking on their own threads while the world steps on a job system, crates are added and
 // removed, and an elevator rises and sinks under some of them: every Update answers, none waits for the step,
-// and no character sinks through the floor or the elevator. Part of the test command and run under
+// and no character sinks through the floor or the elevator. Members of a character group, updated on two
+// threads beside the step, meet without passing through each other. Part of the test command and run under
 // ThreadSanitizer in CI (the concurrency label). The single-threaded behaviour is
 // tests/physics/simulation/CharacterControllerTest.cpp.
 
 #include "cairn/jobs/JobSystem.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/character/CharacterController.h"
+#include "cairn/physics/character/CharacterGroup.h"
 #include "cairn/physics/shapes/BoxShape.h"
 #include "cairn/physics/shapes/CapsuleShape.h"
 #include "common/MakePhysicsSystem.h"
@@ -15,6 +17,7 @@
 
 #include <array>
 #include <atomic>
+#include <barrier>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -212,6 +215,103 @@ TEST(CharacterConcurrencyTest, CharactersWalkOnTheirThreadsWhileTheWorldStepsAnd
             << "character " << i;
         EXPECT_GE(position.y(), bodies.GetPosition(elevator).Value().y() + 0.25f + cHalfHeight) << i;
     }
+}
+
+TEST(CharacterConcurrencyTest, GroupMembersOnTwoThreadsMeetWithoutPassingThroughEachOther)
+{
+    const std::unique_ptr<PhysicsSystem> world = test::MakePhysicsSystem();
+    ASSERT_TRUE(world->GetBodyInterface().CreateAndAddBody(test::StaticFloorSettings(30.0f),
+                                                           Activation::DontActivate));
+    // Eight members on a ring, each walking through the centre to its opposite place: they all meet there
+    constexpr int cThreads = 2, cPerThread = 4, cMembers = cThreads * cPerThread;
+    constexpr float cRing = 3.0f, cSpeed = 3.0f;
+    CharacterSettings settings;
+    settings.mShape = CapsuleShape::Create(cHalfHeight, cRadius).Value();
+    CharacterGroup group;
+    std::vector<CharacterController> members;
+    std::vector<Vec3> goals;
+    for (int i = 0; i < cMembers; ++i)
+    {
+        const float angle = 2.0f * cPi * float(i) / float(cMembers);
+        const Vec3 place(cRing * std::cos(angle), cHalfHeight + cRadius + 0.02f, cRing * std::sin(angle));
+        members.push_back(CharacterController::Create(*world, settings, place).Value());
+        goals.push_back(Vec3(-place.x(), place.y(), -place.z()));
+    }
+    for (CharacterController& member : members)
+        ASSERT_TRUE(group.Add(member));
+
+    // A frame: the members update on their threads while this one steps the world; then, with every Update
+    // done (the barrier orders them), the group publishes: its sync point
+    std::barrier frameEdge(cThreads + 1);
+    std::atomic<bool> stop{false}; // Relaxed: read after the barrier, which orders it
+    std::mutex failureMutex;       // Guards firstFailure: written by the member threads
+    std::string firstFailure;
+    std::vector<std::thread> threads;
+    for (int t = 0; t < cThreads; ++t)
+        threads.emplace_back(
+            [&, t]
+            {
+                for (;;)
+                {
+                    frameEdge.arrive_and_wait(); // The frame starts
+                    if (stop.load(std::memory_order_relaxed)) return;
+                    for (int i = t * cPerThread; i < (t + 1) * cPerThread; ++i)
+                    {
+                        CharacterController& member = members[size_t(i)];
+                        Vec3 toGoal = goals[size_t(i)] - member.GetPosition();
+                        toGoal.y() = 0.0f;
+                        Vec3 velocity =
+                            toGoal.norm() > 0.1f ? Vec3(toGoal.normalized() * cSpeed) : Vec3::Zero();
+                        velocity.y() = member.GetLinearVelocity().y();
+                        const Status set = member.SetLinearVelocity(velocity);
+                        const Status updated = member.Update(cDeltaTime, cGravity);
+                        if (!set || !updated)
+                        {
+                            const std::lock_guard lock(failureMutex);
+                            if (firstFailure.empty())
+                                firstFailure = "member " + std::to_string(i) + ": " +
+                                               (set ? updated : set).GetError().mMessage;
+                        }
+                    }
+                    frameEdge.arrive_and_wait(); // Its Updates are done
+                }
+            });
+
+    jobs::JobSystem::Settings jobSettings;
+    jobSettings.mNumThreads = 2;
+    jobs::JobSystem jobSystem(jobSettings);
+    const int frames = test::cSlowBuild ? 120 : 240;
+    float deepest = 0.0f;
+    int contacts = 0;
+    for (int frame = 0; frame < frames; ++frame)
+    {
+        frameEdge.arrive_and_wait();
+        const Status stepped = world->Update(cDeltaTime, 1, jobSystem);
+        frameEdge.arrive_and_wait();
+        EXPECT_TRUE(stepped.IsOk());
+        group.Publish();
+        for (int i = 0; i < cMembers; ++i)
+        {
+            contacts += int(members[size_t(i)].GetCharacterContacts().size());
+            for (int j = i + 1; j < cMembers; ++j)
+            {
+                const Vec3 between = members[size_t(i)].GetPosition() - members[size_t(j)].GetPosition();
+                deepest = std::min(deepest, Vec3(between.x(), 0, between.z()).norm() - 2.0f * cRadius);
+            }
+        }
+    }
+    stop.store(true, std::memory_order_relaxed);
+    frameEdge.arrive_and_wait(); // Lets the threads see the stop
+    for (std::thread& thread : threads)
+        thread.join();
+
+    EXPECT_TRUE(firstFailure.empty()) << firstFailure;
+    EXPECT_GT(contacts, 0) << "they met";
+    // Each sees the others a frame late, so a crowd pressing together overlaps by a few frames' walk at most,
+    // and is pushed apart in the next Updates
+    EXPECT_GT(deepest, -4.0f * cSpeed * cDeltaTime);
+    for (const CharacterController& member : members)
+        EXPECT_GE(member.GetPosition().y(), cHalfHeight + cRadius - cSinkTolerance) << "on the floor";
 }
 
 } // namespace

@@ -194,6 +194,8 @@ Status CharacterController::SetPosition(const Vec3& inPosition)
     mGroundMoves = false;
     mGroundVelocity = Vec3::Zero();
     mContacts.clear(); // Not where it is now: nothing for PushBodies
+    mCharacterContacts.clear();
+    if (mSeat.GetGroup() != nullptr) mSeat.GetGroup()->SetNext(mSeat.GetMember(), mPosition);
     return Status::Ok();
 }
 
@@ -212,9 +214,19 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
 
     const Vec3& up = mSettings.mUp;
     mNextContacts.clear();
-    const CharacterMoveContext context{
-        mWorld->GetWorldQuery(), *mSettings.mShape, mShapeRotation, mSettings.mFilter, up, mCosMaxSlope,
-        mSettings.mPadding,      mShapeBottom,      mNextContacts};
+    mNextCharacterContacts.clear();
+    const CharacterMoveContext context{mWorld->GetWorldQuery(),
+                                       *mSettings.mShape,
+                                       mShapeRotation,
+                                       mSettings.mFilter,
+                                       up,
+                                       mCosMaxSlope,
+                                       mSettings.mPadding,
+                                       mShapeBottom,
+                                       mNextContacts,
+                                       mSeat.GetGroup(),
+                                       mSeat.GetMember(),
+                                       mNextCharacterContacts};
 
     // On its feet unless it jumps: then the floor holds it (no gravity, nothing of the velocity into it)
     Vec3 velocity = mVelocity;
@@ -268,6 +280,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
                  cGroundProbePaddings * mSettings.mPadding);
     std::optional<CharacterContact> ground;
     std::optional<CharacterSupport> support;
+    CharacterGroup::MemberID groundMember = CharacterGroup::cNoMember; // Another character under it
     if (!jumps)
     {
         Result<CharacterSweep> stick = SweepCharacter(context, position, -up * stickDistance, false);
@@ -284,9 +297,13 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
                 position = stick.Value().mEnd;
                 support = found.Value();
                 ground = met;
+                groundMember = stick.Value().mHitMember;
             }
             else if (hit.mFraction * stickDistance * std::max(hit.mNormal.dot(up), 0.1f) <= groundGap)
+            {
                 ground = met; // Within the gap along the slope's normal
+                groundMember = stick.Value().mHitMember;
+            }
         }
     }
 
@@ -310,6 +327,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     // What it touched below, and what holds it up where that is another body (a tread under a stair's edge)
     if (ground) RecordContact(context, ground->mBody, ground->mPoint, ground->mNormal);
     if (support) RecordContact(context, support->mBody, support->mPoint, support->mNormal);
+    RecordCharacterContact(context, groundMember);
     // On the ground the velocity is the walk: the ground takes it up and down its slopes, so no speed along
     // up is left to read as a jump (or a fall) in the next Update
     if (state == GroundState::OnGround) velocity = AcrossAxis(velocity, up);
@@ -351,6 +369,8 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     mLastDeltaTime = inDeltaTime;
     mLastGravity = inGravity;
     mContacts.swap(mNextContacts);
+    mCharacterContacts.swap(mNextCharacterContacts);
+    if (mSeat.GetGroup() != nullptr) mSeat.GetGroup()->SetNext(mSeat.GetMember(), mPosition);
     return Status::Ok();
 }
 

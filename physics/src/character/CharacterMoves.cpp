@@ -1,5 +1,6 @@
 #include "character/CharacterMoves.h"
 
+#include "character/CharacterGroupQueries.h"
 #include "narrowphase/FaceClipping.h"
 
 #include <algorithm>
@@ -31,9 +32,19 @@ constexpr float cStepForwardTest = 0.15f;
 void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,
                    const Vec3& inNormal)
 {
+    if (inBody.IsInvalid()) return;
     for (const CharacterContact& contact : inContext.mContacts)
         if (contact.mBody == inBody) return;
     inContext.mContacts.push_back({inBody, inPoint, inNormal});
+}
+
+void RecordCharacterContact(const CharacterMoveContext& inContext, CharacterGroup::MemberID inMember)
+{
+    if (inMember == CharacterGroup::cNoMember ||
+        std::find(inContext.mCharacterContacts.begin(), inContext.mCharacterContacts.end(), inMember) !=
+            inContext.mCharacterContacts.end())
+        return;
+    inContext.mCharacterContacts.push_back(inMember);
 }
 
 Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, const Vec3& inStart,
@@ -45,18 +56,35 @@ Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, con
     Result<std::optional<ShapeCastResult>> cast = inContext.mQuery.CastShapeClosest(
         inContext.mShape, inContext.At(inStart), inDisplacement, inContext.mFilter);
     if (!cast) return cast.GetError();
-    if (!cast.Value())
+    std::optional<ShapeCastResult> first = cast.Value();
+    if (inContext.mGroup != nullptr)
+    {
+        // Another member in the way before the body (which holds none of them)
+        const std::optional<MemberCastHit> member =
+            CastAgainstMembers(*inContext.mGroup, inContext.mSelf, inContext.mShape, inContext.At(inStart),
+                               inDisplacement, first ? first->mFraction : 1.0f);
+        if (member && (!first || member->mCast.mFraction < first->mFraction))
+        {
+            first = member->mCast;
+            sweep.mHitMember = member->mMember;
+        }
+    }
+    if (!first)
     {
         sweep.mEnd = inStart + inDisplacement;
         return sweep;
     }
-    const ShapeCastResult& hit = *cast.Value();
+    const ShapeCastResult& hit = *first;
     const Vec3 direction = inDisplacement / length;
     const float approach = std::max(-direction.dot(hit.mNormal), cMinApproachCos);
     const float travel = std::max(hit.mFraction * length - inContext.mPadding / approach, 0.0f);
     sweep.mEnd = inStart + direction * travel;
     sweep.mHit = hit;
-    if (inRecordContact) RecordContact(inContext, hit.mBody, hit.mContactPoint, hit.mNormal);
+    if (inRecordContact)
+    {
+        RecordContact(inContext, hit.mBody, hit.mContactPoint, hit.mNormal);
+        RecordCharacterContact(inContext, sweep.mHitMember);
+    }
     return sweep;
 }
 
@@ -137,17 +165,27 @@ Result<Vec3> PushOutOfBodies(const CharacterMoveContext& inContext, const Vec3& 
                 deepestPenetration = penetration;
             }
         }
-        if (deepest == nullptr) break;
+        // Another member deeper still
+        const std::optional<MemberOverlap> member =
+            inContext.mGroup == nullptr
+                ? std::nullopt
+                : DeepestMemberOverlap(*inContext.mGroup, inContext.mSelf, inContext.mShape,
+                                       inContext.At(position), deepestPenetration);
+        if (deepest == nullptr && !member) break;
         // The manifold's normal points from the character towards the body. The push is swept: a body behind
         // the character stops it, rather than taking it in (it leaves the body it is pushed out of, which
         // so does not stop it)
-        const ContactManifold& manifold = deepest->mManifold;
+        const ContactManifold& manifold = member ? member->mManifold : deepest->mManifold;
+        if (member) deepestPenetration = MaxPenetration(manifold);
         int deepestPoint = 0;
         for (int i = 1; i < manifold.mNumPoints; ++i)
             if (manifold.mPoints[i].mPenetration > manifold.mPoints[deepestPoint].mPenetration)
                 deepestPoint = i;
-        RecordContact(inContext, deepest->mBody, manifold.mPoints[deepestPoint].mPositionOnB,
-                      -manifold.mNormal);
+        if (member)
+            RecordCharacterContact(inContext, member->mMember);
+        else
+            RecordContact(inContext, deepest->mBody, manifold.mPoints[deepestPoint].mPositionOnB,
+                          -manifold.mNormal);
         Result<CharacterSweep> push = SweepCharacter(
             inContext, position, -manifold.mNormal * (deepestPenetration + inContext.mPadding), false);
         if (!push) return push.GetError();

@@ -25,6 +25,10 @@ struct CharacterMoveContext
     float mPadding;
     float mBottom; ///< From the shape's origin down to its lowest point, along -mUp
     std::vector<CharacterContact>& mContacts; ///< Every body a move met, each once
+    /// The character's group (null: none) and its number there; every member a move met, each once
+    const CharacterGroup* mGroup;
+    CharacterGroup::MemberID mSelf;
+    std::vector<CharacterGroup::MemberID>& mCharacterContacts;
 
     bool IsWalkable(const Vec3& inNormal) const { return inNormal.dot(mUp) >= mCosMaxSlope; }
     Transform At(const Vec3& inPosition) const { return {inPosition, mRotation}; }
@@ -36,9 +40,12 @@ inline Vec3 AcrossAxis(const Vec3& inVector, const Vec3& inAxis)
     return inVector - inVector.dot(inAxis) * inAxis;
 }
 
-/// Adds a contact with inBody to the context's, unless it holds one with that body already.
+/// Adds a contact with inBody to the context's, unless it holds one with that body already or inBody is none
+/// (another character).
 void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,
                    const Vec3& inNormal);
+/// Adds inMember to the context's members met, unless it is there already or is none.
+void RecordCharacterContact(const CharacterMoveContext& inContext, CharacterGroup::MemberID inMember);
 
 /// Moves shorter than this (metres) are not cast: nothing can stop them that a query would see.
 inline constexpr float cMinCharacterMove = 1.0e-6f;
@@ -46,11 +53,12 @@ inline constexpr float cMinCharacterMove = 1.0e-6f;
 struct CharacterSweep
 {
     Vec3 mEnd;                           ///< Where the move ends
-    std::optional<ShapeCastResult> mHit; ///< What stopped it, if anything
+    std::optional<ShapeCastResult> mHit; ///< What stopped it, if anything (no body: a member of the group)
+    CharacterGroup::MemberID mHitMember = CharacterGroup::cNoMember; ///< The member that stopped it
 };
 
-/// From inStart along inDisplacement, to its end or mPadding short of the first body in the way (a contact,
-/// unless inRecordContact is false).
+/// From inStart along inDisplacement, to its end or mPadding short of the first body or other member of the
+/// group in the way (a contact, unless inRecordContact is false).
 Result<CharacterSweep> SweepCharacter(const CharacterMoveContext& inContext, const Vec3& inStart,
                                       const Vec3& inDisplacement, bool inRecordContact = true);
 
@@ -73,8 +81,9 @@ Result<std::optional<CharacterSupport>> FindSupport(const CharacterMoveContext& 
 /// itself, its projection on one plane, on the crease of two, or zero in a corner.
 Vec3 ClipToPlanes(const Vec3& inVector, std::span<const Vec3> inNormals);
 
-/// inStart moved out of the bodies that overlap the shape there (a body that moved into the character, or a
-/// body added on it), deepest first, each to mPadding clear, in a few rounds: a corner may push it back in.
+/// inStart moved out of the bodies and other members of the group that overlap the shape there (a body or a
+/// character that moved into the character, or a body added on it), deepest first, each to mPadding clear, in
+/// a few rounds: a corner may push it back in.
 Result<Vec3> PushOutOfBodies(const CharacterMoveContext& inContext, const Vec3& inStart);
 
 /// A step up a stair: up by at most inStepHeight, along inHorizontal, then down onto walkable ground no lower

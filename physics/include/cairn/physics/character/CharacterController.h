@@ -12,6 +12,8 @@
 // published (the last collision step, or the last move by hand). Update moves no body: the bodies it touched
 // are in GetContacts, and PushBodies, called after it, pushes the dynamic ones through BodyInterface (its one
 // write, which takes body locks as BodyInterface does).
+// Characters do not see each other unless they are members of one CharacterGroup, whose Publish is then
+// their sync point (CharacterGroup.h).
 // The world (PhysicsSystem) must outlive the controller.
 // Errors: bad input (a NaN or out-of-world position, a velocity or gravity that is not finite, a time step
 // that is not positive and finite, a move past the queries' reach, settings out of range, a shape that is
@@ -19,6 +21,7 @@
 
 #include "cairn/physics/body/BodyInterface.h"
 #include "cairn/physics/body/Layers.h"
+#include "cairn/physics/character/CharacterGroup.h"
 #include "cairn/physics/math/Result.h"
 #include "cairn/physics/queries/WorldQuery.h"
 #include "cairn/physics/shapes/Shape.h"
@@ -107,6 +110,11 @@ public:
     Vec3 GetGroundVelocity() const { return mGroundVelocity; }
     /// The bodies the last Update touched (the ground among them), each once.
     std::span<const CharacterContact> GetContacts() const { return mContacts; }
+    /// The members of its CharacterGroup the last Update touched (one it stands on among them), each once.
+    std::span<const CharacterGroup::MemberID> GetCharacterContacts() const { return mCharacterContacts; }
+    /// Its group (null when it is in none) and its number there.
+    const CharacterGroup* GetGroup() const { return mSeat.GetGroup(); }
+    CharacterGroup::MemberID GetGroupMember() const { return mSeat.GetMember(); }
 
     /// Pushes the dynamic bodies the last Update walked into, each with an impulse at its contact, along
     /// -mNormal: as much as would stop the character's walk into it (mMass times mApproachSpeed), at most
@@ -118,6 +126,8 @@ public:
     const CharacterSettings& GetSettings() const { return mSettings; }
 
 private:
+    friend class CharacterGroup;
+
     CharacterController(const PhysicsSystem& inWorld, const CharacterSettings& inSettings,
                         const Vec3& inPosition);
 
@@ -144,6 +154,9 @@ private:
     Vec3 mGroundVelocity = Vec3::Zero();
     std::vector<CharacterContact> mContacts;
     std::vector<CharacterContact> mNextContacts; ///< An Update's, kept only if it succeeds
+    std::vector<CharacterGroup::MemberID> mCharacterContacts,
+        mNextCharacterContacts; ///< The same, of members
+    CharacterGroup::Seat mSeat; ///< Its place in a group, if any
     /// The last Update's: where the character stood on its ground, its time step and gravity (PushBodies)
     Vec3 mGroundPoint = Vec3::Zero();
     float mLastDeltaTime = 0.0f;

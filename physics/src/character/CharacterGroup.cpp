@@ -1,0 +1,191 @@
+#include "cairn/physics/character/CharacterGroup.h"
+
+#include "cairn/physics/character/CharacterController.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn::physics
+{
+
+Result<CharacterGroup::MemberID> CharacterGroup::Add(CharacterController& ioCharacter)
+{
+    if (ioCharacter.mSeat.mGroup != nullptr)
+        return MakeError(ErrorCode::AlreadyAdded,
+                         "character group: the character is a member of a group already");
+    if (mNumMembers >= cMaxMembers)
+        return MakeError(ErrorCode::OutOfCapacity,
+                         "character group: it holds " + std::to_string(cMaxMembers) + " members already");
+    MemberID member;
+    if (!mFree.empty())
+    {
+        member = mFree.back();
+        mFree.pop_back();
+    }
+    else
+    {
+        member = MemberID(mMembers.size());
+        mMembers.emplace_back();
+    }
+    const AABB bounds = ioCharacter.mSettings.mShape->GetLocalBounds();
+    mMembers[member] = {ioCharacter.mSettings.mShape,
+                        ioCharacter.mShapeRotation,
+                        std::max(bounds.mMin.norm(), bounds.mMax.norm()),
+                        ioCharacter.mPosition,
+                        ioCharacter.mPosition,
+                        &ioCharacter.mSeat};
+    ++mNumMembers;
+    ioCharacter.mSeat.mGroup = this;
+    ioCharacter.mSeat.mMember = member;
+    BuildGrid();
+    return member;
+}
+
+Status CharacterGroup::Remove(CharacterController& ioCharacter)
+{
+    if (ioCharacter.mSeat.mGroup != this)
+        return MakeError(ErrorCode::NotAdded, "character group: the character is not a member of this group");
+    ioCharacter.mSeat.Leave();
+    return Status::Ok();
+}
+
+CharacterGroup::~CharacterGroup()
+{
+    for (Member& member : mMembers)
+        if (member.mSeat != nullptr)
+        {
+            member.mSeat->mGroup = nullptr;
+            member.mSeat->mMember = cNoMember;
+        }
+}
+
+CharacterGroup::Seat::Seat(Seat&& ioOther) noexcept
+{
+    TakeOver(ioOther);
+}
+
+CharacterGroup::Seat& CharacterGroup::Seat::operator=(const Seat& inOther)
+{
+    if (this != &inOther) Leave(); // It becomes a copy, which is in no group
+    return *this;
+}
+
+CharacterGroup::Seat& CharacterGroup::Seat::operator=(Seat&& ioOther) noexcept
+{
+    if (this != &ioOther)
+    {
+        Leave();
+        TakeOver(ioOther);
+    }
+    return *this;
+}
+
+void CharacterGroup::Seat::TakeOver(Seat& ioOther)
+{
+    mGroup = ioOther.mGroup;
+    mMember = ioOther.mMember;
+    ioOther.mGroup = nullptr;
+    ioOther.mMember = cNoMember;
+    if (mGroup != nullptr)
+        mGroup->mMembers[mMember].mSeat = this; // The group finds the place where it is now
+}
+
+void CharacterGroup::Seat::Leave()
+{
+    if (mGroup != nullptr) mGroup->Leave(mMember);
+    mGroup = nullptr;
+    mMember = cNoMember;
+}
+
+void CharacterGroup::Leave(MemberID inMember)
+{
+    mMembers[inMember] = Member{};
+    mFree.push_back(inMember);
+    --mNumMembers;
+    BuildGrid();
+}
+
+void CharacterGroup::Publish()
+{
+    for (Member& member : mMembers)
+        member.mPublished = member.mNext;
+    BuildGrid();
+}
+
+namespace
+{
+/// Cell coordinates packed 21 bits each
+constexpr int64_t cCellRange = (int64_t(1) << 20) - 1;
+
+int64_t CellOf(float inCoordinate, float inCellSize)
+{
+    return std::clamp(int64_t(std::floor(inCoordinate / inCellSize)), -cCellRange, cCellRange);
+}
+
+uint64_t CellKey(int64_t inX, int64_t inY, int64_t inZ)
+{
+    const auto field = [](int64_t inValue) { return uint64_t(inValue + cCellRange); };
+    return field(inX) << 42 | field(inY) << 21 | field(inZ);
+}
+} // namespace
+
+void CharacterGroup::BuildGrid()
+{
+    mMaxRadius = 0.0f;
+    for (const Member& member : mMembers)
+        mMaxRadius = std::max(mMaxRadius, member.mRadius);
+    mCellSize = std::max(2.0f * mMaxRadius, cMinCellSize);
+    mGrid.clear();
+    for (MemberID member = 0; member < MemberID(mMembers.size()); ++member)
+    {
+        const Vec3& at = mMembers[member].mPublished;
+        if (mMembers[member].mShape != nullptr)
+            mGrid.emplace_back(
+                CellKey(CellOf(at.x(), mCellSize), CellOf(at.y(), mCellSize), CellOf(at.z(), mCellSize)),
+                member);
+    }
+    std::sort(mGrid.begin(), mGrid.end());
+}
+
+void CharacterGroup::Visit(MemberID inMember, MemberVisitor inVisit) const
+{
+    const Member& member = mMembers[inMember];
+    inVisit(inMember, *member.mShape, Transform{member.mPublished, member.mRotation}, member.mRadius);
+}
+
+void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVisit) const
+{
+    if (mGrid.empty()) return;
+    const AABB reach = inBounds.Expanded(mMaxRadius);
+    int64_t low[3], high[3];
+    uint64_t cells = 1;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+        low[axis] = CellOf(reach.mMin[axis], mCellSize);
+        high[axis] = CellOf(reach.mMax[axis], mCellSize);
+        cells *= uint64_t(high[axis] - low[axis] + 1);
+    }
+    // A long move crosses more cells than there are members: each member once is less work
+    if (cells > mGrid.size())
+    {
+        ForEachMember(inVisit);
+        return;
+    }
+    for (int64_t x = low[0]; x <= high[0]; ++x)
+        for (int64_t y = low[1]; y <= high[1]; ++y)
+            for (int64_t z = low[2]; z <= high[2]; ++z)
+            {
+                const uint64_t key = CellKey(x, y, z);
+                auto cell = std::lower_bound(mGrid.begin(), mGrid.end(), std::make_pair(key, MemberID(0)));
+                for (; cell != mGrid.end() && cell->first == key; ++cell)
+                    Visit(cell->second, inVisit);
+            }
+}
+
+void CharacterGroup::ForEachMember(MemberVisitor inVisit) const
+{
+    for (MemberID member = 0; member < MemberID(mMembers.size()); ++member)
+        if (mMembers[member].mShape != nullptr) Visit(member, inVisit);
+}
+
+} // namespace cairn::physics
