@@ -37,7 +37,9 @@ Result<CharacterGroup::MemberID> CharacterGroup::Add(CharacterController& ioChar
     ++mNumMembers;
     ioCharacter.mSeat.mGroup = this;
     ioCharacter.mSeat.mMember = member;
-    BuildGrid();
+    // Seen from now on: outside the grid until the next Publish builds it, so adding many costs no rebuilds
+    mUnplaced.push_back(member);
+    mMaxRadius = std::max(mMaxRadius, mMembers[member].mRadius);
     return member;
 }
 
@@ -99,10 +101,11 @@ void CharacterGroup::Seat::Leave()
 
 void CharacterGroup::Leave(MemberID inMember)
 {
+    // Its cell in the grid, or its place among the unplaced, stays till the next Publish: a free slot is
+    // passed over, and a slot taken again is looked at where its new member stands
     mMembers[inMember] = Member{};
     mFree.push_back(inMember);
     --mNumMembers;
-    BuildGrid();
 }
 
 void CharacterGroup::Publish()
@@ -136,6 +139,7 @@ void CharacterGroup::BuildGrid()
         mMaxRadius = std::max(mMaxRadius, member.mRadius);
     mCellSize = std::max(2.0f * mMaxRadius, cMinCellSize);
     mGrid.clear();
+    mUnplaced.clear();
     for (MemberID member = 0; member < MemberID(mMembers.size()); ++member)
     {
         const Vec3& at = mMembers[member].mPublished;
@@ -150,12 +154,14 @@ void CharacterGroup::BuildGrid()
 void CharacterGroup::Visit(MemberID inMember, MemberVisitor inVisit) const
 {
     const Member& member = mMembers[inMember];
-    inVisit(inMember, *member.mShape, Transform{member.mPublished, member.mRotation}, member.mRadius);
+    if (member.mShape != nullptr)
+        inVisit(inMember, *member.mShape, Transform{member.mPublished, member.mRotation}, member.mRadius);
 }
 
 void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVisit) const
 {
-    if (mGrid.empty()) return;
+    // Grown by the widest member's radius (since an Add, wider than the grid's cells: still every cell a
+    // member in the grid reaches from)
     const AABB reach = inBounds.Expanded(mMaxRadius);
     int64_t low[3], high[3];
     uint64_t cells = 1;
@@ -166,11 +172,13 @@ void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVis
         cells *= uint64_t(high[axis] - low[axis] + 1);
     }
     // A long move crosses more cells than there are members: each member once is less work
-    if (cells > mGrid.size())
+    if (cells > mGrid.size() + mUnplaced.size())
     {
         ForEachMember(inVisit);
         return;
     }
+    for (const MemberID member : mUnplaced)
+        Visit(member, inVisit);
     for (int64_t x = low[0]; x <= high[0]; ++x)
         for (int64_t y = low[1]; y <= high[1]; ++y)
             for (int64_t z = low[2]; z <= high[2]; ++z)
@@ -185,7 +193,7 @@ void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVis
 void CharacterGroup::ForEachMember(MemberVisitor inVisit) const
 {
     for (MemberID member = 0; member < MemberID(mMembers.size()); ++member)
-        if (mMembers[member].mShape != nullptr) Visit(member, inVisit);
+        Visit(member, inVisit);
 }
 
 } // namespace cairn::physics

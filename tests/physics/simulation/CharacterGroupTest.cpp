@@ -135,28 +135,25 @@ TEST_F(CharacterGroupTest, AMemberSlidesAroundAnotherInItsWay)
 
 TEST_F(CharacterGroupTest, InALargeGroupAMemberMeetsEachNeighbourItsGridHolds)
 {
-    // 64 members standing 1 m apart (0.4 m between them): a large group looks its members up in its grid
+    // 400 members standing 1 m apart (0.4 m between them), more than the cells a move looks at: a large group
+    // finds its members in its grid. They stand still, so only the walkers update
     AddFloor();
     CharacterGroup group;
+    constexpr int cSide = 20;
     std::vector<CharacterController> standers;
-    standers.reserve(64);
-    for (int i = 0; i < 64; ++i)
+    standers.reserve(cSide * cSide);
+    for (int i = 0; i < cSide * cSide; ++i)
     {
-        standers.push_back(MakeCharacter(Vec3(float(i % 8), cStandHeight + 0.02f, float(i / 8))));
+        standers.push_back(MakeCharacter(Vec3(float(i % cSide), cStandHeight + 0.02f, float(i / cSide))));
         ASSERT_TRUE(group.Add(standers.back()));
     }
-    // Walkers into the lattice from each side, one between two rows, one along a row
+    // Walkers into the lattice from two sides, one between two rows, one along a row
     CharacterController west = MakeCharacter(Vec3(-2, cStandHeight + 0.02f, 3.5f));
     CharacterController south = MakeCharacter(Vec3(5, cStandHeight + 0.02f, -2));
     ASSERT_TRUE(group.Add(west));
     ASSERT_TRUE(group.Add(south));
-    std::vector<CharacterController*> everyone{&west, &south};
-    std::vector<Vec3> walks{Vec3(2, 0, 0), Vec3(0, 0, 2)};
-    for (CharacterController& stander : standers)
-    {
-        everyone.push_back(&stander);
-        walks.push_back(Vec3::Zero());
-    }
+    const std::vector<CharacterController*> everyone{&west, &south};
+    const std::vector<Vec3> walks{Vec3(2, 0, 0), Vec3(0, 0, 2)};
     float deepest = 0.0f;
     for (int frame = 0; frame < 120; ++frame)
     {
@@ -170,9 +167,9 @@ TEST_F(CharacterGroupTest, InALargeGroupAMemberMeetsEachNeighbourItsGridHolds)
     EXPECT_FALSE(west.GetCharacterContacts().empty());
     EXPECT_FALSE(south.GetCharacterContacts().empty());
 
-    // Two walkers meeting away from the lattice: each finds the other where the last Publish put it
-    CharacterController a = MakeCharacter(Vec3(-6, cStandHeight + 0.02f, 20));
-    CharacterController b = MakeCharacter(Vec3(6, cStandHeight + 0.02f, 20));
+    // Two walkers meeting beside the lattice: each finds the other where the last Publish put it
+    CharacterController a = MakeCharacter(Vec3(-6, cStandHeight + 0.02f, 25));
+    CharacterController b = MakeCharacter(Vec3(6, cStandHeight + 0.02f, 25));
     ASSERT_TRUE(group.Add(a));
     ASSERT_TRUE(group.Add(b));
     for (int frame = 0; frame < 150; ++frame)
@@ -180,18 +177,18 @@ TEST_F(CharacterGroupTest, InALargeGroupAMemberMeetsEachNeighbourItsGridHolds)
     EXPECT_LT(a.GetPosition().x(), b.GetPosition().x()) << "they did not pass through each other";
     EXPECT_GE(SideGap(a, b), -0.2f);
 
-    // A wide member added in a walker's way is there for its next Update, Publish or not, and stops it at its
-    // side. The grid's cells are as wide as the wide member: this one stands near its cell's upper edge, so
-    // the cells the walker's own reach covers when it meets it do not hold it
+    // A wide member stops a walker at its side. The grid's cells are as wide as the wide member: this one
+    // stands near its cell's upper edge, so the cells the walker's own reach covers when it meets it do not
+    // hold it
     CharacterSettings wideSettings;
     wideSettings.mShape = CapsuleShape::Create(0.3f, 1.2f).Value();
     constexpr float cWideX = 13.3f;
     CharacterController wide =
-        CharacterController::Create(System(), wideSettings, Vec3(cWideX, 1.52f, 30)).Value();
-    CharacterController walker = MakeCharacter(Vec3(18, cStandHeight + 0.02f, 30));
+        CharacterController::Create(System(), wideSettings, Vec3(cWideX, 1.52f, 35)).Value();
+    CharacterController walker = MakeCharacter(Vec3(18, cStandHeight + 0.02f, 35));
     ASSERT_TRUE(group.Add(walker));
-    group.Publish();
     ASSERT_TRUE(group.Add(wide));
+    group.Publish();
     float closest = 10.0f;
     for (int frame = 0; frame < 90; ++frame)
     {
@@ -201,6 +198,15 @@ TEST_F(CharacterGroupTest, InALargeGroupAMemberMeetsEachNeighbourItsGridHolds)
     EXPECT_GT(closest, -1.0e-3f) << "never in the wide member";
     EXPECT_LT(closest, 0.1f) << "but at its side";
     EXPECT_TRUE(Touches(walker, wide.GetGroupMember()));
+
+    // A member added in a walker's way is there for its next Update, before any Publish puts it in the grid
+    CharacterController blocker = MakeCharacter(Vec3(-10, cStandHeight + 0.02f, 25));
+    ASSERT_TRUE(group.Add(blocker));
+    for (int frame = 0; frame < 240; ++frame)
+        Frame({&a}, {Vec3(-3, 0, 0)}, nullptr);
+    EXPECT_GT(a.GetPosition().x(), -10.0f + 2.0f * cRadius - 1.0e-3f) << "stopped at the new member";
+    EXPECT_LT(a.GetPosition().x(), -10.0f + 2.0f * cRadius + 0.1f) << "and there";
+    EXPECT_TRUE(Touches(a, blocker.GetGroupMember()));
 }
 
 TEST_F(CharacterGroupTest, AMemberStandsOnAnothersHead)
@@ -299,17 +305,43 @@ TEST_F(CharacterGroupTest, MembershipFollowsTheController)
         EXPECT_EQ(second.GetGroupMember(), CharacterGroup::cNoMember);
     }
 
-    ASSERT_TRUE(group.Remove(moved).IsOk());
-    EXPECT_EQ(moved.GetGroup(), nullptr);
-    EXPECT_EQ(group.GetNumMembers(), 0u);
-    EXPECT_EQ(group.Remove(moved).GetError().mCode, ErrorCode::NotAdded);
-    // Gone from the group: a member walking through its place is not stopped
     CharacterController walker = MakeCharacter(Vec3(-2, cStandHeight + 0.02f, 0));
     ASSERT_TRUE(group.Add(walker));
+    group.Publish();
+    ASSERT_TRUE(group.Remove(moved).IsOk());
+    EXPECT_EQ(moved.GetGroup(), nullptr);
+    EXPECT_EQ(group.GetNumMembers(), 1u);
+    EXPECT_EQ(group.Remove(moved).GetError().mCode, ErrorCode::NotAdded);
+    // Gone from the group, though its place was published: a member walking through it is not stopped
     for (int frame = 0; frame < 60; ++frame)
         Frame({&walker}, {Vec3(4, 0, 0)}, &group);
     EXPECT_GT(walker.GetPosition().x(), 1.0f);
     EXPECT_TRUE(walker.GetCharacterContacts().empty());
+}
+
+TEST_F(CharacterGroupTest, AGroupRefusesMembersPastItsCapacity)
+{
+    CharacterGroup group;
+    CharacterSettings settings;
+    settings.mShape = CapsuleShape::Create(cHalfHeight, cRadius).Value();
+    std::vector<CharacterController> crowd;
+    crowd.reserve(CharacterGroup::cMaxMembers + 1);
+    for (uint32_t i = 0; i <= CharacterGroup::cMaxMembers; ++i)
+        crowd.push_back(CharacterController::Create(System(), settings,
+                                                    Vec3(float(i % 256), cStandHeight, float(i / 256)))
+                            .Value());
+    for (uint32_t i = 0; i < CharacterGroup::cMaxMembers; ++i)
+        ASSERT_TRUE(group.Add(crowd[i])) << i;
+    const Result<CharacterGroup::MemberID> over = group.Add(crowd.back());
+    ASSERT_FALSE(over);
+    EXPECT_EQ(over.GetError().mCode, ErrorCode::OutOfCapacity);
+    EXPECT_EQ(crowd.back().GetGroup(), nullptr);
+    EXPECT_EQ(group.GetNumMembers(), CharacterGroup::cMaxMembers);
+    group.Publish(); // Its grid of them all
+    // One leaves, and the one left out takes its place
+    ASSERT_TRUE(group.Remove(crowd[7]).IsOk());
+    ASSERT_TRUE(group.Add(crowd.back()));
+    EXPECT_EQ(crowd.back().GetGroupMember(), CharacterGroup::MemberID(7)) << "the free slot, taken again";
 }
 
 } // namespace

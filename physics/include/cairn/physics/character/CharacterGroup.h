@@ -85,9 +85,9 @@ public:
     using MemberVisitor = FunctionRef<void(MemberID, const Shape&, const Transform&, float inRadius)>;
     /// Calls inVisit with each member: to draw them.
     void ForEachMember(MemberVisitor inVisit) const;
-    /// The same for the members whose shapes may reach into inBounds, found in a grid of their places (built
-    /// by Add, Remove and Publish): what a character's moves look at, so a move's cost grows with the members
-    /// near it, not with the group's size.
+    /// The same for the members whose shapes may reach into inBounds (and perhaps a few more), found in a
+    /// grid of their places that Publish builds (members added since are each looked at): what a character's
+    /// moves look at, so a move's cost grows with the members near it, not with the group's size.
     void ForEachMemberNear(const AABB& inBounds, MemberVisitor inVisit) const;
 
 private:
@@ -110,6 +110,7 @@ private:
 
     /// The grid of the members' published places: each member's cell, by a key packing its coordinates
     void BuildGrid();
+    /// inVisit with the member, unless its slot is free
     void Visit(MemberID inMember, MemberVisitor inVisit) const;
 
     /// The least cell size (metres): the keys' 21 bits a coordinate then reach past the world's edge
@@ -123,6 +124,8 @@ private:
     std::vector<std::pair<uint64_t, MemberID>> mGrid;
     float mCellSize = cMinCellSize;
     float mMaxRadius = 0.0f;
+    /// Members added since the grid was built: every look-up visits them
+    std::vector<MemberID> mUnplaced;
 };
 
 } // namespace cairn::physics
