@@ -120,9 +120,14 @@ namespace
 /// Cell coordinates packed 21 bits each
 constexpr int64_t cCellRange = (int64_t(1) << 20) - 1;
 
+/// A coordinate's cell, clamped to the keys' range before it is made an integer (a coordinate past the
+/// world's edge would overflow it)
 int64_t CellOf(float inCoordinate, float inCellSize)
 {
-    return std::clamp(int64_t(std::floor(inCoordinate / inCellSize)), -cCellRange, cCellRange);
+    const float cell = std::floor(inCoordinate / inCellSize);
+    if (!(cell > float(-cCellRange))) return -cCellRange;
+    if (!(cell < float(cCellRange))) return cCellRange;
+    return int64_t(cell);
 }
 
 uint64_t CellKey(int64_t inX, int64_t inY, int64_t inZ)
@@ -160,6 +165,12 @@ void CharacterGroup::Visit(MemberID inMember, MemberVisitor inVisit) const
 
 void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVisit) const
 {
+    // Bounds that are not numbers hold no cells to look in: every member is looked at
+    if (!IsFinite(inBounds.mMin) || !IsFinite(inBounds.mMax))
+    {
+        ForEachMember(inVisit);
+        return;
+    }
     // Grown by the widest member's radius (since an Add, wider than the grid's cells: still every cell a
     // member in the grid reaches from)
     const AABB reach = inBounds.Expanded(mMaxRadius);

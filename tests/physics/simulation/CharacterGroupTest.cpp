@@ -10,6 +10,7 @@
 #include "cairn/physics/shapes/CapsuleShape.h"
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -317,6 +318,33 @@ TEST_F(CharacterGroupTest, MembershipFollowsTheController)
         Frame({&walker}, {Vec3(4, 0, 0)}, &group);
     EXPECT_GT(walker.GetPosition().x(), 1.0f);
     EXPECT_TRUE(walker.GetCharacterContacts().empty());
+}
+
+TEST_F(CharacterGroupTest, ALookUpNearBoundsThatAreNotNumbersOrPastTheWorldSeesEveryoneItShould)
+{
+    CharacterGroup group;
+    std::vector<CharacterController> members;
+    members.reserve(40);
+    for (int i = 0; i < 40; ++i)
+    {
+        members.push_back(MakeCharacter(Vec3(float(i) * 3.0f, cStandHeight, 0)));
+        ASSERT_TRUE(group.Add(members.back()));
+    }
+    group.Publish();
+    const auto count = [&](const AABB& inBounds)
+    {
+        int seen = 0;
+        group.ForEachMemberNear(inBounds, [&](CharacterGroup::MemberID, const Shape&, const Transform&, float)
+                                { ++seen; });
+        return seen;
+    };
+    EXPECT_EQ(count(AABB(Vec3(-0.5f, 0, -0.5f), Vec3(0.5f, 2, 0.5f))), 1) << "the one there";
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(count(AABB(Vec3(nan, 0, 0), Vec3(1, 1, 1))), 40) << "not a number: everyone";
+    EXPECT_EQ(count(AABB(Vec3(-inf, -inf, -inf), Vec3(inf, inf, inf))), 40);
+    EXPECT_EQ(count(AABB(Vec3(-1.0e30f, -1.0e30f, -1.0e30f), Vec3(1.0e30f, 1.0e30f, 1.0e30f))), 40)
+        << "past the world's edge, every cell: everyone";
+    EXPECT_EQ(count(AABB(Vec3(1.0e30f, 0, 0), Vec3(2.0e30f, 1, 1))), 0) << "far past it: no one";
 }
 
 TEST_F(CharacterGroupTest, AGroupRefusesMembersPastItsCapacity)

@@ -87,7 +87,8 @@ public:
     void ForEachMember(MemberVisitor inVisit) const;
     /// The same for the members whose shapes may reach into inBounds (and perhaps a few more), found in a
     /// grid of their places that Publish builds (members added since are each looked at): what a character's
-    /// moves look at, so a move's cost grows with the members near it, not with the group's size.
+    /// moves look at, so a move's cost grows with the members near it, not with the group's size. Bounds
+    /// that are not finite visit every member.
     void ForEachMemberNear(const AABB& inBounds, MemberVisitor inVisit) const;
 
 private:
