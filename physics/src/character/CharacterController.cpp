@@ -193,6 +193,7 @@ Status CharacterController::SetPosition(const Vec3& inPosition)
     mGroundNormal = mSettings.mUp;
     mGroundMoves = false;
     mGroundVelocity = Vec3::Zero();
+    mGroundMember = CharacterGroup::cNoMember;
     mContacts.clear(); // Not where it is now: nothing for PushBodies
     mCharacterContacts.clear();
     if (mSeat.GetGroup() != nullptr) mSeat.GetGroup()->SetNext(mSeat.GetMember(), mPosition);
@@ -255,6 +256,20 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         {
             Result<CharacterSweep> carry =
                 SweepCharacter(context, position, pose.mTransform * mPositionOnGround - position);
+            if (!carry) return carry.GetError();
+            groundVelocity = (carry.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
+            position = carry.Value().mEnd;
+            groundMovedNow = true;
+        }
+    }
+    // Or by the member of its group it stands on, where a Publish has moved it since
+    CharacterGroup* const group = mSeat.GetGroup();
+    if (mGroundState != GroundState::InAir && mGroundMember != CharacterGroup::cNoMember && group != nullptr)
+    {
+        const Vec3* below = group->PublishedPlace(mGroundMember, mGroundMemberSerial);
+        if (below != nullptr && *below != mGroundMemberAt)
+        {
+            Result<CharacterSweep> carry = SweepCharacter(context, position, *below - mGroundMemberAt);
             if (!carry) return carry.GetError();
             groundVelocity = (carry.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
             position = carry.Value().mEnd;
@@ -333,9 +348,10 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     if (state == GroundState::OnGround) velocity = AcrossAxis(velocity, up);
     // At rest, or another body's: this one's is measured from its next move
     if ((!groundMovedNow && sinceGroundMoved > cGroundAtRestAfter) ||
-        (state != GroundState::InAir && groundBody != mGroundBody))
+        (state != GroundState::InAir && (groundBody != mGroundBody || groundMember != mGroundMember)))
         groundVelocity = Vec3::Zero();
-    if (wasOnGround && state == GroundState::InAir) velocity += groundVelocity; // Off a moving platform
+    // Off a moving platform (or a moving member of its group), from its top or down its steep side
+    if (mGroundState != GroundState::InAir && state == GroundState::InAir) velocity += groundVelocity;
 
     // A move the queries allowed can still end past the world's edge (they reach farther), and a step of a
     // nanosecond can measure an enormous speed: such an Update is refused whole, as bad input is
@@ -358,7 +374,24 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
             mGroundPoseVersion = pose.mVersion;
         }
     }
-    mTimeSinceGroundMoved = groundMovedNow || groundBody != previousGround ? 0.0f : sinceGroundMoved;
+    const CharacterGroup::MemberID previousGroundMember = mGroundMember;
+    mGroundMember = CharacterGroup::cNoMember;
+    if (state != GroundState::InAir && groundMember != CharacterGroup::cNoMember && group != nullptr)
+    {
+        // Its anchor is the place it was carried to: a Publish can not come between the moves and here
+        const uint32_t serial = group->SerialOf(groundMember);
+        if (const Vec3* below = group->PublishedPlace(groundMember, serial))
+        {
+            mGroundMoves = true;
+            mGroundMember = groundMember;
+            mGroundMemberSerial = serial;
+            mGroundMemberAt = *below;
+        }
+    }
+    mTimeSinceGroundMoved =
+        groundMovedNow || groundBody != previousGround || mGroundMember != previousGroundMember
+            ? 0.0f
+            : sinceGroundMoved;
     mGroundVelocity = mGroundMoves ? groundVelocity : Vec3::Zero();
     mPosition = position;
     mVelocity = velocity;

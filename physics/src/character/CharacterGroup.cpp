@@ -33,7 +33,8 @@ Result<CharacterGroup::MemberID> CharacterGroup::Add(CharacterController& ioChar
                         std::max(bounds.mMin.norm(), bounds.mMax.norm()),
                         ioCharacter.mPosition,
                         ioCharacter.mPosition,
-                        &ioCharacter.mSeat};
+                        &ioCharacter.mSeat,
+                        mNextSerial++};
     ++mNumMembers;
     ioCharacter.mSeat.mGroup = this;
     ioCharacter.mSeat.mMember = member;

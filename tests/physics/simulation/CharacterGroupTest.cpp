@@ -49,6 +49,17 @@ protected:
         if (ioGroup != nullptr) ioGroup->Publish();
     }
 
+    /// Adds ioBelow and ioAbove (over it) to ioGroup, and lets ioAbove come to rest on ioBelow's head.
+    static void SettleOnHead(CharacterGroup& ioGroup, CharacterController& ioBelow,
+                             CharacterController& ioAbove)
+    {
+        ASSERT_TRUE(ioGroup.Add(ioBelow));
+        ASSERT_TRUE(ioGroup.Add(ioAbove));
+        for (int frame = 0; frame < 30; ++frame)
+            Frame({&ioBelow, &ioAbove}, {Vec3::Zero(), Vec3::Zero()}, &ioGroup);
+        ASSERT_EQ(ioAbove.GetGroundMember(), ioBelow.GetGroupMember());
+    }
+
     static bool Touches(const CharacterController& inCharacter, CharacterGroup::MemberID inMember)
     {
         const auto contacts = inCharacter.GetCharacterContacts();
@@ -227,6 +238,50 @@ TEST_F(CharacterGroupTest, AMemberStandsOnAnothersHead)
     const float top = below.GetPosition().y() + cStandHeight;
     EXPECT_GE(above.GetPosition().y(), top + cStandHeight - 1.0e-3f);
     EXPECT_LE(above.GetPosition().y(), top + cStandHeight + above.GetSettings().mPadding + 1.0e-3f);
+}
+
+TEST_F(CharacterGroupTest, AMemberOnAnothersHeadIsCarriedWhereItWalks)
+{
+    AddFloor();
+    CharacterGroup group;
+    CharacterController below = MakeCharacter(Vec3(0, cStandHeight + 0.02f, 0));
+    CharacterController above = MakeCharacter(Vec3(0, 3.0f * cStandHeight + 0.1f, 0));
+    SettleOnHead(group, below, above);
+    ASSERT_EQ(above.GetGroundState(), GroundState::OnGround);
+    // The one below walks 2 m; the one above stands still on it
+    for (int frame = 0; frame < 60; ++frame)
+    {
+        Frame({&below, &above}, {Vec3(2, 0, 0), Vec3::Zero()}, &group);
+        ASSERT_EQ(above.GetGroundMember(), below.GetGroupMember()) << "frame " << frame;
+    }
+    EXPECT_NEAR(above.GetPosition().x(), below.GetPosition().x(), 2.0f * 2.0f * cDeltaTime)
+        << "a frame behind at most";
+    EXPECT_GT(above.GetPosition().y(), below.GetPosition().y() + 2.0f * cStandHeight - 1.0e-3f)
+        << "still on its head";
+    EXPECT_NEAR(above.GetGroundVelocity().x(), 2.0f, 0.05f);
+    // Stepping off sideways it leaves with the speed it was carried at
+    int frame = 0;
+    for (; frame < 30 && above.GetGroundMember() != CharacterGroup::cNoMember; ++frame)
+        Frame({&below, &above}, {Vec3(2, 0, 0), Vec3(0, 0, 3)}, &group);
+    ASSERT_LT(frame, 30) << "it stepped off";
+    EXPECT_EQ(above.GetGroundState(), GroundState::InAir);
+    EXPECT_NEAR(above.GetLinearVelocity().x(), 2.0f, 0.05f);
+}
+
+TEST_F(CharacterGroupTest, AMemberIsNotCarriedByAnotherThatTookTheSlotOfTheOneItStoodOn)
+{
+    AddFloor();
+    CharacterGroup group;
+    CharacterController below = MakeCharacter(Vec3(0, cStandHeight + 0.02f, 0));
+    CharacterController above = MakeCharacter(Vec3(0, 3.0f * cStandHeight + 0.1f, 0));
+    SettleOnHead(group, below, above);
+    const CharacterGroup::MemberID slot = below.GetGroupMember();
+    ASSERT_TRUE(group.Remove(below).IsOk());
+    CharacterController elsewhere = MakeCharacter(Vec3(10, cStandHeight + 0.02f, 0));
+    ASSERT_EQ(group.Add(elsewhere).Value(), slot);
+    group.Publish();
+    Frame({&above}, {Vec3::Zero()}, &group);
+    EXPECT_NEAR(above.GetPosition().x(), 0.0f, 1.0e-3f) << "not carried 10 m to the slot's new member";
 }
 
 TEST_F(CharacterGroupTest, MembersSeeEachOtherAsLastPublished)

@@ -100,8 +100,11 @@ public:
     Status SetLinearVelocity(const Vec3& inVelocity);
 
     GroundState GetGroundState() const { return mGroundState; }
-    /// The body under the character, invalid InAir
+    /// The body under the character, invalid InAir and on another character
     BodyID GetGroundBody() const { return mGroundBody; }
+    /// The member of its group it stands on (CharacterGroup::cNoMember when none): as a moving ground body,
+    /// it carries the character where the group's Publishes put it
+    CharacterGroup::MemberID GetGroundMember() const { return mGroundMember; }
     /// The ground's surface normal under the character (towards it); mUp InAir
     Vec3 GetGroundNormal() const { return mGroundNormal; }
     /// The ground body's velocity where the character stands, as its moves since the last Updates measured
@@ -157,6 +160,10 @@ private:
     std::vector<CharacterGroup::MemberID> mCharacterContacts,
         mNextCharacterContacts; ///< The same, of members
     CharacterGroup::Seat mSeat; ///< Its place in a group, if any
+    /// The member it stands on, that member's serial, and the member's published place it was carried to
+    CharacterGroup::MemberID mGroundMember = CharacterGroup::cNoMember;
+    uint32_t mGroundMemberSerial = 0;
+    Vec3 mGroundMemberAt = Vec3::Zero();
     /// The last Update's: where the character stood on its ground, its time step and gravity (PushBodies)
     Vec3 mGroundPoint = Vec3::Zero();
     float mLastDeltaTime = 0.0f;

@@ -1,12 +1,13 @@
 #pragma once
 
 // CharacterGroup: characters that block each other. CharacterControllers are not bodies, so the world's
-// queries do not see them; the members of a group see each other: a member's moves stop at the others' shapes
-// as at a wall, it stands on another's head, and one that moved into it pushes it out. What Jolt's
-// CharacterVsCharacterCollision gives, without a lock and without a wait: a member's Update sees the others
-// where they stood at the group's last Publish, so the members of a group update at once on any threads, as
-// characters do (two characters walking into each other meet within a frame's move, and the next Update's
-// push-out parts them).
+// queries do not see them; the members of a group see each other: a member's moves stop at the others'
+// shapes as at a wall, it stands on another's head (carried where that one walks, as by a moving body), and
+// one that moved into it pushes it out. What Jolt's CharacterVsCharacterCollision gives, without a lock and
+// without a wait: a member's Update sees the others where they stood at the group's last Publish, so the
+// members of a group update at once on any threads, as characters do (two characters walking into each other
+// meet within a frame's move, and the next Update's push-out parts them; a member is carried a frame behind
+// the one it stands on).
 //
 // Threads: Add, Remove, Publish, and a member's controller's move or destruction, on one thread while no
 // member's Update runs (the game's thread, between frames: Publish is the group's sync point). Between two of
@@ -102,8 +103,19 @@ private:
         Vec3 mPublished = Vec3::Zero(); ///< Written by Add and Publish, read by every member's Update
         Vec3 mNext = Vec3::Zero(); ///< Written by the member's own Update and SetPosition, read by Publish
         Seat* mSeat = nullptr;     ///< The member's, wherever its controller has moved
+        uint32_t mSerial = 0;      ///< Tells apart the members a slot has held
     };
 
+    /// A member's published place, or null when inSerial is not its serial (it left, its slot perhaps taken
+    /// again): what a member standing on it is carried by.
+    const Vec3* PublishedPlace(MemberID inMember, uint32_t inSerial) const
+    {
+        return inMember < mMembers.size() && mMembers[inMember].mShape != nullptr &&
+                       mMembers[inMember].mSerial == inSerial
+                   ? &mMembers[inMember].mPublished
+                   : nullptr;
+    }
+    uint32_t SerialOf(MemberID inMember) const { return mMembers[inMember].mSerial; }
     /// The member's place after its Update or SetPosition: on its own thread.
     void SetNext(MemberID inMember, const Vec3& inPosition) { mMembers[inMember].mNext = inPosition; }
     /// A member gone (removed, or destroyed without being removed).
@@ -127,6 +139,7 @@ private:
     float mMaxRadius = 0.0f;
     /// Members added since the grid was built: every look-up visits them
     std::vector<MemberID> mUnplaced;
+    uint32_t mNextSerial = 1;
 };
 
 } // namespace cairn::physics
