@@ -191,15 +191,16 @@ void CharacterGroup::ForEachMemberNear(const AABB& inBounds, MemberVisitor inVis
     }
     for (const MemberID member : mUnplaced)
         Visit(member, inVisit);
+    // A row of cells along z has consecutive keys (z is the key's lowest field): one search a row
     for (int64_t x = low[0]; x <= high[0]; ++x)
         for (int64_t y = low[1]; y <= high[1]; ++y)
-            for (int64_t z = low[2]; z <= high[2]; ++z)
-            {
-                const uint64_t key = CellKey(x, y, z);
-                auto cell = std::lower_bound(mGrid.begin(), mGrid.end(), std::make_pair(key, MemberID(0)));
-                for (; cell != mGrid.end() && cell->first == key; ++cell)
-                    Visit(cell->second, inVisit);
-            }
+        {
+            const uint64_t last = CellKey(x, y, high[2]);
+            auto cell = std::lower_bound(mGrid.begin(), mGrid.end(),
+                                         std::make_pair(CellKey(x, y, low[2]), MemberID(0)));
+            for (; cell != mGrid.end() && cell->first <= last; ++cell)
+                Visit(cell->second, inVisit);
+        }
 }
 
 void CharacterGroup::ForEachMember(MemberVisitor inVisit) const
