@@ -244,6 +244,16 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     Vec3 groundVelocity = mGroundVelocity;
     const float sinceGroundMoved = mTimeSinceGroundMoved + inDeltaTime;
     bool groundMovedNow = false;
+    // Swept along by inMove, the ground's since the last Update; its velocity is measured from it
+    const auto carry = [&](const Vec3& inMove) -> Status
+    {
+        Result<CharacterSweep> carried = SweepCharacter(context, position, inMove);
+        if (!carried) return carried.GetError();
+        groundVelocity = (carried.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
+        position = carried.Value().mEnd;
+        groundMovedNow = true;
+        return Status::Ok();
+    };
     // The ground's pose the character is carried to: kept as its anchor when it still stands on that body,
     // since a pose read after the moves could be a step newer than the one they were made against
     std::optional<PublishedPose> carriedBy;
@@ -254,12 +264,8 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         if (poses.Read(mGroundBody, pose)) carriedBy = pose;
         if (carriedBy && pose.mVersion != mGroundPoseVersion)
         {
-            Result<CharacterSweep> carry =
-                SweepCharacter(context, position, pose.mTransform * mPositionOnGround - position);
-            if (!carry) return carry.GetError();
-            groundVelocity = (carry.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
-            position = carry.Value().mEnd;
-            groundMovedNow = true;
+            if (Status carried = carry(pose.mTransform * mPositionOnGround - position); !carried)
+                return carried;
         }
     }
     // Or by the member of its group it stands on, where a Publish has moved it since
@@ -269,11 +275,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         const Vec3* below = group->PublishedPlace(mGroundMember, mGroundMemberSerial);
         if (below != nullptr && *below != mGroundMemberAt)
         {
-            Result<CharacterSweep> carry = SweepCharacter(context, position, *below - mGroundMemberAt);
-            if (!carry) return carry.GetError();
-            groundVelocity = (carry.Value().mEnd - position) / std::max(sinceGroundMoved, cMinGroundMoveTime);
-            position = carry.Value().mEnd;
-            groundMovedNow = true;
+            if (Status carried = carry(*below - mGroundMemberAt); !carried) return carried;
         }
     }
 

@@ -1,6 +1,7 @@
 #include "cairn/physics/character/CharacterGroup.h"
 
 #include "cairn/physics/character/CharacterController.h"
+#include "character/CharacterGroupQueries.h"
 
 #include <algorithm>
 #include <cmath>
@@ -27,10 +28,9 @@ Result<CharacterGroup::MemberID> CharacterGroup::Add(CharacterController& ioChar
         member = MemberID(mMembers.size());
         mMembers.emplace_back();
     }
-    const AABB bounds = ioCharacter.mSettings.mShape->GetLocalBounds();
     mMembers[member] = {ioCharacter.mSettings.mShape,
                         ioCharacter.mShapeRotation,
-                        std::max(bounds.mMin.norm(), bounds.mMax.norm()),
+                        BoundingRadius(*ioCharacter.mSettings.mShape),
                         ioCharacter.mPosition,
                         ioCharacter.mPosition,
                         &ioCharacter.mSeat,

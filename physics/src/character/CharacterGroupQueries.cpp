@@ -6,15 +6,14 @@
 
 namespace cairn::physics
 {
-namespace
-{
-/// The radius round a shape's origin that holds it.
 float BoundingRadius(const Shape& inShape)
 {
     const AABB bounds = inShape.GetLocalBounds();
     return std::max(bounds.mMin.norm(), bounds.mMax.norm());
 }
 
+namespace
+{
 /// The distance from inPoint to the segment from inStart along inDisplacement.
 float DistanceToSegment(const Vec3& inPoint, const Vec3& inStart, const Vec3& inDisplacement)
 {

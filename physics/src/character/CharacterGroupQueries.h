@@ -13,6 +13,9 @@
 namespace cairn::physics
 {
 
+/// The radius round a shape's origin that holds it: a member's reach, wherever it turns.
+float BoundingRadius(const Shape& inShape);
+
 struct MemberCastHit
 {
     CharacterGroup::MemberID mMember;
