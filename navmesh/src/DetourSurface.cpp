@@ -99,19 +99,21 @@ Result<NavRaycastHit> CastAcrossSurface(const dtNavMeshQuery& inQuery, const dtN
 {
     const Vec3 along = AcrossXZ(inEnd - inStartPoint);
     NavRaycastHit result;
-    // The walk stops leaving the last polygon it may use: at its fraction of the whole line
-    auto stopLeaving = [&](dtPolyRef inLast) -> Result<NavRaycastHit>
+    // The walk stops leaving the last polygon it may use (inLeaving: where the line leaves it), at its
+    // fraction of the whole line
+    auto stopAt = [&](dtPolyRef inLast, const std::optional<Leaving>& inLeaving) -> Result<NavRaycastHit>
     {
-        const std::optional<Leaving> leaving = LeavePolygon(inNavMesh, inLast, inStartPoint, inEnd);
-        if (!leaving)
+        if (!inLeaving)
             return MakeError(ErrorCode::InvalidArgument,
                              "raycast: the line lost its way along Detour's polygons");
         result.mHit = true;
-        result.mFraction = leaving->mFraction;
-        result.mWallNormal = leaving->mNormal;
+        result.mFraction = inLeaving->mFraction;
+        result.mWallNormal = inLeaving->mNormal;
         result.mPosition = OnPolygon(inQuery, inLast, inStartPoint + result.mFraction * along);
         return result;
     };
+    auto stopLeaving = [&](dtPolyRef inLast)
+    { return stopAt(inLast, LeavePolygon(inNavMesh, inLast, inStartPoint, inEnd)); };
     dtPolyRef from = inStart, last = inStart;
     Vec3 fromPoint = inStartPoint;
     for (int leg = 0;; ++leg)
@@ -153,7 +155,7 @@ Result<NavRaycastHit> CastAcrossSurface(const dtNavMeshQuery& inQuery, const dtN
         const bool lostItsWay = hit.hitNormal[0] == 0.0f && hit.hitNormal[2] == 0.0f;
         if (!lostItsWay || leg == cMaxBorderRetries) return stopLeaving(last);
         const std::optional<Leaving> leaving = LeavePolygon(inNavMesh, last, inStartPoint, inEnd);
-        if (!leaving) return stopLeaving(last);
+        if (!leaving) return stopAt(last, leaving);
         const float length = along.norm();
         Vec3 probe = inStartPoint + std::min(leaving->mFraction + cBorderStep / length, 1.0f) * along;
         probe.y() = OnPolygon(inQuery, last, probe).y();
@@ -163,7 +165,7 @@ Result<NavRaycastHit> CastAcrossSurface(const dtNavMeshQuery& inQuery, const dtN
         inQuery.findNearestPoly(probe.data(), extent.data(), &inDetourFilter, &next, onNext.data());
         // The probe may lie on the next polygon's edge (a line along a border): on it counts as in it
         if (next == 0 || next == last || AcrossXZ(onNext - probe).norm() > cOnPolygon)
-            return stopLeaving(last); // A gap: the border is a wall
+            return stopAt(last, leaving); // A gap: the border is a wall
         from = next;
         fromPoint = onNext;
     }
@@ -194,8 +196,10 @@ Result<NavWall> FindWallAround(dtNavMeshQuery& inQuery, const dtNavMesh& inNavMe
         if (dtStatusDetail(status, DT_BUFFER_TOO_SMALL) || dtStatusDetail(status, DT_OUT_OF_NODES))
             return MakeError(ErrorCode::OutOfCapacity, "nearest wall: the circle holds more than " +
                                                            std::to_string(cMaxQueryNodes) + " polygons");
-        NavWall nearest;
+        // The nearest wall segment so far: its polygon, the segment's ends and the point on it
         float nearestSquared = radius * radius;
+        int nearestPolygon = -1;
+        Vec3 nearestA, nearestB, onWall;
         outOfReach.clear();
         // Detour lists a polygon after the one it came from, and an excluded area's high cost makes it come
         // from one outside excluded areas wherever it can: a polygon is out of reach when it is a jump, is
@@ -226,20 +230,25 @@ Result<NavWall> FindWallAround(dtNavMeshQuery& inQuery, const dtNavMesh& inNavMe
                 const float* b = a + 3;
                 float along = 0.0f;
                 const float distanceSquared = dtDistancePtSegSqr2D(inPoint.data(), a, b, along);
-                if (distanceSquared > nearestSquared || (nearest.mFound && distanceSquared == nearestSquared))
+                if (distanceSquared > nearestSquared ||
+                    (nearestPolygon >= 0 && distanceSquared == nearestSquared))
                     continue;
-                Vec3 onWall;
-                dtVlerp(onWall.data(), a, b, along);
                 nearestSquared = distanceSquared;
-                nearest.mFound = true;
-                nearest.mPosition = OnPolygon(inQuery, polygons[size_t(i)], onWall);
-                const Vec3 away = AcrossXZ(inPoint - onWall);
-                nearest.mNormal = away.norm() > cOnWall ? Vec3(away.normalized()) : InwardNormal(a, b);
+                nearestPolygon = i;
+                nearestA = Vec3(a[0], a[1], a[2]);
+                nearestB = Vec3(b[0], b[1], b[2]);
+                dtVlerp(onWall.data(), a, b, along);
             }
         }
-        if (nearest.mFound)
+        if (nearestPolygon >= 0)
         {
+            NavWall nearest;
+            nearest.mFound = true;
             nearest.mDistance = std::sqrt(nearestSquared);
+            nearest.mPosition = OnPolygon(inQuery, polygons[size_t(nearestPolygon)], onWall);
+            const Vec3 away = AcrossXZ(inPoint - onWall);
+            nearest.mNormal = away.norm() > cOnWall ? Vec3(away.normalized())
+                                                    : InwardNormal(nearestA.data(), nearestB.data());
             return nearest;
         }
         if (radius >= inMaxRadius) return NavWall{};

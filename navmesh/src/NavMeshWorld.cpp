@@ -317,11 +317,8 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
 Result<Vec3> NavMeshWorld::FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter,
                                             const Vec3& inSearchExtent) const
 {
-    if (!IsValidWorldPosition(inPoint))
-        return MakeError(ErrorCode::InvalidArgument, "nearest point: the point must be finite");
-    if (Status extent = CheckSearchExtent(inSearchExtent, mGrid.GetTileSize(), "nearest point"); !extent)
-        return extent.GetError();
-    Result<dtQueryFilter> filter = MakeDetourFilter(inFilter, "nearest point");
+    Result<dtQueryFilter> filter =
+        CheckPointQuery(inPoint, inSearchExtent, inFilter, mGrid.GetTileSize(), "nearest point", "the point");
     if (!filter) return filter.GetError();
 
     std::shared_lock lock(mNavMeshMutex);
