@@ -39,6 +39,9 @@ constexpr int cMaxWallSegments = 8;
 /// off the straight line from where they were found to the first (see Crowd::Agent::Corners)
 constexpr uint64_t cCornerReuseUpdates = 8;
 constexpr float cCornerLineToleranceRadii = 0.1f;
+/// An agent whose corridor was cut short of its path asks for the rest when this many polygons are left
+/// (DetourCrowd's CHECK_LOOKAHEAD): enough to walk on while the queue searches
+constexpr int cCutCorridorReplanPolygons = 10;
 
 /// DetourCrowd's "medium" quality: adaptive sampling, 5 divisions, 2 rings, depth 2 (22 samples a threatened
 /// agent, against 75 for its "good": the sampling was half of a 10,000-agent crowd's time at "good").
@@ -129,6 +132,9 @@ struct Crowd::Agent
     AgentState mState = AgentState::Idle;
     float mStuckSeconds = 0.0f;     ///< Moving but hardly: how long, for the way out of a jam
     bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
+    /// Its path was longer than its corridor holds: the corridor ends short of the target, and the agent
+    /// asks for the rest as it nears that end
+    bool mCorridorCut = false;
     dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
     dtPolyRef mLastPolygon = 0;     ///< Its corridor's first polygon at its last move
     bool mWallsStale = false;       ///< A tile near its walls changed since they were gathered
@@ -265,7 +271,8 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
         return MakeError(ErrorCode::OutOfCapacity, "agent: the crowd is full");
     auto agent = std::make_unique<Agent>();
     agent->mParams = inParams;
-    if (!agent->mCorridor.init(mSettings.mMaxCorridorPolygons))
+    // One more than it holds: Detour's setCorridor asserts that a path is shorter than the corridor's size
+    if (!agent->mCorridor.init(mSettings.mMaxCorridorPolygons + 1))
         return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not allocate its corridor");
     bool queryReady = false, onNavMesh = false;
     mWorld.Read(
@@ -679,8 +686,13 @@ void Crowd::RequestPaths()
             agent.mTicket = {};
             continue;
         }
-        // An agent that needs a path and has no request (a replan, back on navmesh, or a full queue last
-        // time) asks now; a full queue is asked again next Update
+        // Near the end of a corridor cut short, the rest of the way, walking on meanwhile (DetourCrowd asks
+        // again likewise); it would stop there as if it had arrived
+        if (agent.mState == AgentState::Moving && agent.mCorridorCut &&
+            agent.mCorridor.getPathCount() <= cCutCorridorReplanPolygons)
+            agent.mState = AgentState::WaitingForPath;
+        // An agent that needs a path and has no request (a replan, back on navmesh, a corridor cut short, or
+        // a full queue last time) asks now; a full queue is asked again next Update
         if (agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue == 0)
         {
             Result<PathTicket> ticket = RequestPath(agent);
@@ -721,8 +733,8 @@ void Crowd::ApplyPathResults()
             continue;
         }
         std::vector<dtPolyRef> path(polygons.begin() + long(from), polygons.end());
-        if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
-            path.resize(size_t(mSettings.mMaxCorridorPolygons));
+        agent.mCorridorCut = path.size() > size_t(mSettings.mMaxCorridorPolygons);
+        if (agent.mCorridorCut) path.resize(size_t(mSettings.mMaxCorridorPolygons));
         corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(), int(path.size()));
         agent.mCorners.mValid = false;
         agent.mState = AgentState::Moving;

@@ -395,6 +395,30 @@ TEST_F(CrowdTest, AgentsStandOnTheSurfaceTheyWalkOver)
     EXPECT_EQ(belowTheirTop, 0);
 }
 
+// A path of more polygons than the agent's corridor holds is walked a corridor at a time, to its goal (the
+// agent stopped at its corridor's end as if it had arrived; and a path as long as the corridor failed
+// Detour's assertion)
+TEST_F(CrowdTest, APathLongerThanTheCorridorIsWalkedWhole)
+{
+    BuildWalledGround();
+    const Vec3 start(-22, 0, -22), goal(22, 0, 22);
+    const Result<PathResult> path = mWorld->FindPath(start, goal);
+    ASSERT_TRUE(path && path.Value().mReachedEnd);
+    for (const int corridor : {3, path.Value().mNumPolygons})
+    {
+        Crowd::Settings settings;
+        settings.mMaxCorridorPolygons = corridor;
+        std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld, settings).Value();
+        const Crowd::AgentID agent = crowd->AddAgent(start).Value();
+        ASSERT_TRUE(crowd->SetTarget(agent, goal).IsOk());
+        for (int frame = 0; frame < 1800; ++frame)
+            ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
+        EXPECT_EQ(crowd->GetState(agent).Value(), AgentState::Arrived) << corridor << " polygons";
+        EXPECT_LT((crowd->GetPosition(agent).Value() - path.Value().mStraightPath.back()).norm(), 0.6f)
+            << corridor << " polygons, of a path of " << path.Value().mNumPolygons;
+    }
+}
+
 TEST_F(CrowdTest, BadInputGetsClearErrors)
 {
     BuildWalledGround();

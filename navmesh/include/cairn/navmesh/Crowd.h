@@ -74,7 +74,9 @@ public:
     {
         int mMaxAgents = 16384;
         float mMaxAgentRadius = 2.0f;   ///< m: the neighbour grid's cell is twice this
-        int mMaxCorridorPolygons = 256; ///< Per agent
+        /// Per agent, in [2, 1024]: a longer path is walked a corridor at a time, the rest asked for as the
+        /// agent nears the corridor's end
+        int mMaxCorridorPolygons = 256;
         /// Updates an agent on a collision course keeps the velocity it sampled (DetourCrowd samples every
         /// Update: 1). 2 halves the sampling, the crowd's largest cost in a dense crowd: avoidance is planned
         /// at 30 Hz while agents move and part at 60.
