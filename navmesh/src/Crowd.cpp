@@ -1,6 +1,7 @@
 #include "cairn/navmesh/Crowd.h"
 
 #include "DetourPaths.h"
+#include "LinkMotion.h"
 #include "cairn/physics/PhysicsSystem.h"
 #include "cairn/physics/body/PublishedPose.h"
 
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace cairn::navmesh
 {
@@ -39,6 +41,10 @@ constexpr int cMaxWallSegments = 8;
 /// off the straight line from where they were found to the first (see Crowd::Agent::Corners)
 constexpr uint64_t cCornerReuseUpdates = 8;
 constexpr float cCornerLineToleranceRadii = 0.1f;
+/// An agent takes an off-mesh link that is its next corner within this many of its radii (DetourCrowd's
+/// trigger): it walks the rest of the way to the start as part of the link, so no Update finds it short of
+/// the start with the link behind it
+constexpr float cLinkReachRadii = 2.25f;
 /// An agent whose corridor was cut short of its path asks for the rest when this many polygons are left
 /// (DetourCrowd's CHECK_LOOKAHEAD): enough to walk on while the queue searches
 constexpr int cCutCorridorReplanPolygons = 10;
@@ -130,8 +136,8 @@ struct Crowd::Agent
     bool mHasTarget = false;
     PathTicket mTicket;
     AgentState mState = AgentState::Idle;
-    float mStuckSeconds = 0.0f;     ///< Moving but hardly: how long, for the way out of a jam
-    bool mReplanned = false;        ///< This Update's corridor check cut its corridor short
+    float mStuckSeconds = 0.0f; ///< Moving but hardly: how long, for the way out of a jam
+    bool mReplanned = false;    ///< This Update's corridor check cut its corridor short
     /// Its path was longer than its corridor holds: the corridor ends short of the target, and the agent
     /// asks for the rest as it nears that end
     bool mCorridorCut = false;
@@ -140,6 +146,8 @@ struct Crowd::Agent
     bool mWallsStale = false;       ///< A tile near its walls changed since they were gathered
     uint64_t mSampledAt = 0; ///< The Update of its last velocity sampling (0: not threatened last time)
     Vec3 mSampledVelocity = Vec3::Zero();
+    /// The off-mesh link it is taking: its corridor already goes on from the link's end, where it lands
+    std::optional<LinkMotion> mLink;
 
     /// The first corners of its corridor's straight path, as FindCorners found them at mFrom. From any point
     /// on the straight line from mFrom to the first corner, the path through the same polygons has the same
@@ -190,7 +198,10 @@ struct Crowd::Agent
     /// the crate. The height is taken from the polygon's surface after every move (SetHeightFromSurface).
     float mHeight = 0.0f;
 
-    Vec3 Position() const { return Vec3(mCorridor.getPos()[0], mHeight, mCorridor.getPos()[2]); }
+    /// Where it stands on its corridor (on a link: the link's end)
+    Vec3 CorridorPosition() const { return Vec3(mCorridor.getPos()[0], mHeight, mCorridor.getPos()[2]); }
+    /// Where it is: on a link, the way along it
+    Vec3 Position() const { return mLink ? mLink->GetPosition() : CorridorPosition(); }
     /// mHeight from the surface of the agent's polygon under its position (its corridor's height if none).
     void SetHeightFromSurface(const dtNavMeshQuery& inQuery)
     {
@@ -200,6 +211,59 @@ struct Crowd::Agent
             dtStatusSucceed(
                 inQuery.closestPointOnPoly(mCorridor.getFirstPoly(), mCorridor.getPos(), closest, nullptr)))
             mHeight = closest[1];
+    }
+
+    /// Takes the off-mesh link inLink, the first of its corners, from inPosition: its corridor moves over the
+    /// link to the polygon at the far end. False (and nothing changed) where Detour finds no such link in the
+    /// corridor.
+    bool TakeLink(dtPolyRef inLink, const Vec3& inPosition, dtNavMeshQuery& ioQuery)
+    {
+        const dtNavMesh& navMesh = *ioQuery.getAttachedNavMesh();
+        const dtOffMeshConnection* connection = navMesh.getOffMeshConnectionByRef(inLink);
+        const dtMeshTile* tile = nullptr;
+        const dtPoly* polygon = nullptr;
+        // The link with a polygon after it in the corridor: Detour's move cuts the corridor up to there
+        // before it asks for the link's ends, and a corridor cut short may end on the link (the agent then
+        // waits at the start for the rest of its path)
+        bool inCorridor = false;
+        for (int p = 0; p + 1 < mCorridor.getPathCount() && !inCorridor; ++p)
+            inCorridor = mCorridor.getPath()[p] == inLink;
+        if (connection == nullptr || !inCorridor ||
+            dtStatusFailed(navMesh.getTileAndPolyByRef(inLink, &tile, &polygon)))
+            return false;
+        const dtPolyRef before = mCorridor.getFirstPoly();
+        const Vec3 beforePosition = CorridorPosition();
+        dtPolyRef ends[2];
+        Vec3 start, end;
+        if (!mCorridor.moveOverOffmeshConnection(inLink, ends, start.data(), end.data(), &ioQuery))
+        {
+            // Not expected (the link is there): it stands where it was and asks for its path again
+            mCorridor.reset(before, beforePosition.data());
+            mCorners.mValid = false;
+            if (mState == AgentState::Moving) mState = AgentState::WaitingForPath;
+            return false;
+        }
+        SetHeightFromSurface(ioQuery); // At the link's end, for the corridor's place
+        OffMeshLinkCrossing crossing;
+        crossing.mStart = start;
+        crossing.mEnd = end; // Detour moved it onto the polygon it lands on when it joined the link
+        crossing.mUserID = connection->userId;
+        crossing.mArea = polygon->getArea();
+        mLink.emplace(inPosition, crossing, mParams.mMaxSpeed, mParams.mLinkMode);
+        mCorners.mValid = false;
+        return true;
+    }
+
+    /// One Update along its link from inPosition; off it at the end (an automatic link), going on at the
+    /// speed it had along the link, not the shorter last step's (it slowed to a crawl as it landed).
+    void MoveAlongLink(const Vec3& inPosition, float inDeltaTime)
+    {
+        if (mLink->Advance(inDeltaTime))
+        {
+            mLink.reset(); // mVelocity stays the last Update's along the link
+            return;
+        }
+        mVelocity = Flat(Position() - inPosition) / inDeltaTime;
     }
 };
 
@@ -222,8 +286,9 @@ Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const 
     if (!(inSettings.mAvoidancePeriod >= 1 && inSettings.mAvoidancePeriod <= 60))
         return MakeError(ErrorCode::InvalidArgument,
                          "crowd: the avoidance period must be in [1, 60] Updates");
-    if (!(inSettings.mMaxCorridorPolygons >= 2 && inSettings.mMaxCorridorPolygons <= cMaxPathPolygons))
-        return MakeError(ErrorCode::InvalidArgument, "crowd: corridor polygons must be in [2, 1024]");
+    // Three at least: an off-mesh link and a polygon on either side of it
+    if (!(inSettings.mMaxCorridorPolygons >= 3 && inSettings.mMaxCorridorPolygons <= cMaxPathPolygons))
+        return MakeError(ErrorCode::InvalidArgument, "crowd: corridor polygons must be in [3, 1024]");
     std::unique_ptr<Crowd> crowd(new Crowd(inWorld, inSettings));
     Result<std::unique_ptr<PathRequestQueue>> paths = PathRequestQueue::Create(inWorld, inSettings.mPaths);
     if (!paths) return paths.GetError();
@@ -425,6 +490,7 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             // agents: the two run side by side, the search as a task
             mChunkSampled.assign(std::max<uint32_t>(chunks, 1), 0);
             mChunkWalls.assign(std::max<uint32_t>(chunks, 1), 0);
+            mChunkLinks.assign(std::max<uint32_t>(chunks, 1), 0);
             auto search = [&]
             {
                 const Clock::time_point searchStart = Clock::now();
@@ -443,6 +509,8 @@ Status Crowd::Update(float inDeltaTime, jobs::JobInterface* ioJobs)
             mStatistics.mLastWallUpdates = 0;
             for (uint32_t walls : mChunkWalls)
                 mStatistics.mLastWallUpdates += walls;
+            for (uint32_t links : mChunkLinks)
+                mStatistics.mLinksTaken += links;
             ApplyPathResults();
         });
     if (!scratchReady)
@@ -611,8 +679,9 @@ bool Crowd::MakeScratch(const dtNavMesh& inNavMesh, size_t inChunks)
 
 Result<PathTicket> Crowd::RequestPath(const Agent& inAgent)
 {
-    // From the agent's own polygon: snapping its position may pick the neighbour on a shared edge
-    return mPaths->Request(inAgent.Position(), inAgent.mTarget, {}, cSnapExtent,
+    // From the agent's own polygon: snapping its position may pick the neighbour on a shared edge. From its
+    // corridor's place, which on a link is the link's end: where the path will start
+    return mPaths->Request(inAgent.CorridorPosition(), inAgent.mTarget, {}, cSnapExtent,
                            inAgent.mCorridor.getFirstPoly());
 }
 
@@ -750,8 +819,15 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
     for (uint32_t i = inBegin; i < inEnd; ++i)
     {
         Agent& agent = *mAgents[mOrder[i]];
-        if (agent.mState == AgentState::OffNavMesh) continue;
         const Vec3 position = mSnapshotPositions[i];
+        // On a link it steers round no one (DetourCrowd's agents do not either): the others avoid it. Its
+        // corridor, from the link's end, may meanwhile be checked, cut or replaced: it lands on what is there
+        if (agent.mLink)
+        {
+            agent.MoveAlongLink(position, inDeltaTime);
+            continue;
+        }
+        if (agent.mState == AgentState::OffNavMesh) continue;
         const float radius = agent.mParams.mRadius, maxSpeed = agent.mParams.mMaxSpeed;
         const float range = cCollisionRangeRadii * radius;
         const float neighbourRange = cNeighbourRangeRadii * radius;
@@ -775,6 +851,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         }
 
         Vec3 desired = Vec3::Zero();
+        bool wallsThreaten = true; ///< See the walls' threat below
         // An agent waiting for a new path walks on along what is left of its old corridor
         const bool waitingOnItsWay =
             agent.mState == AgentState::WaitingForPath && agent.mCorridor.getPathCount() > 1;
@@ -807,6 +884,14 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                 }
             }
             agent.mLastPolygon = first;
+            if (numCorners > 0 && (flags[0] & DT_STRAIGHTPATH_OFFMESH_CONNECTION) != 0 &&
+                Flat(Vec3(corners[0], corners[1], corners[2]) - position).norm() < cLinkReachRadii * radius &&
+                agent.TakeLink(agent.mCorners.mPolygons[0], position, ioQuery))
+            {
+                ++mChunkLinks[inBegin / cAgentsPerChunk];
+                agent.MoveAlongLink(position, inDeltaTime);
+                continue;
+            }
             const Vec3 end(agent.mCorridor.getTarget()[0], agent.mCorridor.getTarget()[1],
                            agent.mCorridor.getTarget()[2]);
             if (numCorners == 0 || Flat(end - position).norm() < radius)
@@ -822,6 +907,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                 const bool last = (flags[0] & DT_STRAIGHTPATH_END) != 0;
                 const float speed = last ? maxSpeed * std::min(1.0f, distance / (2.0f * radius)) : maxSpeed;
                 if (distance > 1.0e-4f) desired = toCorner * (speed / distance);
+                // Heading for a link's start, no wall threatens it: the straight line there is clear (the
+                // start is its next corner), and the edge the link goes over, just beyond, slowed it before
+                // every jump
+                wallsThreaten = (flags[0] & DT_STRAIGHTPATH_OFFMESH_CONNECTION) == 0;
                 // A jam (agents wanting through each other, each waiting for the other) dissolves when the
                 // stuck ones step aside for a moment: to the left or the right by the parity of their ids
                 agent.mStuckSeconds = Flat(mSnapshotVelocities[i]).norm() < 0.1f * maxSpeed
@@ -892,11 +981,11 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             threatened = (offset - closing * t).squaredNorm() < reach * reach;
         }
         // A wall threatens only an agent heading into it: where its desired velocity takes it in half a
-        // second is within half a radius of the wall, in front of it. The corridor keeps every agent on the
-        // navmesh whatever it samples, so walls beside an agent's way (nearly every agent among props) are
-        // left to the move along the surface
+        // second is within half a radius of the wall, in front of it. The corridor keeps
+        // every agent on the navmesh whatever it samples, so walls beside an agent's way (nearly every agent
+        // among props) are left to the move along the surface
         const Vec3 ahead = position + desired * 0.5f;
-        for (int w = 0; w < agent.mBoundary.getSegmentCount() && !threatened; ++w)
+        for (int w = 0; w < agent.mBoundary.getSegmentCount() && wallsThreaten && !threatened; ++w)
         {
             const float* segment = agent.mBoundary.getSegment(w);
             if (dtTriArea2D(position.data(), segment, segment + 3) < 0.0f) continue; // Behind it
@@ -993,7 +1082,25 @@ Result<AgentState> Crowd::GetState(AgentID inAgent) const
 {
     const Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
-    return agent->mState;
+    return agent->mLink ? AgentState::OnOffMeshLink : agent->mState;
+}
+
+Result<OffMeshLinkCrossing> Crowd::GetOffMeshLink(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    if (!agent->mLink) return MakeError(ErrorCode::InvalidArgument, "agent: not on an off-mesh link");
+    return agent->mLink->GetCrossing();
+}
+
+Status Crowd::CompleteOffMeshLink(AgentID inAgent)
+{
+    Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    if (!agent->mLink) return MakeError(ErrorCode::InvalidArgument, "agent: not on an off-mesh link");
+    agent->mLink.reset(); // At its corridor's place now: the link's end
+    agent->mVelocity.setZero();
+    return Status::Ok();
 }
 
 Result<float> Crowd::GetRadius(AgentID inAgent) const

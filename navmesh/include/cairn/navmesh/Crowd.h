@@ -12,6 +12,12 @@
 // navmesh is published under it again. So no agent keeps a path through a polygon that no longer exists, and
 // none walks off the navmesh.
 //
+// A path may go over an off-mesh link (a jump, a drop, a ladder). An agent that comes within a few radii of
+// the link's start, with the link its next corner, takes it: its corridor moves over the link to the
+// polygon at the far end, and the agent walks to the start and then along the link by itself, or waits at
+// the start for the game to play its jump (OffMeshLinkMode). Others avoid it where it is meanwhile; it
+// steers round no one.
+//
 // Why not dtCrowd itself: its update is one serial pass over every agent (and its own path queue): it cannot
 // spread over job threads. Here the steering and moving run as a ParallelFor over the agents, each agent
 // reading the others' positions and velocities as they were at the start of the Update (a snapshot) and
@@ -22,8 +28,8 @@
 // Threads. Update: one thread at a time, not inside another navmesh call; its loop and the path search run
 // on the job interface's threads while the calling thread holds the navmesh shared (a Publish waits for the
 // Update).
-// AddAgent, RemoveAgent, SetTarget and the setters: the thread that calls Update, between Updates. The
-// getters: that thread, or several threads at once between Updates (they only read).
+// AddAgent, RemoveAgent, SetTarget, CompleteOffMeshLink and the setters: the thread that calls Update,
+// between Updates. The getters: that thread, or several threads at once between Updates (they only read).
 
 #include "cairn/jobs/JobInterface.h"
 #include "cairn/navmesh/NavMeshWorld.h"
@@ -50,11 +56,31 @@ class PhysicsSystem;
 namespace cairn::navmesh
 {
 
+/// How an agent takes an off-mesh link (a jump, a drop, a ladder; TileScheduler::AddOffMeshLink) that its
+/// path goes over. Either way the crowd first walks it to the link's start, and it is committed to the link
+/// from there: its corridor goes on from the link's end.
+enum class OffMeshLinkMode : uint8_t
+{
+    Automatic, ///< Then along the link to its end, in a straight line at its top speed (DetourCrowd's way)
+    ByGame, ///< Then held at the start until the game calls CompleteOffMeshLink, after its own jump or climb
+};
+
 struct AgentParams
 {
     float mRadius = 0.6f;          ///< m; at most the crowd's mMaxAgentRadius
     float mMaxSpeed = 3.5f;        ///< m/s
     float mMaxAcceleration = 8.0f; ///< m/s^2
+    OffMeshLinkMode mLinkMode = OffMeshLinkMode::Automatic;
+};
+
+/// The off-mesh link an agent is on (Crowd::GetOffMeshLink).
+struct OffMeshLinkCrossing
+{
+    Vec3 mStart = Vec3::Zero(); ///< The end it takes the link from (either end of a bidirectional link)
+    Vec3 mEnd = Vec3::Zero();   ///< Where it comes off the link, on the navmesh
+    uint32_t mUserID = 0;       ///< The link's OffMeshLink::mUserID: which jump or ladder, for the game
+    uint8_t mArea = 0;          ///< The link's area
+    bool mAtStart = false;      ///< It has reached the start (it is on the link itself from now on)
 };
 
 enum class AgentState : uint8_t
@@ -65,6 +91,7 @@ enum class AgentState : uint8_t
     Arrived,        ///< Within its radius of the target's reachable point
     NoPath,         ///< The last request found no path (target off the navmesh or unreachable)
     OffNavMesh,     ///< Its polygon went away with a tile: waits in place for navmesh under it
+    OnOffMeshLink,  ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
 };
 
 class Crowd
@@ -73,8 +100,8 @@ public:
     struct Settings
     {
         int mMaxAgents = 16384;
-        float mMaxAgentRadius = 2.0f;   ///< m: the neighbour grid's cell is twice this
-        /// Per agent, in [2, 1024]: a longer path is walked a corridor at a time, the rest asked for as the
+        float mMaxAgentRadius = 2.0f; ///< m: the neighbour grid's cell is twice this
+        /// Per agent, in [3, 1024]: a longer path is walked a corridor at a time, the rest asked for as the
         /// agent nears the corridor's end
         int mMaxCorridorPolygons = 256;
         /// Updates an agent on a collision course keeps the velocity it sampled (DetourCrowd samples every
@@ -135,6 +162,12 @@ public:
     Result<Vec3> GetVelocity(AgentID inAgent) const;
     Result<AgentState> GetState(AgentID inAgent) const;
     Result<float> GetRadius(AgentID inAgent) const;
+    /// The link an agent in the OnOffMeshLink state is taking; error for an agent on none.
+    Result<OffMeshLinkCrossing> GetOffMeshLink(AgentID inAgent) const;
+    /// Ends an agent's link now: it stands at the link's end and goes on along its corridor (the game's
+    /// call for OffMeshLinkMode::ByGame once its animation is done; it also cuts an automatic one short).
+    /// Error for an agent on no link.
+    Status CompleteOffMeshLink(AgentID inAgent);
     /// The agent's corridor, Detour polygon references (to draw it, or to check it against the navmesh).
     Result<std::vector<uint64_t>> GetCorridor(AgentID inAgent) const;
     /// The ids of the agents in the crowd, in slot order (the order of their updates).
@@ -159,6 +192,7 @@ public:
         uint32_t mLastSampled = 0;
         /// Agents that gathered their walls again in the last Update (moved on, or a tile near them changed)
         uint32_t mLastWallUpdates = 0;
+        uint64_t mLinksTaken = 0; ///< Off-mesh links agents have started to take
     };
     const Statistics& GetStatistics() const { return mStatistics; }
     const PathRequestQueue& GetPathQueue() const { return *mPaths; }
@@ -201,6 +235,7 @@ private:
     std::vector<uint32_t> mOrder;       ///< The agents' slots in order, for this Update
     std::vector<uint32_t> mChunkSampled; ///< Per ParallelFor chunk: its agents that sampled (a chunk's own)
     std::vector<uint32_t> mChunkWalls;   ///< Per ParallelFor chunk: its agents that gathered walls again
+    std::vector<uint32_t> mChunkLinks;   ///< Per ParallelFor chunk: its agents that took a link
     // The snapshot every agent steers from: positions and velocities at the Update's start, by mOrder index
     std::vector<Vec3> mSnapshotPositions;
     std::vector<Vec3> mSnapshotVelocities;
