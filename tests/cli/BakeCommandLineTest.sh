@@ -42,6 +42,14 @@ grep -q "area 4: " preview.svg || fail "the map has no road (area 4)"
 grep -q "ground: " preview.svg || fail "the map has no default ground"
 grep -q "^f " preview.obj || fail "the OBJ preview has no triangles"
 
+# An off-mesh link (a one-way drop across the floor's two tiles): in the navmesh, drawn on the map
+echo '{"links": [{"start": [2, 0, 2], "end": [20, 0, 20], "bidirectional": false, "user_id": 9}]}' >links.json
+"$bake" bake level.obj -o linked.navmesh --areas areas.json --links links.json --preview-svg linked.svg \
+    >linked.log 2>&1 ||
+    fail "the bake with links failed: $(cat linked.log)"
+grep -q 'marker-end="url(#arrow)"' linked.svg || fail "the map has no link arrow"
+cmp -s level.navmesh linked.navmesh && fail "the link left the navmesh as it was"
+
 # Part of the level: a box or a list of tiles
 "$bake" bake level.obj -o part.navmesh --box 1,1,10,10 >part.log 2>&1 || fail "the box bake failed: $(cat part.log)"
 grep -q "baked 1 of 4 tiles" part.log || fail "--box 1,1,10,10 should bake tile (0, 0) alone: $(cat part.log)"
@@ -62,6 +70,11 @@ expect_error() { # <what the message names> <output file> <arguments...>
 echo '{"materials": {"road": 99}}' >bad-areas.json
 expect_error "bad-areas.json" out1.navmesh bake level.obj -o out1.navmesh --areas bad-areas.json
 expect_error "missing-areas.json" out2.navmesh bake level.obj -o out2.navmesh --areas missing-areas.json
+echo '{"links": [{"start": [2, 0, 2], "end": [20, 0]}]}' >bad-links.json
+expect_error "bad-links.json: link 0: 'end' must be three finite numbers" out2.navmesh bake level.obj \
+    -o out2.navmesh --links bad-links.json
+echo '{"links": [{"start": [2, 0, 2], "end": [200, 0, 20]}]}' >far-links.json
+expect_error "off-mesh link 0: its end" out2.navmesh bake level.obj -o out2.navmesh --links far-links.json
 printf 'v 0 0 0\nv 1 0 0\nv 1 0 1\nusemtl road\nf 1 2 -9\n' >broken.obj
 expect_error "broken.obj" out3.navmesh bake broken.obj -o out3.navmesh
 expect_error "broken.obj:5:" out3.navmesh bake broken.obj -o out3.navmesh

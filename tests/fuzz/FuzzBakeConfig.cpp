@@ -1,7 +1,9 @@
-// libFuzzer: the baker's JSON readers, the agent profile config and the material area mapping, on each input.
+// libFuzzer: the baker's JSON readers, the agent profile config, the material area mapping and the off-mesh
+// links, on each input.
 
 #include "BakeConfig.h"
 #include "FuzzInputFile.h"
+#include "OffMeshLinksFile.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* inData, size_t inSize)
 {
@@ -9,5 +11,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* inData, size_t inSize)
     cairn::navmesh::AgentProfile profile;
     (void)cairn::bake::LoadBakeConfig(path, profile);
     (void)cairn::bake::LoadAreaMapping(path);
+    (void)cairn::bake::LoadOffMeshLinks(path);
     return 0;
 }

@@ -5,6 +5,7 @@
 
 #include "BakeConfig.h"
 #include "Baker.h"
+#include "OffMeshLinksFile.h"
 #include "OutputPaths.h"
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/NavMeshPreview.h"
@@ -75,7 +76,7 @@ int main(int argc, char** argv)
     navmesh::AgentProfile flagProfile;
     std::string configPath;
     bakeCommand->add_option("--config", configPath, "Agent profile and tile size from a JSON file");
-    std::string areasPath, previewObjPath, previewSvgPath;
+    std::string areasPath, linksPath, previewObjPath, previewSvgPath;
     bakeCommand->add_option("--preview-obj", previewObjPath,
                             "Also write the navmesh's walkable surface as Wavefront OBJ");
     bakeCommand->add_option("--preview-svg", previewSvgPath,
@@ -83,6 +84,10 @@ int main(int argc, char** argv)
     bakeCommand->add_option("--areas", areasPath,
                             "Navmesh area ids of material names, from a JSON file "
                             "({\"default\": 0, \"materials\": {\"road\": 1}})");
+    bakeCommand->add_option(
+        "--links", linksPath,
+        "Off-mesh links (jumps, drops, ladders) from a JSON file "
+        "({\"links\": [{\"start\": [x, y, z], \"end\": [x, y, z]}]}, see docs/BAKING.md)");
     navmesh::LevelLoadLimits& limits = settings.mLoadLimits;
     bakeCommand->add_flag("--allow-outside-files", limits.mAllowFilesOutsideFolder,
                           "glTF buffers may come from outside the level file's folder");
@@ -183,6 +188,7 @@ int main(int argc, char** argv)
         if (!optional.mPath.empty()) outputs.push_back(optional);
     std::vector<bake::NamedPath> inputs{{"--config", configPath},
                                         {"--areas", areasPath},
+                                        {"--links", linksPath},
                                         {"--previous", previousSummaryPath},
                                         {"--previous-navmesh", previousNavMeshPath}};
     for (const std::string& path : settings.mInputs)
@@ -198,6 +204,12 @@ int main(int argc, char** argv)
         Result<navmesh::AreaMapping> areas = bake::LoadAreaMapping(areasPath);
         if (!areas) return Fail(areas.GetError().mMessage);
         settings.mAreas = std::move(areas.Value());
+    }
+    if (!linksPath.empty())
+    {
+        Result<std::vector<navmesh::OffMeshLink>> links = bake::LoadOffMeshLinks(linksPath);
+        if (!links) return Fail(links.GetError().mMessage);
+        settings.mLinks = std::move(links.Value());
     }
     for (size_t i = 0; i < std::size(flags); ++i)
         if (flags[i]->count() > 0) settings.mProfile.*fields[i] = flagProfile.*fields[i];

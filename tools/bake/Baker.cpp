@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstring>
 #include <deque>
+#include <map>
 #include <optional>
 
 namespace cairn::bake
@@ -67,7 +68,40 @@ struct TileJobContext
     const navmesh::GeometryCollector* mCollector;
     float mBorder;
     uint64_t mSettingsHash;
+    const std::map<navmesh::TileCoord, std::vector<navmesh::OffMeshLink>>* mLinks; ///< By their start's tile
 };
+
+/// inHash with the links added: what a link decides of its tile's output.
+uint64_t HashLinks(std::span<const navmesh::OffMeshLink> inLinks, uint64_t inHash)
+{
+    for (const navmesh::OffMeshLink& link : inLinks)
+    {
+        const float numbers[] = {link.mStart.x(), link.mStart.y(), link.mStart.z(), link.mEnd.x(),
+                                 link.mEnd.y(),   link.mEnd.z(),   link.mRadius};
+        const uint32_t words[] = {uint32_t(link.mBidirectional), link.mArea, link.mUserID};
+        inHash = Hash64Of(std::span<const float>(numbers), inHash);
+        inHash = Hash64Of(std::span<const uint32_t>(words), inHash);
+    }
+    return inHash;
+}
+
+/// Links whose end is in no tile of the level (inTiles, sorted) never join it: an error naming the first.
+/// Either end's tile is the one its x and z fall in.
+Status CheckLinksInLevel(std::span<const navmesh::OffMeshLink> inLinks, const navmesh::TileGrid& inGrid,
+                         const std::vector<navmesh::TileCoord>& inTiles)
+{
+    for (size_t i = 0; i < inLinks.size(); ++i)
+        for (const bool start : {true, false})
+        {
+            const Vec3& end = start ? inLinks[i].mStart : inLinks[i].mEnd;
+            if (!std::binary_search(inTiles.begin(), inTiles.end(), inGrid.TileAt(end.x(), end.z())))
+                return MakeError(ErrorCode::InvalidArgument,
+                                 "off-mesh link " + std::to_string(i) + ": its " + (start ? "start" : "end") +
+                                     " (" + std::to_string(end.x()) + ", " + std::to_string(end.z()) +
+                                     ") is in no tile of the level");
+        }
+    return Status::Ok();
+}
 
 const navmesh::NavMeshFileTile* FindPreviousTile(const navmesh::NavMeshFileContents& inPrevious,
                                                  const navmesh::TileCoord& inTile)
@@ -101,6 +135,10 @@ void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
     hash = Hash64Of(std::span<const float>(geometry.mVertices), hash);
     hash = Hash64Of(std::span<const int>(geometry.mTriangles), hash);
     hash = Hash64Of(std::span<const uint8_t>(geometry.mAreas), hash);
+    std::span<const navmesh::OffMeshLink> links;
+    if (auto found = inContext.mLinks->find(ioTile.mTile); found != inContext.mLinks->end())
+        links = found->second;
+    hash = HashLinks(links, hash); // No links: the hash of a bake without any
     ioTile.mRecord.mTile = ioTile.mTile;
     ioTile.mRecord.mInputHash = hash;
     // Unchanged input: the previous output, built or empty, is this tile's
@@ -114,7 +152,7 @@ void BuildTileInFlight(const TileJobContext& inContext, TileInFlight& ioTile)
         ioTile.mRecord = *before;
         return;
     }
-    ioTile.mBuilt = navmesh::BuildTile(settings.mProfile, *inContext.mGrid, ioTile.mTile, geometry);
+    ioTile.mBuilt = navmesh::BuildTile(settings.mProfile, *inContext.mGrid, ioTile.mTile, geometry, links);
 }
 
 /// The tiles of the sorted list inTiles that inSettings' region and tile list choose, sorted. Errors: a
@@ -190,6 +228,11 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     result.mNavMesh.mParams = params.Value();
     result.mTilesInWorld = uint32_t(tiles.size());
     std::sort(tiles.begin(), tiles.end()); // The sorted list the shards split and the file keeps
+    if (Status inLevel = CheckLinksInLevel(inSettings.mLinks, grid, tiles); !inLevel)
+        return inLevel.GetError();
+    std::map<navmesh::TileCoord, std::vector<navmesh::OffMeshLink>> linksByTile;
+    for (const navmesh::OffMeshLink& link : inSettings.mLinks)
+        linksByTile[grid.TileAt(link.mStart.x(), link.mStart.z())].push_back(link);
     Result<std::vector<navmesh::TileCoord>> selected = SelectTiles(tiles, grid, inSettings);
     if (!selected) return selected.GetError();
     std::vector<navmesh::TileCoord> mine;
@@ -229,7 +272,8 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     LiveObjects objects(physics, inSource);
     const navmesh::GeometryCollector collector(physics.GetBodyManager(), physics.GetBroadPhase());
     const float border = float(profile.GetBorderCells()) * profile.mCellSize;
-    const TileJobContext context{&inSettings, &grid, &collector, border, SettingsHash(profile, grid)};
+    const TileJobContext context{&inSettings, &grid, &collector, border, SettingsHash(profile, grid),
+                                 &linksByTile};
     std::deque<TileInFlight> inFlight; // References stay valid when the ends change
     std::vector<SourceObject> near;
     // On an error, the jobs still running read the tiles: wait for them before anything goes

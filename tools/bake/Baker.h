@@ -14,6 +14,7 @@
 #include "cairn/navmesh/AgentProfile.h"
 #include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/NavMeshFile.h"
+#include "cairn/navmesh/TileBuilder.h"
 
 #include <functional>
 #include <optional>
@@ -37,7 +38,10 @@ struct BakeSettings
     /// enter while their objects would not fit; a single tile with more objects near it is an error
     uint32_t mMaxBodiesInWorld = 0;
     navmesh::AgentProfile mProfile;
-    navmesh::AreaMapping mAreas;          ///< Area ids of material names
+    navmesh::AreaMapping mAreas; ///< Area ids of material names
+    /// Off-mesh links (LoadOffMeshLinks), each built into the tile its start lies in; a link with an end in
+    /// no tile of the level is an error (it could never join the navmesh there)
+    std::vector<navmesh::OffMeshLink> mLinks;
     navmesh::LevelLoadLimits mLoadLimits; ///< What the level files may make the loaders do (Bake)
     uint32_t mThreads = 0;                ///< 0: all cores
     uint32_t mShard = 0;                  ///< This shard (0-based) ...

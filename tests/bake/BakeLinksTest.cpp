@@ -1,0 +1,190 @@
+// Off-mesh links in a bake: a link from the links file joins two platforms a gap apart in the baked navmesh
+// (a path crosses it, with the link's user id and area kept, one way only for a drop); an incremental bake
+// builds again the tile whose link changed and only that one; the links file's errors name the file, the
+// link and the key, and a link with an end in no tile of the level is refused.
+
+#include "Baker.h"
+#include "OffMeshLinksFile.h"
+#include "cairn/navmesh/NavMeshFile.h"
+#include "common/TempFiles.h"
+
+#include <DetourNavMesh.h>
+#include <DetourNavMeshQuery.h>
+#include <gtest/gtest.h>
+
+namespace cairn::bake
+{
+using namespace cairn::physics;
+namespace
+{
+
+/// Two floors a 3 m gap apart along x (x in [0, 10] and [13, 24], z in [0, 8]), both in tile (0, 0) and the
+/// second also in tile (1, 0) of the 12.8 m grid.
+const char* cTwoPlatforms = "v 0 0 0\nv 10 0 0\nv 10 0 8\nv 0 0 8\n"
+                            "v 13 0 0\nv 24 0 0\nv 24 0 8\nv 13 0 8\n"
+                            "o West\nf 1 4 3\nf 1 3 2\no East\nf 5 8 7\nf 5 7 6\n";
+
+const char* cJump = R"({"links": [{"start": [9, 0, 4], "end": [14, 0, 4], "radius": 0.6, "area": 3,
+                                   "user_id": 42, "bidirectional": false}]})";
+
+class BakeLinksTest : public ::testing::Test
+{
+protected:
+    std::string Write(const std::string& inName, const std::string& inText)
+    {
+        return mFiles.Write(inName, inText);
+    }
+
+    Result<BakeResult> BakeWith(const std::string& inLinks, const BakeSummary* inPrevious = nullptr,
+                                const navmesh::NavMeshFileContents* inPreviousNavMesh = nullptr)
+    {
+        BakeSettings settings;
+        settings.mInputs = {Write("platforms.obj", cTwoPlatforms)};
+        settings.mThreads = 1;
+        settings.mPrevious = inPrevious;
+        settings.mPreviousNavMesh = inPreviousNavMesh;
+        if (!inLinks.empty())
+        {
+            Result<std::vector<navmesh::OffMeshLink>> links = LoadOffMeshLinks(Write("links.json", inLinks));
+            if (!links) return links.GetError();
+            settings.mLinks = links.Value();
+        }
+        return Bake(settings);
+    }
+
+    /// Whether Detour finds a whole path on inContents from inFrom to inTo (the default filter).
+    static bool Reaches(const navmesh::NavMeshFileContents& inContents, const Vec3& inFrom, const Vec3& inTo)
+    {
+        Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(inContents);
+        EXPECT_TRUE(navMesh);
+        if (!navMesh) return false;
+        dtNavMeshQuery query;
+        EXPECT_TRUE(dtStatusSucceed(query.init(navMesh.Value().get(), 2048)));
+        const dtQueryFilter filter;
+        const float extent[3] = {1, 2, 1};
+        dtPolyRef from = 0, to = 0;
+        float fromPoint[3], toPoint[3];
+        query.findNearestPoly(inFrom.data(), extent, &filter, &from, fromPoint);
+        query.findNearestPoly(inTo.data(), extent, &filter, &to, toPoint);
+        EXPECT_NE(from, 0u);
+        EXPECT_NE(to, 0u);
+        dtPolyRef path[256];
+        int count = 0;
+        query.findPath(from, to, fromPoint, toPoint, &filter, path, &count, 256);
+        return count > 0 && path[count - 1] == to;
+    }
+
+    /// The off-mesh connections in inContents' tiles, each with its polygon's area.
+    static std::vector<std::pair<dtOffMeshConnection, int>>
+    Links(const navmesh::NavMeshFileContents& inContents)
+    {
+        std::vector<std::pair<dtOffMeshConnection, int>> links;
+        Result<navmesh::DetourNavMeshPtr> navMesh = navmesh::CreateDetourNavMesh(inContents);
+        if (!navMesh) return links;
+        const dtNavMesh& mesh = *navMesh.Value();
+        for (int i = 0; i < mesh.getMaxTiles(); ++i)
+            if (const dtMeshTile* tile = mesh.getTile(i); tile != nullptr && tile->header != nullptr)
+                for (int c = 0; c < tile->header->offMeshConCount; ++c)
+                    links.push_back({tile->offMeshCons[c], tile->polys[tile->offMeshCons[c].poly].getArea()});
+        return links;
+    }
+
+    cairn::test::TempFiles mFiles;
+};
+
+TEST_F(BakeLinksTest, ALinkJoinsPlatformsAGapApart)
+{
+    const Vec3 west(3, 0, 4), east(20, 0, 4);
+    Result<BakeResult> apart = BakeWith("");
+    ASSERT_TRUE(apart) << apart.GetError().mMessage;
+    EXPECT_FALSE(Reaches(apart.Value().mNavMesh, west, east));
+    EXPECT_TRUE(Links(apart.Value().mNavMesh).empty());
+
+    Result<BakeResult> joined = BakeWith(cJump);
+    ASSERT_TRUE(joined) << joined.GetError().mMessage;
+    EXPECT_TRUE(Reaches(joined.Value().mNavMesh, west, east));
+    EXPECT_FALSE(Reaches(joined.Value().mNavMesh, east, west)) << "a drop, one way";
+    const std::vector<std::pair<dtOffMeshConnection, int>> links = Links(joined.Value().mNavMesh);
+    ASSERT_EQ(links.size(), 1u);
+    EXPECT_EQ(links[0].first.userId, 42u);
+    EXPECT_EQ(links[0].second, 3);
+    EXPECT_NEAR(links[0].first.pos[0], 9.0f, 0.01f);
+    EXPECT_NEAR(links[0].first.pos[3], 14.0f, 0.01f);
+    EXPECT_NEAR(links[0].first.rad, 0.6f, 1e-6f);
+}
+
+// An incremental bake after the link moved builds again the tile of its start (the link is in that tile's
+// data) and takes the other tile over; the result is the full bake's
+TEST_F(BakeLinksTest, AMovedLinkRebuildsItsTileOnly)
+{
+    Result<BakeResult> first = BakeWith(cJump);
+    ASSERT_TRUE(first) << first.GetError().mMessage;
+    ASSERT_EQ(first.Value().mSummary.mTiles.size(), 2u);
+    // Only the start's z changes
+    const std::string moved = R"({"links": [{"start": [9, 0, 5], "end": [14, 0, 4], "radius": 0.6, "area": 3,
+                                             "user_id": 42, "bidirectional": false}]})";
+    Result<BakeResult> again = BakeWith(moved, &first.Value().mSummary, &first.Value().mNavMesh);
+    ASSERT_TRUE(again) << again.GetError().mMessage;
+    EXPECT_EQ(again.Value().mSummary.mTilesRebuilt, 1u);
+    Result<BakeResult> full = BakeWith(moved);
+    ASSERT_TRUE(full);
+    ASSERT_EQ(again.Value().mNavMesh.mTiles.size(), full.Value().mNavMesh.mTiles.size());
+    for (size_t i = 0; i < full.Value().mNavMesh.mTiles.size(); ++i)
+        EXPECT_EQ(again.Value().mNavMesh.mTiles[i].mData, full.Value().mNavMesh.mTiles[i].mData) << i;
+    Result<BakeResult> same = BakeWith(moved, &full.Value().mSummary, &full.Value().mNavMesh);
+    ASSERT_TRUE(same);
+    EXPECT_EQ(same.Value().mSummary.mTilesRebuilt, 0u) << "nothing changed";
+}
+
+TEST_F(BakeLinksTest, AnEndInNoTileOfTheLevelIsRefused)
+{
+    Result<BakeResult> baked = BakeWith(R"({"links": [{"start": [9, 0, 4], "end": [9, 0, 40]}]})");
+    ASSERT_FALSE(baked);
+    EXPECT_NE(baked.GetError().mMessage.find("off-mesh link 0: its end"), std::string::npos)
+        << baked.GetError().mMessage;
+}
+
+TEST_F(BakeLinksTest, TheLinksFileErrorsNameTheFileTheLinkAndTheKey)
+{
+    struct Case
+    {
+        const char* mText;
+        const char* mSays;
+    };
+    const Case cases[] = {
+        {"[]", "not a JSON object"},
+        {R"({"link": []})", "unknown key 'link'"},
+        {R"({"links": {}})", "'links' must be an array"},
+        {R"({"links": [3]})", "link 0: not a JSON object"},
+        {R"({"links": [{"start": [0, 0, 0]}]})", "link 0: needs 'start' and 'end'"},
+        {R"({"links": [{"start": [0, 0], "end": [1, 0, 0]}]})", "link 0: 'start' must be three finite"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 1e39]}]})", "link 0: 'end' must be three finite"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, "x"]}]})", "'end' must be three finite"},
+        {R"({"links": [{"start": [0,0,0], "end": [1,0,0]}, {"start": [0,0,0], "end": [1,0,0], "radius": 0}]})",
+         "link 1: 'radius' must be a number in (0, 1000]"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 0], "area": 63}]})",
+         "'area' must be a whole number"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 0], "user_id": 4294967296}]})",
+         "'user_id' must be a whole number from 0 to 4294967295"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 0], "bidirectional": 1}]})",
+         "'bidirectional' must be true or false"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 0], "raduis": 1}]})", "unknown key 'raduis'"},
+        {"{\"links\": [", "links.json"},
+    };
+    for (const Case& c : cases)
+    {
+        const std::string path = Write("links.json", c.mText);
+        Result<std::vector<navmesh::OffMeshLink>> links = LoadOffMeshLinks(path);
+        ASSERT_FALSE(links) << c.mText;
+        EXPECT_NE(links.GetError().mMessage.find(c.mSays), std::string::npos)
+            << c.mText << " said: " << links.GetError().mMessage;
+        EXPECT_NE(links.GetError().mMessage.find(path), std::string::npos) << "names the file";
+    }
+    EXPECT_FALSE(LoadOffMeshLinks(mFiles.Path("missing.json")));
+    Result<std::vector<navmesh::OffMeshLink>> none = LoadOffMeshLinks(Write("links.json", "{}"));
+    ASSERT_TRUE(none);
+    EXPECT_TRUE(none.Value().empty());
+}
+
+} // namespace
+} // namespace cairn::bake
