@@ -1,0 +1,54 @@
+#include "cairn/navmesh/BakedTiles.h"
+
+#include <DetourAlloc.h>
+#include <cstring>
+
+namespace cairn::navmesh
+{
+
+Result<std::vector<BuiltTile>> MakeBakedTileChanges(const NavMeshFileContents& inContents,
+                                                    const TileGrid& inGrid,
+                                                    const std::optional<AABB>& inRegion)
+{
+    const dtNavMeshParams& params = inContents.mParams;
+    // Detour places a tile by the navmesh's origin and tile size: the world's must be the bake's, to the bit
+    // (both come from the same numbers, and a tile built a hair off is a seam agents cannot cross)
+    if (params.orig[0] != inGrid.GetOriginX() || params.orig[2] != inGrid.GetOriginZ() ||
+        params.tileWidth != inGrid.GetTileSize() || params.tileHeight != inGrid.GetTileSize())
+        return MakeError(
+            ErrorCode::InvalidArgument,
+            "baked navmesh: baked on a grid of origin (" + std::to_string(params.orig[0]) + ", " +
+                std::to_string(params.orig[2]) + ") and " + std::to_string(params.tileWidth) +
+                " m tiles, the world's is (" + std::to_string(inGrid.GetOriginX()) + ", " +
+                std::to_string(inGrid.GetOriginZ()) + ") and " + std::to_string(inGrid.GetTileSize()) + " m");
+    std::vector<BuiltTile> changes;
+    for (const NavMeshFileTile& tile : inContents.mTiles)
+    {
+        if (inRegion.has_value())
+        {
+            const AABB bounds = inGrid.GetTileBounds(tile.mTile);
+            if (bounds.mMax.x() < inRegion->mMin.x() || bounds.mMin.x() > inRegion->mMax.x() ||
+                bounds.mMax.z() < inRegion->mMin.z() || bounds.mMin.z() > inRegion->mMax.z())
+                continue;
+        }
+        if (tile.mData.size() < sizeof(dtMeshHeader))
+            return MakeError(ErrorCode::InvalidArgument,
+                             "baked navmesh: tile (" + std::to_string(tile.mTile.mX) + ", " +
+                                 std::to_string(tile.mTile.mZ) + ") is shorter than its header");
+        BuiltTile change;
+        change.mTile = tile.mTile;
+        change.mData.reset(static_cast<unsigned char*>(dtAlloc(tile.mData.size(), DT_ALLOC_PERM)));
+        if (change.mData == nullptr)
+            return MakeError(ErrorCode::OutOfCapacity, "baked navmesh: out of memory");
+        std::memcpy(change.mData.get(), tile.mData.data(), tile.mData.size());
+        change.mDataSize = int(tile.mData.size());
+        dtMeshHeader header;
+        std::memcpy(&header, tile.mData.data(), sizeof(header));
+        change.mNumPolygons = header.polyCount;
+        change.mNumVertices = header.vertCount;
+        changes.push_back(std::move(change));
+    }
+    return changes;
+}
+
+} // namespace cairn::navmesh
