@@ -141,6 +141,7 @@ struct Crowd::Agent
     /// Its path was longer than its corridor holds: the corridor ends short of the target, and the agent
     /// asks for the rest as it nears that end
     bool mCorridorCut = false;
+    PathStatus mPathStatus = PathStatus::None;
     dtPolyRef mBoundaryPolygon = 0; ///< Where mBoundary was gathered (0: not yet)
     dtPolyRef mLastPolygon = 0;     ///< Its corridor's first polygon at its last move
     bool mWallsStale = false;       ///< A tile near its walls changed since they were gathered
@@ -394,6 +395,7 @@ Status Crowd::SetTarget(AgentID inAgent, const Vec3& inTarget)
     agent->mTicket = {};
     agent->mTarget = inTarget;
     agent->mHasTarget = true;
+    agent->mPathStatus = PathStatus::None;
     // An agent with no navmesh under it asks once it has some (CheckCorridors)
     if (agent->mState == AgentState::OffNavMesh) return Status::Ok();
     Result<PathTicket> ticket = RequestPath(*agent);
@@ -784,6 +786,7 @@ void Crowd::ApplyPathResults()
         {
             ++mStatistics.mPathsFailed;
             agent.mState = AgentState::NoPath;
+            agent.mPathStatus = PathStatus::None;
             continue;
         }
         // The path starts where the agent was when it asked; it may have walked on since, along what was
@@ -802,7 +805,12 @@ void Crowd::ApplyPathResults()
             continue;
         }
         std::vector<dtPolyRef> path(polygons.begin() + long(from), polygons.end());
-        agent.mCorridorCut = path.size() > size_t(mSettings.mMaxCorridorPolygons);
+        // A path as long as the search's buffer goes on past it: asked again on the way, as a corridor cut
+        // short is, and not short of the target for want of a way
+        const bool searchCut = !result->Value().mReachedEnd && polygons.size() >= size_t(cMaxPathPolygons);
+        agent.mPathStatus =
+            result->Value().mReachedEnd || searchCut ? PathStatus::Complete : PathStatus::Partial;
+        agent.mCorridorCut = path.size() > size_t(mSettings.mMaxCorridorPolygons) || searchCut;
         if (agent.mCorridorCut) path.resize(size_t(mSettings.mMaxCorridorPolygons));
         corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(), int(path.size()));
         agent.mCorners.mValid = false;
@@ -1083,6 +1091,13 @@ Result<AgentState> Crowd::GetState(AgentID inAgent) const
     const Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
     return agent->mLink ? AgentState::OnOffMeshLink : agent->mState;
+}
+
+Result<PathStatus> Crowd::GetPathStatus(AgentID inAgent) const
+{
+    const Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    return agent->mPathStatus;
 }
 
 Result<OffMeshLinkCrossing> Crowd::GetOffMeshLink(AgentID inAgent) const

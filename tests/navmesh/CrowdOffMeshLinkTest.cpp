@@ -66,6 +66,7 @@ protected:
         int mOffNavMeshElsewhere = 0;    ///< Updates off the navmesh while not on the link
         float mSlowest = 1e9f; ///< m/s: the slowest Update from full speed to 10 Updates after landing
         AgentState mFinalState = AgentState::Idle;
+        PathStatus mFinalPathStatus = PathStatus::None;
         Vec3 mFinalPosition = Vec3::Zero();
     };
 
@@ -112,6 +113,7 @@ protected:
             previous = position;
         }
         walk.mFinalState = crowd->GetState(agent).Value();
+        walk.mFinalPathStatus = crowd->GetPathStatus(agent).Value();
         walk.mFinalPosition = crowd->GetPosition(agent).Value();
         EXPECT_EQ(crowd->GetStatistics().mLinksTaken, walk.mUpdatesOnLink > 0 ? 1u : 0u);
         return walk;
@@ -131,6 +133,7 @@ protected:
         EXPECT_GT(inWalk.mSlowest, 0.95f * AgentParams().mMaxSpeed) << "it slowed at the link";
         EXPECT_EQ(inWalk.mOffNavMeshElsewhere, 0);
         EXPECT_EQ(inWalk.mFinalState, AgentState::Arrived);
+        EXPECT_EQ(inWalk.mFinalPathStatus, PathStatus::Complete);
         EXPECT_LT((inWalk.mFinalPosition - inGoal).norm(), AgentParams().mRadius);
     }
 };
@@ -155,6 +158,8 @@ TEST_F(CrowdOffMeshLinkTest, AnAgentTakesAOneWayDropDown)
     EXPECT_EQ(up.mUpdatesOnLink, 0);
     EXPECT_EQ(up.mOffNavMeshElsewhere, 0);
     EXPECT_GT(up.mFinalPosition.x(), 1.5f);
+    EXPECT_EQ(up.mFinalState, AgentState::Arrived);
+    EXPECT_EQ(up.mFinalPathStatus, PathStatus::Partial) << "short of its target";
 }
 
 // The game crosses the link: the agent waits at its start, as long as the game takes, and goes on from the
@@ -197,6 +202,7 @@ TEST_F(CrowdOffMeshLinkTest, AnAgentTheGameCrossesWaitsAtTheStartUntilTheGameIsD
     ASSERT_TRUE(crowd->RemoveAgent(agent).IsOk());
     EXPECT_FALSE(crowd->GetOffMeshLink(agent)) << "a stale id";
     EXPECT_FALSE(crowd->CompleteOffMeshLink(agent)) << "a stale id";
+    EXPECT_FALSE(crowd->GetPathStatus(agent)) << "a stale id";
 }
 
 // An agent held on the link while the far side's tile is rebuilt (its corridor's polygons there are gone)
@@ -218,6 +224,7 @@ TEST_F(CrowdOffMeshLinkTest, AnAgentOnALinkLandsOnTheFarSideAsRebuilt)
     mWorld->Read([&](const dtNavMesh& inNavMesh)
                  { ASSERT_FALSE(inNavMesh.isValidPolyRef(dtPolyRef(landing))) << "the far side rebuilt"; });
     ASSERT_TRUE(crowd->SetTarget(agent, Vec3(8, 0, 3)).IsOk());
+    EXPECT_EQ(crowd->GetPathStatus(agent).Value(), PathStatus::None) << "a new target, no path yet";
     for (int update = 0; update < 30; ++update)
         ASSERT_TRUE(crowd->Update(cFrame).IsOk());
     EXPECT_EQ(crowd->GetState(agent).Value(), AgentState::OnOffMeshLink) << "the game has not finished";
@@ -258,6 +265,7 @@ TEST_F(CrowdOffMeshLinkTest, ALinkRemovedBeforeAnAgentReachesItIsNotTaken)
         ASSERT_LT(crowd->GetPosition(agent).Value().x(), -1.5f) << "update " << update;
     }
     EXPECT_EQ(crowd->GetState(agent).Value(), AgentState::Arrived);
+    EXPECT_EQ(crowd->GetPathStatus(agent).Value(), PathStatus::Partial) << "short of its target";
     EXPECT_GT(crowd->GetPosition(agent).Value().x(), -3.5f) << "at the gap's edge";
     EXPECT_EQ(crowd->GetStatistics().mLinksTaken, 0u);
 }

@@ -458,6 +458,7 @@ TEST_F(CrowdTest, BadInputGetsClearErrors)
     for (int frame = 0; frame < 10; ++frame)
         ASSERT_TRUE(crowd->Update(1.0f / 60.0f).IsOk());
     EXPECT_EQ(crowd->GetState(b).Value(), AgentState::NoPath);
+    EXPECT_EQ(crowd->GetPathStatus(b).Value(), PathStatus::None);
 }
 
 } // namespace

@@ -73,6 +73,17 @@ struct AgentParams
     OffMeshLinkMode mLinkMode = OffMeshLinkMode::Automatic;
 };
 
+/// Where an agent's path goes (Crowd::GetPathStatus), as Unity's NavMeshPathStatus tells it.
+enum class PathStatus : uint8_t
+{
+    None,     ///< No path found since its target was set (or no target)
+    Complete, ///< To the target
+    /// To the reachable point nearest the target, which cannot be reached from where the agent asked (a
+    /// closed door, a gap with no link, a target off the navmesh's connected part): the agent stops there,
+    /// Arrived, and the game may choose another target
+    Partial,
+};
+
 /// The off-mesh link an agent is on (Crowd::GetOffMeshLink).
 struct OffMeshLinkCrossing
 {
@@ -88,7 +99,7 @@ enum class AgentState : uint8_t
     Idle,           ///< No target
     WaitingForPath, ///< A path request is queued or searched (it may move along a valid part meanwhile)
     Moving,         ///< Following its corridor
-    Arrived,        ///< Within its radius of the target's reachable point
+    Arrived,        ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
     NoPath,         ///< The last request found no path (target off the navmesh or unreachable)
     OffNavMesh,     ///< Its polygon went away with a tile: waits in place for navmesh under it
     OnOffMeshLink,  ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
@@ -161,6 +172,9 @@ public:
     Result<Vec3> GetPosition(AgentID inAgent) const;
     Result<Vec3> GetVelocity(AgentID inAgent) const;
     Result<AgentState> GetState(AgentID inAgent) const;
+    /// Whether its last path found reaches its target; a new target's path (SetTarget) starts at None. A
+    /// replan after a tile changed says it again.
+    Result<PathStatus> GetPathStatus(AgentID inAgent) const;
     Result<float> GetRadius(AgentID inAgent) const;
     /// The link an agent in the OnOffMeshLink state is taking; error for an agent on none.
     Result<OffMeshLinkCrossing> GetOffMeshLink(AgentID inAgent) const;
