@@ -193,6 +193,7 @@ Status CharacterController::SetPosition(const Vec3& inPosition)
     mGroundNormal = mSettings.mUp;
     mGroundMoves = false;
     mGroundVelocity = Vec3::Zero();
+    mGroundTurn = Quat::Identity();
     mGroundMember = CharacterGroup::cNoMember;
     mContacts.clear(); // Not where it is now: nothing for PushBodies
     mCharacterContacts.clear();
@@ -244,6 +245,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
     Vec3 groundVelocity = mGroundVelocity;
     const float sinceGroundMoved = mTimeSinceGroundMoved + inDeltaTime;
     bool groundMovedNow = false;
+    Quat groundTurn = Quat::Identity();
     // Swept along by inMove, the ground's since the last Update; its velocity is measured from it
     const auto carry = [&](const Vec3& inMove) -> Status
     {
@@ -266,6 +268,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         {
             if (Status carried = carry(pose.mTransform * mPositionOnGround - position); !carried)
                 return carried;
+            groundTurn = TwistAbout(pose.mTransform.mRotation * mGroundRotationAtAnchor.conjugate(), up);
         }
     }
     // Or by the member of its group it stands on, where a Publish has moved it since
@@ -373,6 +376,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
         {
             mGroundMoves = true;
             mPositionOnGround = pose.mTransform.InverseTransformPoint(position);
+            mGroundRotationAtAnchor = pose.mTransform.mRotation;
             mGroundPoseVersion = pose.mVersion;
         }
     }
@@ -395,6 +399,7 @@ Status CharacterController::Update(float inDeltaTime, const Vec3& inGravity)
             ? 0.0f
             : sinceGroundMoved;
     mGroundVelocity = mGroundMoves ? groundVelocity : Vec3::Zero();
+    mGroundTurn = groundTurn;
     mPosition = position;
     mVelocity = velocity;
     mGroundState = state;

@@ -40,6 +40,17 @@ inline Vec3 AcrossAxis(const Vec3& inVector, const Vec3& inAxis)
     return inVector - inVector.dot(inAxis) * inAxis;
 }
 
+/// The part of inRotation that turns about inAxis (a unit vector), the twist of its swing-twist split: how
+/// far a rotating platform turns a character standing on it. Identity for a rotation with none (a half turn
+/// about a level axis).
+inline Quat TwistAbout(const Quat& inRotation, const Vec3& inAxis)
+{
+    const Vec3 along = inAxis * inRotation.vec().dot(inAxis);
+    const Quat twist(inRotation.w(), along.x(), along.y(), along.z());
+    const float norm = twist.norm();
+    return norm > 1.0e-6f ? Quat(twist.coeffs() / norm) : Quat::Identity();
+}
+
 /// Adds a contact with inBody to the context's, unless it holds one with that body already or inBody is none
 /// (another character).
 void RecordContact(const CharacterMoveContext& inContext, const BodyID& inBody, const Vec3& inPoint,

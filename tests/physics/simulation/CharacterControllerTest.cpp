@@ -492,6 +492,58 @@ TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
     EXPECT_NEAR(rider.GetLinearVelocity().y(), 3.0f + 1.0f - 9.81f * cDeltaTime, 0.05f);
 }
 
+// A turntable at 1 rad/s about +y carries a rider round and turns it by as much (GetGroundTurn, the game's
+// to apply to the rider's facing); a platform tilting about a level axis turns it by nothing about +y; on
+// static ground the turn is none
+TEST_F(CharacterControllerTest, ATurntableTurnsItsRiderAndATiltingPlatformDoesNot)
+{
+    AddFloor();
+    const BodyID id =
+        Bodies()
+            .CreateAndAddBody(BoxBodySettings(Vec3(0, 1, 0), Vec3(3, 0.25f, 3), MotionType::Kinematic),
+                              Activation::Activate)
+            .Value();
+    CharacterController rider = MakeCharacter(Vec3(1, 1.25f + cCharacterStandHeight + 0.02f, 0));
+    Walk(rider, Vec3::Zero(), 10);
+    ASSERT_EQ(rider.GetGroundBody(), id);
+    EXPECT_TRUE(rider.GetGroundTurn().isApprox(Quat::Identity())) << "the table has not turned yet";
+    const auto yawOf = [](const Quat& inTurn) { return 2.0f * std::atan2(inTurn.y(), inTurn.w()); };
+
+    Quat facing = Quat::Identity(), table = Quat::Identity();
+    for (int frame = 0; frame < 90; ++frame)
+    {
+        table = Quat(Eigen::AngleAxisf(cDeltaTime, Vec3::UnitY())) * table;
+        ASSERT_TRUE(Bodies().MoveKinematic(id, Vec3(0, 1, 0), table, cDeltaTime).IsOk());
+        ASSERT_TRUE(UpdateWorld(cDeltaTime).IsOk());
+        Walk(rider, Vec3::Zero(), 1);
+        facing = rider.GetGroundTurn() * facing;
+    }
+    EXPECT_NEAR(yawOf(facing), 1.5f, 0.03f) << "turned as far as the table";
+    EXPECT_NEAR(yawOf(rider.GetGroundTurn()), cDeltaTime, 0.002f) << "a frame's turn";
+    // Carried round with it: 1 m out, 1.5 rad on (counter-clockwise seen from above, from +x towards -z)
+    EXPECT_NEAR(rider.GetPosition().x(), std::cos(1.5f), 0.05f);
+    EXPECT_NEAR(rider.GetPosition().z(), -std::sin(1.5f), 0.05f);
+    CharacterController moved = rider;
+    ASSERT_TRUE(moved.SetPosition(Vec3(8, cCharacterStandHeight + 0.02f, 8)).IsOk());
+    EXPECT_TRUE(moved.GetGroundTurn().isApprox(Quat::Identity())) << "put elsewhere";
+    Walk(moved, Vec3::Zero(), 5);
+    EXPECT_TRUE(moved.GetGroundTurn().isApprox(Quat::Identity())) << "on the static floor";
+
+    // Tilting about x by 0.1 rad over a second: the rider rides it, turned by nothing about +y
+    Quat tilt = table;
+    float mostTurn = 0.0f;
+    for (int frame = 0; frame < 60; ++frame)
+    {
+        tilt = tilt * Quat(Eigen::AngleAxisf(0.1f * cDeltaTime, Vec3::UnitX()));
+        ASSERT_TRUE(Bodies().MoveKinematic(id, Vec3(0, 1, 0), tilt, cDeltaTime).IsOk());
+        ASSERT_TRUE(UpdateWorld(cDeltaTime).IsOk());
+        Walk(rider, Vec3::Zero(), 1);
+        ASSERT_EQ(rider.GetGroundBody(), id) << "frame " << frame;
+        mostTurn = std::max(mostTurn, rider.GetGroundTurn().angularDistance(Quat::Identity()));
+    }
+    EXPECT_LT(mostTurn, 1.0e-4f);
+}
+
 TEST_F(CharacterControllerTest, ItPushesADynamicBoxItWalksIntoWhenAskedTo)
 {
     AddFloor();

@@ -111,6 +111,10 @@ public:
     /// it (zero for static ground, a ground body at rest for 0.1 s, and InAir): what the character keeps when
     /// it steps off.
     Vec3 GetGroundVelocity() const { return mGroundVelocity; }
+    /// How far its ground body turned it about mUp in the last Update (identity when it did not turn, on
+    /// static ground and InAir): the character's facing is the game's, which turns it by this to ride a
+    /// rotating platform as Unreal's characters follow their base's rotation.
+    Quat GetGroundTurn() const { return mGroundTurn; }
     /// The bodies the last Update touched (the ground among them), each once.
     std::span<const CharacterContact> GetContacts() const { return mContacts; }
     /// The members of its CharacterGroup the last Update touched (one it stands on among them), each once.
@@ -149,7 +153,9 @@ private:
     /// Where the character stood in its ground body's frame, and the version of that body's pose then: a
     /// ground body that moved since carries the character along
     Vec3 mPositionOnGround = Vec3::Zero();
+    Quat mGroundRotationAtAnchor = Quat::Identity(); ///< That pose's rotation
     uint32_t mGroundPoseVersion = 0;
+    Quat mGroundTurn = Quat::Identity();
     bool mGroundMoves = false;
     /// Seconds since the ground body's pose last changed, and its velocity as its carries measured it: what a
     /// character leaving a moving platform keeps
