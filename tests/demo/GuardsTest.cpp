@@ -1,7 +1,7 @@
 // The demo's guards (Guards.h) in a world of the default seed's terrain alone, stepped on one thread: the
 // player walks its path and shoots each guard as it nears; a guard hit goes limp as a ragdoll, which comes
-// to rest on the ground, every part above the terrain's surface once at rest; the guards the player passed are replaced
-// by new ones ahead.
+// to rest on the ground, every part above the terrain's surface once at rest; the guards the player passed
+// are replaced by new ones ahead.
 
 #include "Guards.h"
 

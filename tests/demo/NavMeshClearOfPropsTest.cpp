@@ -11,6 +11,7 @@
 
 #include "Agents.h"
 #include "WorldGenerator.h"
+#include "WorldNavTile.h"
 #include "cairn/navmesh/GeometryCollector.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/PhysicsSystem.h"
@@ -120,14 +121,7 @@ int ScanWorldTile(const WorldSettings& inWorld)
             {
                 const navmesh::TileCoord tile{worldTile.mX * navTilesAcross + x,
                                               worldTile.mZ * navTilesAcross + z};
-                const AABB box =
-                    grid.GetTileBoundsWithBorder(tile, float(profile.GetBorderCells()) * profile.mCellSize);
-                std::vector<BodyID> found;
-                navmesh::TileGeometry geometry;
-                navmesh::CollectStats stats;
-                collector.FindBodies(box, {}, found);
-                collector.CollectTriangles(box, {}, found, geometry, stats);
-                Result<navmesh::BuiltTile> built = navmesh::BuildTile(profile, grid, tile, geometry);
+                Result<navmesh::BuiltTile> built = BuildWorldNavTile(collector, profile, grid, tile);
                 if (!built)
                 {
                     ADD_FAILURE() << built.GetError().mMessage;

@@ -253,7 +253,9 @@ void Agents::Decide(uint32_t inIndex, const Vec3& inPlayer, Action& outAction) c
         return;
     }
     if (state == navmesh::AgentState::OffNavMesh || agent.mRetrySeconds > 0.0f) return;
-    const bool moving = state == navmesh::AgentState::Moving || state == navmesh::AgentState::WaitingForPath;
+    const bool moving = state == navmesh::AgentState::Moving ||
+                        state == navmesh::AgentState::WaitingForPath ||
+                        state == navmesh::AgentState::OnOffMeshLink;
     outAction.mStuck = moving && agent.mProgressSeconds >= cStuckSeconds &&
                        FlatDistance(position, agent.mProgressFrom) < cStuckMetres;
     const bool following = agent.mCompanion && toHome > cFollowDistance;
@@ -348,6 +350,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
         mainMs += crowd->GetStatistics().mLastSerialMs;
         jobMs += crowd->GetStatistics().mLastMoveMs;
         mStats.mReplans += crowd->GetStatistics().mReplans - before.mReplans;
+        mStats.mLinksTaken += crowd->GetStatistics().mLinksTaken - before.mLinksTaken;
     }
     const int64_t switchesAfter = mWatchedThreads.empty() ? -1 : tools::InvoluntarySwitches(mWatchedThreads);
     mStats.mMainThreadMs.push_back(mainMs);
@@ -368,7 +371,10 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
                                action.mWalked = FlatDistance(position, agent.mLastPosition);
                                action.mOffNavMesh =
                                    crowd.GetState(agent.mID).Value() == navmesh::AgentState::OffNavMesh;
-                               action.mChecked = (i + mFrame) % cCheckPeriodFrames == 0;
+                               // On a ladder it climbs over the hut's wall: not a place it walks to
+                               action.mChecked =
+                                   (i + mFrame) % cCheckPeriodFrames == 0 &&
+                                   crowd.GetState(agent.mID).Value() != navmesh::AgentState::OnOffMeshLink;
                                action.mInsideStatic = action.mChecked && InsideStatic(position);
                            }
                        });

@@ -493,15 +493,17 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                                         AtMost(double(agents.mPathWaitP99Frames), cPathWaitTargetFrames, "")},
           {"max", Count(agents.mPathWaitMaxFrames)},
           {"replans (tile changes)", Count(agents.mReplans)}}});
-    sections.push_back({"agents",
-                        {{"agents", Format("%d", inRun.mAgents)},
-                         {"goals", Count(agents.mGoalsSet)},
-                         {"arrivals", Count(agents.mArrivals)},
-                         {"goals given up after 15 s", Count(agents.mGoalTimeouts)},
-                         {"stuck 5 s", Count(agents.mStuck)},
-                         {"no goal found", Count(agents.mGoalsNotFound)},
-                         {"walked m", Fixed(agents.mDistance, 0)},
-                         {"put back by the player", Count(agents.mCatchUps)}}});
+    sections.push_back(
+        {"agents",
+         {{"agents", Format("%d", inRun.mAgents)},
+          {"goals", Count(agents.mGoalsSet)},
+          {"arrivals", Count(agents.mArrivals)},
+          {"goals given up after 15 s", Count(agents.mGoalTimeouts)},
+          {"stuck 5 s", Count(agents.mStuck)},
+          {"no goal found", Count(agents.mGoalsNotFound)},
+          {"walked m", Fixed(agents.mDistance, 0)},
+          {"put back by the player", Count(agents.mCatchUps)},
+          {"ladders climbed", Count(agents.mLinksTaken) + " of " + Count(inRun.mLaddersMost) + " at most"}}});
     sections.push_back(
         {"agent checks",
          {{"overlapping > 10 % of a radius",

@@ -37,7 +37,8 @@ struct AgentStats
     uint64_t mPathsRequested = 0; ///< Through the crowds' queues, replans included
     uint64_t mPathsServed = 0;    ///< Found (whole or partial)
     uint64_t mPathsFailed = 0;
-    uint64_t mReplans = 0; ///< Corridors cut by a tile change, asked again
+    uint64_t mReplans = 0;    ///< Corridors cut by a tile change, asked again
+    uint64_t mLinksTaken = 0; ///< Off-mesh links (the huts' ladders) agents started to climb
     uint64_t mPathWaitP99Frames = 0;
     uint64_t mPathWaitMaxFrames = 0;
     uint64_t mCatchUps = 0;    ///< Put back by the player after falling 50 m behind
@@ -173,6 +174,7 @@ struct DemoRunResult
     AgentStats mAgentStats;
     DoorStats mDoorStats;
     GuardStats mGuardStats;
+    uint32_t mLaddersMost = 0; ///< Most hut ladders (off-mesh links) declared at once
     /// The final navmesh of the human profile, for the map: each polygon's outline (x, z) and the build
     /// latency of its tile in frames (-1: not known, a tile built before the run)
     struct MapPolygon

@@ -4,6 +4,7 @@
 #include "Doors.h"
 #include "GameObjects.h"
 #include "Guards.h"
+#include "HutLadders.h"
 #include "Projectiles.h"
 #include "TileStreamer.h"
 #include "WorldGenerator.h"
@@ -208,7 +209,9 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     if (!RunUntil(
             physics, frameJobs, navMeshes, [&] { return streamer->IsSettled(); }, 60.0))
         result.mErrors.push_back("the start area did not load within 60 s");
-    // And the agents' navmesh round the start, of both profiles
+    // The huts' ladders, then the agents' navmesh round the start, of both profiles
+    auto ladders = std::make_unique<HutLadders>(*streamer, generator, *navMeshes.mSchedulers[0]);
+    ladders->Update();
     if (Status focused = navMeshes.Focus(generator.GetPlayerPosition(0.0f), navMeshRadius); !focused)
         result.mErrors.push_back("navmesh invoker: " + focused.GetError().mMessage);
     if (!RunUntil(
@@ -244,6 +247,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         if (inSettings.mThrowBalls) projectiles.Update(frame, player);
         guards.Update(frame, seconds, player, projectiles, inSettings.mThrowBalls);
         doors.Command(seconds);
+        ladders->Update();
 
         // A frame pipeline: the game objects' queries and the step are two jobs that run at once (each waits
         // only for jobs it scheduled itself, so neither runs the other's work on its stack); the queries
@@ -331,6 +335,9 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
         result.mErrors.push_back("doors: " + error);
     agents->FinishStats();
     result.mAgentStats = agents->GetStats();
+    result.mLaddersMost = ladders->GetMostLadders();
+    if (ladders->GetNumRefused() > 0)
+        result.mErrors.push_back("ladders: " + std::to_string(ladders->GetNumRefused()) + " refused");
     for (const std::string& error : result.mAgentStats.mErrors)
         result.mErrors.push_back("agents: " + error);
     if (result.mAgentStats.mInsideStatic > 0)
@@ -367,6 +374,7 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     // Tear down in dependency order: agents (invokers), the scheduler (its jobs read the world), then the
     // streamer, whose unload checks every body it made once more
     agents.reset();
+    ladders.reset(); // Withdrawn from the human scheduler
     for (auto& scheduler : navMeshes.mSchedulers)
         scheduler.reset();
     result.mLostOrDuplicatedBodies += streamer->UnloadAllAndCheck();
