@@ -47,7 +47,9 @@ constexpr float cCornerLineToleranceRadii = 0.1f;
 constexpr float cLinkReachRadii = 2.25f;
 /// An agent whose corridor was cut short of its path asks for the rest when this many polygons are left
 /// (DetourCrowd's CHECK_LOOKAHEAD): enough to walk on while the queue searches
-constexpr int cCutCorridorReplanPolygons = 10;
+constexpr int cCutCorridorReplanPolygons = 10; ///< At most: a third of a short corridor, 2 at least
+/// The polygons dtPathCorridor's merges may put at a corridor's start: a raycast's (optimizePathVisibility)
+constexpr int cDetourMergeRoom = 32;
 
 /// DetourCrowd's "medium" quality: adaptive sampling, 5 divisions, 2 rings, depth 2 (22 samples a threatened
 /// agent, against 75 for its "good": the sampling was half of a 10,000-agent crowd's time at "good").
@@ -249,7 +251,7 @@ struct Crowd::Agent
         crossing.mStart = start;
         crossing.mEnd = end; // Detour moved it onto the polygon it lands on when it joined the link
         crossing.mUserID = connection->userId;
-        crossing.mArea = polygon->getArea();
+        crossing.mArea = uint8_t(FromDetourArea(polygon->getArea()));
         mLink.emplace(inPosition, crossing, mParams.mMaxSpeed, mParams.mLinkMode);
         mCorners.mValid = false;
         return true;
@@ -337,8 +339,10 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
         return MakeError(ErrorCode::OutOfCapacity, "agent: the crowd is full");
     auto agent = std::make_unique<Agent>();
     agent->mParams = inParams;
-    // One more than it holds: Detour's setCorridor asserts that a path is shorter than the corridor's size
-    if (!agent->mCorridor.init(mSettings.mMaxCorridorPolygons + 1))
+    // One more than it holds: Detour's setCorridor asserts that a path is shorter than the corridor's size.
+    // And room for what a move or a shortcut merges in at its start: this Detour's merges do not check
+    // their room, and wrote past a corridor smaller than a raycast's 32 polygons
+    if (!agent->mCorridor.init(std::max(mSettings.mMaxCorridorPolygons, cDetourMergeRoom) + 1))
         return MakeError(ErrorCode::OutOfCapacity, "agent: Detour could not allocate its corridor");
     bool queryReady = false, onNavMesh = false;
     mWorld.Read(
@@ -760,7 +764,8 @@ void Crowd::RequestPaths()
         // Near the end of a corridor cut short, the rest of the way, walking on meanwhile (DetourCrowd asks
         // again likewise); it would stop there as if it had arrived
         if (agent.mState == AgentState::Moving && agent.mCorridorCut &&
-            agent.mCorridor.getPathCount() <= cCutCorridorReplanPolygons)
+            agent.mCorridor.getPathCount() <=
+                std::min(cCutCorridorReplanPolygons, std::max(2, mSettings.mMaxCorridorPolygons / 3)))
             agent.mState = AgentState::WaitingForPath;
         // An agent that needs a path and has no request (a replan, back on navmesh, a corridor cut short, or
         // a full queue last time) asks now; a full queue is asked again next Update
@@ -805,13 +810,14 @@ void Crowd::ApplyPathResults()
             continue;
         }
         std::vector<dtPolyRef> path(polygons.begin() + long(from), polygons.end());
-        // A path as long as the search's buffer goes on past it: asked again on the way, as a corridor cut
-        // short is, and not short of the target for want of a way
-        const bool searchCut = !result->Value().mReachedEnd && polygons.size() >= size_t(cMaxPathPolygons);
+        // A search that ran out of its budget went that way but not all of it: asked again on the way, as a
+        // corridor cut short is, and not short of the target for want of a way
+        const bool searchCut = result->Value().mSearchLimited;
         agent.mPathStatus =
             result->Value().mReachedEnd || searchCut ? PathStatus::Complete : PathStatus::Partial;
         agent.mCorridorCut = path.size() > size_t(mSettings.mMaxCorridorPolygons) || searchCut;
-        if (agent.mCorridorCut) path.resize(size_t(mSettings.mMaxCorridorPolygons));
+        if (path.size() > size_t(mSettings.mMaxCorridorPolygons))
+            path.resize(size_t(mSettings.mMaxCorridorPolygons));
         corridor.setCorridor(result->Value().mStraightPath.back().data(), path.data(), int(path.size()));
         agent.mCorners.mValid = false;
         agent.mState = AgentState::Moving;
@@ -1113,6 +1119,8 @@ Status Crowd::CompleteOffMeshLink(AgentID inAgent)
     Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
     if (!agent->mLink) return MakeError(ErrorCode::InvalidArgument, "agent: not on an off-mesh link");
+    if (!agent->mLink->GetCrossing().mAtStart)
+        return MakeError(ErrorCode::InvalidArgument, "agent: not at its off-mesh link's start yet");
     agent->mLink.reset(); // At its corridor's place now: the link's end
     agent->mVelocity.setZero();
     return Status::Ok();

@@ -28,7 +28,7 @@ bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilte
     const dtMeshTile* tile = nullptr;
     const dtPoly* poly = nullptr;
     inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
-    const int area = poly->getArea() == 63 ? cDefaultArea : poly->getArea();
+    const int area = FromDetourArea(poly->getArea());
     return area <= cMaxAreaId && ((inFilter.mExcludedAreas >> area) & 1u) != 0;
 }
 
@@ -50,7 +50,8 @@ Status CheckSearchExtent(const Vec3& inSearchExtent, float inTileSize, const cha
 
 Result<PathResult> FinishPath(const dtNavMeshQuery& inQuery, const dtNavMesh& inNavMesh,
                               const dtPolyRef* inCorridor, int inNumPolygons, dtPolyRef inEndRef,
-                              const float* inStartPoint, const float* inEndPoint, const PathFilter& inFilter)
+                              const float* inStartPoint, const float* inEndPoint, const PathFilter& inFilter,
+                              dtStatus inSearchStatus)
 {
     // Cut the corridor before the first polygon of an excluded area
     for (int i = 0; i < inNumPolygons; ++i)
@@ -63,9 +64,25 @@ Result<PathResult> FinishPath(const dtNavMeshQuery& inQuery, const dtNavMesh& in
             break;
         }
     }
+    // A partial corridor never ends on an off-mesh link: Detour's search steps onto a link whose far end
+    // joins nothing (its tile not loaded) and, its node at the link's start, may find that nearest the end.
+    // The path would end in the air between the link's ends, and a crowd agent would wait at the link for
+    // ever
+    const auto isLink = [&](dtPolyRef inPolygon)
+    {
+        const dtMeshTile* tile = nullptr;
+        const dtPoly* poly = nullptr;
+        inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
+        return poly->getType() == DT_POLYTYPE_OFFMESH_CONNECTION;
+    };
+    if (inCorridor[inNumPolygons - 1] != inEndRef)
+        while (inNumPolygons > 1 && isLink(inCorridor[inNumPolygons - 1]))
+            --inNumPolygons;
     PathResult result;
     result.mNumPolygons = inNumPolygons;
     result.mReachedEnd = inCorridor[inNumPolygons - 1] == inEndRef;
+    result.mSearchLimited = !result.mReachedEnd && (dtStatusDetail(inSearchStatus, DT_OUT_OF_NODES) ||
+                                                    dtStatusDetail(inSearchStatus, DT_BUFFER_TOO_SMALL));
     // A partial path ends at the point of its last polygon nearest the end
     float target[3] = {inEndPoint[0], inEndPoint[1], inEndPoint[2]};
     if (!result.mReachedEnd)

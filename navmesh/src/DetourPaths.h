@@ -25,6 +25,11 @@ inline unsigned char ToDetourArea(int inArea)
 {
     return inArea == cDefaultArea ? 63 : (unsigned char)inArea; // RC_WALKABLE_AREA is 63
 }
+/// The Cairn area id of a Detour area id.
+inline int FromDetourArea(unsigned char inArea)
+{
+    return inArea == 63 ? cDefaultArea : int(inArea);
+}
 
 /// Detour's filter for a PathFilter. Detour excludes by polygon flags, not areas: an excluded area gets a
 /// prohibitive cost, and callers check the areas of what they find (IsExcluded).
@@ -34,9 +39,11 @@ bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilte
 /// Checks a search extent against the grid's limit (NavMeshWorld::cMaxSearchExtentTiles tiles across).
 Status CheckSearchExtent(const Vec3& inSearchExtent, float inTileSize, const char* inWhat);
 /// A found corridor (inNumPolygons > 0) made a PathResult: cut before its first polygon of an excluded area,
-/// ending at the end or, for a partial corridor, at the point of its last polygon nearest the end.
+/// ending at the end or, for a partial corridor, at the point of its last polygon nearest the end (never on
+/// an off-mesh link). inSearchStatus: Detour's status of the search that found it (its budget details).
 Result<PathResult> FinishPath(const dtNavMeshQuery& inQuery, const dtNavMesh& inNavMesh,
                               const dtPolyRef* inCorridor, int inNumPolygons, dtPolyRef inEndRef,
-                              const float* inStartPoint, const float* inEndPoint, const PathFilter& inFilter);
+                              const float* inStartPoint, const float* inEndPoint, const PathFilter& inFilter,
+                              dtStatus inSearchStatus);
 
 } // namespace cairn::navmesh

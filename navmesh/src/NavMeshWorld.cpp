@@ -307,11 +307,12 @@ Result<PathResult> NavMeshWorld::FindPath(const Vec3& inStart, const Vec3& inEnd
 
     dtPolyRef corridor[cMaxPathPolygons];
     int numPolygons = 0;
-    if (dtStatusFailed(query->findPath(startRef, endRef, startPoint, endPoint, &filter, corridor,
-                                       &numPolygons, cMaxPathPolygons)) ||
-        numPolygons == 0)
+    const dtStatus status = query->findPath(startRef, endRef, startPoint, endPoint, &filter, corridor,
+                                            &numPolygons, cMaxPathPolygons);
+    if (dtStatusFailed(status) || numPolygons == 0)
         return MakeError(ErrorCode::InvalidArgument, "path: no path");
-    return FinishPath(*query, *mNavMesh, corridor, numPolygons, endRef, startPoint, endPoint, inFilter);
+    return FinishPath(*query, *mNavMesh, corridor, numPolygons, endRef, startPoint, endPoint, inFilter,
+                      status);
 }
 
 Result<Vec3> NavMeshWorld::FindNearestPoint(const Vec3& inPoint, const PathFilter& inFilter,

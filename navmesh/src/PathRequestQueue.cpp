@@ -151,10 +151,10 @@ int PathRequestQueue::Search(const dtNavMesh& inNavMesh)
         if (dtStatusInProgress(status)) continue; // The budget ran out: the search goes on next Update
         dtPolyRef corridor[cMaxPathPolygons];
         int numPolygons = 0;
-        const bool found =
-            dtStatusSucceed(status) &&
-            dtStatusSucceed(mQuery->finalizeSlicedFindPath(corridor, &numPolygons, cMaxPathPolygons)) &&
-            numPolygons > 0;
+        const dtStatus finalized =
+            dtStatusSucceed(status) ? mQuery->finalizeSlicedFindPath(corridor, &numPolygons, cMaxPathPolygons)
+                                    : status;
+        const bool found = dtStatusSucceed(finalized) && numPolygons > 0;
         const std::lock_guard lock(mMutex);
         if (!found && mActive->mRestarts < mSettings.mMaxRestarts && dtStatusFailed(status))
         {
@@ -167,7 +167,7 @@ int PathRequestQueue::Search(const dtNavMesh& inNavMesh)
         }
         finished += FinishActiveLocked(
             found ? FinishPath(*mQuery, inNavMesh, corridor, numPolygons, dtPolyRef(mEndRef), mStartPoint,
-                               mEndPoint, request.mFilter)
+                               mEndPoint, request.mFilter, finalized)
                   : Result<PathResult>(MakeError(ErrorCode::InvalidArgument, "path request: no path")));
     }
     return finished;

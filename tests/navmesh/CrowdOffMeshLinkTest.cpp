@@ -126,6 +126,7 @@ protected:
         EXPECT_LT((inWalk.mLink.mStart - inStart).norm(), 0.3f);
         EXPECT_LT((inWalk.mLink.mEnd - inEnd).norm(), 0.3f);
         EXPECT_EQ(inWalk.mLink.mUserID, cJumpID);
+        EXPECT_EQ(inWalk.mLink.mArea, cDefaultArea) << "Cairn's area id, not Detour's";
         // Along the link at its top speed: 5 m or more at 3.5 m/s, from its start to its end
         const float length = (inEnd - inStart).norm();
         EXPECT_NEAR(float(inWalk.mUpdatesAlongLink) * cFrame, length / AgentParams().mMaxSpeed, 0.05f);
@@ -174,6 +175,10 @@ TEST_F(CrowdOffMeshLinkTest, AnAgentTheGameCrossesWaitsAtTheStartUntilTheGameIsD
     EXPECT_FALSE(crowd->GetOffMeshLink(agent)) << "on no link yet";
     EXPECT_FALSE(crowd->CompleteOffMeshLink(agent)) << "on no link yet";
     int update = 0;
+    for (; update < 600 && crowd->GetState(agent).Value() != AgentState::OnOffMeshLink; ++update)
+        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+    ASSERT_FALSE(crowd->GetOffMeshLink(agent).Value().mAtStart) << "it takes the link short of its start";
+    EXPECT_FALSE(crowd->CompleteOffMeshLink(agent)) << "not at the start yet";
     for (; update < 600 && !(crowd->GetState(agent).Value() == AgentState::OnOffMeshLink &&
                              crowd->GetOffMeshLink(agent).Value().mAtStart);
          ++update)
@@ -375,6 +380,43 @@ TEST_F(CrowdOffMeshLinkTest, AgentsCrossWhileTheLinkComesAndGoesAndTilesRebuild)
     EXPECT_GE(crossings, 10) << "the agents kept crossing";
     EXPECT_GE(crowd->GetStatistics().mLinksTaken, uint64_t(crossings));
     EXPECT_GT(crowd->GetStatistics().mReplans, 0u) << "some corridors lost the link or the far tile";
+}
+
+// A link whose far end joins nothing (no navmesh there) to a platform no link reaches: Detour's search steps
+// onto the link and may find its start nearest the goal. The path must not end on the link (in the air
+// between its ends): it ends on the near side, and an agent arrives there, short (it waited at the link)
+TEST_F(CrowdOffMeshLinkTest, APathShortOfItsGoalNeverEndsOnALinkToNowhere)
+{
+    AddStaticBox(Vec3(-6, -0.5f, 0), Vec3(4.5f, 0.5f, 4)); // x in [-10.5, -1.5]
+    AddStaticBox(Vec3(6, -0.5f, 0), Vec3(4.5f, 0.5f, 4));  // x in [1.5, 10.5]
+    MakeNavMesh();
+    OffMeshLink nowhere;
+    nowhere.mStart = Vec3(-2.5f, 0, 0);
+    nowhere.mEnd = Vec3(0, 0, 0); // Over the gap: no polygon within its radius
+    nowhere.mRadius = 0.6f;
+    ASSERT_TRUE(mScheduler->AddOffMeshLink(nowhere));
+    ASSERT_TRUE(RunUntilIdle());
+    const Result<PathResult> path = mWorld->FindPath(Vec3(-8, 0, 0), Vec3(8, 0, 0));
+    ASSERT_TRUE(path) << path.GetError().mMessage;
+    EXPECT_FALSE(path.Value().mReachedEnd);
+    mWorld->Read(
+        [&](const dtNavMesh& inNavMesh)
+        {
+            const dtMeshTile* tile = nullptr;
+            const dtPoly* poly = nullptr;
+            inNavMesh.getTileAndPolyByRefUnsafe(dtPolyRef(path.Value().mPolygons.back()), &tile, &poly);
+            EXPECT_NE(poly->getType(), DT_POLYTYPE_OFFMESH_CONNECTION) << "the path ends on the link";
+        });
+    EXPECT_TRUE(OnNavMesh(path.Value().mStraightPath.back())) << "it ends on the navmesh";
+
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    const Crowd::AgentID agent = crowd->AddAgent(Vec3(-8, 0, 0)).Value();
+    ASSERT_TRUE(crowd->SetTarget(agent, Vec3(8, 0, 0)).IsOk());
+    for (int update = 0; update < 300; ++update)
+        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+    EXPECT_EQ(crowd->GetState(agent).Value(), AgentState::Arrived);
+    EXPECT_EQ(crowd->GetPathStatus(agent).Value(), PathStatus::Partial);
+    EXPECT_LT(crowd->GetPosition(agent).Value().x(), -1.5f);
 }
 
 } // namespace

@@ -60,5 +60,20 @@ TEST_F(OffMeshLinkTest, AOneWayDropIsTakenOneWayOnly)
     EXPECT_FALSE(mWorld->FindPath(Vec3(8, 0, 0), Vec3(-8, 0, 0)).Value().mReachedEnd);
 }
 
+// A link whose end lies more than a tile from its start's tile is refused: Detour would never join it
+TEST_F(OffMeshLinkTest, ALinkLongerThanATileAcrossIsRefused)
+{
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(12, 0.5f, 4));
+    MakeNavMesh(2); // Tiles of 12.8 m from x = -25.6
+    OffMeshLink far;
+    far.mStart = Vec3(-20, 0, 0); // Tile 0 across
+    far.mEnd = Vec3(11, 0, 0);    // Tile 2
+    const Result<TileScheduler::LinkID> refused = mScheduler->AddOffMeshLink(far);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.GetError().mMessage.find("more than a tile"), std::string::npos);
+    far.mEnd = Vec3(-5, 0, 0); // Tile 1, the next
+    EXPECT_TRUE(mScheduler->AddOffMeshLink(far));
+}
+
 } // namespace
 } // namespace cairn::navmesh::test

@@ -99,10 +99,10 @@ enum class AgentState : uint8_t
     Idle,           ///< No target
     WaitingForPath, ///< A path request is queued or searched (it may move along a valid part meanwhile)
     Moving,         ///< Following its corridor
-    Arrived,        ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
-    NoPath,         ///< The last request found no path (target off the navmesh or unreachable)
-    OffNavMesh,     ///< Its polygon went away with a tile: waits in place for navmesh under it
-    OnOffMeshLink,  ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
+    Arrived,    ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
+    NoPath,     ///< The last request found no path (target off the navmesh or unreachable)
+    OffNavMesh, ///< Its polygon went away with a tile: waits in place for navmesh under it
+    OnOffMeshLink, ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
 };
 
 class Crowd
@@ -113,7 +113,7 @@ public:
         int mMaxAgents = 16384;
         float mMaxAgentRadius = 2.0f; ///< m: the neighbour grid's cell is twice this
         /// Per agent, in [3, 1024]: a longer path is walked a corridor at a time, the rest asked for as the
-        /// agent nears the corridor's end
+        /// agent nears the corridor's end (10 polygons before it; a third of a shorter corridor, 2 at least)
         int mMaxCorridorPolygons = 256;
         /// Updates an agent on a collision course keeps the velocity it sampled (DetourCrowd samples every
         /// Update: 1). 2 halves the sampling, the crowd's largest cost in a dense crowd: avoidance is planned
@@ -180,7 +180,7 @@ public:
     Result<OffMeshLinkCrossing> GetOffMeshLink(AgentID inAgent) const;
     /// Ends an agent's link now: it stands at the link's end and goes on along its corridor (the game's
     /// call for OffMeshLinkMode::ByGame once its animation is done; it also cuts an automatic one short).
-    /// Error for an agent on no link.
+    /// Error for an agent on no link, or not yet at its start (OffMeshLinkCrossing::mAtStart).
     Status CompleteOffMeshLink(AgentID inAgent);
     /// The agent's corridor, Detour polygon references (to draw it, or to check it against the navmesh).
     Result<std::vector<uint64_t>> GetCorridor(AgentID inAgent) const;

@@ -42,7 +42,10 @@ struct PathFilter
 
 struct PathResult
 {
-    bool mReachedEnd = false;        ///< False: the path ends at the reachable point nearest the end
+    bool mReachedEnd = false; ///< False: the path ends at the reachable point nearest the end
+    /// The search ran out of its nodes or its corridor's room before it reached the end: the path goes that
+    /// way but may stop short of an end that can be reached (ask again from farther on)
+    bool mSearchLimited = false;
     int mNumPolygons = 0;            ///< Length of the polygon corridor
     std::vector<Vec3> mStraightPath; ///< Corner points from start to (reachable) end
     /// The polygon corridor, Detour polygon references from the start's polygon on: valid until a Publish

@@ -104,8 +104,9 @@ public:
     /// Off-mesh links (jumps, ladders): built into the tile that holds the start; adding or removing one
     /// makes that tile dirty. Any thread.
     using LinkID = uint32_t;
-    /// Error for an end outside the world, a radius not in (0, 1e3] m or an area over cMaxAreaId (the tile
-    /// build would refuse the whole tile).
+    /// Error for an end outside the world, an end more than a tile from the start's tile (Detour would never
+    /// join it), a radius not in (0, 1e3] m or an area over cMaxAreaId (the tile build would refuse the whole
+    /// tile).
     Result<LinkID> AddOffMeshLink(const OffMeshLink& inLink);
     void RemoveOffMeshLink(LinkID inLink);
 
