@@ -1,15 +1,23 @@
 #include "cairn/navmesh/BakedTiles.h"
 
 #include <DetourAlloc.h>
+#include <cmath>
 #include <cstring>
 
 namespace cairn::navmesh
 {
 
 Result<std::vector<BuiltTile>> MakeBakedTileChanges(const NavMeshFileContents& inContents,
-                                                    const TileGrid& inGrid,
+                                                    const NavMeshWorld& inWorld,
                                                     const std::optional<AABB>& inRegion)
 {
+    const TileGrid& inGrid = inWorld.GetGrid();
+    const AgentProfile& profile = inWorld.GetProfile();
+    if (inRegion.has_value() &&
+        (!inRegion->mMin.allFinite() || !inRegion->mMax.allFinite() ||
+         inRegion->mMin.x() > inRegion->mMax.x() || inRegion->mMin.z() > inRegion->mMax.z()))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "baked navmesh: the region is not a box of finite numbers");
     const dtNavMeshParams& params = inContents.mParams;
     // Detour places a tile by the navmesh's origin and tile size: the world's must be the bake's, to the bit
     // (both come from the same numbers, and a tile built a hair off is a seam agents cannot cross)
@@ -44,6 +52,16 @@ Result<std::vector<BuiltTile>> MakeBakedTileChanges(const NavMeshFileContents& i
         change.mDataSize = int(tile.mData.size());
         dtMeshHeader header;
         std::memcpy(&header, tile.mData.data(), sizeof(header));
+        // The bake's agent, as BuildTile writes it into each tile
+        const auto same = [](float inBaked, float inOurs) { return std::abs(inBaked - inOurs) <= 1.0e-4f; };
+        if (!same(header.walkableHeight, profile.mHeight) || !same(header.walkableRadius, profile.mRadius) ||
+            !same(header.walkableClimb, profile.mMaxClimb))
+            return MakeError(ErrorCode::InvalidArgument,
+                             "baked navmesh: tile (" + std::to_string(tile.mTile.mX) + ", " +
+                                 std::to_string(tile.mTile.mZ) + ") was baked for an agent of height " +
+                                 std::to_string(header.walkableHeight) + ", radius " +
+                                 std::to_string(header.walkableRadius) + " and climb " +
+                                 std::to_string(header.walkableClimb) + " m, not the world's");
         change.mNumPolygons = header.polyCount;
         change.mNumVertices = header.vertCount;
         changes.push_back(std::move(change));

@@ -36,10 +36,11 @@ protected:
     }
 
     Result<BakeResult> BakeWith(const std::string& inLinks, const BakeSummary* inPrevious = nullptr,
-                                const navmesh::NavMeshFileContents* inPreviousNavMesh = nullptr)
+                                const navmesh::NavMeshFileContents* inPreviousNavMesh = nullptr,
+                                const std::string& inLevel = cTwoPlatforms)
     {
         BakeSettings settings;
-        settings.mInputs = {Write("platforms.obj", cTwoPlatforms)};
+        settings.mInputs = {Write("platforms.obj", inLevel)};
         settings.mThreads = 1;
         settings.mPrevious = inPrevious;
         settings.mPreviousNavMesh = inPreviousNavMesh;
@@ -136,12 +137,34 @@ TEST_F(BakeLinksTest, AMovedLinkRebuildsItsTileOnly)
     EXPECT_EQ(same.Value().mSummary.mTilesRebuilt, 0u) << "nothing changed";
 }
 
-TEST_F(BakeLinksTest, AnEndInNoTileOfTheLevelIsRefused)
+// Links that could never join the navmesh are refused: an end in no tile of the level, an end more than a
+// tile from its start's (Detour joins ends in the start's tile and the eight around it only), a start in a
+// tile of the level that has no navmesh
+TEST_F(BakeLinksTest, LinksThatCouldNeverJoinAreRefused)
 {
-    Result<BakeResult> baked = BakeWith(R"({"links": [{"start": [9, 0, 4], "end": [9, 0, 40]}]})");
-    ASSERT_FALSE(baked);
-    EXPECT_NE(baked.GetError().mMessage.find("off-mesh link 0: its end"), std::string::npos)
-        << baked.GetError().mMessage;
+    const auto refusal = [&](const std::string& inLinks)
+    {
+        Result<BakeResult> baked = BakeWith(inLinks);
+        return baked ? std::string("baked") : baked.GetError().mMessage;
+    };
+    EXPECT_NE(
+        refusal(R"({"links": [{"start": [9, 0, 4], "end": [9, 0, 40]}]})").find("off-mesh link 0: its end"),
+        std::string::npos);
+    EXPECT_NE(
+        refusal(
+            R"({"links": [{"start": [1, 0, 1], "end": [2, 0, 2]}, {"start": [9, 0, 4], "end": [30, 0, 4]}]})")
+            .find("off-mesh link 1: its end is more than a tile from its start's"),
+        std::string::npos);
+    // The level's bounds reach z = 8 from x = 0 to 24 only; (20, 0, 6) is on the east platform
+    EXPECT_EQ(refusal(R"({"links": [{"start": [9, 0, 4], "end": [20, 0, 6]}]})"), "baked");
+    // A wall at z = 20 makes tile (0, 1) the level's, with nothing to walk on
+    const std::string withWall =
+        std::string(cTwoPlatforms) + "v 2 0 20\nv 4 0 20\nv 4 3 20\nv 2 3 20\no Wall\nf 9 10 11\nf 9 11 12\n";
+    Result<BakeResult> walled =
+        BakeWith(R"({"links": [{"start": [3, 0, 15], "end": [3, 0, 6]}]})", nullptr, nullptr, withWall);
+    ASSERT_FALSE(walled);
+    EXPECT_NE(walled.GetError().mMessage.find("has no navmesh for the off-mesh links"), std::string::npos)
+        << walled.GetError().mMessage;
 }
 
 TEST_F(BakeLinksTest, TheLinksFileErrorsNameTheFileTheLinkAndTheKey)
@@ -157,9 +180,10 @@ TEST_F(BakeLinksTest, TheLinksFileErrorsNameTheFileTheLinkAndTheKey)
         {R"({"links": {}})", "'links' must be an array"},
         {R"({"links": [3]})", "link 0: not a JSON object"},
         {R"({"links": [{"start": [0, 0, 0]}]})", "link 0: needs 'start' and 'end'"},
-        {R"({"links": [{"start": [0, 0], "end": [1, 0, 0]}]})", "link 0: 'start' must be three finite"},
-        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 1e39]}]})", "link 0: 'end' must be three finite"},
-        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, "x"]}]})", "'end' must be three finite"},
+        {R"({"links": [{"start": [0, 0], "end": [1, 0, 0]}]})", "link 0: 'start' must be three numbers"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 1e39]}]})", "link 0: 'end' must be three numbers"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, "x"]}]})", "'end' must be three numbers"},
+        {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 2e6]}]})", "within the world's range"},
         {R"({"links": [{"start": [0,0,0], "end": [1,0,0]}, {"start": [0,0,0], "end": [1,0,0], "radius": 0}]})",
          "link 1: 'radius' must be a number in (0, 1000]"},
         {R"({"links": [{"start": [0, 0, 0], "end": [1, 0, 0], "area": 63}]})",

@@ -1,6 +1,6 @@
 // A baked navmesh at run time: the tiles of a bake with an off-mesh link, saved and loaded back, published
 // into a NavMeshWorld, where a path query and a crowd agent go over the link; a region's tiles alone, as a
-// streaming game loads them, and their removal; a file baked on another grid is refused.
+// streaming game loads them, and their removal; a file baked on another grid or for another agent is refused.
 
 #include "Baker.h"
 #include "OffMeshLinksFile.h"
@@ -10,6 +10,7 @@
 #include "common/TempFiles.h"
 
 #include <gtest/gtest.h>
+#include <limits>
 
 namespace cairn::bake
 {
@@ -53,7 +54,7 @@ protected:
 
 TEST_F(BakedNavMeshAtRunTimeTest, ACrowdAgentGoesOverTheBakedLink)
 {
-    Result<std::vector<navmesh::BuiltTile>> tiles = navmesh::MakeBakedTileChanges(mBaked, mGrid);
+    Result<std::vector<navmesh::BuiltTile>> tiles = navmesh::MakeBakedTileChanges(mBaked, *mWorld);
     ASSERT_TRUE(tiles) << tiles.GetError().mMessage;
     EXPECT_EQ(mWorld->Publish(std::move(tiles.Value())), 2);
     EXPECT_EQ(mWorld->GetRefusedTiles(), 0u);
@@ -81,7 +82,7 @@ TEST_F(BakedNavMeshAtRunTimeTest, ACrowdAgentGoesOverTheBakedLink)
 TEST_F(BakedNavMeshAtRunTimeTest, ARegionsTilesAloneAreLoadedAndRemoved)
 {
     const AABB westOnly(Vec3(1, -10, 1), Vec3(5, 10, 5));
-    Result<std::vector<navmesh::BuiltTile>> tiles = navmesh::MakeBakedTileChanges(mBaked, mGrid, westOnly);
+    Result<std::vector<navmesh::BuiltTile>> tiles = navmesh::MakeBakedTileChanges(mBaked, *mWorld, westOnly);
     ASSERT_TRUE(tiles);
     ASSERT_EQ(tiles.Value().size(), 1u);
     EXPECT_EQ(tiles.Value()[0].mTile, (navmesh::TileCoord{0, 0}));
@@ -95,15 +96,35 @@ TEST_F(BakedNavMeshAtRunTimeTest, ARegionsTilesAloneAreLoadedAndRemoved)
     EXPECT_FALSE(mWorld->FindNearestPoint(Vec3(3, 0, 4)));
 }
 
-TEST_F(BakedNavMeshAtRunTimeTest, AFileBakedOnAnotherGridIsRefused)
+// A file baked on another grid, or for another agent, is refused, as is a region that is no box
+TEST_F(BakedNavMeshAtRunTimeTest, AFileBakedForAnotherGridOrAgentIsRefused)
 {
+    const auto refusal = [&](const navmesh::NavMeshWorld& inWorld, const std::optional<AABB>& inRegion = {})
+    {
+        Result<std::vector<navmesh::BuiltTile>> tiles =
+            navmesh::MakeBakedTileChanges(mBaked, inWorld, inRegion);
+        return tiles ? std::string("accepted") : tiles.GetError().mMessage;
+    };
+    const navmesh::AgentProfile human;
     const navmesh::TileGrid shifted(1.0f, 0.0f, mGrid.GetTileSize(), -50.0f, 100.0f);
-    Result<std::vector<navmesh::BuiltTile>> tiles = navmesh::MakeBakedTileChanges(mBaked, shifted);
-    ASSERT_FALSE(tiles);
-    EXPECT_NE(tiles.GetError().mMessage.find("baked on a grid of origin"), std::string::npos)
-        << tiles.GetError().mMessage;
-    const navmesh::TileGrid wider(0.0f, 0.0f, 2.0f * mGrid.GetTileSize(), -50.0f, 100.0f);
-    EXPECT_FALSE(navmesh::MakeBakedTileChanges(mBaked, wider));
+    EXPECT_NE(
+        refusal(*navmesh::NavMeshWorld::Create(shifted, human).Value()).find("baked on a grid of origin"),
+        std::string::npos);
+    navmesh::AgentProfile wide = human;
+    wide.mTileSize *= 2.0f;
+    const navmesh::TileGrid wider(0.0f, 0.0f, wide.mTileSize, -50.0f, 100.0f);
+    EXPECT_NE(refusal(*navmesh::NavMeshWorld::Create(wider, wide).Value()).find("baked on a grid"),
+              std::string::npos);
+    navmesh::AgentProfile large = human;
+    large.mRadius = 1.5f;
+    EXPECT_NE(
+        refusal(*navmesh::NavMeshWorld::Create(mGrid, large).Value()).find("baked for an agent of height"),
+        std::string::npos)
+        << "a large agent's world";
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_NE(refusal(*mWorld, AABB(Vec3(nan, 0, 0), Vec3(1, 1, 1))).find("not a box"), std::string::npos);
+    EXPECT_NE(refusal(*mWorld, AABB(Vec3(5, 0, 0), Vec3(1, 1, 1))).find("not a box"), std::string::npos);
+    EXPECT_EQ(refusal(*mWorld), "accepted");
 }
 
 } // namespace

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <map>
@@ -85,12 +86,20 @@ uint64_t HashLinks(std::span<const navmesh::OffMeshLink> inLinks, uint64_t inHas
     return inHash;
 }
 
-/// Links whose end is in no tile of the level (inTiles, sorted) never join it: an error naming the first.
-/// Either end's tile is the one its x and z fall in.
+/// Links that never join the navmesh: an end in no tile of the level (inTiles, sorted), or an end more than
+/// a tile from the start's tile (Detour joins a link's end in its start's tile and the eight around it only).
+/// An error naming the first. Either end's tile is the one its x and z fall in.
 Status CheckLinksInLevel(std::span<const navmesh::OffMeshLink> inLinks, const navmesh::TileGrid& inGrid,
                          const std::vector<navmesh::TileCoord>& inTiles)
 {
     for (size_t i = 0; i < inLinks.size(); ++i)
+    {
+        const navmesh::TileCoord from = inGrid.TileAt(inLinks[i].mStart.x(), inLinks[i].mStart.z());
+        const navmesh::TileCoord to = inGrid.TileAt(inLinks[i].mEnd.x(), inLinks[i].mEnd.z());
+        if (std::abs(int64_t(to.mX) - from.mX) > 1 || std::abs(int64_t(to.mZ) - from.mZ) > 1)
+            return MakeError(ErrorCode::InvalidArgument, "off-mesh link " + std::to_string(i) +
+                                                             ": its end is more than a tile from its start's "
+                                                             "tile, where Detour never joins it");
         for (const bool start : {true, false})
         {
             const Vec3& end = start ? inLinks[i].mStart : inLinks[i].mEnd;
@@ -100,6 +109,7 @@ Status CheckLinksInLevel(std::span<const navmesh::OffMeshLink> inLinks, const na
                                      " (" + std::to_string(end.x()) + ", " + std::to_string(end.z()) +
                                      ") is in no tile of the level");
         }
+    }
     return Status::Ok();
 }
 
@@ -341,6 +351,10 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
             }
         }
         result.mPolygons += uint64_t(record.mPolygons);
+        if (data.empty() && linksByTile.contains(tile.mTile))
+            return MakeError(ErrorCode::InvalidArgument,
+                             "tile (" + std::to_string(tile.mTile.mX) + ", " + std::to_string(tile.mTile.mZ) +
+                                 ") has no navmesh for the off-mesh links that start in it");
         if (!data.empty())
         {
             ++result.mTilesWithPolygons;

@@ -22,7 +22,7 @@ bool GetPosition(const nlohmann::json& inValue, Vec3& outPosition)
         outPosition[axis] = inValue[size_t(axis)].get<float>();
         if (!std::isfinite(outPosition[axis])) return false;
     }
-    return true;
+    return IsValidWorldPosition(outPosition);
 }
 
 /// One link of the file; inWhere names it in errors.
@@ -37,7 +37,8 @@ Result<navmesh::OffMeshLink> ReadLink(const nlohmann::json& inJson, const std::s
         if (key == "start" || key == "end")
         {
             if (!GetPosition(value, key == "start" ? link.mStart : link.mEnd))
-                return MakeError(ErrorCode::ParseError, where + " must be three finite numbers [x, y, z]");
+                return MakeError(ErrorCode::ParseError,
+                                 where + " must be three numbers [x, y, z] within the world's range");
             (key == "start" ? hasStart : hasEnd) = true;
         }
         else if (key == "radius")

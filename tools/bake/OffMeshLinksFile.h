@@ -23,7 +23,8 @@ using namespace cairn::physics;
 inline constexpr size_t cMaxOffMeshLinks = size_t(1) << 20;
 
 /// The links of inPath, in the file's order. Errors name the file and the link (its index) and key: not a
-/// JSON object of that form, a position that is not three finite numbers, a radius not in (0, 1000] m, an
+/// JSON object of that form, a position that is not three numbers within the world's range, a radius not in
+/// (0, 1000] m, an
 /// area over navmesh::cMaxAreaId, a user id that is not a whole number from 0 to 2^32 - 1, more than
 /// cMaxOffMeshLinks links.
 Result<std::vector<navmesh::OffMeshLink>> LoadOffMeshLinks(const std::string& inPath);

@@ -10,6 +10,7 @@
 // Threads: plain functions over plain data, any thread; NavMeshWorld::Publish is the world's.
 
 #include "cairn/navmesh/NavMeshFile.h"
+#include "cairn/navmesh/NavMeshWorld.h"
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/physics/math/AABB.h"
 
@@ -20,11 +21,13 @@ namespace cairn::navmesh
 {
 using namespace cairn::physics;
 
-/// The tiles of inContents as changes for NavMeshWorld::Publish (copies in Detour's allocation, in the
-/// file's order), only those whose tile overlaps inRegion (x and z) when it is set. Error when the file was
-/// baked on another grid than inGrid (its origin or tile size): every tile would be refused.
+/// The tiles of inContents as changes for inWorld's Publish (copies in Detour's allocation, in the file's
+/// order), only those whose tile overlaps inRegion (x and z) when it is set. Errors: the file was baked on
+/// another grid than inWorld's (its origin or tile size: every tile would be refused), a tile was baked for
+/// another agent (its height, radius or climb not the world's profile's: agents would fit where they do
+/// not), a region that is not a box of finite numbers.
 Result<std::vector<BuiltTile>> MakeBakedTileChanges(const NavMeshFileContents& inContents,
-                                                    const TileGrid& inGrid,
+                                                    const NavMeshWorld& inWorld,
                                                     const std::optional<AABB>& inRegion = std::nullopt);
 
 } // namespace cairn::navmesh
