@@ -11,34 +11,26 @@ Result<std::vector<BuiltTile>> MakeBakedTileChanges(const NavMeshFileContents& i
                                                     const NavMeshWorld& inWorld,
                                                     const std::optional<AABB>& inRegion)
 {
-    const TileGrid& inGrid = inWorld.GetGrid();
+    const TileGrid& grid = inWorld.GetGrid();
     const AgentProfile& profile = inWorld.GetProfile();
-    if (inRegion.has_value() &&
-        (!inRegion->mMin.allFinite() || !inRegion->mMax.allFinite() ||
-         inRegion->mMin.x() > inRegion->mMax.x() || inRegion->mMin.z() > inRegion->mMax.z()))
+    if (inRegion.has_value() && !TileGrid::IsRegion(*inRegion))
         return MakeError(ErrorCode::InvalidArgument,
                          "baked navmesh: the region is not a box of finite numbers");
     const dtNavMeshParams& params = inContents.mParams;
     // Detour places a tile by the navmesh's origin and tile size: the world's must be the bake's, to the bit
     // (both come from the same numbers, and a tile built a hair off is a seam agents cannot cross)
-    if (params.orig[0] != inGrid.GetOriginX() || params.orig[2] != inGrid.GetOriginZ() ||
-        params.tileWidth != inGrid.GetTileSize() || params.tileHeight != inGrid.GetTileSize())
-        return MakeError(
-            ErrorCode::InvalidArgument,
-            "baked navmesh: baked on a grid of origin (" + std::to_string(params.orig[0]) + ", " +
-                std::to_string(params.orig[2]) + ") and " + std::to_string(params.tileWidth) +
-                " m tiles, the world's is (" + std::to_string(inGrid.GetOriginX()) + ", " +
-                std::to_string(inGrid.GetOriginZ()) + ") and " + std::to_string(inGrid.GetTileSize()) + " m");
+    if (params.orig[0] != grid.GetOriginX() || params.orig[2] != grid.GetOriginZ() ||
+        params.tileWidth != grid.GetTileSize() || params.tileHeight != grid.GetTileSize())
+        return MakeError(ErrorCode::InvalidArgument,
+                         "baked navmesh: baked on a grid of origin (" + std::to_string(params.orig[0]) +
+                             ", " + std::to_string(params.orig[2]) + ") and " +
+                             std::to_string(params.tileWidth) + " m tiles, the world's is (" +
+                             std::to_string(grid.GetOriginX()) + ", " + std::to_string(grid.GetOriginZ()) +
+                             ") and " + std::to_string(grid.GetTileSize()) + " m");
     std::vector<BuiltTile> changes;
     for (const NavMeshFileTile& tile : inContents.mTiles)
     {
-        if (inRegion.has_value())
-        {
-            const AABB bounds = inGrid.GetTileBounds(tile.mTile);
-            if (bounds.mMax.x() < inRegion->mMin.x() || bounds.mMin.x() > inRegion->mMax.x() ||
-                bounds.mMax.z() < inRegion->mMin.z() || bounds.mMin.z() > inRegion->mMax.z())
-                continue;
-        }
+        if (inRegion.has_value() && !grid.TileMeetsRegion(tile.mTile, *inRegion)) continue;
         if (tile.mData.size() < sizeof(dtMeshHeader))
             return MakeError(ErrorCode::InvalidArgument,
                              "baked navmesh: tile (" + std::to_string(tile.mTile.mX) + ", " +

@@ -995,9 +995,9 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             threatened = (offset - closing * t).squaredNorm() < reach * reach;
         }
         // A wall threatens only an agent heading into it: where its desired velocity takes it in half a
-        // second is within half a radius of the wall, in front of it. The corridor keeps
-        // every agent on the navmesh whatever it samples, so walls beside an agent's way (nearly every agent
-        // among props) are left to the move along the surface
+        // second is within half a radius of the wall, in front of it. The corridor keeps every agent on the
+        // navmesh whatever it samples, so walls beside an agent's way (nearly every agent among props) are
+        // left to the move along the surface
         const Vec3 ahead = position + desired * 0.5f;
         for (int w = 0; w < agent.mBoundary.getSegmentCount() && wallsThreaten && !threatened; ++w)
         {

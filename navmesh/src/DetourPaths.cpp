@@ -23,6 +23,14 @@ Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* i
     return filter;
 }
 
+bool IsOffMeshLink(const dtNavMesh& inNavMesh, dtPolyRef inPolygon)
+{
+    const dtMeshTile* tile = nullptr;
+    const dtPoly* poly = nullptr;
+    inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
+    return poly->getType() == DT_POLYTYPE_OFFMESH_CONNECTION;
+}
+
 bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilter& inFilter)
 {
     const dtMeshTile* tile = nullptr;
@@ -68,15 +76,8 @@ Result<PathResult> FinishPath(const dtNavMeshQuery& inQuery, const dtNavMesh& in
     // joins nothing (its tile not loaded) and, its node at the link's start, may find that nearest the end.
     // The path would end in the air between the link's ends, and a crowd agent would wait at the link for
     // ever
-    const auto isLink = [&](dtPolyRef inPolygon)
-    {
-        const dtMeshTile* tile = nullptr;
-        const dtPoly* poly = nullptr;
-        inNavMesh.getTileAndPolyByRefUnsafe(inPolygon, &tile, &poly);
-        return poly->getType() == DT_POLYTYPE_OFFMESH_CONNECTION;
-    };
     if (inCorridor[inNumPolygons - 1] != inEndRef)
-        while (inNumPolygons > 1 && isLink(inCorridor[inNumPolygons - 1]))
+        while (inNumPolygons > 1 && IsOffMeshLink(inNavMesh, inCorridor[inNumPolygons - 1]))
             --inNumPolygons;
     PathResult result;
     result.mNumPolygons = inNumPolygons;

@@ -34,6 +34,8 @@ inline int FromDetourArea(unsigned char inArea)
 /// Detour's filter for a PathFilter. Detour excludes by polygon flags, not areas: an excluded area gets a
 /// prohibitive cost, and callers check the areas of what they find (IsExcluded).
 Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat);
+/// True if the polygon is an off-mesh link's (a jump, a drop, a ladder), not ground.
+bool IsOffMeshLink(const dtNavMesh& inNavMesh, dtPolyRef inPolygon);
 /// True if the polygon's Cairn area is one inFilter excludes.
 bool IsExcluded(const dtNavMesh& inNavMesh, dtPolyRef inPolygon, const PathFilter& inFilter);
 /// Checks a search extent against the grid's limit (NavMeshWorld::cMaxSearchExtentTiles tiles across).

@@ -206,10 +206,7 @@ Result<NavWall> FindWallAround(dtNavMeshQuery& inQuery, const dtNavMesh& inNavMe
         // excluded, or came from one out of reach
         for (int i = 0; i < count; ++i)
         {
-            const dtMeshTile* tile = nullptr;
-            const dtPoly* polygon = nullptr;
-            inNavMesh.getTileAndPolyByRefUnsafe(polygons[size_t(i)], &tile, &polygon);
-            if (polygon->getType() == DT_POLYTYPE_OFFMESH_CONNECTION ||
+            if (IsOffMeshLink(inNavMesh, polygons[size_t(i)]) ||
                 IsExcluded(inNavMesh, polygons[size_t(i)], inFilter) ||
                 (!outOfReach.empty() && outOfReach.contains(parents[size_t(i)])))
             {

@@ -137,9 +137,9 @@ Result<TileScheduler::LinkID> TileScheduler::AddOffMeshLink(const OffMeshLink& i
         return MakeError(ErrorCode::InvalidArgument, "off-mesh link: area " + std::to_string(inLink.mArea) +
                                                          " is over " + std::to_string(cMaxAreaId));
     // Detour joins a link's end in its start's tile and the eight around it only: farther, it never would
-    const TileCoord from = mWorld.GetGrid().TileAt(inLink.mStart.x(), inLink.mStart.z());
-    const TileCoord to = mWorld.GetGrid().TileAt(inLink.mEnd.x(), inLink.mEnd.z());
-    if (std::abs(int64_t(to.mX) - from.mX) > 1 || std::abs(int64_t(to.mZ) - from.mZ) > 1)
+    const TileGrid& grid = mWorld.GetGrid();
+    if (!TileGrid::AreNeighbours(grid.TileAt(inLink.mStart.x(), inLink.mStart.z()),
+                                 grid.TileAt(inLink.mEnd.x(), inLink.mEnd.z())))
         return MakeError(
             ErrorCode::InvalidArgument,
             "off-mesh link: its end is more than a tile from its start's tile, where Detour never "

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <map>
@@ -94,9 +93,8 @@ Status CheckLinksInLevel(std::span<const navmesh::OffMeshLink> inLinks, const na
 {
     for (size_t i = 0; i < inLinks.size(); ++i)
     {
-        const navmesh::TileCoord from = inGrid.TileAt(inLinks[i].mStart.x(), inLinks[i].mStart.z());
-        const navmesh::TileCoord to = inGrid.TileAt(inLinks[i].mEnd.x(), inLinks[i].mEnd.z());
-        if (std::abs(int64_t(to.mX) - from.mX) > 1 || std::abs(int64_t(to.mZ) - from.mZ) > 1)
+        if (!navmesh::TileGrid::AreNeighbours(inGrid.TileAt(inLinks[i].mStart.x(), inLinks[i].mStart.z()),
+                                              inGrid.TileAt(inLinks[i].mEnd.x(), inLinks[i].mEnd.z())))
             return MakeError(ErrorCode::InvalidArgument, "off-mesh link " + std::to_string(i) +
                                                              ": its end is more than a tile from its start's "
                                                              "tile, where Detour never joins it");
@@ -189,16 +187,10 @@ Result<std::vector<navmesh::TileCoord>> SelectTiles(const std::vector<navmesh::T
     if (inSettings.mRegion.has_value())
     {
         const AABB& region = *inSettings.mRegion;
-        if (!region.mMin.allFinite() || !region.mMax.allFinite() || region.mMin.x() > region.mMax.x() ||
-            region.mMin.z() > region.mMax.z())
+        if (!navmesh::TileGrid::IsRegion(region))
             return MakeError(ErrorCode::InvalidArgument, "the region to bake is not a box (min above max)");
-        std::erase_if(selected,
-                      [&](const navmesh::TileCoord& inTile)
-                      {
-                          const AABB bounds = inGrid.GetTileBounds(inTile);
-                          return bounds.mMax.x() < region.mMin.x() || bounds.mMin.x() > region.mMax.x() ||
-                                 bounds.mMax.z() < region.mMin.z() || bounds.mMin.z() > region.mMax.z();
-                      });
+        std::erase_if(selected, [&](const navmesh::TileCoord& inTile)
+                      { return !inGrid.TileMeetsRegion(inTile, region); });
     }
     return selected;
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <compare>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <vector>
 
@@ -47,6 +48,27 @@ public:
     {
         const float x = mOriginX + float(inTile.mX) * mTileSize, z = mOriginZ + float(inTile.mZ) * mTileSize;
         return AABB(Vec3(x, mMinY, z), Vec3(x + mTileSize, mMaxY, z + mTileSize));
+    }
+
+    /// Whether inB is inA or one of the eight tiles around it: where Detour joins an off-mesh link's end to
+    /// the tile of its start.
+    static bool AreNeighbours(const TileCoord& inA, const TileCoord& inB)
+    {
+        return std::abs(int64_t(inA.mX) - inB.mX) <= 1 && std::abs(int64_t(inA.mZ) - inB.mZ) <= 1;
+    }
+
+    /// Whether inRegion is a box of finite numbers across x and z: a region of the world to load or bake.
+    static bool IsRegion(const AABB& inRegion)
+    {
+        return inRegion.mMin.allFinite() && inRegion.mMax.allFinite() &&
+               inRegion.mMin.x() <= inRegion.mMax.x() && inRegion.mMin.z() <= inRegion.mMax.z();
+    }
+    /// Whether inTile's area meets inRegion across x and z (its heights not asked).
+    bool TileMeetsRegion(const TileCoord& inTile, const AABB& inRegion) const
+    {
+        const AABB bounds = GetTileBounds(inTile);
+        return bounds.mMax.x() >= inRegion.mMin.x() && bounds.mMin.x() <= inRegion.mMax.x() &&
+               bounds.mMax.z() >= inRegion.mMin.z() && bounds.mMin.z() <= inRegion.mMax.z();
     }
 
     /// The tile's area grown by inBorder on the four sides: the geometry a tile build needs.
