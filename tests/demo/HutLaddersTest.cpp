@@ -67,8 +67,6 @@ TEST(HutLaddersTest, EachLadderJoinsItsHutsInsideToTheOutsideBehindIt)
     world->Publish(std::move(tiles));
     ASSERT_EQ(world->GetRefusedTiles(), 0u);
 
-    navmesh::PathFilter noClimbing;
-    noClimbing.mExcludedAreas = uint64_t(1) << cLadderArea;
     const Vec3 snap(0.6f, 1.0f, 0.6f); // The ladder's radius across
     for (size_t h = 0; h < ladders.size(); ++h)
     {
@@ -84,7 +82,7 @@ TEST(HutLaddersTest, EachLadderJoinsItsHutsInsideToTheOutsideBehindIt)
         ASSERT_TRUE(over && over.Value().mReachedEnd);
         EXPECT_LT(PathLength(over.Value()), 3.5f) << "over the ladder";
         const Result<navmesh::PathResult> round =
-            world->FindPath(ladder.mStart, ladder.mEnd, noClimbing, snap);
+            world->FindPath(ladder.mStart, ladder.mEnd, NoClimbing(), snap);
         ASSERT_TRUE(round && round.Value().mReachedEnd) << "round through the open doorway";
         EXPECT_GT(PathLength(round.Value()), 8.0f) << "round the hut";
     }

@@ -369,12 +369,11 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
                                Action& action = mActions[i];
                                const Vec3 position = crowd.GetPosition(agent.mID).Value();
                                action.mWalked = FlatDistance(position, agent.mLastPosition);
-                               action.mOffNavMesh =
-                                   crowd.GetState(agent.mID).Value() == navmesh::AgentState::OffNavMesh;
+                               const navmesh::AgentState state = crowd.GetState(agent.mID).Value();
+                               action.mOffNavMesh = state == navmesh::AgentState::OffNavMesh;
                                // On a ladder it climbs over the hut's wall: not a place it walks to
-                               action.mChecked =
-                                   (i + mFrame) % cCheckPeriodFrames == 0 &&
-                                   crowd.GetState(agent.mID).Value() != navmesh::AgentState::OnOffMeshLink;
+                               action.mChecked = (i + mFrame) % cCheckPeriodFrames == 0 &&
+                                                 state != navmesh::AgentState::OnOffMeshLink;
                                action.mInsideStatic = action.mChecked && InsideStatic(position);
                            }
                        });

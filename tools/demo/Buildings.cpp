@@ -127,9 +127,9 @@ DoorSpec MakeBuilding(const BuildingShapes& inShapes, const BuildingSite& inSite
     door.mHinge.mLimitsMax = cDoorLimitSlack;
     door.mHinge.mMotor = DoorMotor(false);
     float x, z;
-    ToWorld(inSite, 0.0f, -cBuildingHalfSize - 1.5f, x, z);
+    ToWorld(inSite, 0.0f, -cBuildingHalfSize - cDoorOutsideDistance, x, z);
     door.mOutside = Vec3(x, inGround(x, z), z);
-    ToWorld(inSite, 0.0f, -inner + 1.8f, x, z);
+    ToWorld(inSite, 0.0f, -inner + cDoorInsideDistance, x, z);
     door.mInside = Vec3(x, inGround(x, z), z);
     return door;
 }

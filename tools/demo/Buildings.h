@@ -39,6 +39,9 @@ inline constexpr float cDoorMotorTorque = 500.0f; ///< N m: opens against its 90
 /// The hinge's angle of an open door (into the room) and the limits' slack beyond open and closed, rad
 inline constexpr float cDoorOpenAngle = -0.5f * std::numbers::pi_v<float>;
 inline constexpr float cDoorLimitSlack = 0.1f;
+/// How far DoorSpec's ground points lie out of the doorway's middle and into the room (m)
+inline constexpr float cDoorOutsideDistance = 1.5f;
+inline constexpr float cDoorInsideDistance = 1.8f;
 /// The footprint circle that keeps other props out of the hut and off its walls
 inline constexpr float cBuildingFootprintRadius = 1.4143f * cBuildingHalfSize;
 /// The most the ground may rise across a hut's square (m): the walls' fixed height covers it, and the gap
@@ -50,8 +53,8 @@ struct DoorSpec
 {
     BodyCreationSettings mPanel;    ///< Dynamic, closed (the hinge's angle 0)
     HingeConstraintSettings mHinge; ///< To the world, its motor holding it closed; mBodyB set once created
-    Vec3 mOutside = Vec3::Zero();   ///< On the ground, 1.5 m out of the doorway's middle
-    Vec3 mInside = Vec3::Zero();    ///< On the ground, 1.8 m into the room from the doorway's middle
+    Vec3 mOutside = Vec3::Zero();   ///< On the ground, cDoorOutsideDistance out of the doorway's middle
+    Vec3 mInside = Vec3::Zero();    ///< On the ground, cDoorInsideDistance into the room from there
     float mPeriod = 12.0f; ///< s: the door opens for half of each period and closes for the other half
     float mPhase = 0.0f;   ///< s, into its period at time 0
 };

@@ -14,14 +14,6 @@ using namespace cairn::physics;
 
 namespace
 {
-/// The doorway paths walk: over a hut's ladder, a shut door would not shut the hut
-navmesh::PathFilter NoClimbing()
-{
-    navmesh::PathFilter filter;
-    filter.mExcludedAreas = uint64_t(1) << cLadderArea;
-    return filter;
-}
-
 /// How near the hinge's angle must be to closed or open for the doorway check to expect that (rad)
 constexpr float cAngleTolerance = 0.1f;
 /// A path's end must come this near the asked-for point to count as through the doorway (m)
@@ -151,6 +143,7 @@ void Doors::CheckDoorway(const Rest& inRest)
     const bool closed = std::abs(inRest.mAngle) < cAngleTolerance;
     const bool open = std::abs(inRest.mAngle - cDoorOpenAngle) < cAngleTolerance;
     Result<navmesh::PathResult> path =
+        // Climbing no ladder: over one, a shut door would not shut the hut
         mNavMeshes[0]->FindPath(inRest.mOutside, inRest.mInside, NoClimbing(), cDoorwaySnap);
     if ((!closed && !open) || !path)
     {

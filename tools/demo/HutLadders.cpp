@@ -14,8 +14,6 @@ namespace
 /// How far each foot stands from the back wall's face on its side (m): clear of the wall by more than an
 /// agent's radius, within the hut's footprint outside
 constexpr float cFootFromWall = 1.2f;
-/// DoorSpec's ground points: 1.5 m out of the doorway's middle
-constexpr float cDoorOutsideDistance = 1.5f;
 } // namespace
 
 HutLadders::HutLadders(const TileStreamer& inStreamer, const WorldGenerator& inGenerator,

@@ -27,8 +27,16 @@ class WorldGenerator;
 /// hut) leaves it out.
 inline constexpr uint8_t cLadderArea = 5;
 
+/// The path filter of a path that may not climb a ladder.
+inline navmesh::PathFilter NoClimbing()
+{
+    navmesh::PathFilter filter;
+    filter.mExcludedAreas = uint64_t(1) << cLadderArea;
+    return filter;
+}
+
 /// The ladder over the back wall of the hut whose door has the ground points inOutside and inInside
-/// (DoorSpec's, 1.5 m out of the doorway and 1.8 m into the room): two-way, its feet on inGenerator's
+/// (DoorSpec's, out of the doorway and into the room): two-way, its feet on inGenerator's
 /// terrain.
 navmesh::OffMeshLink MakeHutLadder(const Vec3& inOutside, const Vec3& inInside,
                                    const WorldGenerator& inGenerator);
