@@ -140,6 +140,9 @@ struct Crowd::Agent
     AgentState mState = AgentState::Idle;
     float mStuckSeconds = 0.0f; ///< Moving but hardly: how long, for the way out of a jam
     bool mReplanned = false;    ///< This Update's corridor check cut its corridor short
+    bool mResnapped = false;    ///< This Update's corridor check moved it onto another polygon
+    /// Its filter changed since the last corridor check (SetFilter): the check covers its whole corridor
+    bool mFilterChanged = false;
     /// Its path was longer than its corridor holds: the corridor ends short of the target, and the agent
     /// asks for the rest as it nears that end
     bool mCorridorCut = false;
@@ -278,6 +281,8 @@ Crowd::~Crowd()
 {
     for (dtNavMeshQuery* query : mQueries)
         dtFreeNavMeshQuery(query);
+    for (const uint16_t flag : mExclusionFlags)
+        mWorld.ReleaseExclusionFlag(flag);
 }
 
 Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const Settings& inSettings)
@@ -296,7 +301,7 @@ Result<std::unique_ptr<Crowd>> Crowd::Create(const NavMeshWorld& inWorld, const 
     Result<std::unique_ptr<PathRequestQueue>> paths = PathRequestQueue::Create(inWorld, inSettings.mPaths);
     if (!paths) return paths.GetError();
     crowd->mPaths = std::move(paths).Value();
-    crowd->mFilter = std::make_unique<dtQueryFilter>(MakeDetourFilter(PathFilter{}, "crowd").Value());
+    crowd->mDetourFilters.assign(cMaxFilters, MakeDetourFilter(PathFilter{}, "crowd").Value());
     return crowd;
 }
 
@@ -325,10 +330,70 @@ Crowd::Agent* Crowd::Find(AgentID inAgent) const
                                                                                 : nullptr;
 }
 
+const dtQueryFilter& Crowd::FilterOf(const Agent& inAgent) const
+{
+    return mDetourFilters[inAgent.mParams.mFilter];
+}
+
+Status Crowd::SetFilter(int inIndex, const PathFilter& inFilter)
+{
+    if (!(inIndex >= 0 && inIndex < cMaxFilters))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "crowd: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    if (Result<dtQueryFilter> checked = MakeDetourFilter(inFilter, "crowd filter"); !checked)
+        return checked.GetError();
+    // The old areas' flag goes in the same step: with every flag held, the new areas may take it
+    Result<uint16_t> flag =
+        mWorld.AcquireExclusionFlag(inFilter.mExcludedAreas, mExclusionFlags[size_t(inIndex)]);
+    if (!flag) return flag.GetError();
+    mExclusionFlags[size_t(inIndex)] = flag.Value();
+    mPathFilters[size_t(inIndex)] = inFilter;
+    mDetourFilters[size_t(inIndex)] = MakeDetourFilter(inFilter, "crowd filter", flag.Value()).Value();
+    for (const std::unique_ptr<Agent>& agent : mAgents)
+        if (agent != nullptr && agent->mParams.mFilter == inIndex) NoteFilterChanged(*agent);
+    return Status::Ok();
+}
+
+Result<PathFilter> Crowd::GetFilter(int inIndex) const
+{
+    if (!(inIndex >= 0 && inIndex < cMaxFilters))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "crowd: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    return mPathFilters[size_t(inIndex)];
+}
+
+Status Crowd::SetAgentFilter(AgentID inAgent, int inIndex)
+{
+    Agent* agent = Find(inAgent);
+    if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
+    if (!(inIndex >= 0 && inIndex < cMaxFilters))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "agent: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    agent->mParams.mFilter = uint8_t(inIndex);
+    NoteFilterChanged(*agent);
+    return Status::Ok();
+}
+
+void Crowd::NoteFilterChanged(Agent& ioAgent)
+{
+    ioAgent.mFilterChanged = true;
+    ioAgent.mCorners.mValid = false;
+    ioAgent.mBoundaryPolygon = 0; // Its walls gathered again: borders of excluded areas are walls
+    // Its path asked for again once the check has put it where it may stand (RequestPaths); meanwhile it
+    // walks on along what the check keeps of its corridor
+    if (!ioAgent.mHasTarget || ioAgent.mState == AgentState::OffNavMesh) return;
+    if (ioAgent.mTicket.mValue != 0) mPaths->Cancel(ioAgent.mTicket);
+    ioAgent.mTicket = {};
+    ioAgent.mState = AgentState::WaitingForPath;
+}
+
 Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams& inParams)
 {
     if (!IsValidWorldPosition(inPosition))
         return MakeError(ErrorCode::InvalidArgument, "agent: bad position");
+    if (inParams.mFilter >= cMaxFilters)
+        return MakeError(ErrorCode::InvalidArgument,
+                         "agent: its filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
     if (!(inParams.mRadius > 0.0f && inParams.mRadius <= mSettings.mMaxAgentRadius) ||
         !(inParams.mMaxSpeed > 0.0f && inParams.mMaxSpeed <= 100.0f) ||
         !(inParams.mMaxAcceleration > 0.0f && inParams.mMaxAcceleration <= 1000.0f))
@@ -352,8 +417,8 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
             if (!queryReady) return;
             dtPolyRef polygon = 0;
             float nearest[3];
-            mQueries[0]->findNearestPoly(inPosition.data(), cSnapExtent.data(), mFilter.get(), &polygon,
-                                         nearest);
+            mQueries[0]->findNearestPoly(inPosition.data(), cSnapExtent.data(),
+                                         &mDetourFilters[inParams.mFilter], &polygon, nearest);
             onNavMesh = polygon != 0;
             agent->mCorridor.reset(polygon, onNavMesh ? nearest : inPosition.data());
             agent->SetHeightFromSurface(*mQueries[0]);
@@ -687,8 +752,8 @@ Result<PathTicket> Crowd::RequestPath(const Agent& inAgent)
 {
     // From the agent's own polygon: snapping its position may pick the neighbour on a shared edge. From its
     // corridor's place, which on a link is the link's end: where the path will start
-    return mPaths->Request(inAgent.CorridorPosition(), inAgent.mTarget, {}, cSnapExtent,
-                           inAgent.mCorridor.getFirstPoly());
+    return mPaths->Request(inAgent.CorridorPosition(), inAgent.mTarget, mPathFilters[inAgent.mParams.mFilter],
+                           cSnapExtent, inAgent.mCorridor.getFirstPoly());
 }
 
 void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQuery)
@@ -698,14 +763,18 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
     {
         Agent& agent = *mAgents[mOrder[i]];
         dtPathCorridor& corridor = agent.mCorridor;
+        const dtQueryFilter& filter = FilterOf(agent);
         agent.mReplanned = false;
-        if (!navMesh.isValidPolyRef(corridor.getFirstPoly()))
+        agent.mResnapped = false;
+        if (!ioQuery.isValidPolyRef(corridor.getFirstPoly(), &filter))
         {
-            // Its tile went away under it, or it was added where no tile was built yet: it waits in place
-            // until navmesh is published within the snapping extent
+            // Its tile went away under it, it was added where no tile was built yet, or it stands in an area
+            // its filter excludes now: it goes to the nearest polygon it may stand on within the snapping
+            // extent, or waits in place until there is one
+            agent.mResnapped = true;
             dtPolyRef polygon = 0;
             float nearest[3];
-            ioQuery.findNearestPoly(corridor.getPos(), cSnapExtent.data(), mFilter.get(), &polygon, nearest);
+            ioQuery.findNearestPoly(corridor.getPos(), cSnapExtent.data(), &filter, &polygon, nearest);
             if (polygon == 0)
             {
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it
@@ -729,13 +798,17 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
         if (mAnyTileChanged)
             for (int p = 0; p < corridor.getPathCount() && !crossesChange; ++p)
                 crossesChange = mTileChanged[navMesh.decodePolyIdTile(corridor.getPath()[p])] != 0;
+        // Or its filter changed
+        crossesChange |= agent.mFilterChanged;
+        agent.mFilterChanged = false;
         if (crossesChange) agent.mCorners.mValid = false; // Its polygons may have moved
         if (crossesChange && corridor.getPathCount() > 1 &&
-            !corridor.isValid(corridor.getPathCount(), &ioQuery, mFilter.get()))
+            !corridor.isValid(corridor.getPathCount(), &ioQuery, &filter))
         {
-            // A polygon of its corridor went away (a tile rebuilt or removed): it keeps the part up to there
-            // and walks it meanwhile, and, if it was on its way, asks again from here (DetourCrowd does so)
-            corridor.trimInvalidPath(corridor.getFirstPoly(), corridor.getPos(), &ioQuery, mFilter.get());
+            // A polygon of its corridor went away (a tile rebuilt or removed) or is in an area its filter
+            // excludes now: it keeps the part up to there and walks it meanwhile, and, if it was on its way,
+            // asks again from here (DetourCrowd does so)
+            corridor.trimInvalidPath(corridor.getFirstPoly(), corridor.getPos(), &ioQuery, &filter);
             if (agent.mState == AgentState::Moving)
             {
                 agent.mState = AgentState::WaitingForPath;
@@ -767,8 +840,16 @@ void Crowd::RequestPaths()
             agent.mCorridor.getPathCount() <=
                 std::min(cCutCorridorReplanPolygons, std::max(2, mSettings.mMaxCorridorPolygons / 3)))
             agent.mState = AgentState::WaitingForPath;
-        // An agent that needs a path and has no request (a replan, back on navmesh, a corridor cut short, or
-        // a full queue last time) asks now; a full queue is asked again next Update
+        // A request made before the check moved it to another polygon starts where it may no longer stand
+        // (an area its filter excludes now: a target set with a filter change, a tile rebuilt with other
+        // areas): asked again from here, before the search (it would fail there)
+        if (agent.mResnapped && agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue != 0)
+        {
+            mPaths->Cancel(agent.mTicket);
+            agent.mTicket = {};
+        }
+        // An agent that needs a path and has no request (a replan, back on navmesh, a corridor cut short, a
+        // changed filter, or a full queue last time) asks now; a full queue is asked again next Update
         if (agent.mState == AgentState::WaitingForPath && agent.mTicket.mValue == 0)
         {
             Result<PathTicket> ticket = RequestPath(agent);
@@ -843,6 +924,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         }
         if (agent.mState == AgentState::OffNavMesh) continue;
         const float radius = agent.mParams.mRadius, maxSpeed = agent.mParams.mMaxSpeed;
+        const dtQueryFilter& filter = FilterOf(agent);
         const float range = cCollisionRangeRadii * radius;
         const float neighbourRange = cNeighbourRangeRadii * radius;
         // The walls near it, again once it has moved a quarter of the range from where they were gathered,
@@ -857,8 +939,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         if (Flat(position - boundaryCentre).norm() > 0.25f * range || agent.mBoundaryPolygon == 0 ||
             (agent.mWallsStale && (mUpdates + mOrder[i]) % cWallRefreshSpread == 0))
         {
-            agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery,
-                                   mFilter.get());
+            agent.mBoundary.update(agent.mCorridor.getFirstPoly(), position.data(), range, &ioQuery, &filter);
             agent.mBoundaryPolygon = agent.mCorridor.getFirstPoly();
             agent.mWallsStale = false;
             ++mChunkWalls[inBegin / cAgentsPerChunk];
@@ -871,7 +952,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
             agent.mState == AgentState::WaitingForPath && agent.mCorridor.getPathCount() > 1;
         if (agent.mState == AgentState::Moving || waitingOnItsWay)
         {
-            agent.UpdateCorners(position, mUpdates, ioQuery, *mFilter);
+            agent.UpdateCorners(position, mUpdates, ioQuery, filter);
             const float* corners = agent.mCorners.mPoints;
             const unsigned char* flags = agent.mCorners.mFlags;
             int numCorners = agent.mCorners.mCount;
@@ -890,10 +971,10 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
                 {
                     agent.mCorridor.optimizePathVisibility(&corners[3 * std::min(1, numCorners - 1)],
                                                            cPathOptimizationRangeRadii * radius, &ioQuery,
-                                                           mFilter.get());
-                    agent.mCorridor.optimizePathTopology(&ioQuery, mFilter.get());
+                                                           &filter);
+                    agent.mCorridor.optimizePathTopology(&ioQuery, &filter);
                     agent.mCorners.mValid = false;
-                    agent.UpdateCorners(position, mUpdates, ioQuery, *mFilter);
+                    agent.UpdateCorners(position, mUpdates, ioQuery, filter);
                     numCorners = agent.mCorners.mCount;
                 }
             }
@@ -1064,7 +1145,7 @@ void Crowd::MoveAgents(uint32_t inBegin, uint32_t inEnd, float inDeltaTime, dtNa
         if (velocity.norm() > 2.0f * maxSpeed) velocity *= 2.0f * maxSpeed / velocity.norm();
         const Vec3 wanted = position + velocity * inDeltaTime;
         // Along the navmesh surface, inside the corridor: never off it
-        agent.mCorridor.movePosition(wanted.data(), &ioQuery, mFilter.get());
+        agent.mCorridor.movePosition(wanted.data(), &ioQuery, &filter);
         agent.SetHeightFromSurface(ioQuery);
         agent.mVelocity = Flat(agent.Position() - position) / inDeltaTime;
     }

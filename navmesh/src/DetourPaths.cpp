@@ -6,11 +6,12 @@
 namespace cairn::navmesh
 {
 
-Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat)
+Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat,
+                                       uint16_t inExcludeFlags)
 {
     dtQueryFilter filter;
     filter.setIncludeFlags(cPolyFlagWalk);
-    filter.setExcludeFlags(0);
+    filter.setExcludeFlags(inExcludeFlags);
     for (int area = 0; area <= cMaxAreaId; ++area)
     {
         const bool excluded = (inFilter.mExcludedAreas >> area) & 1u;

@@ -32,8 +32,10 @@ inline int FromDetourArea(unsigned char inArea)
 }
 
 /// Detour's filter for a PathFilter. Detour excludes by polygon flags, not areas: an excluded area gets a
-/// prohibitive cost, and callers check the areas of what they find (IsExcluded).
-Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat);
+/// prohibitive cost, and callers check the areas of what they find (IsExcluded), unless the world marks the
+/// filter's areas with a flag (NavMeshWorld::AcquireExclusionFlag), given as inExcludeFlags.
+Result<dtQueryFilter> MakeDetourFilter(const PathFilter& inFilter, const char* inWhat,
+                                       uint16_t inExcludeFlags = 0);
 /// True if the polygon is an off-mesh link's (a jump, a drop, a ladder), not ground.
 bool IsOffMeshLink(const dtNavMesh& inNavMesh, dtPolyRef inPolygon);
 /// True if the polygon's Cairn area is one inFilter excludes.

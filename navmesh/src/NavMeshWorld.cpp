@@ -55,6 +55,19 @@ float NextRandomFloat()
     z ^= z >> 31;
     return float(z >> 40) * (1.0f / 16777216.0f); // 24 bits: in [0, 1)
 }
+/// Sets inFlag in the flags of inTile's polygons whose area is in inAreas, and clears it in the others'.
+void MarkAreas(dtNavMesh& ioNavMesh, const dtMeshTile& inTile, uint16_t inFlag, uint64_t inAreas)
+{
+    const dtPolyRef base = ioNavMesh.getPolyRefBase(&inTile);
+    for (int p = 0; p < inTile.header->polyCount; ++p)
+    {
+        const dtPoly& polygon = inTile.polys[p];
+        const bool marked = ((inAreas >> FromDetourArea(polygon.getArea())) & 1u) != 0;
+        const uint16_t flags = marked ? polygon.flags | inFlag : polygon.flags & ~inFlag;
+        ioNavMesh.setPolyFlags(base | dtPolyRef(p), flags);
+    }
+}
+
 /// The checks of a query from one point before the navmesh is locked: the point, the search extent and the
 /// filter, made Detour's. inRole names the point in the errors ("the centre").
 Result<dtQueryFilter> CheckPointQuery(const Vec3& inPoint, const Vec3& inSearchExtent,
@@ -246,6 +259,10 @@ int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
     if (dtStatusSucceed(added))
     {
         entry->second = {ref, ioTile.mNumPolygons, ioTile.mDataSize, std::move(ioTile.mData)};
+        // Whatever flags the data came with, its polygons are marked as the held area sets say
+        const dtMeshTile& tile = *mNavMesh->getTileByRef(ref);
+        for (int b = 0; b < cMaxExclusionFlags; ++b)
+            MarkAreas(*mNavMesh, tile, uint16_t(2u << b), mExclusionFlags[size_t(b)].mAreas);
         return isNew ? 1 : 2;
     }
     const std::string why = dtStatusDetail(added, DT_OUT_OF_MEMORY) ? "no free tile slot" : "invalid data";
@@ -266,6 +283,53 @@ int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
     mTiles.erase(entry);
     RefuseLocked(inCoord, "Detour refused it (" + why + "), and the old tile could not go back: a hole");
     return 1; // The old tile's removal
+}
+
+Result<uint16_t> NavMeshWorld::AcquireExclusionFlag(uint64_t inAreas, uint16_t inReleased) const
+{
+    std::unique_lock lock(mNavMeshMutex);
+    ExclusionFlag* released = nullptr;
+    for (int b = 0; b < cMaxExclusionFlags; ++b)
+        if (inReleased == uint16_t(2u << b) && mExclusionFlags[size_t(b)].mHolders > 0)
+            released = &mExclusionFlags[size_t(b)];
+    if (released != nullptr) --released->mHolders;
+    if (inAreas == 0) return uint16_t(0);
+    // The bit of these areas if one has them (held or not); else one never given; else one no one holds
+    int chosen = -1;
+    for (int b = 0; b < cMaxExclusionFlags && chosen < 0; ++b)
+        if (mExclusionFlags[size_t(b)].mAreas == inAreas) chosen = b;
+    for (int b = 0; b < cMaxExclusionFlags && chosen < 0; ++b)
+        if (mExclusionFlags[size_t(b)].mAreas == 0) chosen = b;
+    for (int b = 0; b < cMaxExclusionFlags && chosen < 0; ++b)
+        if (mExclusionFlags[size_t(b)].mHolders == 0) chosen = b;
+    if (chosen < 0)
+    {
+        if (released != nullptr) ++released->mHolders; // Still held: nothing changed
+        return MakeError(ErrorCode::OutOfCapacity, "navmesh: " + std::to_string(cMaxExclusionFlags) +
+                                                       " other sets of excluded areas are in use already");
+    }
+    ExclusionFlag& flag = mExclusionFlags[size_t(chosen)];
+    const uint16_t bit = uint16_t(2u << chosen);
+    if (flag.mAreas != inAreas)
+    {
+        flag.mAreas = inAreas;
+        for (int i = 0; i < mNavMesh->getMaxTiles(); ++i)
+        {
+            const dtMeshTile* tile = static_cast<const dtNavMesh*>(mNavMesh)->getTile(i);
+            if (tile->header != nullptr) MarkAreas(*mNavMesh, *tile, bit, inAreas);
+        }
+    }
+    ++flag.mHolders;
+    return bit;
+}
+
+void NavMeshWorld::ReleaseExclusionFlag(uint16_t inFlag) const
+{
+    if (inFlag == 0) return;
+    std::unique_lock lock(mNavMeshMutex);
+    for (int b = 0; b < cMaxExclusionFlags; ++b)
+        if (inFlag == uint16_t(2u << b) && mExclusionFlags[size_t(b)].mHolders > 0)
+            --mExclusionFlags[size_t(b)].mHolders;
 }
 
 void NavMeshWorld::RefuseLocked(const TileCoord& inCoord, const std::string& inWhy)

@@ -25,11 +25,16 @@
 // searched beside them, as a task: the calling thread only checks corridors, makes the snapshot and hands
 // the paths found to their agents, so its cost is bounded by the agents' count, never by path finding.
 //
+// Each agent follows one of the crowd's path filters (SetFilter): it never enters an area its filter
+// excludes, not on its path, nor pushed by others, nor by a shortcut, since the world marks those areas in
+// Detour's polygon flags for the filter, and every Detour call the agent makes honours them.
+//
 // Threads. Update: one thread at a time, not inside another navmesh call; its loop and the path search run
 // on the job interface's threads while the calling thread holds the navmesh shared (a Publish waits for the
 // Update).
 // AddAgent, RemoveAgent, SetTarget, CompleteOffMeshLink and the setters: the thread that calls Update,
-// between Updates. The getters: that thread, or several threads at once between Updates (they only read).
+// between Updates (SetFilter and the destructor never inside a navmesh call: they may mark the navmesh).
+// The getters: that thread, or several threads at once between Updates (they only read).
 
 #include "cairn/jobs/JobInterface.h"
 #include "cairn/navmesh/NavMeshWorld.h"
@@ -71,6 +76,7 @@ struct AgentParams
     float mMaxSpeed = 3.5f;        ///< m/s
     float mMaxAcceleration = 8.0f; ///< m/s^2
     OffMeshLinkMode mLinkMode = OffMeshLinkMode::Automatic;
+    uint8_t mFilter = 0; ///< Which of the crowd's path filters it follows (Crowd::SetFilter)
 };
 
 /// Where an agent's path goes (Crowd::GetPathStatus), as Unity's NavMeshPathStatus tells it.
@@ -99,9 +105,11 @@ enum class AgentState : uint8_t
     Idle,           ///< No target
     WaitingForPath, ///< A path request is queued or searched (it may move along a valid part meanwhile)
     Moving,         ///< Following its corridor
-    Arrived,    ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
-    NoPath,     ///< The last request found no path (target off the navmesh or unreachable)
-    OffNavMesh, ///< Its polygon went away with a tile: waits in place for navmesh under it
+    Arrived, ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
+    NoPath,  ///< The last request found no path (target off the navmesh or unreachable)
+    /// Its polygon went away with a tile, or its filter excludes it with no other within 2 m: waits in
+    /// place for navmesh under it
+    OffNavMesh,
     OnOffMeshLink, ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
 };
 
@@ -138,13 +146,31 @@ public:
     Crowd(const Crowd&) = delete;
     Crowd& operator=(const Crowd&) = delete;
 
-    /// An agent at inPosition, snapped to the navmesh within 2 m across and 4 m up and down; where there is
-    /// none yet (its tiles not built), it waits there, OffNavMesh, until there is. Errors: bad parameters or
+    /// An agent at inPosition, snapped to the navmesh within 2 m across and 4 m up and down, outside the
+    /// areas its filter excludes; where there is none yet (its tiles not built), it waits there, OffNavMesh,
+    /// until there is. Errors: bad parameters or
     /// numbers, the crowd full (OutOfCapacity).
     Result<AgentID> AddAgent(const Vec3& inPosition, const AgentParams& inParams = {});
     Status RemoveAgent(AgentID inAgent);
     /// Asks for a path to inTarget through the crowd's queue; the agent moves once it arrives.
     Status SetTarget(AgentID inAgent, const Vec3& inTarget);
+
+    /// The path filters agents follow, picked by AgentParams::mFilter (DetourCrowd's query filter types,
+    /// Unity's per-agent area mask and costs, an Unreal agent's query filter). Each says which areas its
+    /// agents never enter and what each area costs their paths. Every one starts as PathFilter{}: no area
+    /// excluded, each costing 1.
+    static constexpr int cMaxFilters = 16;
+    /// Filter inIndex is inFilter from now on. Its agents with a target ask for their paths again, walking on
+    /// meanwhile along what their corridors keep outside the areas it excludes; one standing in such an area
+    /// is moved to the nearest point it may stand on within 2 m across (DetourCrowd's way), or waits
+    /// OffNavMesh. Errors: an index out of range, a cost FindPath refuses, or OutOfCapacity when the
+    /// world's crowds hold 15 other sets of excluded areas (of all their filters together). Between Updates:
+    /// a new set of excluded areas is marked on the world's navmesh at once, waiting for the queries in
+    /// progress as a Publish does.
+    Status SetFilter(int inIndex, const PathFilter& inFilter);
+    Result<PathFilter> GetFilter(int inIndex) const;
+    /// The agent follows filter inIndex from now on, as if its filter had changed (SetFilter).
+    Status SetAgentFilter(AgentID inAgent, int inIndex);
 
     /// Which dynamic bodies the agents avoid as obstacles.
     enum class Obstacles : uint8_t
@@ -240,7 +266,15 @@ private:
     const NavMeshWorld& mWorld;
     const Settings mSettings;
     std::unique_ptr<PathRequestQueue> mPaths;
-    std::unique_ptr<dtQueryFilter> mFilter;
+    /// By filter index: the PathFilter, its Detour filter (excluding the world's flag for its areas) and that
+    /// flag, held from the world (0: no area excluded)
+    std::array<PathFilter, cMaxFilters> mPathFilters;
+    std::vector<dtQueryFilter> mDetourFilters;
+    std::array<uint16_t, cMaxFilters> mExclusionFlags{};
+    const dtQueryFilter& FilterOf(const Agent& inAgent) const;
+    /// After its filter changed: it checks its corridor, its corners and walls again, and asks for its path
+    /// again after the check, if it has a target.
+    void NoteFilterChanged(Agent& ioAgent);
     std::vector<dtNavMeshQuery*> mQueries; ///< One per ParallelFor chunk, made as needed (scratch only)
     std::vector<std::unique_ptr<dtObstacleAvoidanceQuery>> mAvoidance; ///< Likewise, for the avoidance
     std::vector<std::unique_ptr<Agent>> mAgents;                       ///< By slot; null where removed

@@ -178,6 +178,27 @@ private:
 
     NavMeshWorld(const TileGrid& inGrid, const AgentProfile& inProfile);
 
+    friend class Crowd; // Its path filters' excluded areas become polygon flags (AcquireExclusionFlag)
+    /// The polygon flag bit that marks the polygons of the areas inAreas (0: none, for no areas). A Detour
+    /// filter that excludes the bit keeps every Detour call out of those areas (a move along the surface, a
+    /// raycast, the walls gathered), where the prohibitive cost MakeDetourFilter gives them binds the
+    /// searches alone. The same areas get the same bit, counted; other areas a bit no one holds, marked on
+    /// every published polygon at once under the exclusive lock (as a Publish marks the polygons it adds).
+    /// Const: it changes no query's answer, only what the bit's holders see. inReleased: a bit the caller
+    /// lets go of first (0: none), in the same step, so a filter replaced when every bit is held can take
+    /// its own; kept when there is no bit for inAreas. OutOfCapacity when cMaxExclusionFlags other area sets
+    /// are held. Any thread, never inside a Read.
+    Result<uint16_t> AcquireExclusionFlag(uint64_t inAreas, uint16_t inReleased = 0) const;
+    /// Lets go of a bit AcquireExclusionFlag gave (0: nothing). Any thread, never inside a Read.
+    void ReleaseExclusionFlag(uint16_t inFlag) const;
+    /// Polygon flag bits 1 to 15: bit 0 is cPolyFlagWalk, which every polygon has
+    static constexpr int cMaxExclusionFlags = 15;
+    struct ExclusionFlag
+    {
+        uint64_t mAreas = 0; ///< The areas its bit marks (0: never given); kept after the last holder goes
+        int mHolders = 0;
+    };
+
     /// Empty when Detour can take inTile (data not null) at inCoord, else why not. No lock: it reads the tile
     /// and mMaxTilePolygons only.
     std::string CheckTile(const TileCoord& inCoord, const BuiltTile& inTile) const;
@@ -190,13 +211,16 @@ private:
     const TileGrid mGrid;
     const AgentProfile mProfile;
     const uint64_t mSerial;                  ///< Tells apart worlds for the per-thread query objects
-    mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish; shared: queries
+    mutable std::shared_mutex mNavMeshMutex; ///< Exclusive: Publish, exclusion flags; shared: queries
     dtNavMesh* mNavMesh = nullptr;           ///< Guarded by mNavMeshMutex
     int mMaxTilePolygons = 0; ///< Detour's polygons per tile reference: set by Create, read-only after
     /// Guarded by mNavMeshMutex; exactly the tiles mNavMesh holds (each at its own coordinate, layer 0)
     std::map<TileCoord, PublishedTile> mTiles;
     uint64_t mRefusedTiles = 0; ///< Guarded by mNavMeshMutex
-    std::string mLastRefusal;   ///< Guarded by mNavMeshMutex
+    /// Bit b + 1 of a published polygon's flags is set exactly where [b].mAreas holds its area. Guarded by
+    /// mNavMeshMutex: written exclusively (acquire, release), read by Publish
+    mutable std::array<ExclusionFlag, cMaxExclusionFlags> mExclusionFlags{};
+    std::string mLastRefusal; ///< Guarded by mNavMeshMutex
 };
 
 } // namespace cairn::navmesh
