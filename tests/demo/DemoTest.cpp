@@ -62,6 +62,8 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_GT(agents.mInsideStaticChecks, 0u) << inRun.mModeName;
     EXPECT_EQ(agents.mOffNavMeshOverOneSecond, 0u) << inRun.mModeName;
     EXPECT_EQ(agents.mCorridorsThroughGone, 0u) << inRun.mModeName;
+    EXPECT_EQ(agents.mNonClimberLadderFrames, 0u) << inRun.mModeName;
+    EXPECT_GT(agents.mNonClimbers, 0u) << inRun.mModeName;
     // The huts' doors moved on their timers and their tiles were built again as they came to rest; the
     // navmesh had each door where it stood: closed, no path through the doorway; open, one
     const DoorStats& doors = inRun.mDoorStats;

@@ -1,5 +1,6 @@
 #include "Agents.h"
 
+#include "HutLadders.h"
 #include "common/Mix64.h"
 #include "common/ThreadSwitches.h"
 
@@ -23,8 +24,12 @@ constexpr float cWanderRadius = 15.0f;   ///< Goals within this of the agent, re
 constexpr float cFollowDistance = 25.0f; ///< Further from its place by the player, the agent follows
 /// How far the player's way a follower heads while the player's tiles are not built (inside the navmesh)
 constexpr float cFollowStep = 15.0f;
-constexpr float cCatchUpDistance = 50.0f;    ///< An agent this far from its place is put back there
-constexpr uint32_t cCompanionEvery = 20;     ///< One agent in this many follows the player; the others wander
+constexpr float cCatchUpDistance = 50.0f; ///< An agent this far from its place is put back there
+constexpr uint32_t cCompanionEvery = 20;  ///< One agent in this many follows the player; the others wander
+/// One human in this many may not climb (a pack animal, a child): it follows the human crowd's no-climbing
+/// filter, so its paths, goals and moves keep off the huts' ladders
+constexpr uint32_t cNonClimberEvery = 5;
+constexpr int cNoClimbingFilter = 1;         ///< The human crowd's filter index of those that may not climb
 constexpr int cPlacementTries = 4;           ///< Spots tried for an agent put back, the first free one taken
 constexpr float cPlacementSpread = 6.0f;     ///< m round its place
 constexpr float cGoalSeconds = 15.0f;        ///< A goal not reached in this long is given up for another
@@ -67,6 +72,7 @@ struct Agents::Agent
 {
     uint8_t mProfile = 0;
     bool mCompanion = false; ///< Follows the player (else it wanders where it is)
+    bool mMayClimb = true;   ///< Else it follows cNoClimbingFilter: no ladder
     navmesh::Crowd::AgentID mID = 0;
     Vec3 mHome = Vec3::Zero(); ///< Its place relative to the player (x, z)
     bool mHasGoal = false;
@@ -98,6 +104,7 @@ struct Agents::Action
     // The checks of the run
     bool mChecked = false;
     bool mInsideStatic = false;
+    bool mOnForbiddenLadder = false; ///< On a ladder it may not climb
     float mWalked = 0.0f;
     bool mOffNavMesh = false;
 };
@@ -124,6 +131,8 @@ Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, cons
         // they come to rest and a tile is rebuilt: the sleeping ones are in it)
         mCrowds[profile]->SetPhysicsObstacles(&mPhysics, ObjectLayerMask(1) << Layers::cMoving,
                                               navmesh::Crowd::Obstacles::AwakeOnly);
+        if (Status noClimbing = mCrowds[profile]->SetFilter(cNoClimbingFilter, NoClimbing()); !noClimbing)
+            mStats.mErrors.push_back("crowd: " + noClimbing.GetError().mMessage);
     }
     // Humans and large agents walk the same ground: each crowd avoids the other's agents
     if (mCrowds[0] != nullptr && mCrowds[1] != nullptr)
@@ -140,6 +149,8 @@ Agents::Agents(PhysicsSystem& ioPhysics, const WorldGenerator& inGenerator, cons
         Agent& agent = mAgents[i];
         agent.mProfile = i % 10 == 9 ? 1 : 0; // One in ten large
         agent.mCompanion = i % cCompanionEvery == 0;
+        agent.mMayClimb = !(agent.mProfile == 0 && i % cNonClimberEvery == 3);
+        mStats.mNonClimbers += agent.mMayClimb ? 0 : 1;
         const uint64_t random = Mix64(mSeed ^ Mix64(i));
         const float angle = float(random & 0xffffff) / float(1 << 24) * 2.0f * std::numbers::pi_v<float>;
         const float distance = homeRadius * std::sqrt(float((random >> 24) & 0xffffff) / float(1 << 24));
@@ -181,6 +192,7 @@ void Agents::AddAgent(uint32_t inIndex, const Vec3& inPosition)
     if (crowd == nullptr) return;
     navmesh::AgentParams params;
     params.mRadius = mProfiles[agent.mProfile].mRadius;
+    params.mFilter = agent.mMayClimb ? 0 : cNoClimbingFilter;
     Result<navmesh::Crowd::AgentID> id = crowd->AddAgent(inPosition, params);
     if (!id)
     {
@@ -263,8 +275,10 @@ void Agents::Decide(uint32_t inIndex, const Vec3& inPlayer, Action& outAction) c
         !agent.mHasGoal || !moving || outAction.mStuck || agent.mGoalSeconds > cGoalSeconds ||
         (following && agent.mGoalSeconds > cFollowRepathSeconds) || (agent.mFollowing && !following);
     if (!wantsGoal) return;
-    const Result<Vec3> goal = following ? FollowGoal(navMesh, position, home, cFollowStep, ground)
-                                        : navMesh.FindRandomPointAround(position, cWanderRadius, seed);
+    const Result<Vec3> goal =
+        following ? FollowGoal(navMesh, position, home, cFollowStep, ground)
+                  : navMesh.FindRandomPointAround(position, cWanderRadius, seed,
+                                                  agent.mMayClimb ? navmesh::PathFilter{} : NoClimbing());
     outAction.mKind = goal ? Action::Kind::Goal : Action::Kind::NoGoal;
     if (goal) outAction.mPoint = goal.Value();
     outAction.mFollowing = following;
@@ -375,6 +389,9 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
                                action.mChecked = (i + mFrame) % cCheckPeriodFrames == 0 &&
                                                  state != navmesh::AgentState::OnOffMeshLink;
                                action.mInsideStatic = action.mChecked && InsideStatic(position);
+                               action.mOnForbiddenLadder =
+                                   !agent.mMayClimb && state == navmesh::AgentState::OnOffMeshLink &&
+                                   crowd.GetOffMeshLink(agent.mID).Value().mArea == cLadderArea;
                            }
                        });
     for (uint32_t i = 0; i < count; ++i)
@@ -401,6 +418,7 @@ void Agents::Update(float inDeltaTime, const Vec3& inPlayer, jobs::JobInterface&
             agent.mOffNavMeshFrames = 0;
         mStats.mInsideStaticChecks += action.mChecked ? 1 : 0;
         mStats.mInsideStatic += action.mInsideStatic ? 1 : 0;
+        mStats.mNonClimberLadderFrames += action.mOnForbiddenLadder ? 1 : 0;
         if (action.mInsideStatic && mStats.mErrors.size() < 20)
         {
             const Vec3 p = agent.mLastPosition;

@@ -8,7 +8,9 @@
 // twenty is a companion that follows the player once 25 m from its place (to the navmesh under its place,
 // or while there is none there yet, the navmesh 15 m that way; renewed every 2 s). The player runs faster
 // than agents walk: one 50 m from its place is put back near it, on a free spot of navmesh, as an open
-// world's population is moved from behind the player to ahead of it.
+// world's population is moved from behind the player to ahead of it. One human in five may not climb: it
+// follows the human crowd's no-climbing filter (its paths, moves and wander goals keep off the huts'
+// ladders), and no such agent is ever on a ladder (a check of the run).
 //
 // The frame's navigation work: the goals (random points and nearest points, Detour searches) are picked on
 // the job threads, each agent from its own seed, and set in id order; then each crowd's Update (its path

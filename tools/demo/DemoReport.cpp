@@ -317,7 +317,7 @@ bool InvariantsHold(const DemoRunResult& inRun)
     return inRun.mLostOrDuplicatedBodies == 0 && inRun.mTilesRequestedNeverBuilt == 0 &&
            inRun.mAgentStats.mInsideStatic == 0 && inRun.mAgentStats.mOffNavMeshOverOneSecond == 0 &&
            inRun.mAgentStats.mCorridorsThroughGone == 0 && DoorwaysNotAsTheirDoor(inRun.mDoorStats) == 0 &&
-           inRun.mErrors.empty();
+           inRun.mAgentStats.mNonClimberLadderFrames == 0 && inRun.mErrors.empty();
 }
 
 std::vector<Section> BuildSummary(const DemoRunResult& inRun)
@@ -503,7 +503,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
           {"no goal found", Count(agents.mGoalsNotFound)},
           {"walked m", Fixed(agents.mDistance, 0)},
           {"put back by the player", Count(agents.mCatchUps)},
-          {"ladders climbed", Count(agents.mLinksTaken) + " of " + Count(inRun.mLaddersMost) + " at most"}}});
+          {"ladders climbed", Count(agents.mLinksTaken) + " of " + Count(inRun.mLaddersMost) + " at most"},
+          {"agents that may not climb", Count(agents.mNonClimbers)}}});
     sections.push_back(
         {"agent checks",
          {{"overlapping > 10 % of a radius",
@@ -514,15 +515,17 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
                              " %"))},
           {"off navmesh agent-frames", percentOf(agents.mOffNavMeshFrames, agents.mAgentFrames)},
           {"longest off navmesh frames", Count(agents.mLongestOffNavMeshFrames)}}});
-    sections.push_back({"invariants",
-                        {{"lost/duplicated bodies", Count(inRun.mLostOrDuplicatedBodies)},
-                         {"tiles never built", Count(inRun.mTilesRequestedNeverBuilt)},
-                         {"agents inside static bodies", Count(agents.mInsideStatic) + " of " +
-                                                             Count(agents.mInsideStaticChecks) + " checks"},
-                         {"off navmesh over 1 s", Count(agents.mOffNavMeshOverOneSecond)},
-                         {"corridors through gone polygons", Count(agents.mCorridorsThroughGone)},
-                         {"doorways not as their door", Count(DoorwaysNotAsTheirDoor(inRun.mDoorStats))},
-                         {"status", InvariantsHold(inRun) ? "OK" : "FAILED"}}});
+    sections.push_back(
+        {"invariants",
+         {{"lost/duplicated bodies", Count(inRun.mLostOrDuplicatedBodies)},
+          {"tiles never built", Count(inRun.mTilesRequestedNeverBuilt)},
+          {"agents inside static bodies",
+           Count(agents.mInsideStatic) + " of " + Count(agents.mInsideStaticChecks) + " checks"},
+          {"off navmesh over 1 s", Count(agents.mOffNavMeshOverOneSecond)},
+          {"corridors through gone polygons", Count(agents.mCorridorsThroughGone)},
+          {"doorways not as their door", Count(DoorwaysNotAsTheirDoor(inRun.mDoorStats))},
+          {"frames on a ladder by agents that may not climb", Count(agents.mNonClimberLadderFrames)},
+          {"status", InvariantsHold(inRun) ? "OK" : "FAILED"}}});
     return sections;
 }
 

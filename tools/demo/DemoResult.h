@@ -37,8 +37,11 @@ struct AgentStats
     uint64_t mPathsRequested = 0; ///< Through the crowds' queues, replans included
     uint64_t mPathsServed = 0;    ///< Found (whole or partial)
     uint64_t mPathsFailed = 0;
-    uint64_t mReplans = 0;    ///< Corridors cut by a tile change, asked again
-    uint64_t mLinksTaken = 0; ///< Off-mesh links (the huts' ladders) agents started to climb
+    uint64_t mReplans = 0;     ///< Corridors cut by a tile change, asked again
+    uint64_t mLinksTaken = 0;  ///< Off-mesh links (the huts' ladders) agents started to climb
+    uint64_t mNonClimbers = 0; ///< Agents that may not climb (the human crowd's no-climbing filter)
+    /// Agent-frames of those on a ladder (an invariant: none)
+    uint64_t mNonClimberLadderFrames = 0;
     uint64_t mPathWaitP99Frames = 0;
     uint64_t mPathWaitMaxFrames = 0;
     uint64_t mCatchUps = 0;    ///< Put back by the player after falling 50 m behind

@@ -346,6 +346,9 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     if (result.mAgentStats.mOffNavMeshOverOneSecond > 0)
         result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mOffNavMeshOverOneSecond) +
                                  " times an agent was off the navmesh for over 1 s");
+    if (result.mAgentStats.mNonClimberLadderFrames > 0)
+        result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mNonClimberLadderFrames) +
+                                 " frames an agent that may not climb was on a ladder");
     if (result.mAgentStats.mCorridorsThroughGone > 0)
         result.mErrors.push_back("agents: " + std::to_string(result.mAgentStats.mCorridorsThroughGone) +
                                  " corridors went through a polygon that was gone");
