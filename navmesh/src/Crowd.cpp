@@ -21,6 +21,9 @@ namespace
 {
 /// Where AddAgent looks for navmesh under a position (half extents), as FindPath snaps its ends.
 const Vec3 cSnapExtent(2.0f, 4.0f, 2.0f);
+/// Where an agent standing in an area its filter excludes looks for a polygon it may stand on: as far across,
+/// but no farther up or down than a step or two (not onto another floor)
+const Vec3 cLeaveExcludedExtent(2.0f, 1.0f, 2.0f);
 /// Agents in a ParallelFor chunk: steering one costs a few microseconds.
 constexpr uint32_t cAgentsPerChunk = 64;
 /// The neighbours and walls an agent avoids: within this many of its radii (DetourCrowd's choice)
@@ -154,6 +157,7 @@ struct Crowd::Agent
     Vec3 mSampledVelocity = Vec3::Zero();
     /// The off-mesh link it is taking: its corridor already goes on from the link's end, where it lands
     std::optional<LinkMotion> mLink;
+    dtPolyRef mLinkPolygon = 0; ///< mLink's polygon
 
     /// The first corners of its corridor's straight path, as FindCorners found them at mFrom. From any point
     /// on the straight line from mFrom to the first corner, the path through the same polygons has the same
@@ -256,6 +260,7 @@ struct Crowd::Agent
         crossing.mUserID = connection->userId;
         crossing.mArea = uint8_t(FromDetourArea(polygon->getArea()));
         mLink.emplace(inPosition, crossing, mParams.mMaxSpeed, mParams.mLinkMode);
+        mLinkPolygon = inLink;
         mCorners.mValid = false;
         return true;
     }
@@ -766,15 +771,31 @@ void Crowd::CheckCorridors(uint32_t inBegin, uint32_t inEnd, dtNavMeshQuery& ioQ
         const dtQueryFilter& filter = FilterOf(agent);
         agent.mReplanned = false;
         agent.mResnapped = false;
+        // A changed filter that excludes the link an agent is walking to, or the polygon it lands on: the
+        // agent does not take it, and stands where it is. One on the link itself (it reached the start) is
+        // committed: it lands, and then leaves an excluded landing as anyone standing in an excluded area
+        // does
+        if (agent.mFilterChanged && agent.mLink && !agent.mLink->GetCrossing().mAtStart &&
+            (!ioQuery.isValidPolyRef(agent.mLinkPolygon, &filter) ||
+             !ioQuery.isValidPolyRef(corridor.getFirstPoly(), &filter)))
+        {
+            const Vec3 standing = agent.Position();
+            agent.mLink.reset();
+            corridor.reset(0, standing.data()); // Snapped again below, from where it stands
+        }
         if (!ioQuery.isValidPolyRef(corridor.getFirstPoly(), &filter))
         {
             // Its tile went away under it, it was added where no tile was built yet, or it stands in an area
             // its filter excludes now: it goes to the nearest polygon it may stand on within the snapping
             // extent, or waits in place until there is one
-            agent.mResnapped = true;
+            const bool excluded = navMesh.isValidPolyRef(corridor.getFirstPoly());
             dtPolyRef polygon = 0;
             float nearest[3];
-            ioQuery.findNearestPoly(corridor.getPos(), cSnapExtent.data(), &filter, &polygon, nearest);
+            ioQuery.findNearestPoly(corridor.getPos(), (excluded ? cLeaveExcludedExtent : cSnapExtent).data(),
+                                    &filter, &polygon, nearest);
+            // A request made from where it stood starts where it may no longer stand, or from a place it
+            // left: asked again (a polygon rebuilt under it in place leaves the request as good as it was)
+            agent.mResnapped = polygon != 0 && (excluded || dtVdistSqr(nearest, corridor.getPos()) > 1.0e-4f);
             if (polygon == 0)
             {
                 corridor.reset(0, corridor.getPos()); // Holds no polygon until navmesh is back under it

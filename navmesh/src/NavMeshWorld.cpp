@@ -55,15 +55,21 @@ float NextRandomFloat()
     z ^= z >> 31;
     return float(z >> 40) * (1.0f / 16777216.0f); // 24 bits: in [0, 1)
 }
-/// Sets inFlag in the flags of inTile's polygons whose area is in inAreas, and clears it in the others'.
-void MarkAreas(dtNavMesh& ioNavMesh, const dtMeshTile& inTile, uint16_t inFlag, uint64_t inAreas)
+/// Marks inTile's polygons with the exclusion flags in inFlags: flag 2 << b set where inAreasByFlag[b] holds
+/// the polygon's area, cleared elsewhere (in one pass over the polygons, whatever the flags).
+template <size_t N>
+void MarkTile(dtNavMesh& ioNavMesh, const dtMeshTile& inTile, uint16_t inFlags,
+              const std::array<uint64_t, N>& inAreasByFlag)
 {
     const dtPolyRef base = ioNavMesh.getPolyRefBase(&inTile);
     for (int p = 0; p < inTile.header->polyCount; ++p)
     {
         const dtPoly& polygon = inTile.polys[p];
-        const bool marked = ((inAreas >> FromDetourArea(polygon.getArea())) & 1u) != 0;
-        const uint16_t flags = marked ? polygon.flags | inFlag : polygon.flags & ~inFlag;
+        const int area = FromDetourArea(polygon.getArea());
+        uint16_t flags = polygon.flags & ~inFlags;
+        for (size_t b = 0; b < N; ++b)
+            if ((inFlags & (2u << b)) != 0 && ((inAreasByFlag[b] >> area) & 1u) != 0)
+                flags |= uint16_t(2u << b);
         ioNavMesh.setPolyFlags(base | dtPolyRef(p), flags);
     }
 }
@@ -259,10 +265,12 @@ int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
     if (dtStatusSucceed(added))
     {
         entry->second = {ref, ioTile.mNumPolygons, ioTile.mDataSize, std::move(ioTile.mData)};
-        // Whatever flags the data came with, its polygons are marked as the held area sets say
-        const dtMeshTile& tile = *mNavMesh->getTileByRef(ref);
+        // Whatever flags the data came with, its polygons are marked as every flag given says (held or not:
+        // a flag no one holds keeps its marks, for a filter that asks for its areas again)
+        std::array<uint64_t, cMaxExclusionFlags> areas;
         for (int b = 0; b < cMaxExclusionFlags; ++b)
-            MarkAreas(*mNavMesh, tile, uint16_t(2u << b), mExclusionFlags[size_t(b)].mAreas);
+            areas[size_t(b)] = mExclusionFlags[size_t(b)].mAreas;
+        MarkTile(*mNavMesh, *mNavMesh->getTileByRef(ref), cExclusionFlagBits, areas);
         return isNew ? 1 : 2;
     }
     const std::string why = dtStatusDetail(added, DT_OUT_OF_MEMORY) ? "no free tile slot" : "invalid data";
@@ -287,6 +295,8 @@ int NavMeshWorld::ReplaceTileLocked(const TileCoord& inCoord, BuiltTile& ioTile)
 
 Result<uint16_t> NavMeshWorld::AcquireExclusionFlag(uint64_t inAreas, uint16_t inReleased) const
 {
+    inAreas &= cAllAreas; // The bits of no area would take a flag that marks nothing
+    if (inAreas == 0 && inReleased == 0) return uint16_t(0);
     std::unique_lock lock(mNavMeshMutex);
     ExclusionFlag* released = nullptr;
     for (int b = 0; b < cMaxExclusionFlags; ++b)
@@ -313,14 +323,24 @@ Result<uint16_t> NavMeshWorld::AcquireExclusionFlag(uint64_t inAreas, uint16_t i
     if (flag.mAreas != inAreas)
     {
         flag.mAreas = inAreas;
+        std::array<uint64_t, cMaxExclusionFlags> areas{};
+        areas[size_t(chosen)] = inAreas;
         for (int i = 0; i < mNavMesh->getMaxTiles(); ++i)
         {
             const dtMeshTile* tile = static_cast<const dtNavMesh*>(mNavMesh)->getTile(i);
-            if (tile->header != nullptr) MarkAreas(*mNavMesh, *tile, bit, inAreas);
+            if (tile->header != nullptr) MarkTile(*mNavMesh, *tile, bit, areas);
         }
     }
     ++flag.mHolders;
     return bit;
+}
+
+uint16_t NavMeshWorld::MarkedExclusionFlagLocked(uint64_t inAreas) const
+{
+    inAreas &= cAllAreas;
+    for (int b = 0; b < cMaxExclusionFlags && inAreas != 0; ++b)
+        if (mExclusionFlags[size_t(b)].mAreas == inAreas) return uint16_t(2u << b);
+    return 0;
 }
 
 void NavMeshWorld::ReleaseExclusionFlag(uint16_t inFlag) const
@@ -419,20 +439,25 @@ Result<Vec3> NavMeshWorld::FindRandomPointAround(const Vec3& inCenter, float inR
     const float* startPoint = centre.Value().mPoint.data();
     // Detour spreads through every polygon the circle touches, excluded areas included (its filter knows only
     // flags, and its spread no costs): a point in an excluded area, or one that can only be reached through
-    // one, is drawn again
+    // one, is drawn again. Unless a crowd's filter has the world mark these areas: the spread then keeps out
+    // of them, so every point it draws is reachable without crossing one, and the first draw is taken
+    const uint16_t marked = MarkedExclusionFlagLocked(inFilter.mExcludedAreas);
+    dtQueryFilter spread = filter.Value();
+    spread.setExcludeFlags(marked);
     constexpr int cMaxTries = 16;
     tRandomState = inSeed;
     for (int attempt = 0; attempt < cMaxTries; ++attempt)
     {
         dtPolyRef polygon = 0;
         Vec3 point;
-        if (dtStatusFailed(query->findRandomPointAroundCircle(start, startPoint, inRadius, &filter.Value(),
+        if (dtStatusFailed(query->findRandomPointAroundCircle(start, startPoint, inRadius, &spread,
                                                               NextRandomFloat, &polygon, point.data())) ||
             polygon == 0)
             return MakeError(ErrorCode::InvalidArgument,
                              "random point: Detour found no polygon around the centre");
         if (IsExcluded(*mNavMesh, polygon, inFilter)) continue;
-        if (inFilter.mExcludedAreas == 0) return point; // Detour's spread went there: reachable
+        if ((inFilter.mExcludedAreas & cAllAreas) == 0 || marked != 0)
+            return point; // Detour's spread went there: reachable
         // An excluded area costs so much that the search goes around it if it can; a way that must cross
         // one ends at or before it
         dtPolyRef corridor[cMaxPathPolygons];

@@ -49,13 +49,16 @@ protected:
     }
 
     /// Walks inAgent for inUpdates Updates or until it arrives; the Updates in which it was in the water.
-    int WalkCountingWater(Crowd& ioCrowd, Crowd::AgentID inAgent, int inUpdates = 1200)
+    /// outFarthestX: the farthest east it went (over the bridge: beyond x = 8).
+    int WalkCountingWater(Crowd& ioCrowd, Crowd::AgentID inAgent, float* outFarthestX = nullptr,
+                          int inUpdates = 1200)
     {
         int inWater = 0;
         for (int update = 0; update < inUpdates; ++update)
         {
             EXPECT_TRUE(ioCrowd.Update(cFrame).IsOk());
             const Vec3 position = ioCrowd.GetPosition(inAgent).Value();
+            if (outFarthestX != nullptr) *outFarthestX = std::max(*outFarthestX, position.x());
             if (InWater(position) || StandsInWaterPolygon(ioCrowd, inAgent)) ++inWater;
             if (ioCrowd.GetState(inAgent).Value() == AgentState::Arrived) break;
         }
@@ -101,8 +104,8 @@ protected:
         return count;
     }
 
-    /// Polygons whose flags do not carry one mark for each set of inAreaSets holding their area (the
-    /// world's marks for the sets its crowds hold now).
+    /// Polygons whose flags do not carry one mark for each set of inAreaSets holding their area: the world's
+    /// marks when its 15 flags are given to exactly those sets (a flag no one holds keeps its marks).
     int WronglyMarkedPolygons(const std::vector<uint64_t>& inAreaSets) const
     {
         int wrong = 0, polygons = 0;
@@ -210,7 +213,9 @@ TEST_F(CrowdFilterTest, AnAgentWhoseFilterChangesInTheWaterLeavesItAndTakesTheBr
         else
             ASSERT_TRUE(crowd->SetFilter(2, NoSwimming()).IsOk());
         // Out of the water at once, onto the nearer bank, then by the bridge
-        EXPECT_EQ(WalkCountingWater(*crowd, agent), 0);
+        float farthestX = -100.0f;
+        EXPECT_EQ(WalkCountingWater(*crowd, agent, &farthestX), 0);
+        EXPECT_GT(farthestX, 8.0f) << "it took the bridge";
         ExpectArrivedAt(*crowd, agent, mEnd);
         ASSERT_TRUE(crowd->RemoveAgent(agent).IsOk());
     }
@@ -225,8 +230,9 @@ TEST_F(CrowdFilterTest, UntilItsNewPathComesAnAgentKeepsOnlyTheWayItsNewFilterAl
     std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld, settings).Value();
     const Crowd::AgentID agent = crowd->AddAgent(mStart).Value();
     ASSERT_TRUE(crowd->SetTarget(agent, mEnd).IsOk());
-    while (crowd->GetState(agent).Value() != AgentState::Moving)
+    for (int update = 0; update < 600 && crowd->GetState(agent).Value() != AgentState::Moving; ++update)
         ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+    ASSERT_EQ(crowd->GetState(agent).Value(), AgentState::Moving);
     ASSERT_TRUE(crowd->SetFilter(cMaySwim, NoSwimming()).IsOk());
     // Its corridor, through the water, is cut at the bank as soon as the filter is checked
     int updatesWaiting = 0, waterPolygonsKept = 0;
@@ -319,6 +325,10 @@ TEST_F(CrowdFilterTest, TheWorldMarksExactlyTheAreasItsCrowdsExcludeAsTheirSetsC
         ASSERT_FALSE(full.IsOk());
         EXPECT_EQ(full.GetError().mCode, ErrorCode::OutOfCapacity);
         EXPECT_EQ(first->GetFilter(0).Value().mExcludedAreas, 0u) << "the refused filter is not taken";
+        // Bits of no area (Cairn's areas end at 62) take no flag
+        PathFilter noArea;
+        noArea.mExcludedAreas = uint64_t(1) << 63;
+        EXPECT_TRUE(first->SetFilter(0, noArea).IsOk());
         // A set held already shares its mark
         PathFilter again;
         again.mExcludedAreas = cGround;
@@ -361,6 +371,49 @@ TEST_F(CrowdFilterTest, TheWorldMarksExactlyTheAreasItsCrowdsExcludeAsTheirSetsC
     ASSERT_TRUE(second->SetTarget(agent, mEnd).IsOk());
     EXPECT_EQ(WalkCountingWater(*second, agent), 0);
     ExpectArrivedAt(*second, agent, mEnd);
+}
+
+TEST_F(CrowdFilterTest, RandomPointsOfAFilterACrowdHoldsAreDrawnFromTheGroundItMayReachAlone)
+{
+    // A dry island 3 m across in a lake: nearly all the circle round its centre is water
+    AddStaticBox(Vec3(0, -0.5f, 0), Vec3(1.5f, 0.5f, 1.5f));
+    AddStaticBox(Vec3(0, -0.5f, -6), Vec3(10, 0.5f, 4.5f), cWater);
+    AddStaticBox(Vec3(0, -0.5f, 6), Vec3(10, 0.5f, 4.5f), cWater);
+    AddStaticBox(Vec3(-6, -0.5f, 0), Vec3(4.5f, 0.5f, 1.5f), cWater);
+    AddStaticBox(Vec3(6, -0.5f, 0), Vec3(4.5f, 0.5f, 1.5f), cWater);
+    MakeNavMesh();
+    ASSERT_TRUE(RunUntilIdle());
+    const Vec3 island(0.2f, 0, 0.3f);
+    auto draw = [&](int& outFailed)
+    {
+        outFailed = 0;
+        for (uint64_t seed = 1; seed <= 40; ++seed)
+        {
+            const Result<Vec3> point = mWorld->FindRandomPointAround(island, 8.0f, seed, NoSwimming());
+            if (!point)
+            {
+                ++outFailed;
+                continue;
+            }
+            // The island's polygons follow its edge to within the voxels' resolution
+            EXPECT_LT(std::max(std::abs(point.Value().x()), std::abs(point.Value().z())), 1.75f)
+                << "on the island";
+        }
+    };
+    // Unmarked, each point drawn is checked and most are in the water: many calls give up
+    int failedUnmarked = 0;
+    draw(failedUnmarked);
+    EXPECT_GT(failedUnmarked, 0);
+    // Marked for a crowd's filter, Detour's spread keeps to the island: every call finds a point there
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    ASSERT_TRUE(crowd->SetFilter(cMayNotSwim, NoSwimming()).IsOk());
+    int failedMarked = 0;
+    draw(failedMarked);
+    EXPECT_EQ(failedMarked, 0);
+    // The marks stay while no one holds them, until another set takes the flag
+    crowd.reset();
+    draw(failedMarked);
+    EXPECT_EQ(failedMarked, 0);
 }
 
 TEST_F(CrowdFilterTest, BadFiltersAndIndicesAreRefused)

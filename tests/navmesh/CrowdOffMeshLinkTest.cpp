@@ -22,8 +22,9 @@ class CrowdOffMeshLinkTest : public NavMeshSceneFixture
 {
 protected:
     /// Two platforms 3 m apart across x = 0 (a gap no agent walks), in different tiles; the near one inHigh
-    /// metres higher. A link from x = -2.5 to x = 2.5 along z = 0.
-    TileScheduler::LinkID BuildGapWithLink(bool inBidirectional, float inHigh = 0.0f)
+    /// metres higher. A link from x = -2.5 to x = 2.5 along z = 0, in area inArea.
+    TileScheduler::LinkID BuildGapWithLink(bool inBidirectional, float inHigh = 0.0f,
+                                           uint8_t inArea = cDefaultArea)
     {
         AddStaticBox(Vec3(-6, inHigh - 0.5f, 0), Vec3(4.5f, 0.5f, 4)); // x in [-10.5, -1.5]
         AddStaticBox(Vec3(6, -0.5f, 0), Vec3(4.5f, 0.5f, 4));          // x in [1.5, 10.5]
@@ -34,6 +35,7 @@ protected:
         jump.mRadius = 0.6f;
         jump.mBidirectional = inBidirectional;
         jump.mUserID = cJumpID;
+        jump.mArea = inArea;
         const TileScheduler::LinkID link = mScheduler->AddOffMeshLink(jump).Value();
         EXPECT_TRUE(RunUntilIdle());
         return link;
@@ -151,6 +153,38 @@ TEST_F(CrowdOffMeshLinkTest, AnAgentJumpsAGapOverALinkEitherWay)
 
 // Down a one-way drop from a platform 2 m higher: it comes down along the link and lands on the lower
 // navmesh; it cannot go back up (it walks to the nearest point it can reach, on its own side)
+TEST_F(CrowdOffMeshLinkTest, AnAgentWhoseFilterComesToExcludeTheLinkAheadStaysOnItsSide)
+{
+    constexpr uint8_t cJumpArea = 7;
+    BuildGapWithLink(true, 0.0f, cJumpArea);
+    std::unique_ptr<Crowd> crowd = Crowd::Create(*mWorld).Value();
+    const Crowd::AgentID agent = crowd->AddAgent(Vec3(-8, 0, 0)).Value();
+    ASSERT_TRUE(crowd->SetTarget(agent, Vec3(8, 0, 0)).IsOk());
+    for (int update = 0; update < 600 && crowd->GetState(agent).Value() != AgentState::OnOffMeshLink;
+         ++update)
+        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+    ASSERT_EQ(crowd->GetState(agent).Value(), AgentState::OnOffMeshLink);
+    ASSERT_FALSE(crowd->GetOffMeshLink(agent).Value().mAtStart) << "on its way to the start";
+    // Its filter now excludes the jump: it stops where it is, and the far side is out of its reach
+    const Vec3 before = crowd->GetPosition(agent).Value();
+    PathFilter noJumping;
+    noJumping.mExcludedAreas = uint64_t(1) << cJumpArea;
+    ASSERT_TRUE(crowd->SetFilter(0, noJumping).IsOk());
+    ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+    EXPECT_LT((crowd->GetPosition(agent).Value() - before).norm(), 0.1f) << "no jump to the far side";
+    float farthestX = -100.0f;
+    for (int update = 0; update < 300; ++update)
+    {
+        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        EXPECT_NE(crowd->GetState(agent).Value(), AgentState::OnOffMeshLink);
+        farthestX = std::max(farthestX, crowd->GetPosition(agent).Value().x());
+    }
+    EXPECT_LT(farthestX, -1.5f) << "it never crossed the gap";
+    EXPECT_EQ(crowd->GetState(agent).Value(), AgentState::Arrived);
+    EXPECT_EQ(crowd->GetPathStatus(agent).Value(), PathStatus::Partial);
+    EXPECT_EQ(crowd->GetStatistics().mLinksTaken, 1u) << "taken once, then let go";
+}
+
 TEST_F(CrowdOffMeshLinkTest, AnAgentTakesAOneWayDropDown)
 {
     BuildGapWithLink(false, 2.0f);

@@ -27,7 +27,10 @@
 //
 // Each agent follows one of the crowd's path filters (SetFilter): it never enters an area its filter
 // excludes, not on its path, nor pushed by others, nor by a shortcut, since the world marks those areas in
-// Detour's polygon flags for the filter, and every Detour call the agent makes honours them.
+// Detour's polygon flags for the filter, and every Detour call the agent makes honours them. A filter changed
+// under an agent is met as it stands: one in an area the filter now excludes leaves it for the nearest point
+// it may stand on, one on its way to a link the filter now excludes stays on its side, and one already on a
+// link (past its start) lands first. The crowd holds its world's marks: the world outlives the crowd.
 //
 // Threads. Update: one thread at a time, not inside another navmesh call; its loop and the path search run
 // on the job interface's threads while the calling thread holds the navmesh shared (a Publish waits for the
@@ -107,8 +110,8 @@ enum class AgentState : uint8_t
     Moving,         ///< Following its corridor
     Arrived, ///< Within its radius of the target's reachable point (GetPathStatus: the target's, or short)
     NoPath,  ///< The last request found no path (target off the navmesh or unreachable)
-    /// Its polygon went away with a tile, or its filter excludes it with no other within 2 m: waits in
-    /// place for navmesh under it
+    /// Its polygon went away with a tile, or its filter excludes it with no other within reach: waits in
+    /// place for navmesh under it, or a filter that lets it stand there
     OffNavMesh,
     OnOffMeshLink, ///< Taking an off-mesh link (walking to its start, on it, or held there: GetOffMeshLink)
 };
@@ -162,11 +165,11 @@ public:
     static constexpr int cMaxFilters = 16;
     /// Filter inIndex is inFilter from now on. Its agents with a target ask for their paths again, walking on
     /// meanwhile along what their corridors keep outside the areas it excludes; one standing in such an area
-    /// is moved to the nearest point it may stand on within 2 m across (DetourCrowd's way), or waits
-    /// OffNavMesh. Errors: an index out of range, a cost FindPath refuses, or OutOfCapacity when the
-    /// world's crowds hold 15 other sets of excluded areas (of all their filters together). Between Updates:
-    /// a new set of excluded areas is marked on the world's navmesh at once, waiting for the queries in
-    /// progress as a Publish does.
+    /// is moved to the nearest point it may stand on within 2 m across and 1 m up or down (DetourCrowd's
+    /// way), or waits OffNavMesh. Errors: an index out of range, a cost FindPath refuses, or OutOfCapacity
+    /// when the world's crowds hold 15 other sets of excluded areas (of all their filters together). Between
+    /// Updates: a new set of excluded areas is marked on the world's navmesh at once, waiting for the queries
+    /// in progress as a Publish does.
     Status SetFilter(int inIndex, const PathFilter& inFilter);
     Result<PathFilter> GetFilter(int inIndex) const;
     /// The agent follows filter inIndex from now on, as if its filter had changed (SetFilter).

@@ -7,9 +7,10 @@
 // world in one hand-off, Publish(changes), called once a frame by the game's sync point (TileScheduler::
 // Update collects the tile jobs' results and the tiles it drops, then calls it), which swaps them all in
 // under mNavMeshMutex held exclusively. Path queries hold mNavMeshMutex shared for their whole length, so a
-// query never sees a half-added tile: it sees the navmesh as of the last Publish. Each thread keeps its own
-// dtNavMeshQuery (Detour's query objects hold per-query scratch). mNavMeshMutex is never held while a body
-// lock is taken.
+// query never sees a half-added tile: it sees the navmesh as of the last Publish. The one other writer is a
+// crowd's filter marking the polygons of its excluded areas in their flags (AcquireExclusionFlag), under
+// mNavMeshMutex held exclusively as well. Each thread keeps its own dtNavMeshQuery (Detour's query objects
+// hold per-query scratch). mNavMeshMutex is never held while a body lock is taken.
 
 #include "cairn/navmesh/TileBuilder.h"
 #include "cairn/navmesh/TileGrid.h"
@@ -124,7 +125,10 @@ public:
     /// proportion to their area, so the point may lie up to one polygon beyond inRadius (Detour's
     /// findRandomPointAroundCircle). The same inSeed on the same navmesh (same tiles, published in the same
     /// order) gives the same point. With areas inFilter excludes, the point is in none of them and FindPath
-    /// reaches it without crossing one, perhaps around them outside the circle (a few draws, then an error).
+    /// reaches it without crossing one, perhaps around them outside the circle (a few draws, each checked by
+    /// a path search, then an error); where a crowd's filter has the world mark those areas (Crowd::
+    /// SetFilter), Detour's spread keeps out of them itself: one draw, no search, and for a seed another
+    /// point than without the marks.
     /// Error when inCenter is off the navmesh or in an excluded area, inRadius is not in (0,
     /// cMaxSearchExtentTiles tiles], or a number is bad. Any thread.
     Result<Vec3> FindRandomPointAround(const Vec3& inCenter, float inRadius, uint64_t inSeed,
@@ -184,15 +188,21 @@ private:
     /// raycast, the walls gathered), where the prohibitive cost MakeDetourFilter gives them binds the
     /// searches alone. The same areas get the same bit, counted; other areas a bit no one holds, marked on
     /// every published polygon at once under the exclusive lock (as a Publish marks the polygons it adds).
-    /// Const: it changes no query's answer, only what the bit's holders see. inReleased: a bit the caller
-    /// lets go of first (0: none), in the same step, so a filter replaced when every bit is held can take
-    /// its own; kept when there is no bit for inAreas. OutOfCapacity when cMaxExclusionFlags other area sets
-    /// are held. Any thread, never inside a Read.
+    /// Const: the navmesh keeps its shape; only the bit's holders and FindRandomPointAround's draws for these
+    /// areas see the marks. inAreas' bits above cMaxAreaId are no area's, ignored. inReleased: a bit the
+    /// caller lets go of first (0: none), in the same step, so a filter replaced when every bit is held can
+    /// take its own; kept when there is no bit for inAreas. OutOfCapacity when cMaxExclusionFlags other area
+    /// sets are held. Any thread, never inside a Read.
     Result<uint16_t> AcquireExclusionFlag(uint64_t inAreas, uint16_t inReleased = 0) const;
     /// Lets go of a bit AcquireExclusionFlag gave (0: nothing). Any thread, never inside a Read.
     void ReleaseExclusionFlag(uint16_t inFlag) const;
+    /// The flag marking exactly inAreas' polygons now, held or not (0: none). The mutex held, shared or
+    /// exclusive: a query may exclude it while it holds the mutex.
+    uint16_t MarkedExclusionFlagLocked(uint64_t inAreas) const;
     /// Polygon flag bits 1 to 15: bit 0 is cPolyFlagWalk, which every polygon has
     static constexpr int cMaxExclusionFlags = 15;
+    static constexpr uint16_t cExclusionFlagBits = 0xfffe;
+    static constexpr uint64_t cAllAreas = (uint64_t(1) << (cMaxAreaId + 1)) - 1;
     struct ExclusionFlag
     {
         uint64_t mAreas = 0; ///< The areas its bit marks (0: never given); kept after the last holder goes
