@@ -1,7 +1,8 @@
 // Off-mesh links in a bake: a link from the links file joins two platforms a gap apart in the baked navmesh
 // (a path crosses it, with the link's user id and area kept, one way only for a drop); an incremental bake
 // builds again the tile whose link changed and only that one; the links file's errors name the file, the
-// link and the key, and a link with an end in no tile of the level is refused.
+// link and the key, and a link with an end in no tile of the level is refused; a link Detour leaves unjoined
+// is reported, by the bake of a whole level and by the merge of shards.
 
 #include "Baker.h"
 #include "OffMeshLinksFile.h"
@@ -165,6 +166,71 @@ TEST_F(BakeLinksTest, LinksThatCouldNeverJoinAreRefused)
     ASSERT_FALSE(walled);
     EXPECT_NE(walled.GetError().mMessage.find("has no navmesh for the off-mesh links"), std::string::npos)
         << walled.GetError().mMessage;
+}
+
+// Links no agent can take are reported: an end over the gap and an end 2 m above the floor (past the climb),
+// which Detour leaves unjoined, and a start 3 m in the air, which its tile builder leaves out. A joined link
+// whose end is in the next tile is not. A shard leaves the check to the merge, which finds the same
+TEST_F(BakeLinksTest, LinksNoAgentCanTakeAreReported)
+{
+    const std::string links = R"({"links": [
+        {"start": [9, 0, 4], "end": [14, 0, 4], "radius": 0.6, "user_id": 1},
+        {"start": [9, 0, 2], "end": [11.5, 0, 2], "radius": 0.5, "user_id": 2},
+        {"start": [9, 0, 6], "end": [20, 2, 6], "radius": 0.6, "user_id": 3},
+        {"start": [5, 3, 4], "end": [14, 0, 5], "radius": 0.6, "user_id": 4}]})";
+    Result<BakeResult> baked = BakeWith(links);
+    ASSERT_TRUE(baked) << baked.GetError().mMessage;
+    ASSERT_TRUE(baked.Value().mLinksChecked);
+    const std::vector<UnjoinedLink>& unjoined = baked.Value().mUnjoinedLinks;
+    ASSERT_EQ(unjoined.size(), 3u);
+    EXPECT_EQ(unjoined[0].mUserID, 2u);
+    EXPECT_EQ(unjoined[1].mUserID, 3u);
+    EXPECT_EQ(unjoined[2].mUserID, 4u);
+    for (int i : {0, 1})
+    {
+        EXPECT_TRUE(unjoined[size_t(i)].mStartJoined) << i;
+        EXPECT_FALSE(unjoined[size_t(i)].mEndJoined) << i;
+        EXPECT_NE(DescribeUnjoinedLink(unjoined[size_t(i)]).find("its end joins no navmesh"),
+                  std::string::npos);
+    }
+    EXPECT_FALSE(unjoined[2].mBuilt);
+    EXPECT_NE(DescribeUnjoinedLink(unjoined[2]).find("is not in the navmesh"), std::string::npos);
+    EXPECT_NE(DescribeUnjoinedLink(unjoined[2]).find("(5.00, 3.00, 4.00)"), std::string::npos);
+    EXPECT_EQ(Links(baked.Value().mNavMesh).size(), 3u) << "the builder left the fourth out";
+    EXPECT_TRUE(Reaches(baked.Value().mNavMesh, Vec3(3, 0, 4), Vec3(20, 0, 4))) << "link 1 joins";
+
+    // Two shards: each bakes part of the level and checks nothing; their merge is checked as the whole
+    std::vector<navmesh::NavMeshFileContents> shards;
+    for (uint32_t shard = 0; shard < 2; ++shard)
+    {
+        BakeSettings settings;
+        settings.mInputs = {Write("platforms.obj", cTwoPlatforms)};
+        settings.mThreads = 1;
+        settings.mLinks = LoadOffMeshLinks(Write("links.json", links)).Value();
+        settings.mShard = shard;
+        settings.mShardCount = 2;
+        Result<BakeResult> part = Bake(settings);
+        ASSERT_TRUE(part) << part.GetError().mMessage;
+        EXPECT_FALSE(part.Value().mLinksChecked);
+        EXPECT_TRUE(part.Value().mUnjoinedLinks.empty());
+        shards.push_back(std::move(part.Value().mNavMesh));
+    }
+    Result<navmesh::NavMeshFileContents> merged = MergeShards(shards);
+    ASSERT_TRUE(merged) << merged.GetError().mMessage;
+    const std::vector<navmesh::OffMeshLink> declared = LoadOffMeshLinks(Write("links.json", links)).Value();
+    Result<std::vector<UnjoinedLink>> again = FindUnjoinedLinks(merged.Value(), declared);
+    ASSERT_TRUE(again) << again.GetError().mMessage;
+    ASSERT_EQ(again.Value().size(), 3u);
+    for (size_t i = 0; i < 3; ++i)
+        EXPECT_EQ(again.Value()[i].mUserID, unjoined[i].mUserID);
+    // Without the east platform's tile, link 1's end is in no tile given: unjoined
+    navmesh::NavMeshFileContents westOnly = merged.Value();
+    std::erase_if(westOnly.mTiles,
+                  [](const navmesh::NavMeshFileTile& inTile) { return inTile.mTile.mX != 0; });
+    ASSERT_EQ(westOnly.mTiles.size(), 1u);
+    EXPECT_EQ(FindUnjoinedLinks(westOnly, declared).Value().size(), 4u);
+    EXPECT_EQ(FindUnjoinedLinks(westOnly).Value().size(), 3u)
+        << "without the declared links, not the left-out one";
 }
 
 TEST_F(BakeLinksTest, TheLinksFileErrorsNameTheFileTheLinkAndTheKey)

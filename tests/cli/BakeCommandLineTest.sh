@@ -49,6 +49,13 @@ echo '{"links": [{"start": [2, 0, 2], "end": [20, 0, 20], "bidirectional": false
     fail "the bake with links failed: $(cat linked.log)"
 grep -q 'marker-end="url(#arrow)"' linked.svg || fail "the map has no link arrow"
 cmp -s level.navmesh linked.navmesh && fail "the link left the navmesh as it was"
+grep -q "off-mesh links: 1, 0 that no agent can take" linked.log || fail "the link was not checked: $(cat linked.log)"
+# A link whose end is 5 m above the floor: baked, with a warning that no agent can take it
+echo '{"links": [{"start": [2, 0, 2], "end": [20, 5, 20], "user_id": 9}]}' >dead-links.json
+"$bake" bake level.obj -o dead.navmesh --links dead-links.json >dead.log 2>&1 || fail "the dead link's bake failed"
+grep -q "warning: off-mesh link (user id 9) .*its end joins no navmesh" dead.log ||
+    fail "no warning for a link no agent can take: $(cat dead.log)"
+grep -q "off-mesh links: 1, 1 that no agent can take" dead.log || fail "the dead link was not counted: $(cat dead.log)"
 
 # Part of the level: a box or a list of tiles
 "$bake" bake level.obj -o part.navmesh --box 1,1,10,10 >part.log 2>&1 || fail "the box bake failed: $(cat part.log)"
@@ -146,6 +153,16 @@ expect_error "different bakes" merged.navmesh merge shard0.navmesh shard1.navmes
 "$bake" merge shard0.navmesh shard1.navmesh shard2.navmesh --summary shard0.json --summary shard1.json \
     --summary shard2.json -o merged.navmesh >merge.log 2>&1 || fail "merging every shard failed: $(cat merge.log)"
 cmp -s merged.navmesh level.navmesh || fail "the merged shards differ from the one-machine bake"
+# Shards leave the links to the merge, which warns of the dead one
+for k in 0 1; do
+    "$bake" bake level.obj -o dead$k.navmesh --links dead-links.json --shard $k/2 >dead$k.log 2>&1 ||
+        fail "dead link shard $k/2 failed"
+done
+grep -q "off-mesh links: 1, not checked" dead0.log || fail "a shard claimed to check the links: $(cat dead0.log)"
+"$bake" merge dead0.navmesh dead1.navmesh --links dead-links.json -o dead-merged.navmesh >merge.log 2>&1 ||
+    fail "merging the dead link's shards failed: $(cat merge.log)"
+grep -q "warning: off-mesh link (user id 9) .*its end joins no navmesh" merge.log ||
+    fail "the merge did not warn of the dead link: $(cat merge.log)"
 "$bake" merge shard0.navmesh shard2.navmesh -o merged2.navmesh >merge.log 2>&1 || fail "merge without summaries"
 grep -q "a missing shard cannot be noticed" merge.log || fail "merge without summaries did not warn: $(cat merge.log)"
 

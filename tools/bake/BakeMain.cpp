@@ -124,6 +124,9 @@ int main(int argc, char** argv)
     CLI::App* mergeCommand = app.add_subcommand("merge", "Combine shard outputs into one navmesh file");
     mergeCommand->add_option("shards", shards, "Navmesh files of the shards")->required();
     mergeCommand->add_option("-o,--output", mergedOutput, "The navmesh file to write")->required();
+    std::string mergeLinksPath;
+    mergeCommand->add_option("--links", mergeLinksPath,
+                             "The shards' links file: then a link the tile builder left out is reported too");
     std::vector<std::string> shardSummaries;
     mergeCommand->add_option(
         "--summary", shardSummaries,
@@ -146,6 +149,7 @@ int main(int argc, char** argv)
             shardInputs.push_back({"shard", path});
         for (const std::string& path : shardSummaries)
             shardInputs.push_back({"--summary", path});
+        if (!mergeLinksPath.empty()) shardInputs.push_back({"--links", mergeLinksPath});
         if (Status usable = bake::CheckOutputPaths({{"-o", mergedOutput}}, shardInputs); !usable)
             return Fail(usable.GetError().mMessage);
         std::vector<navmesh::NavMeshFileContents> loaded;
@@ -173,6 +177,17 @@ int main(int argc, char** argv)
         }
         Result<navmesh::NavMeshFileContents> merged = bake::MergeShards(loaded);
         if (!merged) return Fail(merged.GetError().mMessage);
+        std::vector<navmesh::OffMeshLink> declared;
+        if (!mergeLinksPath.empty())
+        {
+            Result<std::vector<navmesh::OffMeshLink>> links = bake::LoadOffMeshLinks(mergeLinksPath);
+            if (!links) return Fail(links.GetError().mMessage);
+            declared = std::move(links.Value());
+        }
+        Result<std::vector<bake::UnjoinedLink>> unjoined = bake::FindUnjoinedLinks(merged.Value(), declared);
+        if (!unjoined) return Fail(unjoined.GetError().mMessage);
+        for (const bake::UnjoinedLink& link : unjoined.Value())
+            std::fprintf(stderr, "cairn-bake: warning: %s\n", bake::DescribeUnjoinedLink(link).c_str());
         if (Status saved = navmesh::SaveNavMeshFile(mergedOutput, merged.Value()); !saved)
             return Fail(saved.GetError().mMessage);
         std::printf("merged %zu shards: %zu tiles -> %s\n", shards.size(), merged.Value().mTiles.size(),
@@ -315,5 +330,16 @@ int main(int argc, char** argv)
                 baked.mTilesBaked, baked.mTilesInWorld, settings.mShard, settings.mShardCount,
                 baked.mTilesWithPolygons, (unsigned long long)baked.mPolygons, baked.mBakeMs, baked.mLoadMs,
                 output.c_str());
+    if (!settings.mLinks.empty())
+    {
+        for (const bake::UnjoinedLink& link : baked.mUnjoinedLinks)
+            std::fprintf(stderr, "cairn-bake: warning: %s\n", bake::DescribeUnjoinedLink(link).c_str());
+        if (baked.mLinksChecked)
+            std::printf("off-mesh links: %zu, %zu that no agent can take\n", settings.mLinks.size(),
+                        baked.mUnjoinedLinks.size());
+        else
+            std::printf("off-mesh links: %zu, not checked (a part of the level: the merge checks them)\n",
+                        settings.mLinks.size());
+    }
     return 0;
 }

@@ -235,6 +235,17 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     std::map<navmesh::TileCoord, std::vector<navmesh::OffMeshLink>> linksByTile;
     for (const navmesh::OffMeshLink& link : inSettings.mLinks)
         linksByTile[grid.TileAt(link.mStart.x(), link.mStart.z())].push_back(link);
+    // The tiles with links and those next to them, kept for the link check when this bake holds every tile
+    const bool wholeLevel = inSettings.mShardCount == 1 && !inSettings.mRegion && inSettings.mTiles.empty();
+    navmesh::NavMeshFileContents linkTiles;
+    linkTiles.mParams = params.Value();
+    auto nearLinks = [&](const navmesh::TileCoord& inTile)
+    {
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dz = -1; dz <= 1; ++dz)
+                if (linksByTile.contains({inTile.mX + dx, inTile.mZ + dz})) return true;
+        return false;
+    };
     Result<std::vector<navmesh::TileCoord>> selected = SelectTiles(tiles, grid, inSettings);
     if (!selected) return selected.GetError();
     std::vector<navmesh::TileCoord> mine;
@@ -350,6 +361,9 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
         if (!data.empty())
         {
             ++result.mTilesWithPolygons;
+            if (wholeLevel && nearLinks(tile.mTile))
+                linkTiles.mTiles.push_back(
+                    {tile.mTile, std::vector<unsigned char>(data.begin(), data.end())});
             if (output != nullptr)
             {
                 if (Status added = output->Add(tile.mTile, data); !added) return added.GetError();
@@ -381,6 +395,13 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     }
     result.mSummary.mBakeMs = result.mBakeMs;
     result.mSummary.mPolygons = result.mPolygons;
+    if (wholeLevel)
+    {
+        Result<std::vector<UnjoinedLink>> unjoined = FindUnjoinedLinks(linkTiles, inSettings.mLinks);
+        if (!unjoined) return unjoined.GetError();
+        result.mUnjoinedLinks = std::move(unjoined.Value());
+        result.mLinksChecked = true;
+    }
     return result;
 }
 

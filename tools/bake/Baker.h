@@ -11,6 +11,7 @@
 
 #include "BakeSummary.h"
 #include "LevelSource.h"
+#include "LinkCheck.h"
 #include "cairn/navmesh/AgentProfile.h"
 #include "cairn/navmesh/LevelMesh.h"
 #include "cairn/navmesh/NavMeshFile.h"
@@ -73,6 +74,11 @@ struct BakeResult
     BakeSummary mSummary; ///< Per tile hashes, for the next incremental bake
     /// With mOutputPath and not mCommitOutput: the navmesh file, complete, to Commit into place
     std::unique_ptr<navmesh::NavMeshFileWriter> mOutput;
+    /// The off-mesh links no agent can take (FindUnjoinedLinks): looked for when the bake holds every tile
+    /// of the level (no shard, region or tile list; mLinksChecked), since a link's end may lie in the tile
+    /// next to its start's. After a sharded bake, the merge looks
+    std::vector<UnjoinedLink> mUnjoinedLinks;
+    bool mLinksChecked = false;
 };
 
 /// Bakes the files of inSettings.mInputs. Errors: unreadable or malformed inputs (naming the file and line),

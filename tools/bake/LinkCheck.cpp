@@ -1,0 +1,113 @@
+#include "LinkCheck.h"
+
+#include <DetourNavMesh.h>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <set>
+
+namespace cairn::bake
+{
+
+Result<std::vector<UnjoinedLink>> FindUnjoinedLinks(const navmesh::NavMeshFileContents& inNavMesh,
+                                                    std::span<const navmesh::OffMeshLink> inDeclared)
+{
+    // Only the tiles with links and those next to them, where their ends can lie: a whole world's navmesh
+    // need not be made twice
+    std::set<navmesh::TileCoord> withLinks;
+    for (const navmesh::NavMeshFileTile& tile : inNavMesh.mTiles)
+    {
+        dtMeshHeader header;
+        if (tile.mData.size() < sizeof(header)) continue; // CreateDetourNavMesh refuses it below
+        std::memcpy(&header, tile.mData.data(), sizeof(header));
+        if (header.offMeshConCount > 0) withLinks.insert(tile.mTile);
+    }
+    // The declared links' tiles too, to look for them there
+    const float tileWidth = inNavMesh.mParams.tileWidth, tileHeight = inNavMesh.mParams.tileHeight;
+    auto tileOf = [&](const Vec3& inPoint)
+    {
+        return navmesh::TileCoord{int(std::floor((inPoint.x() - inNavMesh.mParams.orig[0]) / tileWidth)),
+                                  int(std::floor((inPoint.z() - inNavMesh.mParams.orig[2]) / tileHeight))};
+    };
+    for (const navmesh::OffMeshLink& link : inDeclared)
+        withLinks.insert(tileOf(link.mStart));
+    if (withLinks.empty()) return std::vector<UnjoinedLink>();
+    navmesh::NavMeshFileContents near;
+    near.mParams = inNavMesh.mParams;
+    for (const navmesh::NavMeshFileTile& tile : inNavMesh.mTiles)
+    {
+        bool nearLinks = false;
+        for (int dx = -1; dx <= 1 && !nearLinks; ++dx)
+            for (int dz = -1; dz <= 1 && !nearLinks; ++dz)
+                nearLinks = withLinks.contains({tile.mTile.mX + dx, tile.mTile.mZ + dz});
+        if (nearLinks || tile.mData.size() < sizeof(dtMeshHeader)) near.mTiles.push_back(tile);
+    }
+    Result<navmesh::DetourNavMeshPtr> created = navmesh::CreateDetourNavMesh(near);
+    if (!created) return created.GetError();
+    const dtNavMesh& navMesh = *created.Value();
+    std::vector<UnjoinedLink> unjoined;
+    for (const navmesh::NavMeshFileTile& fileTile : near.mTiles)
+    {
+        const dtMeshTile* tile = navMesh.getTileAt(fileTile.mTile.mX, fileTile.mTile.mZ, 0);
+        if (tile == nullptr || tile->header == nullptr) continue;
+        for (int c = 0; c < tile->header->offMeshConCount; ++c)
+        {
+            const dtOffMeshConnection& connection = tile->offMeshCons[c];
+            const dtPoly& polygon = tile->polys[connection.poly];
+            // Detour's links of a link's polygon: edge 0 to the polygon its start joined, edge 1 to its end's
+            bool joined[2] = {false, false};
+            for (unsigned int k = polygon.firstLink; k != DT_NULL_LINK; k = tile->links[k].next)
+                if (tile->links[k].edge < 2) joined[tile->links[k].edge] = true;
+            if (joined[0] && joined[1]) continue;
+            unjoined.push_back({.mTile = fileTile.mTile,
+                                .mStart = Vec3(connection.pos[0], connection.pos[1], connection.pos[2]),
+                                .mEnd = Vec3(connection.pos[3], connection.pos[4], connection.pos[5]),
+                                .mUserID = connection.userId,
+                                .mStartJoined = joined[0],
+                                .mEndJoined = joined[1]});
+        }
+    }
+    // Declared links their tile's data does not hold: Detour's builder left them out
+    for (const navmesh::OffMeshLink& link : inDeclared)
+    {
+        const navmesh::TileCoord coord = tileOf(link.mStart);
+        const dtMeshTile* tile = navMesh.getTileAt(coord.mX, coord.mZ, 0);
+        if (tile == nullptr || tile->header == nullptr) continue; // Not a tile given
+        bool built = false;
+        for (int c = 0; c < tile->header->offMeshConCount && !built; ++c)
+        {
+            const float* pos = tile->offMeshCons[c].pos;
+            built = (Vec3(pos[0], pos[1], pos[2]) - link.mStart).norm() < 1.0e-3f &&
+                    (Vec3(pos[3], pos[4], pos[5]) - link.mEnd).norm() < 1.0e-3f;
+        }
+        if (built) continue;
+        unjoined.push_back({.mBuilt = false,
+                            .mTile = coord,
+                            .mStart = link.mStart,
+                            .mEnd = link.mEnd,
+                            .mUserID = link.mUserID});
+    }
+    return unjoined;
+}
+
+std::string DescribeUnjoinedLink(const UnjoinedLink& inLink)
+{
+    // Detour joins the end only after the start: an unjoined start leaves the end unjoined too
+    const char* which = !inLink.mStartJoined ? "its start" : "its end";
+    const std::string what =
+        inLink.mBuilt
+            ? std::string(which) + " joins no navmesh within its radius (and the agent's climb up or down)"
+            : "is not in the navmesh: Detour keeps a link only where its start is within the heights of its "
+              "tile's navmesh";
+    char text[640];
+    std::snprintf(
+        text, sizeof(text),
+        "off-mesh link (user id %u) from (%.2f, %.2f, %.2f) to (%.2f, %.2f, %.2f) in tile (%d, %d): %s: "
+        "no agent can take it",
+        inLink.mUserID, double(inLink.mStart.x()), double(inLink.mStart.y()), double(inLink.mStart.z()),
+        double(inLink.mEnd.x()), double(inLink.mEnd.y()), double(inLink.mEnd.z()), inLink.mTile.mX,
+        inLink.mTile.mZ, what.c_str());
+    return text;
+}
+
+} // namespace cairn::bake
