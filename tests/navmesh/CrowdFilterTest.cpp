@@ -17,7 +17,7 @@ using namespace cairn::physics;
 namespace
 {
 
-constexpr float cFrame = 1.0f / 60.0f;
+constexpr float cStep = 1.0f / 60.0f;
 constexpr int cMaySwim = 0;
 constexpr int cMayNotSwim = 1;
 
@@ -56,7 +56,7 @@ protected:
         int inWater = 0;
         for (int update = 0; update < inUpdates; ++update)
         {
-            EXPECT_TRUE(ioCrowd.Update(cFrame).IsOk());
+            EXPECT_TRUE(ioCrowd.Update(cStep).IsOk());
             const Vec3 position = ioCrowd.GetPosition(inAgent).Value();
             if (outFarthestX != nullptr) *outFarthestX = std::max(*outFarthestX, position.x());
             if (InWater(position) || StandsInWaterPolygon(ioCrowd, inAgent)) ++inWater;
@@ -85,7 +85,7 @@ protected:
         int inWater = 0;
         for (int update = 0; update < 30; ++update)
         {
-            EXPECT_TRUE(ioCrowd.Update(cFrame).IsOk());
+            EXPECT_TRUE(ioCrowd.Update(cStep).IsOk());
             if (InWater(ioCrowd.GetPosition(edge).Value()) || StandsInWaterPolygon(ioCrowd, edge)) ++inWater;
         }
         // They did part: the pusher went away from the water, the other stopped at its border
@@ -149,7 +149,7 @@ TEST_F(CrowdFilterTest, AgentsOfOneCrowdTakeTheWaysTheirFiltersAllow)
     int walkerInWater = 0, swimmerInWater = 0;
     for (int update = 0; update < 1500; ++update)
     {
-        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        ASSERT_TRUE(crowd->Update(cStep).IsOk());
         const Vec3 swimmerAt = crowd->GetPosition(swimmer).Value(),
                    walkerAt = crowd->GetPosition(walking).Value();
         farthestSwimmerX = std::max(farthestSwimmerX, swimmerAt.x());
@@ -206,7 +206,7 @@ TEST_F(CrowdFilterTest, AnAgentWhoseFilterChangesInTheWaterLeavesItAndTakesTheBr
         ASSERT_TRUE(crowd->SetTarget(agent, mEnd).IsOk());
         int update = 0;
         while (!(std::abs(crowd->GetPosition(agent).Value().z()) < 0.3f) && update++ < 600)
-            ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+            ASSERT_TRUE(crowd->Update(cStep).IsOk());
         ASSERT_TRUE(InWater(crowd->GetPosition(agent).Value())) << "it swam to the river's middle";
         if (byAgent)
             ASSERT_TRUE(crowd->SetAgentFilter(agent, cMayNotSwim).IsOk());
@@ -231,14 +231,14 @@ TEST_F(CrowdFilterTest, UntilItsNewPathComesAnAgentKeepsOnlyTheWayItsNewFilterAl
     const Crowd::AgentID agent = crowd->AddAgent(mStart).Value();
     ASSERT_TRUE(crowd->SetTarget(agent, mEnd).IsOk());
     for (int update = 0; update < 600 && crowd->GetState(agent).Value() != AgentState::Moving; ++update)
-        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        ASSERT_TRUE(crowd->Update(cStep).IsOk());
     ASSERT_EQ(crowd->GetState(agent).Value(), AgentState::Moving);
     ASSERT_TRUE(crowd->SetFilter(cMaySwim, NoSwimming()).IsOk());
     // Its corridor, through the water, is cut at the bank as soon as the filter is checked
     int updatesWaiting = 0, waterPolygonsKept = 0;
     while (crowd->GetState(agent).Value() == AgentState::WaitingForPath && updatesWaiting < 600)
     {
-        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        ASSERT_TRUE(crowd->Update(cStep).IsOk());
         ++updatesWaiting;
         const std::vector<uint64_t> corridor = crowd->GetCorridor(agent).Value();
         mWorld->Read(
@@ -266,7 +266,7 @@ TEST_F(CrowdFilterTest, AFilterThatMakesTheWaterCostlySendsItsAgentsOnTheirWayRo
     const Crowd::AgentID agent = crowd->AddAgent(mStart).Value();
     ASSERT_TRUE(crowd->SetTarget(agent, mEnd).IsOk());
     for (int update = 0; update < 20; ++update)
-        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        ASSERT_TRUE(crowd->Update(cStep).IsOk());
     ASSERT_EQ(crowd->GetState(agent).Value(), AgentState::Moving);
     ASSERT_FALSE(InWater(crowd->GetPosition(agent).Value())) << "still on the south bank";
     // No area excluded: the water may be crossed, but the bridge is far cheaper. Only turning round the
@@ -277,7 +277,7 @@ TEST_F(CrowdFilterTest, AFilterThatMakesTheWaterCostlySendsItsAgentsOnTheirWayRo
     float farthestX = -100.0f, deepestInWater = 0.0f;
     for (int update = 0; update < 1200 && crowd->GetState(agent).Value() != AgentState::Arrived; ++update)
     {
-        ASSERT_TRUE(crowd->Update(cFrame).IsOk());
+        ASSERT_TRUE(crowd->Update(cStep).IsOk());
         const Vec3 position = crowd->GetPosition(agent).Value();
         farthestX = std::max(farthestX, position.x());
         if (InWater(position))
