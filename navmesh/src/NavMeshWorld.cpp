@@ -2,6 +2,7 @@
 
 #include "DetourPaths.h"
 #include "DetourSurface.h"
+#include "cairn/navmesh/OffMeshLinkJoins.h"
 #include "cairn/navmesh/TileData.h"
 
 #include <DetourNavMesh.h>
@@ -513,6 +514,27 @@ Result<NavWall> NavMeshWorld::FindNearestWall(const Vec3& inPoint, float inMaxRa
     if (!point) return point.GetError();
     return FindWallAround(*point.Value().mQuery, *mNavMesh, point.Value().mPolygon, point.Value().mPoint,
                           inMaxRadius, filter.Value(), inFilter);
+}
+
+Result<OffMeshLinkState> NavMeshWorld::GetOffMeshLinkState(const OffMeshLink& inLink) const
+{
+    if (!IsValidWorldPosition(inLink.mStart) || !IsValidWorldPosition(inLink.mEnd))
+        return MakeError(ErrorCode::InvalidArgument,
+                         "off-mesh link state: an end is NaN or outside the world");
+    const TileCoord startTile = mGrid.TileAt(inLink.mStart.x(), inLink.mStart.z());
+    const TileCoord endTile = mGrid.TileAt(inLink.mEnd.x(), inLink.mEnd.z());
+    std::shared_lock lock(mNavMeshMutex);
+    const dtNavMesh& navMesh = *mNavMesh;
+    const dtMeshTile* tile = navMesh.getTileAt(startTile.mX, startTile.mZ, 0);
+    if (tile == nullptr || tile->header == nullptr) return OffMeshLinkState::StartTileMissing;
+    const int connection = FindOffMeshConnection(*tile, inLink.mStart, inLink.mEnd);
+    if (connection < 0) return OffMeshLinkState::LeftOut;
+    const OffMeshLinkJoins joins = GetOffMeshLinkJoins(*tile, connection);
+    if (!joins.mStart) return OffMeshLinkState::StartUnjoined;
+    if (joins.mEnd) return OffMeshLinkState::Joined;
+    const dtMeshTile* end = navMesh.getTileAt(endTile.mX, endTile.mZ, 0);
+    return end != nullptr && end->header != nullptr ? OffMeshLinkState::EndUnjoined
+                                                    : OffMeshLinkState::EndTileMissing;
 }
 
 int NavMeshWorld::GetNumTiles() const

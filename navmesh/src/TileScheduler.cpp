@@ -164,6 +164,23 @@ void TileScheduler::RemoveOffMeshLink(LinkID inLink)
     mLinks.erase(link);
 }
 
+Result<OffMeshLinkState> TileScheduler::GetOffMeshLinkState(LinkID inLink) const
+{
+    OffMeshLink link;
+    {
+        std::lock_guard lock(mMutex);
+        auto found = mLinks.find(inLink);
+        if (found == mLinks.end())
+            return MakeError(ErrorCode::InvalidArgument, "off-mesh link: no such link");
+        link = found->second;
+        auto tile = mTiles.find(mWorld.GetGrid().TileAt(link.mStart.x(), link.mStart.z()));
+        if (tile != mTiles.end() && (tile->second.mDirty || tile->second.mJob != nullptr))
+            return OffMeshLinkState::Pending;
+    }
+    // The navmesh's lock is never taken under mMutex
+    return mWorld.GetOffMeshLinkState(link);
+}
+
 void TileScheduler::MarkDirty(const AABB& inBounds)
 {
     std::lock_guard lock(mMutex);

@@ -64,6 +64,9 @@ void ExpectInvariants(const DemoRunResult& inRun)
     EXPECT_EQ(agents.mCorridorsThroughGone, 0u) << inRun.mModeName;
     EXPECT_EQ(agents.mNonClimberLadderFrames, 0u) << inRun.mModeName;
     EXPECT_GT(agents.mNonClimbers, 0u) << inRun.mModeName;
+    EXPECT_EQ(inRun.mLaddersDead, 0u) << inRun.mModeName;
+    EXPECT_GT(inRun.mLaddersJoined, 0u)
+        << inRun.mModeName << ": the ladders by the player are in its navmesh";
     // The huts' doors moved on their timers and their tiles were built again as they came to rest; the
     // navmesh had each door where it stood: closed, no path through the doorway; open, one
     const DoorStats& doors = inRun.mDoorStats;

@@ -1,5 +1,7 @@
 #include "LinkCheck.h"
 
+#include "cairn/navmesh/OffMeshLinkJoins.h"
+
 #include <DetourNavMesh.h>
 #include <cmath>
 #include <cstdio>
@@ -53,18 +55,14 @@ Result<std::vector<UnjoinedLink>> FindUnjoinedLinks(const navmesh::NavMeshFileCo
         for (int c = 0; c < tile->header->offMeshConCount; ++c)
         {
             const dtOffMeshConnection& connection = tile->offMeshCons[c];
-            const dtPoly& polygon = tile->polys[connection.poly];
-            // Detour's links of a link's polygon: edge 0 to the polygon its start joined, edge 1 to its end's
-            bool joined[2] = {false, false};
-            for (unsigned int k = polygon.firstLink; k != DT_NULL_LINK; k = tile->links[k].next)
-                if (tile->links[k].edge < 2) joined[tile->links[k].edge] = true;
-            if (joined[0] && joined[1]) continue;
+            const navmesh::OffMeshLinkJoins joins = navmesh::GetOffMeshLinkJoins(*tile, c);
+            if (joins.mStart && joins.mEnd) continue;
             unjoined.push_back({.mTile = fileTile.mTile,
                                 .mStart = Vec3(connection.pos[0], connection.pos[1], connection.pos[2]),
                                 .mEnd = Vec3(connection.pos[3], connection.pos[4], connection.pos[5]),
                                 .mUserID = connection.userId,
-                                .mStartJoined = joined[0],
-                                .mEndJoined = joined[1]});
+                                .mStartJoined = joins.mStart,
+                                .mEndJoined = joins.mEnd});
         }
     }
     // Declared links their tile's data does not hold: Detour's builder left them out
@@ -73,14 +71,7 @@ Result<std::vector<UnjoinedLink>> FindUnjoinedLinks(const navmesh::NavMeshFileCo
         const navmesh::TileCoord coord = tileOf(link.mStart);
         const dtMeshTile* tile = navMesh.getTileAt(coord.mX, coord.mZ, 0);
         if (tile == nullptr || tile->header == nullptr) continue; // Not a tile given
-        bool built = false;
-        for (int c = 0; c < tile->header->offMeshConCount && !built; ++c)
-        {
-            const float* pos = tile->offMeshCons[c].pos;
-            built = (Vec3(pos[0], pos[1], pos[2]) - link.mStart).norm() < 1.0e-3f &&
-                    (Vec3(pos[3], pos[4], pos[5]) - link.mEnd).norm() < 1.0e-3f;
-        }
-        if (built) continue;
+        if (navmesh::FindOffMeshConnection(*tile, link.mStart, link.mEnd) >= 0) continue;
         unjoined.push_back({.mBuilt = false,
                             .mTile = coord,
                             .mStart = link.mStart,

@@ -6,8 +6,8 @@
 // there is left unjoined without a word, and the link is dead: a ladder whose foot is a metre off the ground
 // a level designer moved. And Detour's tile builder keeps a link only where its start is within the heights
 // of its tile's navmesh: one whose start is in the air is dropped from the tile, again without a word. The
-// check loads the tiles into a Detour navmesh as the runtime would and reads the links Detour made. Any
-// thread.
+// check loads the tiles into a Detour navmesh as the runtime would and reads the links Detour made
+// (navmesh/OffMeshLinkJoins.h, as NavMeshWorld::GetOffMeshLinkState does at run time). Any thread.
 
 #include "cairn/navmesh/NavMeshFile.h"
 #include "cairn/navmesh/TileBuilder.h"

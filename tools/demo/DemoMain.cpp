@@ -138,7 +138,8 @@ int main(int argc, char** argv)
     for (const DemoRunResult& run : runs)
         if (!run.mErrors.empty() || run.mLostOrDuplicatedBodies != 0 || run.mAgentStats.mInsideStatic != 0 ||
             run.mAgentStats.mOffNavMeshOverOneSecond != 0 || run.mAgentStats.mCorridorsThroughGone != 0 ||
-            run.mTilesRequestedNeverBuilt != 0 || run.mAgentStats.mNonClimberLadderFrames != 0)
+            run.mTilesRequestedNeverBuilt != 0 || run.mAgentStats.mNonClimberLadderFrames != 0 ||
+            run.mLaddersDead != 0)
             exitCode = 1;
     if (!output.empty())
     {

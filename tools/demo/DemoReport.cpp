@@ -317,7 +317,7 @@ bool InvariantsHold(const DemoRunResult& inRun)
     return inRun.mLostOrDuplicatedBodies == 0 && inRun.mTilesRequestedNeverBuilt == 0 &&
            inRun.mAgentStats.mInsideStatic == 0 && inRun.mAgentStats.mOffNavMeshOverOneSecond == 0 &&
            inRun.mAgentStats.mCorridorsThroughGone == 0 && DoorwaysNotAsTheirDoor(inRun.mDoorStats) == 0 &&
-           inRun.mAgentStats.mNonClimberLadderFrames == 0 && inRun.mErrors.empty();
+           inRun.mAgentStats.mNonClimberLadderFrames == 0 && inRun.mLaddersDead == 0 && inRun.mErrors.empty();
 }
 
 std::vector<Section> BuildSummary(const DemoRunResult& inRun)
@@ -504,6 +504,8 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
           {"walked m", Fixed(agents.mDistance, 0)},
           {"put back by the player", Count(agents.mCatchUps)},
           {"ladders climbed", Count(agents.mLinksTaken) + " of " + Count(inRun.mLaddersMost) + " at most"},
+          {"ladders at the end, joined / waiting for tiles",
+           Count(inRun.mLaddersJoined) + " / " + Count(inRun.mLaddersWaiting)},
           {"agents that may not climb", Count(agents.mNonClimbers)}}});
     sections.push_back(
         {"agent checks",
@@ -524,6 +526,7 @@ std::vector<Section> BuildSummary(const DemoRunResult& inRun)
           {"off navmesh over 1 s", Count(agents.mOffNavMeshOverOneSecond)},
           {"corridors through gone polygons", Count(agents.mCorridorsThroughGone)},
           {"doorways not as their door", Count(DoorwaysNotAsTheirDoor(inRun.mDoorStats))},
+          {"ladders no agent can take", Count(inRun.mLaddersDead)},
           {"frames on a ladder by agents that may not climb", Count(agents.mNonClimberLadderFrames)},
           {"status", InvariantsHold(inRun) ? "OK" : "FAILED"}}});
     return sections;

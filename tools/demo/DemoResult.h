@@ -178,6 +178,11 @@ struct DemoRunResult
     DoorStats mDoorStats;
     GuardStats mGuardStats;
     uint32_t mLaddersMost = 0; ///< Most hut ladders (off-mesh links) declared at once
+    /// At the run's end, the ladders declared: joined to the navmesh at both feet, waiting for their tiles,
+    /// and dead (a foot that joins no navmesh, or left out of its tile: an invariant, none)
+    uint32_t mLaddersJoined = 0;
+    uint32_t mLaddersWaiting = 0;
+    uint32_t mLaddersDead = 0;
     /// The final navmesh of the human profile, for the map: each polygon's outline (x, z) and the build
     /// latency of its tile in frames (-1: not known, a tile built before the run)
     struct MapPolygon

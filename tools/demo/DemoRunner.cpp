@@ -336,6 +336,13 @@ Result<DemoRunResult> RunDemo(const DemoSettings& inSettings, BroadPhaseType inM
     agents->FinishStats();
     result.mAgentStats = agents->GetStats();
     result.mLaddersMost = ladders->GetMostLadders();
+    const HutLadders::States ladderStates = ladders->CountStates();
+    result.mLaddersJoined = ladderStates.mJoined;
+    result.mLaddersWaiting = ladderStates.mWaiting;
+    result.mLaddersDead = ladderStates.mDead;
+    if (result.mLaddersDead > 0)
+        result.mErrors.push_back("ladders: " + std::to_string(result.mLaddersDead) +
+                                 " with a foot that joins no navmesh, or left out of their tile");
     if (ladders->GetNumRefused() > 0)
         result.mErrors.push_back("ladders: " + std::to_string(ladders->GetNumRefused()) + " refused");
     for (const std::string& error : result.mAgentStats.mErrors)

@@ -51,6 +51,24 @@ navmesh::OffMeshLink MakeHutLadder(const Vec3& inOutside, const Vec3& inInside,
     return ladder;
 }
 
+HutLadders::States HutLadders::CountStates() const
+{
+    States states;
+    for (const auto& [panel, link] : mLadders)
+    {
+        const Result<navmesh::OffMeshLinkState> state = mScheduler.GetOffMeshLinkState(link);
+        using enum navmesh::OffMeshLinkState;
+        if (state && state.Value() == Joined)
+            ++states.mJoined;
+        else if (state && (state.Value() == Pending || state.Value() == StartTileMissing ||
+                           state.Value() == EndTileMissing))
+            ++states.mWaiting;
+        else
+            ++states.mDead;
+    }
+    return states;
+}
+
 void HutLadders::Update()
 {
     if (!mStreamer.TakeDoorsIfChanged(mDoorsVersion, mDoors)) return;

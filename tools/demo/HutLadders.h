@@ -57,6 +57,15 @@ public:
     uint32_t GetMostLadders() const { return mMostLadders; }
     /// Ladders the scheduler refused (a foot outside its world): none in a good run.
     uint64_t GetNumRefused() const { return mRefused; }
+    /// The declared ladders as the human navmesh has them now (TileScheduler::GetOffMeshLinkState).
+    struct States
+    {
+        uint32_t mJoined = 0;
+        uint32_t mWaiting = 0; ///< Their tiles not built with them yet, or not loaded
+        /// Built into the navmesh but with a foot that joins nothing, or left out: none in a good run
+        uint32_t mDead = 0;
+    };
+    States CountStates() const;
 
 private:
     const TileStreamer& mStreamer;

@@ -79,6 +79,21 @@ struct NavWall
     Vec3 mNormal = Vec3::Zero();   ///< Level, from the wall towards the point
 };
 
+/// Where an off-mesh link stands in the published navmesh (NavMeshWorld::GetOffMeshLinkState).
+enum class OffMeshLinkState : uint8_t
+{
+    /// A TileScheduler's answer only: its start's tile waits for a build that takes the link in
+    Pending,
+    StartTileMissing, ///< The tile its start lies in is not published
+                      /// Its start's tile is published without it: built before it was declared, or Detour's
+                      /// tile builder left it out (its start above or below the tile's navmesh)
+    LeftOut,
+    StartUnjoined,  ///< No polygon of its tile within its radius of its start (and the climb): never taken
+    EndTileMissing, ///< Its start joined; the tile its end lies in is not published (joined once it is)
+    EndUnjoined,    ///< Its start joined; no polygon within its radius of its end: never taken
+    Joined,         ///< Agents can take it
+};
+
 class NavMeshWorld
 {
 public:
@@ -156,6 +171,11 @@ public:
     /// can visit, or a number is bad. Any thread.
     Result<NavWall> FindNearestWall(const Vec3& inPoint, float inMaxRadius, const PathFilter& inFilter = {},
                                     const Vec3& inSearchExtent = Vec3(2.0f, 4.0f, 2.0f)) const;
+
+    /// Whether inLink, as declared for a tile build (TileScheduler::AddOffMeshLink), is in the navmesh and
+    /// joined at both ends (OffMeshLinkJoins.h): Detour says nothing of a link it left unjoined. Error for a
+    /// position that is not a valid world position. Any thread.
+    Result<OffMeshLinkState> GetOffMeshLinkState(const OffMeshLink& inLink) const;
 
     /// Published tiles.
     int GetNumTiles() const;

@@ -109,6 +109,11 @@ public:
     /// tile).
     Result<LinkID> AddOffMeshLink(const OffMeshLink& inLink);
     void RemoveOffMeshLink(LinkID inLink);
+    /// Where a link stands in the world's navmesh (NavMeshWorld::GetOffMeshLinkState), or Pending while its
+    /// start's tile waits for a build that takes it in (dirty, or its job not yet published): a link no agent
+    /// can take, since an end joins no polygon, is otherwise never told. Error for an unknown link. Any
+    /// thread.
+    Result<OffMeshLinkState> GetOffMeshLinkState(LinkID inLink) const;
 
     /// Marks the tiles inBounds touches dirty (for changes the physics world does not report). Any thread.
     void MarkDirty(const AABB& inBounds);
