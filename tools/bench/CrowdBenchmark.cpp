@@ -78,15 +78,20 @@ World MakeWorld()
     }
     const TileGrid grid(-half, -half, profile.mTileSize, -5.0f, 20.0f);
     world.mNavMesh = NavMeshWorld::Create(grid, profile).Value();
+    // One tile at a time: the tiles are published in the same order every run, and Detour's tile slots,
+    // polygon references and links follow that order, and the crowd's paths follow them. Built two at once,
+    // a loaded machine finished them in another order and the runs served different paths
     jobs::BackgroundQueue::Settings queueSettings;
-    queueSettings.mNumThreads = 2;
+    queueSettings.mNumThreads = 1;
     jobs::BackgroundQueue queue(queueSettings);
-    TileScheduler scheduler(*world.mPhysics, *world.mNavMesh, queue, TileScheduler::Settings{});
+    TileScheduler::Settings schedulerSettings;
+    schedulerSettings.mMaxConcurrentJobs = 1;
+    TileScheduler scheduler(*world.mPhysics, *world.mNavMesh, queue, schedulerSettings);
     (void)scheduler.AddArea(AABB(Vec3(-half + 0.1f, -5, -half + 0.1f), Vec3(half - 0.1f, 20, half - 0.1f)));
     while (!scheduler.IsIdle())
     {
         scheduler.Update();
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
     scheduler.Update();
     return world;
