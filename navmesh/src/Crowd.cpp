@@ -335,6 +335,17 @@ Crowd::Agent* Crowd::Find(AgentID inAgent) const
                                                                                 : nullptr;
 }
 
+namespace
+{
+/// Error unless inIndex names one of a crowd's filters; inWhat starts the message ("crowd", "agent").
+Status CheckFilterIndex(int inIndex, const char* inWhat)
+{
+    if (inIndex >= 0 && inIndex < Crowd::cMaxFilters) return Status::Ok();
+    return MakeError(ErrorCode::InvalidArgument, std::string(inWhat) + ": a filter index must be in [0, " +
+                                                     std::to_string(Crowd::cMaxFilters) + ")");
+}
+} // namespace
+
 const dtQueryFilter& Crowd::FilterOf(const Agent& inAgent) const
 {
     return mDetourFilters[inAgent.mParams.mFilter];
@@ -342,9 +353,7 @@ const dtQueryFilter& Crowd::FilterOf(const Agent& inAgent) const
 
 Status Crowd::SetFilter(int inIndex, const PathFilter& inFilter)
 {
-    if (!(inIndex >= 0 && inIndex < cMaxFilters))
-        return MakeError(ErrorCode::InvalidArgument,
-                         "crowd: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    if (Status index = CheckFilterIndex(inIndex, "crowd"); !index) return index.GetError();
     if (Result<dtQueryFilter> checked = MakeDetourFilter(inFilter, "crowd filter"); !checked)
         return checked.GetError();
     // The old areas' flag goes in the same step: with every flag held, the new areas may take it
@@ -361,9 +370,7 @@ Status Crowd::SetFilter(int inIndex, const PathFilter& inFilter)
 
 Result<PathFilter> Crowd::GetFilter(int inIndex) const
 {
-    if (!(inIndex >= 0 && inIndex < cMaxFilters))
-        return MakeError(ErrorCode::InvalidArgument,
-                         "crowd: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    if (Status index = CheckFilterIndex(inIndex, "crowd"); !index) return index.GetError();
     return mPathFilters[size_t(inIndex)];
 }
 
@@ -371,9 +378,7 @@ Status Crowd::SetAgentFilter(AgentID inAgent, int inIndex)
 {
     Agent* agent = Find(inAgent);
     if (agent == nullptr) return MakeError(ErrorCode::InvalidArgument, "agent: no such agent");
-    if (!(inIndex >= 0 && inIndex < cMaxFilters))
-        return MakeError(ErrorCode::InvalidArgument,
-                         "agent: a filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    if (Status index = CheckFilterIndex(inIndex, "agent"); !index) return index.GetError();
     agent->mParams.mFilter = uint8_t(inIndex);
     NoteFilterChanged(*agent);
     return Status::Ok();
@@ -396,9 +401,7 @@ Result<Crowd::AgentID> Crowd::AddAgent(const Vec3& inPosition, const AgentParams
 {
     if (!IsValidWorldPosition(inPosition))
         return MakeError(ErrorCode::InvalidArgument, "agent: bad position");
-    if (inParams.mFilter >= cMaxFilters)
-        return MakeError(ErrorCode::InvalidArgument,
-                         "agent: its filter index must be in [0, " + std::to_string(cMaxFilters) + ")");
+    if (Status index = CheckFilterIndex(inParams.mFilter, "agent"); !index) return index.GetError();
     if (!(inParams.mRadius > 0.0f && inParams.mRadius <= mSettings.mMaxAgentRadius) ||
         !(inParams.mMaxSpeed > 0.0f && inParams.mMaxSpeed <= 100.0f) ||
         !(inParams.mMaxAcceleration > 0.0f && inParams.mMaxAcceleration <= 1000.0f))
