@@ -239,13 +239,6 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
     const bool wholeLevel = inSettings.mShardCount == 1 && !inSettings.mRegion && inSettings.mTiles.empty();
     navmesh::NavMeshFileContents linkTiles;
     linkTiles.mParams = params.Value();
-    auto nearLinks = [&](const navmesh::TileCoord& inTile)
-    {
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dz = -1; dz <= 1; ++dz)
-                if (linksByTile.contains({inTile.mX + dx, inTile.mZ + dz})) return true;
-        return false;
-    };
     Result<std::vector<navmesh::TileCoord>> selected = SelectTiles(tiles, grid, inSettings);
     if (!selected) return selected.GetError();
     std::vector<navmesh::TileCoord> mine;
@@ -361,7 +354,7 @@ Result<BakeResult> BakeSource(const LevelSource& inSource, const BakeSettings& i
         if (!data.empty())
         {
             ++result.mTilesWithPolygons;
-            if (wholeLevel && nearLinks(tile.mTile))
+            if (wholeLevel && IsNearLinks(tile.mTile, linksByTile))
                 linkTiles.mTiles.push_back(
                     {tile.mTile, std::vector<unsigned char>(data.begin(), data.end())});
             if (output != nullptr)

@@ -3,9 +3,11 @@
 #include "cairn/navmesh/OffMeshLinkJoins.h"
 
 #include <DetourNavMesh.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <set>
 
 namespace cairn::bake
@@ -34,16 +36,18 @@ Result<std::vector<UnjoinedLink>> FindUnjoinedLinks(const navmesh::NavMeshFileCo
     for (const navmesh::OffMeshLink& link : inDeclared)
         withLinks.insert(tileOf(link.mStart));
     if (withLinks.empty()) return std::vector<UnjoinedLink>();
-    navmesh::NavMeshFileContents near;
-    near.mParams = inNavMesh.mParams;
-    for (const navmesh::NavMeshFileTile& tile : inNavMesh.mTiles)
+    const auto kept = [&](const navmesh::NavMeshFileTile& inTile)
+    { return IsNearLinks(inTile.mTile, withLinks) || inTile.mData.size() < sizeof(dtMeshHeader); };
+    // Copied only when some tiles are left out (a bake hands in just the tiles near its links)
+    navmesh::NavMeshFileContents copied;
+    const bool keepsAll = std::all_of(inNavMesh.mTiles.begin(), inNavMesh.mTiles.end(), kept);
+    if (!keepsAll)
     {
-        bool nearLinks = false;
-        for (int dx = -1; dx <= 1 && !nearLinks; ++dx)
-            for (int dz = -1; dz <= 1 && !nearLinks; ++dz)
-                nearLinks = withLinks.contains({tile.mTile.mX + dx, tile.mTile.mZ + dz});
-        if (nearLinks || tile.mData.size() < sizeof(dtMeshHeader)) near.mTiles.push_back(tile);
+        copied.mParams = inNavMesh.mParams;
+        std::copy_if(inNavMesh.mTiles.begin(), inNavMesh.mTiles.end(), std::back_inserter(copied.mTiles),
+                     kept);
     }
+    const navmesh::NavMeshFileContents& near = keepsAll ? inNavMesh : copied;
     Result<navmesh::DetourNavMeshPtr> created = navmesh::CreateDetourNavMesh(near);
     if (!created) return created.GetError();
     const dtNavMesh& navMesh = *created.Value();

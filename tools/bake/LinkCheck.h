@@ -41,6 +41,16 @@ struct UnjoinedLink
 Result<std::vector<UnjoinedLink>> FindUnjoinedLinks(const navmesh::NavMeshFileContents& inNavMesh,
                                                     std::span<const navmesh::OffMeshLink> inDeclared = {});
 
+/// Whether inTile or one of the eight around it is in inTilesWithLinks (a set of tiles, or a map by tile):
+/// the tiles a link of those tiles may end in.
+template <class TileSet> bool IsNearLinks(const navmesh::TileCoord& inTile, const TileSet& inTilesWithLinks)
+{
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dz = -1; dz <= 1; ++dz)
+            if (inTilesWithLinks.contains(navmesh::TileCoord{inTile.mX + dx, inTile.mZ + dz})) return true;
+    return false;
+}
+
 /// One line for a link: where it is, which end does not join, and why that matters.
 std::string DescribeUnjoinedLink(const UnjoinedLink& inLink);
 
