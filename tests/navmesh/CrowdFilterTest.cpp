@@ -10,6 +10,7 @@
 #include <DetourNavMesh.h>
 #include <bit>
 #include <set>
+#include <span>
 
 namespace cairn::navmesh::test
 {
@@ -31,21 +32,33 @@ protected:
         return std::abs(inPosition.z()) < 1.0f - 0.01f && inPosition.x() < 8.0f - 0.01f;
     }
 
+    /// How many of inPolygons (Detour references into the published navmesh, each one there) are water.
+    int CountWaterPolygons(std::span<const uint64_t> inPolygons) const
+    {
+        int water = 0;
+        mWorld->Read(
+            [&](const dtNavMesh& inNavMesh)
+            {
+                for (const uint64_t polygon : inPolygons)
+                {
+                    const dtMeshTile* tile = nullptr;
+                    const dtPoly* poly = nullptr;
+                    if (dtStatusFailed(inNavMesh.getTileAndPolyByRef(polygon, &tile, &poly)))
+                    {
+                        ADD_FAILURE() << "a corridor polygon the navmesh does not have";
+                        continue;
+                    }
+                    water += poly->getArea() == cWater ? 1 : 0;
+                }
+            });
+        return water;
+    }
+
     /// Whether the first polygon of the agent's corridor, the one it stands in, is water.
     bool StandsInWaterPolygon(const Crowd& inCrowd, Crowd::AgentID inAgent) const
     {
         const std::vector<uint64_t> corridor = inCrowd.GetCorridor(inAgent).Value();
-        if (corridor.empty()) return false;
-        bool water = false;
-        mWorld->Read(
-            [&](const dtNavMesh& inNavMesh)
-            {
-                const dtMeshTile* tile = nullptr;
-                const dtPoly* polygon = nullptr;
-                if (dtStatusSucceed(inNavMesh.getTileAndPolyByRef(corridor[0], &tile, &polygon)))
-                    water = polygon->getArea() == cWater;
-            });
-        return water;
+        return !corridor.empty() && CountWaterPolygons(std::span(corridor).first(1)) > 0;
     }
 
     /// Walks inAgent for inUpdates Updates or until it arrives; the Updates in which it was in the water.
@@ -240,18 +253,7 @@ TEST_F(CrowdFilterTest, UntilItsNewPathComesAnAgentKeepsOnlyTheWayItsNewFilterAl
     {
         ASSERT_TRUE(crowd->Update(cStep).IsOk());
         ++updatesWaiting;
-        const std::vector<uint64_t> corridor = crowd->GetCorridor(agent).Value();
-        mWorld->Read(
-            [&](const dtNavMesh& inNavMesh)
-            {
-                for (const uint64_t polygon : corridor)
-                {
-                    const dtMeshTile* tile = nullptr;
-                    const dtPoly* poly = nullptr;
-                    ASSERT_TRUE(dtStatusSucceed(inNavMesh.getTileAndPolyByRef(polygon, &tile, &poly)));
-                    waterPolygonsKept += poly->getArea() == cWater ? 1 : 0;
-                }
-            });
+        waterPolygonsKept += CountWaterPolygons(crowd->GetCorridor(agent).Value());
     }
     EXPECT_GT(updatesWaiting, 1) << "the new path took Updates to come";
     EXPECT_EQ(waterPolygonsKept, 0);

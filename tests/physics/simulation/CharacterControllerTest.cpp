@@ -69,6 +69,27 @@ protected:
         EXPECT_EQ(inCharacter.GetGroundState(), GroundState::OnGround);
     }
 
+    /// A kinematic platform inHalfWidth metres across each way from the origin, its top at y = 1.25 above the
+    /// floor, and a character that stood on it at x = inRiderX for 10 frames (its ground the platform).
+    struct Ride
+    {
+        BodyID mPlatform;
+        CharacterController mRider;
+    };
+    Ride AddPlatformWithRider(float inHalfWidth, float inRiderX)
+    {
+        AddFloor();
+        const BodyID platform =
+            Bodies()
+                .CreateAndAddBody(BoxBodySettings(Vec3(0, 1, 0), Vec3(inHalfWidth, 0.25f, inHalfWidth),
+                                                  MotionType::Kinematic),
+                                  Activation::Activate)
+                .Value();
+        CharacterController rider = MakeCharacter(Vec3(inRiderX, 1.25f + cCharacterStandHeight + 0.02f, 0));
+        Walk(rider, Vec3::Zero(), 10);
+        return {platform, std::move(rider)};
+    }
+
     /// Whether inBody is among the contacts of inCharacter's last Update.
     static bool Touches(const CharacterController& inCharacter, const BodyID& inBody)
     {
@@ -459,14 +480,9 @@ TEST_F(CharacterControllerTest, WalkingDownStairsItKeepsToTheFloor)
 
 TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
 {
-    AddFloor();
-    const BodyID id =
-        Bodies()
-            .CreateAndAddBody(BoxBodySettings(Vec3(0, 1, 0), Vec3(2, 0.25f, 2), MotionType::Kinematic),
-                              Activation::Activate)
-            .Value();
-    CharacterController rider = MakeCharacter(Vec3(0, 1.25f + cCharacterStandHeight + 0.02f, 0));
-    Walk(rider, Vec3::Zero(), 10);
+    Ride ride = AddPlatformWithRider(2.0f, 0.0f);
+    const BodyID id = ride.mPlatform;
+    CharacterController& rider = ride.mRider;
     ASSERT_EQ(rider.GetGroundBody(), id);
 
     // Sideways at 1 m/s, then up at 1 m/s, a second each
@@ -497,14 +513,9 @@ TEST_F(CharacterControllerTest, AMovingPlatformCarriesItAndAnElevatorLiftsIt)
 // static ground the turn is none
 TEST_F(CharacterControllerTest, ATurntableTurnsItsRiderAndATiltingPlatformDoesNot)
 {
-    AddFloor();
-    const BodyID id =
-        Bodies()
-            .CreateAndAddBody(BoxBodySettings(Vec3(0, 1, 0), Vec3(3, 0.25f, 3), MotionType::Kinematic),
-                              Activation::Activate)
-            .Value();
-    CharacterController rider = MakeCharacter(Vec3(1, 1.25f + cCharacterStandHeight + 0.02f, 0));
-    Walk(rider, Vec3::Zero(), 10);
+    Ride ride = AddPlatformWithRider(3.0f, 1.0f);
+    const BodyID id = ride.mPlatform;
+    CharacterController& rider = ride.mRider;
     ASSERT_EQ(rider.GetGroundBody(), id);
     EXPECT_TRUE(rider.GetGroundTurn().isApprox(Quat::Identity())) << "the table has not turned yet";
     const auto yawOf = [](const Quat& inTurn) { return 2.0f * std::atan2(inTurn.y(), inTurn.w()); };
